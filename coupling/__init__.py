@@ -1,0 +1,1 @@
+"""Co-simulation of mechanics and circuit: scenes, tribometer fits, the `switchsim` command."""
