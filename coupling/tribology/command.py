@@ -1,0 +1,73 @@
+"""`switchsim fit DATA.csv --out DIR`: fit a tribometer CSV, write fit.json and the figures, print a summary."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from coupling.tribology.data import read_tribometer_csv
+from coupling.tribology.fits import AMBIGUOUS_DELTA, ModelFit, TribometerFit, fit_tribometer
+from coupling.tribology.plots import save_plots
+
+FIT_JSON = "fit.json"
+
+
+def _params(m: ModelFit, skip: tuple[str, ...] = ()) -> str:
+    parts = []
+    for p in m.parameters:
+        if p.name in skip:
+            continue
+        ci = "" if p.ci95 is None else f" [{p.ci95[0]:.4g}, {p.ci95[1]:.4g}]"
+        parts.append(f"{p.name} = {p.value:.4g}{ci}")
+    return ", ".join(parts)
+
+
+def summary(fit: TribometerFit) -> str:
+    """A short human summary of a fit: chosen models, values with 95 % intervals, caveats."""
+    dr = fit.data_range
+    lines = []
+    if any("ILLUSTRATIVE" in h for h in fit.header):
+        lines.append("NOTE: the data file says it is ILLUSTRATIVE, NOT MEASURED.")
+    lines.append(
+        f"data: {fit.source}: {dr.n_points} points, loads {dr.load_range_N[0]:g}-{dr.load_range_N[1]:g} N, "
+        f"currents {', '.join(f'{i:g}' for i in dr.currents_A)} A"
+    )
+    g = fit.friction.gamma
+    ct = fit.friction.coulomb_test
+    lines.append(
+        f"gamma = {g.value:.4f} [{g.ci95[0]:.4f}, {g.ci95[1]:.4f}] (95 % CI); vs Coulomb (gamma = 0): "
+        f"dBIC = {ct.delta_bic:.1f}, F-test p = {ct.p_value:.2g} -> {ct.preferred} preferred"
+    )
+    sel = fit.friction.mu_selection
+    lines.append(f"mu(I) by {sel.criterion}: {sel.chosen.name}: {_params(sel.chosen, skip=('gamma',))} (N^gamma, A)")
+    for label, s in (("mu(I)", sel), ("R_c", fit.resistance.selection)):
+        runner = s.candidates[1] if len(s.candidates) > 1 else None
+        if runner is not None:
+            lines.append(f"  {label}: next best {runner.name} at d{s.criterion} = {s.delta(runner.name):.2f}")
+    rs = fit.resistance.selection
+    lines.append(f"R_c by {rs.criterion}: {rs.chosen.name}: {_params(rs.chosen)} (ohm, A)")
+    if rs.ambiguous:
+        lines.append(
+            f"  not distinguishable from it (d{rs.criterion} < {AMBIGUOUS_DELTA:g}): {', '.join(rs.ambiguous)}; "
+            "they agree on the tested loads but extrapolate differently (docs/tribology.md)"
+        )
+    lines.append(
+        f"validity: loads {dr.load_range_N[0]:g}-{dr.load_range_N[1]:g} N (R_c extrapolates in load with the fitted law), "
+        f"currents {dr.current_range_A[0]:g}-{dr.current_range_A[1]:g} A (|I|, held at the edge outside)"
+    )
+    return "\n".join(lines)
+
+
+def fit_command(data_path: str, out_dir: str) -> int:
+    """Fit DATA.csv, write DIR/fit.json and the PNG figures, print a summary; returns 0.
+
+    Bad input raises ValueError (or FileNotFoundError) with a one-line message.
+    """
+    df = read_tribometer_csv(data_path)
+    fit = fit_tribometer(df)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    fit.to_json(out / FIT_JSON)
+    pngs = save_plots(fit, df, out)
+    print(summary(fit))
+    print("wrote " + ", ".join(str(p) for p in [out / FIT_JSON, *pngs]))
+    return 0

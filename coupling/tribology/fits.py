@@ -1,0 +1,739 @@
+"""Fitting the tribometer laws: gamma and mu(I) from friction, R_c(F_n, I) from resistance, with model selection.
+
+All fits are least squares on log values: the scatter of a tribometer is
+multiplicative (a few % of the reading at every load), so ln F_t and ln R_c have
+constant variance. Uncertainties are the usual Gauss-Newton covariance
+s^2 (J^T J)^-1 with Student-t 95 % intervals. Candidates are ranked by BIC (AICc is
+reported alongside); docs/tribology.md gives the reasons.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+import numpy as np
+import pandas as pd
+from scipy import optimize, stats
+
+from coupling.tribology.data import validate_tribometer_frame
+from coupling.tribology.laws import ContactLaws, MuLaw, ResistanceLaw
+from coupling.tribology.models import CURRENT_FAMILIES, LOAD_FAMILIES, MU_FAMILIES, load_law_parameters
+
+CRITERION = "BIC"
+# Delta BIC below this is "not worth more than a bare mention" (Kass & Raftery 1995):
+# such candidates are listed as indistinguishable from the chosen one.
+AMBIGUOUS_DELTA = 2.0
+FORMAT = "switchsim-tribometer-fit"
+FORMAT_VERSION = 1
+
+
+# ---------------------------------------------------------------------------------
+# Result objects
+
+
+@dataclass(frozen=True)
+class ParameterEstimate:
+    """A fitted parameter: value, standard error and 95 % interval (None when not estimable), unit."""
+
+    name: str
+    value: float
+    stderr: float | None
+    ci95: tuple[float, float] | None
+    unit: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"name": self.name, "value": self.value, "stderr": self.stderr,
+                "ci95": None if self.ci95 is None else list(self.ci95), "unit": self.unit}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "ParameterEstimate":
+        return cls(d["name"], d["value"], d["stderr"], None if d["ci95"] is None else tuple(d["ci95"]), d["unit"])
+
+
+@dataclass(frozen=True)
+class ModelFit:
+    """One fitted candidate and its goodness of fit (all in log space).
+
+    resid_std_log: standard deviation of the ln residuals, about the relative scatter;
+    r_squared_log: R^2 of ln values; lack_of_fit_p: p-value of the lack-of-fit F-test
+    against the scatter of repeats at equal (load, current) (None without repeats):
+    small means the curve misses the repeat means by more than the repeats scatter.
+    covariance: of the parameters in their listed order (None when a parameter sits on
+    a bound or the parameters are not identifiable; `note` says which).
+    """
+
+    name: str
+    formula: str
+    parameters: tuple[ParameterEstimate, ...]
+    covariance: tuple[tuple[float, ...], ...] | None
+    n_points: int
+    rss_log: float
+    resid_std_log: float
+    r_squared_log: float | None
+    aicc: float
+    bic: float
+    lack_of_fit_p: float | None
+    note: str
+
+    @property
+    def n_parameters(self) -> int:
+        return len(self.parameters)
+
+    def value(self, name: str) -> float:
+        for p in self.parameters:
+            if p.name == name:
+                return p.value
+        raise KeyError(f"{self.name} has no parameter {name!r}; it has {[p.name for p in self.parameters]}")
+
+    def estimate(self, name: str) -> ParameterEstimate:
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        raise KeyError(f"{self.name} has no parameter {name!r}; it has {[p.name for p in self.parameters]}")
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "name": self.name, "formula": self.formula,
+            "parameters": [p.to_dict() for p in self.parameters],
+            "covariance": None if self.covariance is None else [list(r) for r in self.covariance],
+            "n_points": self.n_points, "rss_log": self.rss_log, "resid_std_log": self.resid_std_log,
+            "r_squared_log": self.r_squared_log, "aicc": self.aicc, "bic": self.bic,
+            "lack_of_fit_p": self.lack_of_fit_p, "note": self.note,
+        }
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "ModelFit":
+        return cls(
+            d["name"], d["formula"], tuple(ParameterEstimate.from_dict(p) for p in d["parameters"]),
+            None if d["covariance"] is None else tuple(tuple(r) for r in d["covariance"]),
+            d["n_points"], d["rss_log"], d["resid_std_log"], d["r_squared_log"], d["aicc"], d["bic"],
+            d["lack_of_fit_p"], d["note"],
+        )
+
+
+@dataclass(frozen=True)
+class ModelSelection:
+    """Candidates ranked by the criterion (lowest first); `chosen` is the first.
+
+    skipped: (name, reason) of candidates the data cannot fit (too few current levels
+    or loads, or a failed fit). ambiguous: candidates within AMBIGUOUS_DELTA of the
+    chosen one's criterion, i.e. not distinguishable by these data.
+    """
+
+    criterion: str
+    candidates: tuple[ModelFit, ...]
+    skipped: tuple[tuple[str, str], ...]
+
+    @property
+    def chosen(self) -> ModelFit:
+        return self.candidates[0]
+
+    def score(self, m: ModelFit) -> float:
+        return m.bic if self.criterion == "BIC" else m.aicc
+
+    def delta(self, name: str) -> float:
+        """Criterion of candidate `name` minus the chosen one's (>= 0)."""
+        return self.score(self.candidate(name)) - self.score(self.chosen)
+
+    def candidate(self, name: str) -> ModelFit:
+        for m in self.candidates:
+            if m.name == name:
+                return m
+        raise KeyError(f"no fitted candidate {name!r}; fitted: {[m.name for m in self.candidates]}")
+
+    @property
+    def ambiguous(self) -> tuple[str, ...]:
+        return tuple(m.name for m in self.candidates[1:] if self.delta(m.name) < AMBIGUOUS_DELTA)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "criterion": self.criterion, "chosen": self.chosen.name,
+            "candidates": [m.to_dict() for m in self.candidates],
+            "skipped": [list(s) for s in self.skipped],
+        }
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "ModelSelection":
+        return cls(d["criterion"], tuple(ModelFit.from_dict(m) for m in d["candidates"]),
+                   tuple(tuple(s) for s in d["skipped"]))
+
+
+@dataclass(frozen=True)
+class CoulombComparison:
+    """Free gamma against Coulomb (gamma = 0), both with one free mu per current level.
+
+    The models are nested (Coulomb fixes one parameter), so the F-test is exact for
+    Gaussian ln scatter. delta_bic, delta_aicc: Coulomb minus power law (> 0 favours
+    the power law). preferred: by BIC, like every selection here.
+    """
+
+    power_law: ModelFit
+    coulomb: ModelFit
+    f_statistic: float
+    p_value: float
+    delta_aicc: float
+    delta_bic: float
+
+    @property
+    def preferred(self) -> str:
+        return "power_law" if self.delta_bic > 0.0 else "coulomb"
+
+    def rejects_coulomb(self, level: float = 0.05) -> bool:
+        """True when the F-test rejects gamma = 0 at the given significance level."""
+        return self.p_value < level
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"power_law": self.power_law.to_dict(), "coulomb": self.coulomb.to_dict(),
+                "f_statistic": self.f_statistic, "p_value": self.p_value,
+                "delta_aicc": self.delta_aicc, "delta_bic": self.delta_bic, "preferred": self.preferred}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "CoulombComparison":
+        return cls(ModelFit.from_dict(d["power_law"]), ModelFit.from_dict(d["coulomb"]),
+                   d["f_statistic"], d["p_value"], d["delta_aicc"], d["delta_bic"])
+
+
+@dataclass(frozen=True)
+class CurrentLevelMu:
+    """mu at one measured current level (free-mu power-law fit): N^gamma, 95 % interval."""
+
+    current_A: float
+    n_points: int
+    mu: float
+    stderr_log: float
+    ci95: tuple[float, float]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"current_A": self.current_A, "n_points": self.n_points, "mu": self.mu,
+                "stderr_log": self.stderr_log, "ci95": list(self.ci95)}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "CurrentLevelMu":
+        return cls(d["current_A"], d["n_points"], d["mu"], d["stderr_log"], tuple(d["ci95"]))
+
+
+@dataclass(frozen=True)
+class DataRange:
+    """What the data span: the validity range of the fitted laws (N, A)."""
+
+    n_points: int
+    loads_N: tuple[float, ...]
+    currents_A: tuple[float, ...]
+
+    @property
+    def load_range_N(self) -> tuple[float, float]:
+        return self.loads_N[0], self.loads_N[-1]
+
+    @property
+    def current_range_A(self) -> tuple[float, float]:
+        return self.currents_A[0], self.currents_A[-1]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"n_points": self.n_points, "loads_N": list(self.loads_N), "currents_A": list(self.currents_A),
+                "load_range_N": list(self.load_range_N), "current_range_A": list(self.current_range_A)}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "DataRange":
+        return cls(d["n_points"], tuple(d["loads_N"]), tuple(d["currents_A"]))
+
+
+@dataclass(frozen=True)
+class FrictionFit:
+    """gamma and mu(I): per-current estimates, the Coulomb test and the chosen mu(I) model."""
+
+    per_current: tuple[CurrentLevelMu, ...]
+    coulomb_test: CoulombComparison
+    mu_selection: ModelSelection
+    law: MuLaw
+
+    @property
+    def gamma(self) -> ParameterEstimate:
+        """gamma of the chosen mu(I) model (the one the law uses)."""
+        return self.mu_selection.chosen.estimate("gamma")
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"gamma": self.gamma.to_dict(), "per_current": [c.to_dict() for c in self.per_current],
+                "coulomb_test": self.coulomb_test.to_dict(), "mu_selection": self.mu_selection.to_dict(),
+                "law": self.law.to_dict()}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "FrictionFit":
+        return cls(tuple(CurrentLevelMu.from_dict(c) for c in d["per_current"]),
+                   CoulombComparison.from_dict(d["coulomb_test"]), ModelSelection.from_dict(d["mu_selection"]),
+                   MuLaw.from_dict(d["law"]))
+
+
+@dataclass(frozen=True)
+class ResistanceFit:
+    """R_c(F_n, I): the ranked candidates (load law x current factor) and the chosen law."""
+
+    selection: ModelSelection
+    law: ResistanceLaw
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"selection": self.selection.to_dict(), "law": self.law.to_dict()}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "ResistanceFit":
+        return cls(ModelSelection.from_dict(d["selection"]), ResistanceLaw.from_dict(d["law"]))
+
+
+@dataclass(frozen=True)
+class TribometerFit:
+    """Everything fitted from one tribometer dataset, and the laws the coupling calls.
+
+    source: where the data came from; header: the data file's comment lines (an
+    illustrative dataset says so there, and the fit carries it along).
+    Callables (numpy-vectorized, SI): `mu(current_A)`, `contact_resistance(F_n, I)`,
+    `contact_conductance(F_n, I)`; behaviour outside the data range as in `laws.py`.
+    """
+
+    source: str
+    header: tuple[str, ...]
+    data_range: DataRange
+    friction: FrictionFit
+    resistance: ResistanceFit
+
+    @property
+    def laws(self) -> ContactLaws:
+        return ContactLaws(self.friction.law, self.resistance.law)
+
+    @property
+    def gamma(self) -> float:
+        """Friction exponent gamma, dimensionless."""
+        return self.friction.law.gamma
+
+    @property
+    def gamma_stderr(self) -> float | None:
+        return self.friction.gamma.stderr
+
+    @property
+    def gamma_ci95(self) -> tuple[float, float] | None:
+        return self.friction.gamma.ci95
+
+    def mu(self, current_A):
+        """Friction coefficient mu(|I|), N^gamma; held at the edge value outside the measured currents."""
+        return self.friction.law(current_A)
+
+    def friction_force(self, normal_force_N, current_A):
+        """Sliding friction magnitude mu(I) F_n^(1 - gamma), N."""
+        return self.friction.law.friction_force(normal_force_N, current_A)
+
+    def contact_resistance(self, normal_force_N, current_A):
+        """R_c(F_n, |I|), ohm; +inf for F_n <= 0; extrapolates in load with the fitted exponent."""
+        return self.resistance.law.resistance(normal_force_N, current_A)
+
+    def contact_conductance(self, normal_force_N, current_A):
+        """1 / R_c, siemens; exactly 0 for F_n <= 0, continuous as F_n -> 0+."""
+        return self.resistance.law.conductance(normal_force_N, current_A)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "format": FORMAT, "version": FORMAT_VERSION,
+            "source": self.source, "header": list(self.header),
+            "data_range": self.data_range.to_dict(),
+            "laws": self.laws.to_dict(),
+            "friction": self.friction.to_dict(),
+            "resistance": self.resistance.to_dict(),
+        }
+
+    def to_json(self, path) -> None:
+        Path(path).write_text(json.dumps(self.to_dict(), indent=2) + "\n")
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "TribometerFit":
+        if d.get("format") != FORMAT or d.get("version") != FORMAT_VERSION:
+            raise ValueError(
+                f"not a tribometer fit: expected format {FORMAT!r} version {FORMAT_VERSION}, "
+                f"got {d.get('format')!r} version {d.get('version')!r}"
+            )
+        return cls(d["source"], tuple(d["header"]), DataRange.from_dict(d["data_range"]),
+                   FrictionFit.from_dict(d["friction"]), ResistanceFit.from_dict(d["resistance"]))
+
+    @classmethod
+    def from_json(cls, path) -> "TribometerFit":
+        path = Path(path)
+        try:
+            return cls.from_dict(json.loads(path.read_text()))
+        except (KeyError, TypeError, json.JSONDecodeError) as err:
+            raise ValueError(f"{path}: not a readable tribometer fit ({type(err).__name__}: {err})") from None
+
+
+# ---------------------------------------------------------------------------------
+# Least-squares machinery
+
+
+@dataclass(frozen=True)
+class _Problem:
+    """Data in the form the fits use: ln responses, ln loads, |I|, and repeat groups."""
+
+    load: np.ndarray
+    current: np.ndarray
+    ln_load: np.ndarray
+    groups: np.ndarray  # index of the (load, |I|) cell of each row
+    levels: np.ndarray  # distinct |I|
+    level_index: np.ndarray
+
+
+def _problem(df: pd.DataFrame) -> _Problem:
+    load = df["load_N"].to_numpy(float)
+    current = np.abs(df["current_A"].to_numpy(float))
+    levels, level_index = np.unique(current, return_inverse=True)
+    _, groups = np.unique(np.c_[load, current], axis=0, return_inverse=True)
+    return _Problem(load, current, np.log(load), groups.ravel(), levels, level_index.ravel())
+
+
+def _jacobian(residual: Callable[[np.ndarray], np.ndarray], x: np.ndarray) -> np.ndarray:
+    # Central differences: the covariance needs an accurate J at the optimum, which the
+    # optimizer's last (possibly forward-difference) J is not.
+    h = 1e-6 * np.maximum(np.abs(x), 1e-3)
+    cols = []
+    for j in range(len(x)):
+        e = np.zeros_like(x)
+        e[j] = h[j]
+        cols.append((residual(x + e) - residual(x - e)) / (2.0 * h[j]))
+    return np.column_stack(cols) if cols else np.zeros((len(residual(x)), 0))
+
+
+def _lack_of_fit_p(r: np.ndarray, groups: np.ndarray, n_params: int) -> float | None:
+    n = len(r)
+    n_cells = groups.max() + 1
+    df_pe = n - n_cells
+    df_lof = n - n_params - df_pe
+    if df_pe <= 0 or df_lof <= 0:
+        return None
+    means = np.bincount(groups, weights=r) / np.bincount(groups)
+    ss_pe = float(np.sum((r - means[groups]) ** 2))
+    rss = float(r @ r)
+    if ss_pe <= 0.0:
+        return None
+    f = ((rss - ss_pe) / df_lof) / (ss_pe / df_pe)
+    return float(stats.f.sf(max(f, 0.0), df_lof, df_pe))
+
+
+def _model_fit(
+    name: str, formula: str, names: tuple[str, ...], units: tuple[str, ...], x: np.ndarray,
+    residual: Callable[[np.ndarray], np.ndarray], y: np.ndarray, groups: np.ndarray,
+    active: np.ndarray | None = None,
+) -> ModelFit:
+    r = residual(x)
+    n, p = len(r), len(x)
+    rss = float(r @ r)
+    dof = n - p
+    s2 = rss / dof
+    k = p + 1  # the scatter is a parameter too
+    loglik_term = n * np.log(max(rss, 1e-300) / n)
+    aicc = float(loglik_term + 2 * k + 2 * k * (k + 1) / (n - k - 1)) if n - k - 1 > 0 else float("inf")
+    bic = float(loglik_term + k * np.log(n))
+    tss = float(np.sum((y - y.mean()) ** 2))
+    r2 = None if tss == 0.0 else 1.0 - rss / tss
+    note = ""
+    cov = None
+    at_bound = [] if active is None else [names[j] for j in np.flatnonzero(active)]
+    if at_bound:
+        note = f"parameter(s) on a bound: {', '.join(at_bound)}; no covariance (the model reduces to a simpler one)"
+    elif p:
+        J = _jacobian(residual, x)
+        jtj = J.T @ J
+        if np.linalg.cond(jtj) > 1e14:
+            note = "parameters not identifiable from these data (singular J^T J); no covariance"
+        else:
+            cov = s2 * np.linalg.inv(jtj)
+    t = float(stats.t.ppf(0.975, dof))
+    params = []
+    for j in range(p):
+        if cov is None:
+            params.append(ParameterEstimate(names[j], float(x[j]), None, None, units[j]))
+        else:
+            se = float(np.sqrt(cov[j, j]))
+            params.append(ParameterEstimate(names[j], float(x[j]), se, (float(x[j] - t * se), float(x[j] + t * se)), units[j]))
+    return ModelFit(
+        name, formula, tuple(params),
+        None if cov is None else tuple(tuple(float(v) for v in row) for row in cov),
+        n, rss, float(np.sqrt(s2)), r2, aicc, bic, _lack_of_fit_p(r, groups, p), note,
+    )
+
+
+def _solve(residual, starts, lower, upper):
+    best = None
+    for x0 in starts:
+        x0 = np.clip(np.asarray(x0, float), lower, upper)
+        try:
+            res = optimize.least_squares(residual, x0, bounds=(lower, upper), x_scale="jac", method="trf",
+                                         xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=2000)
+        except ValueError:
+            continue
+        if np.all(np.isfinite(res.fun)) and (best is None or res.cost < best.cost):
+            best = res
+    return best
+
+
+def _rank(selection_items: list[ModelFit]) -> tuple[ModelFit, ...]:
+    return tuple(sorted(selection_items, key=lambda m: (m.bic if CRITERION == "BIC" else m.aicc, m.n_parameters)))
+
+
+# ---------------------------------------------------------------------------------
+# Friction
+
+
+def _ln_mu(model: str, theta: np.ndarray, current: np.ndarray) -> np.ndarray:
+    mu = MU_FAMILIES[model].function(current, *theta)
+    # a trial step that makes mu <= 0 is steered back by a steep, finite penalty
+    return np.where(mu > 0.0, np.log(np.maximum(mu, 1e-300)), -700.0 + 1e3 * mu)
+
+
+def _mu_starts(model: str, levels: np.ndarray, mu_k: np.ndarray) -> list[np.ndarray]:
+    """Starting points from the per-current estimates: grid the nonlinear parameter, solve the rest."""
+    scale = levels.max() if levels.max() > 0 else 1.0
+    if model == "constant":
+        return [np.array([np.exp(np.mean(np.log(mu_k)))])]
+    if model == "linear":
+        s, m0 = np.polyfit(levels, mu_k, 1)
+        return [np.array([max(m0, 1e-6), s])]
+    if model == "saturating_exponential":
+        grid, basis = np.geomspace(0.02, 20.0, 25) * scale, lambda c: -np.expm1(-levels / c)
+    else:
+        grid, basis = np.geomspace(0.1, 5.0, 25), lambda c: levels**c
+    trials = []
+    for c in grid:
+        A = np.c_[np.ones_like(levels), basis(c)] / mu_k[:, None]
+        coef, *_ = np.linalg.lstsq(A, np.ones_like(levels), rcond=None)
+        sse = float(np.sum((A @ coef - 1.0) ** 2))
+        trials.append((sse, np.array([max(coef[0], 1e-6), coef[1], c])))
+    trials.sort(key=lambda t: t[0])
+    return [t[1] for t in trials[:3]]
+
+
+def fit_friction(df: pd.DataFrame) -> FrictionFit:
+    """Fit gamma and mu(I) to the friction column of a validated tribometer table.
+
+    Steps: (1) free mu per current level with a shared gamma (linear in ln), and the
+    same with gamma = 0 (Coulomb), compared by F-test and BIC; (2) each mu(I) candidate
+    fitted jointly with gamma, ranked by BIC.
+    """
+    P = _problem(df)
+    y = np.log(df["friction_N"].to_numpy(float))
+    L = len(P.levels)
+    X = np.zeros((len(y), L + 1))
+    X[np.arange(len(y)), P.level_index] = 1.0
+    X[:, L] = -P.ln_load  # column for gamma: ln F_t = ln mu_k + ln F_n - gamma ln F_n
+    level_names = tuple(f"ln_mu_at_{i:g}A" for i in P.levels)
+    level_units = ("ln(N^gamma)",) * L
+
+    def r_power(x):
+        return y - P.ln_load - X @ x
+
+    x_pow, *_ = np.linalg.lstsq(X, y - P.ln_load, rcond=None)
+    power = _model_fit("per_current_power_law", "F_t = mu_k F_n^(1-gamma), one mu_k per current",
+                       level_names + ("gamma",), level_units + ("1",), x_pow, r_power, y, P.groups)
+
+    Xc = X[:, :L]
+
+    def r_coulomb(x):
+        return y - P.ln_load - Xc @ x
+
+    x_c, *_ = np.linalg.lstsq(Xc, y - P.ln_load, rcond=None)
+    coulomb = _model_fit("per_current_coulomb", "F_t = mu_k F_n, one mu_k per current (gamma = 0)",
+                         level_names, level_units, x_c, r_coulomb, y, P.groups)
+    dof = len(y) - (L + 1)
+    f_stat = (coulomb.rss_log - power.rss_log) / (power.rss_log / dof)
+    comparison = CoulombComparison(
+        power, coulomb, float(f_stat), float(stats.f.sf(max(f_stat, 0.0), 1, dof)),
+        coulomb.aicc - power.aicc, coulomb.bic - power.bic,
+    )
+
+    cov = np.array(power.covariance)
+    t = float(stats.t.ppf(0.975, dof))
+    counts = np.bincount(P.level_index, minlength=L)
+    per_current = tuple(
+        CurrentLevelMu(float(P.levels[k]), int(counts[k]), float(np.exp(x_pow[k])), float(np.sqrt(cov[k, k])),
+                       (float(np.exp(x_pow[k] - t * np.sqrt(cov[k, k]))), float(np.exp(x_pow[k] + t * np.sqrt(cov[k, k])))))
+        for k in range(L)
+    )
+
+    gamma0 = x_pow[L]
+    mu_k = np.exp(x_pow[:L])
+    fitted, skipped = [], []
+    for model, family in MU_FAMILIES.items():
+        if L < len(family.parameters):
+            skipped.append((model, f"needs >= {len(family.parameters)} current levels, data have {L}"))
+            continue
+        if len(y) - len(family.parameters) - 3 < 0:
+            skipped.append((model, f"needs >= {len(family.parameters) + 3} points, data have {len(y)}"))
+            continue
+
+        def residual(x, model=model):
+            return y - _ln_mu(model, x[1:], P.current) - (1.0 - x[0]) * P.ln_load
+
+        lower = np.r_[-np.inf, family.lower]
+        upper = np.r_[1.0 - 1e-9, family.upper]
+        res = _solve(residual, [np.r_[gamma0, s] for s in _mu_starts(model, P.levels, mu_k)], lower, upper)
+        if res is None:
+            skipped.append((model, "the least-squares fit failed"))
+            continue
+        mu_range = MU_FAMILIES[model].function(np.array([P.levels[0], P.levels[-1]]), *res.x[1:])
+        if not np.all(mu_range > 0.0):
+            skipped.append((model, "fitted mu is not > 0 over the measured currents"))
+            continue
+        fitted.append(_model_fit(model, f"F_t = ({family.formula}) F_n^(1-gamma)", ("gamma",) + family.parameters,
+                                 ("1",) + family.units, res.x, residual, y, P.groups, res.active_mask))
+    selection = ModelSelection(CRITERION, _rank(fitted), tuple(skipped))
+    chosen = selection.chosen
+    law = MuLaw(chosen.value("gamma"), chosen.name, tuple((p.name, p.value) for p in chosen.parameters[1:]),
+                (float(P.levels[0]), float(P.levels[-1])))
+    return FrictionFit(per_current, comparison, selection, law)
+
+
+# ---------------------------------------------------------------------------------
+# Contact resistance
+
+
+def resistance_candidates() -> list[tuple[str, str]]:
+    """All (load model, current model) pairs the resistance fit ranks."""
+    return [(lm, cm) for lm in LOAD_FAMILIES for cm in CURRENT_FAMILIES]
+
+
+def _ln_resistance(load_model: str, current_model: str, x: np.ndarray, load: np.ndarray, current: np.ndarray) -> np.ndarray:
+    nl = len(LOAD_FAMILIES[load_model].parameters)
+    rf, r1, m = load_law_parameters(load_model, dict(zip(LOAD_FAMILIES[load_model].parameters, x[:nl])))
+    g = CURRENT_FAMILIES[current_model].function(current, *x[nl:])
+    r = g * (rf + r1 * load ** (-m))
+    return np.where(r > 0.0, np.log(np.maximum(r, 1e-300)), -700.0 + 1e3 * r)
+
+
+def _current_grid(current_model: str, scale: float) -> list[tuple[float, ...]]:
+    if current_model == "none":
+        return [()]
+    scales = np.geomspace(0.05, 20.0, 15) * scale
+    if current_model == "hyperbolic":
+        return [(c,) for c in scales]
+    return [(c, r) for c in scales for r in (0.05, 0.1, 0.2, 0.3, 0.45, 0.6, 0.75, 0.9, 1.1, 1.4)]
+
+
+def _load_start(load_model: str, F: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, float]:
+    """Best load parameters for a given current-corrected resistance R (relative least squares)."""
+    fam = LOAD_FAMILIES[load_model]
+    fixed = dict(fam.fixed)
+    if load_model == "power_law":
+        slope, icpt = np.polyfit(np.log(F), np.log(R), 1)
+        x = np.array([np.exp(icpt), min(max(-slope, 1e-3), 5.0)])
+    elif "r_film_ohm" in fam.parameters:
+        m = fixed["load_exponent"]
+        A = np.c_[np.ones_like(F), F ** (-m)] / R[:, None]
+        coef, *_ = np.linalg.lstsq(A, np.ones_like(F), rcond=None)
+        if coef[0] < 0.0 or coef[1] <= 0.0:
+            coef = np.array([0.0, np.exp(np.mean(np.log(R * F**m)))])
+        x = coef
+    else:
+        m = fixed["load_exponent"]
+        x = np.array([np.exp(np.mean(np.log(R * F**m)))])
+    pred = load_law_parameters(load_model, dict(zip(fam.parameters, x)))
+    model = pred[0] + pred[1] * F ** (-pred[2])
+    return x, float(np.sum(np.log(R / model) ** 2))
+
+
+def fit_resistance(df: pd.DataFrame) -> ResistanceFit:
+    """Fit R_c(F_n, I) = g(I) (R_f + R_1 F^-m): every load law x current factor, ranked by BIC."""
+    P = _problem(df)
+    R = df["resistance_ohm"].to_numpy(float)
+    y = np.log(R)
+    n_loads = len(np.unique(P.load))
+    L = len(P.levels)
+    scale = P.levels.max() if P.levels.max() > 0 else 1.0
+    fitted, skipped = [], []
+    for load_model, current_model in resistance_candidates():
+        name = f"{load_model}+{current_model}"
+        lf, cf = LOAD_FAMILIES[load_model], CURRENT_FAMILIES[current_model]
+        if n_loads < len(lf.parameters):
+            skipped.append((name, f"needs >= {len(lf.parameters)} different loads, data have {n_loads}"))
+            continue
+        if L < len(cf.parameters) + 1:
+            skipped.append((name, f"needs >= {len(cf.parameters) + 1} current levels, data have {L}"))
+            continue
+        if len(y) - len(lf.parameters) - len(cf.parameters) - 3 < 0:
+            skipped.append((name, f"needs >= {len(lf.parameters) + len(cf.parameters) + 3} points, data have {len(y)}"))
+            continue
+        trials = []
+        for c in _current_grid(current_model, scale):
+            g = cf.function(P.current, *c)
+            if np.any(g <= 0.0):
+                continue
+            xl, sse = _load_start(load_model, P.load, R / g)
+            trials.append((sse, np.r_[xl, c]))
+        trials.sort(key=lambda t: t[0])
+
+        def residual(x, lm=load_model, cm=current_model):
+            return y - _ln_resistance(lm, cm, x, P.load, P.current)
+
+        lower = np.r_[lf.lower, cf.lower]
+        upper = np.r_[lf.upper, cf.upper]
+        res = _solve(residual, [t[1] for t in trials[:3]], lower, upper)
+        if res is None:
+            skipped.append((name, "the least-squares fit failed"))
+            continue
+        formula = f"R_c = ({cf.formula}) * ({lf.formula}), F in N"
+        fitted.append(_model_fit(name, formula, lf.parameters + cf.parameters, lf.units + cf.units,
+                                 res.x, residual, y, P.groups, res.active_mask))
+    selection = ModelSelection(CRITERION, _rank(fitted), tuple(skipped))
+    chosen = selection.chosen
+    load_model, current_model = chosen.name.split("+")
+    law = ResistanceLaw(load_model, current_model, tuple((p.name, p.value) for p in chosen.parameters),
+                        (float(P.levels[0]), float(P.levels[-1])))
+    return ResistanceFit(selection, law)
+
+
+# ---------------------------------------------------------------------------------
+# Entry point and confidence bands
+
+
+def fit_tribometer(df: pd.DataFrame) -> TribometerFit:
+    """Fit gamma, mu(I) and R_c(F_n, I) to a tribometer table (see `read_tribometer_csv`).
+
+    df: columns load_N (N), current_A (A), friction_N (N), resistance_ohm (ohm), optional
+    run. Validated again here, so a hand-built DataFrame gets the same clear errors.
+    """
+    source = str(df.attrs.get("source", "DataFrame"))
+    header = tuple(df.attrs.get("header", ()))
+    clean = validate_tribometer_frame(df, source=source)
+    P = _problem(clean)
+    data_range = DataRange(len(clean), tuple(float(v) for v in np.unique(P.load)), tuple(float(v) for v in P.levels))
+    return TribometerFit(source, header, data_range, fit_friction(clean), fit_resistance(clean))
+
+
+def _log_band(model: ModelFit, predict_log: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Curve and pointwise 95 % confidence band (delta method on the ln prediction)."""
+    x = np.array([p.value for p in model.parameters])
+    center = predict_log(x)
+    if model.covariance is None:
+        return np.exp(center), np.full_like(center, np.nan), np.full_like(center, np.nan)
+    J = _jacobian(predict_log, x)
+    se = np.sqrt(np.einsum("ij,jk,ik->i", J, np.array(model.covariance), J))
+    t = float(stats.t.ppf(0.975, model.n_points - model.n_parameters))
+    return np.exp(center), np.exp(center - t * se), np.exp(center + t * se)
+
+
+def mu_band(fit: TribometerFit, current_A) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """mu(I) of the chosen model with its 95 % band at currents (A, within the data range)."""
+    chosen = fit.friction.mu_selection.chosen
+    i = np.abs(np.asarray(current_A, float))
+    return _log_band(chosen, lambda x: _ln_mu(chosen.name, x[1:], i))
+
+
+def friction_band(fit: TribometerFit, normal_force_N, current_A: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Friction force mu(I) F^(1-gamma) (N) with its 95 % band, loads in N, one current in A."""
+    chosen = fit.friction.mu_selection.chosen
+    ln_f = np.log(np.asarray(normal_force_N, float))
+    i = np.full_like(ln_f, abs(current_A))
+    return _log_band(chosen, lambda x: _ln_mu(chosen.name, x[1:], i) + (1.0 - x[0]) * ln_f)
+
+
+def resistance_band(fit: TribometerFit, normal_force_N, current_A: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Contact resistance (ohm) of the chosen model with its 95 % band, loads in N, one current in A."""
+    chosen = fit.resistance.selection.chosen
+    lm, cm = chosen.name.split("+")
+    f = np.asarray(normal_force_N, float)
+    i = np.full_like(f, abs(current_A))
+    return _log_band(chosen, lambda x: _ln_resistance(lm, cm, x, f, i))
