@@ -9,8 +9,8 @@ skipped. The sign of the current is ignored by the fits (|I|).
 
 from __future__ import annotations
 
+import csv
 import difflib
-import io
 from pathlib import Path
 from typing import Sequence
 
@@ -44,7 +44,7 @@ def read_tribometer_csv(path) -> pd.DataFrame:
     except FileNotFoundError:
         raise FileNotFoundError(f"{path}: no such tribometer CSV file") from None
     header: list[str] = []
-    kept: list[str] = []
+    rows: list[list[str]] = []
     line_numbers: list[int] = []
     for number, line in enumerate(text.splitlines(), start=1):
         stripped = line.strip()
@@ -53,15 +53,18 @@ def read_tribometer_csv(path) -> pd.DataFrame:
         if stripped.startswith("#"):
             header.append(stripped.lstrip("#").strip())
             continue
-        kept.append(line)
+        rows.append([cell.strip() for cell in next(csv.reader([line]))])
         line_numbers.append(number)
-    if not kept:
+    if not rows:
         raise ValueError(f"{path}: no header line and no data (expected columns {', '.join(NUMERIC_COLUMNS)})")
-    try:
-        raw = pd.read_csv(io.StringIO("\n".join(kept)), dtype=str, keep_default_na=False, skipinitialspace=True)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError) as err:
-        raise ValueError(f"{path}: not a readable CSV table: {err}") from None
-    raw.columns = [str(c).strip() for c in raw.columns]
+    names = rows[0]
+    for cells, number in zip(rows[1:], line_numbers[1:]):
+        if len(cells) != len(names):
+            raise ValueError(
+                f"{path}: line {number} has {len(cells)} fields, the header line {line_numbers[0]} has "
+                f"{len(names)} ({', '.join(names)})"
+            )
+    raw = pd.DataFrame(rows[1:], columns=names) if len(rows) > 1 else pd.DataFrame(columns=names)
     df = validate_tribometer_frame(raw, source=str(path), row_labels=[f"line {n}" for n in line_numbers[1:]])
     df.attrs["header"] = tuple(header)
     df.attrs["source"] = str(path)
@@ -116,7 +119,7 @@ def validate_tribometer_frame(df: pd.DataFrame, source: str = "DataFrame", row_l
     ):
         if bad.any():
             k = int(np.flatnonzero(bad.to_numpy())[0])
-            raise ValueError(f"{source}: column {column}, {row_labels[k]}: value {out[column].iloc[k]!r} {rule}")
+            raise ValueError(f"{source}: column {column}, {row_labels[k]}: value {float(out[column].iloc[k])!r} {rule}")
     if "run" in columns:
         out["run"] = df["run"].to_numpy()
     levels = np.unique(np.abs(out["current_A"].to_numpy()))

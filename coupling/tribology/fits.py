@@ -504,16 +504,22 @@ def _mu_starts(model: str, levels: np.ndarray, mu_k: np.ndarray) -> list[np.ndar
         sse = float(np.sum((A @ coef - 1.0) ** 2))
         trials.append((sse, np.array([max(coef[0], 1e-6), coef[1], c])))
     trials.sort(key=lambda t: t[0])
-    return [t[1] for t in trials[:3]]
+    return [t[1] for t in trials[:2]]
 
 
-def fit_friction(df: pd.DataFrame) -> FrictionFit:
+def fit_friction(df: pd.DataFrame, mu_models: list[str] | None = None) -> FrictionFit:
     """Fit gamma and mu(I) to the friction column of a validated tribometer table.
 
     Steps: (1) free mu per current level with a shared gamma (linear in ln), and the
     same with gamma = 0 (Coulomb), compared by F-test and BIC; (2) each mu(I) candidate
-    fitted jointly with gamma, ranked by BIC.
+    (all of `models.MU_FAMILIES`, or the names in mu_models) fitted jointly with gamma,
+    ranked by BIC.
     """
+    if mu_models is None:
+        mu_models = list(MU_FAMILIES)
+    unknown = [m for m in mu_models if m not in MU_FAMILIES]
+    if unknown or not mu_models:
+        raise ValueError(f"mu models must be among {list(MU_FAMILIES)}, got {unknown or mu_models}")
     P = _problem(df)
     y = np.log(df["friction_N"].to_numpy(float))
     L = len(P.levels)
@@ -557,7 +563,8 @@ def fit_friction(df: pd.DataFrame) -> FrictionFit:
     gamma0 = x_pow[L]
     mu_k = np.exp(x_pow[:L])
     fitted, skipped = [], []
-    for model, family in MU_FAMILIES.items():
+    for model in mu_models:
+        family = MU_FAMILIES[model]
         if L < len(family.parameters):
             skipped.append((model, f"needs >= {len(family.parameters)} current levels, data have {L}"))
             continue
@@ -580,6 +587,8 @@ def fit_friction(df: pd.DataFrame) -> FrictionFit:
             continue
         fitted.append(_model_fit(model, f"F_t = ({family.formula}) F_n^(1-gamma)", ("gamma",) + family.parameters,
                                  ("1",) + family.units, res.x, residual, y, P.groups, res.active_mask))
+    if not fitted:
+        raise ValueError(f"no mu(I) model could be fitted: {'; '.join(f'{n}: {r}' for n, r in skipped)}")
     selection = ModelSelection(CRITERION, _rank(fitted), tuple(skipped))
     chosen = selection.chosen
     law = MuLaw(chosen.value("gamma"), chosen.name, tuple((p.name, p.value) for p in chosen.parameters[1:]),
@@ -607,10 +616,10 @@ def _ln_resistance(load_model: str, current_model: str, x: np.ndarray, load: np.
 def _current_grid(current_model: str, scale: float) -> list[tuple[float, ...]]:
     if current_model == "none":
         return [()]
-    scales = np.geomspace(0.05, 20.0, 15) * scale
+    scales = np.geomspace(0.05, 20.0, 9) * scale
     if current_model == "hyperbolic":
         return [(c,) for c in scales]
-    return [(c, r) for c in scales for r in (0.05, 0.1, 0.2, 0.3, 0.45, 0.6, 0.75, 0.9, 1.1, 1.4)]
+    return [(c, r) for c in scales for r in (0.1, 0.3, 0.5, 0.7, 0.9, 1.2)]
 
 
 def _load_start(load_model: str, F: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, float]:
@@ -635,8 +644,17 @@ def _load_start(load_model: str, F: np.ndarray, R: np.ndarray) -> tuple[np.ndarr
     return x, float(np.sum(np.log(R / model) ** 2))
 
 
-def fit_resistance(df: pd.DataFrame) -> ResistanceFit:
-    """Fit R_c(F_n, I) = g(I) (R_f + R_1 F^-m): every load law x current factor, ranked by BIC."""
+def fit_resistance(df: pd.DataFrame, candidates: list[tuple[str, str]] | None = None) -> ResistanceFit:
+    """Fit R_c(F_n, I) = g(I) (R_f + R_1 F^-m): every load law x current factor, ranked by BIC.
+
+    candidates: (load model, current model) pairs to rank instead of all of
+    `resistance_candidates()`, e.g. to keep only the Holm laws.
+    """
+    if candidates is None:
+        candidates = resistance_candidates()
+    unknown = [c for c in candidates if tuple(c) not in resistance_candidates()]
+    if unknown or not candidates:
+        raise ValueError(f"resistance candidates must be among {resistance_candidates()}, got {unknown or candidates}")
     P = _problem(df)
     R = df["resistance_ohm"].to_numpy(float)
     y = np.log(R)
@@ -644,7 +662,7 @@ def fit_resistance(df: pd.DataFrame) -> ResistanceFit:
     L = len(P.levels)
     scale = P.levels.max() if P.levels.max() > 0 else 1.0
     fitted, skipped = [], []
-    for load_model, current_model in resistance_candidates():
+    for load_model, current_model in candidates:
         name = f"{load_model}+{current_model}"
         lf, cf = LOAD_FAMILIES[load_model], CURRENT_FAMILIES[current_model]
         if n_loads < len(lf.parameters):
@@ -670,13 +688,15 @@ def fit_resistance(df: pd.DataFrame) -> ResistanceFit:
 
         lower = np.r_[lf.lower, cf.lower]
         upper = np.r_[lf.upper, cf.upper]
-        res = _solve(residual, [t[1] for t in trials[:3]], lower, upper)
+        res = _solve(residual, [t[1] for t in trials[:2]], lower, upper)
         if res is None:
             skipped.append((name, "the least-squares fit failed"))
             continue
         formula = f"R_c = ({cf.formula}) * ({lf.formula}), F in N"
         fitted.append(_model_fit(name, formula, lf.parameters + cf.parameters, lf.units + cf.units,
                                  res.x, residual, y, P.groups, res.active_mask))
+    if not fitted:
+        raise ValueError(f"no R_c model could be fitted: {'; '.join(f'{n}: {r}' for n, r in skipped)}")
     selection = ModelSelection(CRITERION, _rank(fitted), tuple(skipped))
     chosen = selection.chosen
     load_model, current_model = chosen.name.split("+")

@@ -180,6 +180,16 @@ class ResistanceLaw:
                                tuple(p[k] for k in CURRENT_FAMILIES[self.current_model].parameters)),
         )
 
+    @property
+    def load_exponent(self) -> float:
+        """m of R_1 F^-m (1/3 Holm elastic, 1/2 Holm plastic, or fitted): the extrapolation in load."""
+        return self._load[2]
+
+    @property
+    def film_resistance_ohm(self) -> float:
+        """R_f, ohm: the floor R_c approaches at high load (0 for the laws without film), at I = 0."""
+        return self._load[0]
+
     def current_factor(self, current_A):
         """g(|I|) with |I| held inside current_range_A; dimensionless."""
         lo, hi = self.current_range_A
