@@ -709,18 +709,23 @@ def fit_resistance(df: pd.DataFrame, candidates: list[tuple[str, str]] | None = 
 # Entry point and confidence bands
 
 
-def fit_tribometer(df: pd.DataFrame) -> TribometerFit:
+def fit_tribometer(
+    df: pd.DataFrame, mu_models: list[str] | None = None, resistance_candidates: list[tuple[str, str]] | None = None,
+) -> TribometerFit:
     """Fit gamma, mu(I) and R_c(F_n, I) to a tribometer table (see `read_tribometer_csv`).
 
     df: columns load_N (N), current_A (A), friction_N (N), resistance_ohm (ohm), optional
     run. Validated again here, so a hand-built DataFrame gets the same clear errors.
+    mu_models, resistance_candidates: restrict the candidates ranked (default: all;
+    see `fit_friction`, `fit_resistance`).
     """
     source = str(df.attrs.get("source", "DataFrame"))
     header = tuple(df.attrs.get("header", ()))
     clean = validate_tribometer_frame(df, source=source)
     P = _problem(clean)
     data_range = DataRange(len(clean), tuple(float(v) for v in np.unique(P.load)), tuple(float(v) for v in P.levels))
-    return TribometerFit(source, header, data_range, fit_friction(clean), fit_resistance(clean))
+    return TribometerFit(source, header, data_range, fit_friction(clean, mu_models),
+                         fit_resistance(clean, resistance_candidates))
 
 
 def _log_band(model: ModelFit, predict_log: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -113,7 +113,7 @@ class MuLaw:
     def __call__(self, current_A):
         """mu at current I (A, any sign), N^gamma; vectorized over numpy arrays."""
         lo, hi = self.current_range_A
-        i = np.clip(np.abs(current_A), lo, hi)
+        i = np.minimum(np.maximum(np.abs(current_A), lo), hi)
         return self._function(i, *self._values)
 
     def friction_force(self, normal_force_N, current_A):
@@ -194,7 +194,7 @@ class ResistanceLaw:
         """g(|I|) with |I| held inside current_range_A; dimensionless."""
         lo, hi = self.current_range_A
         function, values = self._current
-        return function(np.clip(np.abs(current_A), lo, hi), *values)
+        return function(np.minimum(np.maximum(np.abs(current_A), lo), hi), *values)
 
     def conductance(self, normal_force_N, current_A):
         """1 / R_c, siemens: exactly 0 for F_n <= 0, -> 0 continuously as F_n -> 0+."""
