@@ -1,4 +1,76 @@
 """Switch circuits in real ngspice (shared library, through PySpice).
 
 The contact is a time-varying conductance driven from Python. SI units throughout.
+
+- ``Stepper``: co-simulation stepping (advance to t_next with G(t) and breakpoints).
+- ``run_transient`` / ``run_pwl_reference``: one-shot runs.
+- ``ContactSchedule``: prescribed make/break instants.
+- ``SwitchCircuit`` and its parts, ``NetlistCircuit``: the circuit.
+- ``ArcModel``: arc/breakdown of the opening gap.
 """
+
+from .arc import ArcModel, add_arc
+from .contact import add_contact, left_limited
+from .errors import (
+    ConductanceError,
+    ConvergenceError,
+    LibraryNotFoundError,
+    NetlistError,
+    NgspiceError,
+    SessionBusyError,
+    SimulationAborted,
+    SimulationTimeout,
+    TimestepTooSmallError,
+)
+from .netlist import NetlistCircuit
+from .ngspice import find_library, get_session
+from .options import SimulationOptions
+from .probes import COLUMNS, Probes
+from .schedule import ContactSchedule
+from .stepping import StepResult, Stepper
+from .templates import (
+    CapacitiveLoad,
+    DCSource,
+    FlybackDiode,
+    InductiveLoad,
+    ResistiveLoad,
+    Snubber,
+    SwitchCircuit,
+    Wiring,
+)
+from .transient import run_pwl_reference, run_transient
+
+__all__ = [
+    "ArcModel",
+    "COLUMNS",
+    "CapacitiveLoad",
+    "ConductanceError",
+    "ContactSchedule",
+    "ConvergenceError",
+    "DCSource",
+    "FlybackDiode",
+    "InductiveLoad",
+    "LibraryNotFoundError",
+    "NetlistCircuit",
+    "NetlistError",
+    "NgspiceError",
+    "Probes",
+    "ResistiveLoad",
+    "SessionBusyError",
+    "SimulationAborted",
+    "SimulationOptions",
+    "SimulationTimeout",
+    "Snubber",
+    "StepResult",
+    "Stepper",
+    "SwitchCircuit",
+    "TimestepTooSmallError",
+    "Wiring",
+    "add_arc",
+    "add_contact",
+    "find_library",
+    "get_session",
+    "left_limited",
+    "run_pwl_reference",
+    "run_transient",
+]

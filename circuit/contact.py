@@ -1,0 +1,88 @@
+"""The contact element: a conductance G(t) >= 0 (S) given from Python, as ngspice netlist lines.
+
+In the netlist the contact between nodes a and b is three elements::
+
+    Vcontact   a contact_s 0                                  (0 V: contact current probe)
+    Bcontact   contact_s b  I=V(contact_s,b)*(V(contact_g)+G_leak)
+    Vcontact_g contact_g 0  external                          (G(t) in volts = siemens)
+
+``G = 0`` is an open contact: the element then carries only the leakage conductance
+(default 1e-12 S, an insulation resistance of 1 TOhm) and there is no division by
+zero. The conductance source is written ``external`` without a value: ngspice 38-40
+segfault on an EXTERNAL source that also has a DC value. For a one-shot reference the
+same source is written as a PWL instead (see ``deck.py``).
+
+Every make/break instant must be a breakpoint: ngspice does not know the value of an
+EXTERNAL source jumps, and lands exactly on breakpoints, restarting there with a small
+first-order step. At a breakpoint the conductance used is the left limit ``G(t_b-)``
+(the state before the event), so a jump acts from the breakpoint on; see
+``left_limited``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable, Iterable, Sequence
+
+from PySpice.Spice.Netlist import Circuit
+
+CONDUCTANCE_SOURCE = "Vcontact_g"
+CONDUCTANCE_NODE = "contact_g"
+SENSE_SOURCE = "Vcontact"
+SENSE_NODE = "contact_s"
+ELEMENT = "Bcontact"
+DEFAULT_LEAKAGE = 1e-12  # S
+
+Conductance = Callable[[float], float]
+
+
+def add_contact(circuit: Circuit, node_a: str, node_b: str, leakage_conductance: float = DEFAULT_LEAKAGE) -> None:
+    """Add the contact between ``node_a`` and ``node_b`` to a PySpice circuit.
+
+    The contact current (A, positive from a to b) is the branch current of
+    ``Vcontact``; the conductance (S) is the voltage of node ``contact_g``.
+    """
+    circuit.V(SENSE_SOURCE[1:], node_a, SENSE_NODE, 0)
+    circuit.B(
+        ELEMENT[1:],
+        SENSE_NODE,
+        node_b,
+        current_expression=f"V({SENSE_NODE},{node_b})*(V({CONDUCTANCE_NODE})+{float(leakage_conductance)!r})",
+    )
+    circuit.V(CONDUCTANCE_SOURCE[1:], CONDUCTANCE_NODE, circuit.gnd, "external")
+
+
+def left_limited(conductance: Conductance, breakpoints: Sequence[float], span: float) -> Conductance:
+    """``conductance`` evaluated as its left limit at each breakpoint.
+
+    ngspice evaluates the source at the breakpoint time itself, and that value closes
+    the step that ends there. Using the value after a jump would apply the new contact
+    state over the whole preceding step (measured on an RC charge: 3.3 % of the
+    final voltage wrong, against 0.025 % with the left limit). Times within 64 ulp of a
+    breakpoint count as the breakpoint (ngspice lands on it up to rounding); the left
+    limit is taken ``1e-9 * span`` before it (``span``: the macro step length, s).
+    """
+    points = tuple(sorted(float(b) for b in breakpoints))
+    if not points:
+        return conductance
+    windows = tuple((b, 64.0 * math.ulp(b) + 1e-300, b - max(1e-9 * span, 64.0 * math.ulp(b))) for b in points)
+
+    def source(t: float) -> float:
+        for b, tol, before in windows:
+            if abs(t - b) <= tol:
+                return conductance(before)
+        return conductance(t)
+
+    return source
+
+
+def checked_breakpoints(breakpoints: Iterable[float], t_start: float, t_stop: float) -> tuple[float, ...]:
+    """Sorted, de-duplicated breakpoints, each required in (t_start, t_stop] (s)."""
+    result = sorted({float(b) for b in breakpoints})
+    for b in result:
+        if not math.isfinite(b) or not (t_start < b <= t_stop):
+            raise ValueError(
+                f"breakpoint {b!r} s is outside the step ({t_start!r}, {t_stop!r}] s; "
+                "pass only the make/break instants inside the step being advanced"
+            )
+    return tuple(result)

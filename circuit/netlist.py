@@ -1,0 +1,127 @@
+"""A user's own netlist with a named contact: the ``XCONTACT a b`` convention.
+
+Write the circuit as an ordinary SPICE netlist (first line: title; no analysis lines,
+no ``.end``) and mark the contact with one line::
+
+    XCONTACT node_a node_b
+
+switchsim replaces that line by its contact element (and the arc path, when an
+``ArcModel`` is given). The contact voltage is V(node_a) - V(node_b). For the
+``load_current`` column put a 0 V source in series with the load and name it (default
+``VLOAD``, current positive from its + node to its - node)::
+
+    my relay driver
+    V1 supply 0 24
+    R1 supply a 0.1
+    XCONTACT a b
+    Cpar a b 100p
+    VLOAD b coil 0
+    Rcoil coil c1 240
+    Lcoil c1 0 50m
+
+Reserved (do not use): elements Vcontact, Bcontact, Vcontact_g, Varc, Sarc, Barc*,
+Rarc_arm, Carc_arm; nodes contact_s, contact_g, arc_*; model switchsim_arc.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from PySpice.Spice.Netlist import Circuit
+
+from .arc import ArcModel, add_arc
+from .contact import CONDUCTANCE_NODE, DEFAULT_LEAKAGE, SENSE_SOURCE, add_contact
+from .probes import Probes
+from .validation import check_range
+
+_RESERVED_ELEMENTS = re.compile(r"^(vcontact|bcontact|vcontact_g|varc|sarc|barc\w*|rarc_arm|carc_arm)$", re.I)
+_RESERVED_NODES = re.compile(r"^(contact_s|contact_g|arc_\w+)$", re.I)
+_ANALYSIS = re.compile(r"^\.(tran|op|ac|dc|noise|tf|disto|sens|pz|control|endc|end)\b", re.I)
+
+
+@dataclass(frozen=True)
+class NetlistCircuit:
+    """A user netlist (text) with one ``XCONTACT a b`` line. See the module docstring.
+
+    load_probe: name of the 0 V source in series with the load, or None.
+    arc: optional ArcModel across the contact.
+    leakage_conductance: open-contact conductance, S.
+    """
+
+    text: str
+    load_probe: str | None = "VLOAD"
+    arc: ArcModel | None = None
+    leakage_conductance: float = DEFAULT_LEAKAGE
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.text, str) or not self.text.strip():
+            raise ValueError("NetlistCircuit.text: must be a non-empty netlist string")
+        if self.arc is not None and not isinstance(self.arc, ArcModel):
+            raise ValueError(f"NetlistCircuit.arc = {self.arc!r}: must be an ArcModel or None")
+        check_range("NetlistCircuit", "leakage_conductance", self.leakage_conductance, "S", 0.0, 1e-3)
+        self._parse()  # fail early, before anything runs
+
+    @classmethod
+    def from_file(cls, path: str | Path, **kwargs) -> "NetlistCircuit":
+        return cls(Path(path).read_text(), **kwargs)
+
+    def _parse(self) -> tuple[list[str], int, str, str, bool]:
+        lines = self.text.splitlines()
+        contact_rows = []
+        has_load_probe = False
+        for i, line in enumerate(lines):
+            tokens = line.split()
+            if i == 0 or not tokens or tokens[0].startswith(("*", "+")):
+                continue
+            head = tokens[0]
+            if _ANALYSIS.match(head):
+                if head.lower() == ".end":
+                    continue
+                raise ValueError(
+                    f"netlist line {i + 1} {line!r}: remove analysis/control lines; "
+                    "the transient is set by t_end and SimulationOptions"
+                )
+            if head.lower() == "xcontact":
+                if len(tokens) != 3:
+                    raise ValueError(f"netlist line {i + 1} {line!r}: the contact line is 'XCONTACT node_a node_b'")
+                contact_rows.append(i)
+                continue
+            if _RESERVED_ELEMENTS.match(head):
+                raise ValueError(f"netlist line {i + 1} {line!r}: element name {head} is reserved by switchsim")
+            if head[0].isalpha() and any(_RESERVED_NODES.match(t) for t in tokens[1:3]):
+                raise ValueError(f"netlist line {i + 1} {line!r}: node names contact_s, contact_g, arc_* are reserved")
+            if self.load_probe is not None and head.lower() == self.load_probe.lower():
+                has_load_probe = True
+        if len(contact_rows) != 1:
+            raise ValueError(
+                f"the netlist must contain exactly one 'XCONTACT node_a node_b' line (found {len(contact_rows)}); "
+                "the first line is the title"
+            )
+        row = contact_rows[0]
+        _, node_a, node_b = lines[row].split()
+        return lines, row, node_a, node_b, has_load_probe
+
+    @property
+    def probes(self) -> Probes:
+        _, _, node_a, node_b, has_load_probe = self._parse()
+        return Probes(
+            node_a=node_a,
+            node_b=node_b,
+            contact_current=f"{SENSE_SOURCE}#branch",
+            conductance_node=CONDUCTANCE_NODE,
+            load_current=f"{self.load_probe}#branch" if has_load_probe else None,
+            arc_current=None if self.arc is None else "Varc#branch",
+        )
+
+    def netlist(self) -> str:
+        """The netlist with the XCONTACT line expanded (title first, no analysis, no .end)."""
+        lines, row, node_a, node_b, _ = self._parse()
+        scratch = Circuit("contact")
+        add_contact(scratch, node_a, node_b, self.leakage_conductance)
+        if self.arc is not None:
+            add_arc(scratch, self.arc, node_a, node_b)
+        expansion = [line for line in str(scratch).splitlines()[1:] if line.strip()]
+        expanded = lines[:row] + expansion + lines[row + 1 :]
+        return "\n".join(line for line in expanded if line.strip().lower() != ".end")

@@ -1,0 +1,466 @@
+"""The one ngspice of the process: finding libngspice, a PySpice subclass with fixed callbacks, transient control.
+
+ngspice keeps global state, so a process holds exactly one session (``get_session()``);
+it is cleared between runs, and parallel runs need separate processes. Only this
+module talks to the shared library.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import math
+import os
+import re
+import shutil
+import subprocess
+import threading
+import time
+import weakref
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+from PySpice.Spice.NgSpice.Shared import NgSpiceShared, ffi
+
+from .errors import (
+    ConductanceError,
+    ConvergenceError,
+    LibraryNotFoundError,
+    NetlistError,
+    NgspiceError,
+    SessionBusyError,
+    SimulationAborted,
+    SimulationTimeout,
+    TimestepTooSmallError,
+)
+
+LIBRARY_ENV = "NGSPICE_LIBRARY_PATH"
+
+# Where distributions put the library when ldconfig does not know it (e.g. containers
+# without an ld.so.cache); checked after the ldconfig lookup.
+_FALLBACK_PATHS = (
+    "/usr/lib/x86_64-linux-gnu/libngspice.so.0",
+    "/lib/x86_64-linux-gnu/libngspice.so.0",
+    "/usr/lib/aarch64-linux-gnu/libngspice.so.0",
+    "/usr/lib64/libngspice.so.0",
+    "/usr/lib/libngspice.so.0",
+    "/usr/local/lib/libngspice.so.0",
+    "/usr/local/lib/libngspice.so",
+    "/opt/homebrew/lib/libngspice.dylib",
+    "/usr/local/lib/libngspice.dylib",
+)
+
+# PySpice's ngSpice_Command keeps every command in ngspice's history; a stepping run
+# sends three per macro step, so the history is released periodically (as PySpice does).
+_COMMANDS_BEFORE_HISTORY_RELEASE = 5000
+
+
+def find_library() -> str:
+    """Path of the ngspice shared library.
+
+    Order: the environment variable ``NGSPICE_LIBRARY_PATH``; ``ldconfig -p`` for
+    ``libngspice.so.0`` (what Debian's ``libngspice0`` installs, without the -dev
+    symlink ``libngspice.so``) or ``libngspice.so``; a few usual install paths.
+    """
+    override = os.environ.get(LIBRARY_ENV)
+    if override:
+        if not Path(override).is_file():
+            raise LibraryNotFoundError(f"{LIBRARY_ENV}={override!r} does not name an existing file")
+        return override
+    for name in ("libngspice.so.0", "libngspice.so"):
+        found = _ldconfig_lookup(name)
+        if found:
+            return found
+    for candidate in _FALLBACK_PATHS:
+        if Path(candidate).is_file():
+            return candidate
+    raise LibraryNotFoundError(
+        "ngspice shared library not found: install it (Debian/Ubuntu: apt-get install libngspice0) "
+        f"or set {LIBRARY_ENV} to the path of libngspice.so.0"
+    )
+
+
+def _ldconfig_lookup(name: str) -> str | None:
+    exe = shutil.which("ldconfig") or next(
+        (p for p in ("/sbin/ldconfig", "/usr/sbin/ldconfig") if Path(p).is_file()), None
+    )
+    if exe is None:
+        return None
+    try:
+        listing = subprocess.run([exe, "-p"], capture_output=True, text=True, timeout=10).stdout
+    except (OSError, subprocess.SubprocessError):
+        return None
+    for line in listing.splitlines():
+        entry = line.strip()
+        if entry.startswith(name + " ") and "=>" in entry:
+            path = entry.rsplit("=>", 1)[1].strip()
+            if Path(path).is_file():
+                return path
+    return None
+
+
+# Lines ngspice prints on success that PySpice 1.5 mistakes for errors, or that are
+# progress chatter; never part of an error message.
+_CHATTER = re.compile(
+    r"condition met|pause requested|simulation interrupted|^Note:|Trying gmin|Further gmin increment"
+    r"|One successful|Supplies reduced|^Doing analysis|^Reference value|No compatibility mode"
+    r"|can't find the initialization file|^Circuit:|^No\. of Data Rows"
+)
+_ERROR_LINE = re.compile(r"error|abort|fail|too small|trouble with|singular|iteration limit|can't find", re.I)
+
+
+class NgspiceSession(NgSpiceShared):
+    """PySpice's NgSpiceShared with the quirks of PySpice 1.5 + ngspice 39 fixed.
+
+    - stdout/stderr lines are captured per command instead of being logged as errors
+      (PySpice treats "condition met", "Note: ..." and warnings as errors);
+    - the background-thread and status callbacks return an int, as ngspice expects;
+    - the EXTERNAL voltage source gets its value from a Python function of time set
+      with ``set_source``; the GetSyncData callback (installed once: ngspice cannot
+      uninstall it) shortens steps to land exactly on the next macro time, and aborts
+      the run on a callback failure or a wall-clock timeout.
+
+    Use ``get_session()``; do not instantiate directly.
+    """
+
+    def __init__(self, library_path: str):
+        self._lines: list[str] = []
+        self._feed_pyspice = True
+        self._exit_status: tuple[int, bool, bool] | None = None
+        self._source: Callable[[float], float] = _zero
+        self._last_t = math.nan
+        self._last_value = 0.0
+        self._target = math.inf
+        self._deadline = math.inf
+        self._failure: BaseException | None = None
+        self._commands_sent = 0
+        self.source_calls = 0
+        self.owner: weakref.ref | None = None
+        self.lock = threading.Lock()
+        # PySpice formats the path with the instance id; braces in a path must survive.
+        self.LIBRARY_PATH = library_path.replace("{", "{{").replace("}", "}}")
+        pyspice_logger = logging.getLogger("PySpice.Spice.NgSpice.Shared.NgSpiceShared")
+        previous = pyspice_logger.level
+        # PySpice warns "Unsupported Ngspice version" for every version after 34; the
+        # vector-type enumeration it falls back to is the one ngspice 35-42 still use.
+        pyspice_logger.setLevel(logging.ERROR)
+        try:
+            super().__init__(ngspice_id=0, send_data=False, verbose=False)
+        finally:
+            pyspice_logger.setLevel(previous)
+        self._feed_pyspice = False
+        # PySpice's own simulator (circuit.simulator()) asks new_instance() for an
+        # instance; handing it this one avoids a second cffi declaration (an error).
+        NgSpiceShared._instances[0] = self
+        self._vsrc_c = ffi.callback("int(double *, double, char *, int, void *)", self._on_vsrc)
+        self._isrc_c = ffi.callback("int(double *, double, char *, int, void *)", self._on_isrc)
+        self._sync_c = ffi.callback("int(double, double *, double, int, int, int, void *)", self._on_sync)
+        self._ident_c = ffi.new("int *", 0)
+        rc = self._ngspice_shared.ngSpice_Init_Sync(
+            self._vsrc_c, self._isrc_c, self._sync_c, self._ident_c, self._self_c
+        )
+        if rc:
+            raise NgspiceError(f"ngSpice_Init_Sync returned {rc}")
+        self.library = library_path
+
+    # -- PySpice callback overrides (static: PySpice registers them through a handle) --
+
+    @staticmethod
+    def _send_char(message_c, ngspice_id, user_data):
+        self = ffi.from_handle(user_data)
+        message = ffi.string(message_c).decode("utf-8", "replace")
+        prefix, _, content = message.partition(" ")
+        if prefix not in ("stdout", "stderr"):
+            content = message
+        self._lines.append(f"{prefix} {content.rstrip()}" if prefix in ("stdout", "stderr") else content.rstrip())
+        if self._feed_pyspice:
+            # PySpice's version parsing during __init__ reads these two lists.
+            (self._stderr if prefix == "stderr" else self._stdout).append(content)
+        return 0
+
+    @staticmethod
+    def _send_stat(message_c, ngspice_id, user_data):
+        return 0
+
+    @staticmethod
+    def _background_thread_running(is_running, ngspice_id, user_data):
+        return 0
+
+    @staticmethod
+    def _exit(exit_status, immediate_unloading, quit_exit, ngspice_id, user_data):
+        self = ffi.from_handle(user_data)
+        self._exit_status = (int(exit_status), bool(immediate_unloading), bool(quit_exit))
+        return int(exit_status)
+
+    # -- our callbacks --
+
+    def _on_vsrc(self, out, t, name, ident, user):
+        # Called at every Newton iteration and on rejected trial points: the value must
+        # depend on t only. Repeated calls at the same t skip the Python function.
+        if t == self._last_t:
+            out[0] = self._last_value
+            return 0
+        if self._failure is not None:
+            out[0] = self._last_value
+            return 0
+        self.source_calls += 1
+        try:
+            value = float(self._source(t))
+        except BaseException as exc:  # noqa: BLE001 - re-raised after ngspice has stopped
+            self._failure = exc
+            out[0] = self._last_value
+            return 0
+        if not (0.0 <= value < math.inf):
+            self._failure = ConductanceError(
+                f"contact conductance at t = {t!r} s is {value!r} S; it must be finite and >= 0"
+            )
+            out[0] = self._last_value
+            return 0
+        self._last_t = t
+        self._last_value = value
+        out[0] = value
+        return 0
+
+    def _on_isrc(self, out, t, name, ident, user):
+        out[0] = 0.0
+        return 0
+
+    def _on_sync(self, ckttime, pdelta, olddelta, redostep, ident, loc, user):
+        if self._failure is None and time.monotonic() > self._deadline:
+            self._failure = SimulationTimeout("wall-clock limit reached (SimulationOptions.wall_timeout)")
+        if self._failure is not None:
+            # A zero step on a redo makes ngspice abort at once with 'Timestep too
+            # small': the only way to stop a synchronous run from a callback.
+            pdelta[0] = 0.0
+            return 1
+        remaining = self._target - ckttime
+        if remaining > 0.0:
+            delta = pdelta[0]
+            if delta >= remaining:
+                pdelta[0] = remaining
+            elif remaining - delta < 0.25 * delta:
+                # Avoid a sliver step before the target; shortening is always safe,
+                # lengthening could jump over a breakpoint we do not know of.
+                pdelta[0] = 0.5 * remaining
+        return 0
+
+    # -- commands --
+
+    def _check_alive(self) -> None:
+        if self._exit_status is not None:
+            status, immediate, quit_ = self._exit_status
+            raise NgspiceError(
+                f"ngspice has exited (status {status}, unload={immediate}, quit={quit_}); "
+                "it cannot be restarted inside this process"
+            )
+
+    def command(self, text: str) -> list[str]:
+        """Run one ngspice command; returns the lines it printed ("stdout ..."/"stderr ...")."""
+        self._check_alive()
+        if self._commands_sent >= _COMMANDS_BEFORE_HISTORY_RELEASE:
+            self._ngspice_shared.ngSpice_Command(ffi.NULL)
+            self._commands_sent = 0
+        self._commands_sent += 1
+        self._lines = []
+        rc = self._ngspice_shared.ngSpice_Command(text.encode("ascii"))
+        lines = self._lines
+        self._lines = []
+        if rc:
+            raise NgspiceError(f"ngspice rejected the command {text!r} (return code {rc})", "\n".join(lines))
+        return lines
+
+    def clear(self) -> None:
+        """Forget every plot, circuit and stop condition of earlier runs."""
+        for cmd in ("delete all", "destroy all", "remcirc"):
+            self.command(cmd)
+        self._reset_callback_state()
+
+    def _reset_callback_state(self) -> None:
+        self._source = _zero
+        self._last_t = math.nan
+        self._last_value = 0.0
+        self._target = math.inf
+        self._deadline = math.inf
+        self._failure = None
+        self.source_calls = 0
+
+    def load(self, lines: list[str]) -> None:
+        """Load a deck (title line first, ``.end`` last); raises NetlistError with ngspice's message."""
+        self.clear()
+        self._check_alive()
+        keep = [ffi.new("char[]", line.encode("utf-8")) for line in lines] + [ffi.NULL]
+        self._lines = []
+        rc = self._ngspice_shared.ngSpice_Circ(ffi.new("char *[]", keep))
+        printed = self._lines
+        self._lines = []
+        errors = [line for line in printed if re.search(r"error", line, re.I)]
+        if rc or errors:
+            raise NetlistError("ngspice could not parse the netlist", _message(printed))
+
+    def set_source(self, source: Callable[[float], float]) -> None:
+        """The function of time (s) whose value ngspice reads from the EXTERNAL source."""
+        self._source = source
+        self._last_t = math.nan
+
+    def set_breakpoint(self, t: float) -> None:
+        """A transient breakpoint: ngspice lands on t and restarts with a small first-order step."""
+        self._lines = []
+        ok = self._ngspice_shared.ngSpice_SetBkpt(float(t))
+        printed = self._lines
+        self._lines = []
+        if not ok:
+            raise NgspiceError(f"ngspice refused a breakpoint at t = {t!r} s", _message(printed))
+
+    def transient(self, target: float | None, first: bool, wall_timeout: float | None) -> None:
+        """Start (``first``) or resume the loaded transient and pause exactly at ``target``.
+
+        ``target=None`` runs to the end time of the ``.tran`` line (a stop condition at
+        the final time would leave ngspice paused for the next run, so none is set).
+        Raises the ngspice error, or the exception a callback raised, after ngspice has
+        stopped.
+        """
+        self._deadline = math.inf if wall_timeout is None else time.monotonic() + wall_timeout
+        self._target = math.inf if target is None else float(target)
+        try:
+            if target is None:
+                printed = self.command("run" if first else "resume")
+                self._raise_if_failed(printed, target)
+                return
+            if first:
+                # 'stop when time >= x' given before 'run' also becomes a breakpoint at x,
+                # which would cut the step below the target: pause on the first point.
+                self.command("stop when time > 0")
+                printed = self.command("run")
+                self.command("delete all")
+                self._raise_if_failed(printed, target)
+            # ngspice parses the number itself; the margin keeps its rounding harmless.
+            threshold = target - max(1e-12 * abs(target), 1e-300)
+            for _ in range(8):
+                if self.last_time() >= threshold:
+                    return
+                self.command(f"stop when time >= {threshold!r}")
+                printed = self.command("resume")
+                self.command("delete all")
+                self._raise_if_failed(printed, target)
+            raise SimulationAborted(f"ngspice did not reach t = {target!r} s after repeated resumes")
+        finally:
+            self._target = math.inf
+            self._deadline = math.inf
+
+    def _raise_if_failed(self, printed: list[str], target: float | None) -> None:
+        failure, self._failure = self._failure, None
+        aborted = any(re.search(r"aborted|Error:", line) for line in printed)
+        if failure is not None:
+            if isinstance(failure, SimulationTimeout):
+                raise SimulationTimeout(str(failure), _message(printed)) from None
+            raise failure
+        if aborted or self._exit_status is not None:
+            self._check_alive()
+            message = _message(printed)
+            if re.search(r"Transient op failed|gmin stepping failed|source stepping failed|"
+                         r"iteration limit|Transient solution failed", message):
+                raise ConvergenceError("no convergence at the operating point", message)
+            if "Timestep too small" in message:
+                raise TimestepTooSmallError("transient aborted: timestep too small", message)
+            raise SimulationAborted("transient aborted", message)
+
+    # -- results --
+
+    def vector_info(self, name: str):
+        info = self._ngspice_shared.ngGet_Vec_Info(name.encode("ascii"))
+        self._lines = []
+        return None if info == ffi.NULL else info
+
+    def vector(self, name: str, start: int = 0, stop: int | None = None) -> np.ndarray:
+        """Copy of a real vector of the current plot (node name, 'xxx#branch', 'time')."""
+        info = self.vector_info(name)
+        if info is None:
+            raise KeyError(f"ngspice has no vector {name!r} in the current plot")
+        n = info.v_length
+        stop = n if stop is None else min(stop, n)
+        start = max(0, min(start, stop))
+        if info.v_realdata != ffi.NULL:
+            data = np.frombuffer(ffi.buffer(info.v_realdata, n * 8), dtype=np.float64)
+            return data[start:stop].copy()
+        pairs = np.frombuffer(ffi.buffer(info.v_compdata, n * 16), dtype=np.float64)
+        return pairs[2 * start : 2 * stop : 2].copy()
+
+    def length(self) -> int:
+        info = self.vector_info("time")
+        return 0 if info is None else int(info.v_length)
+
+    def last_value(self, name: str) -> float:
+        info = self.vector_info(name)
+        if info is None or info.v_length == 0:
+            raise KeyError(f"ngspice has no data for {name!r}")
+        if info.v_realdata != ffi.NULL:
+            return float(info.v_realdata[info.v_length - 1])
+        return float(info.v_compdata[info.v_length - 1].cx_real)
+
+    def last_time(self) -> float:
+        info = self.vector_info("time")
+        if info is None or info.v_length == 0:
+            return -math.inf
+        return float(info.v_realdata[info.v_length - 1])
+
+    # -- ownership: one user at a time --
+
+    @contextlib.contextmanager
+    def exclusive(self):
+        """Hold the session's thread lock without waiting: a second thread gets an error, never a hang."""
+        if not self.lock.acquire(blocking=False):
+            raise SessionBusyError("ngspice is in use by another thread of this process")
+        try:
+            yield self
+        finally:
+            self.lock.release()
+
+    def claim(self, owner: object) -> None:
+        current = self.owner() if self.owner is not None else None
+        if current is not None and current is not owner:
+            raise SessionBusyError(
+                "this process's ngspice is in use by an open Stepper; close it first "
+                "(one ngspice per process: run parallel simulations in separate processes)"
+            )
+        self.owner = weakref.ref(owner)
+
+    def release(self, owner: object) -> None:
+        if self.owner is not None and self.owner() is owner:
+            self.owner = None
+
+
+def _zero(t: float) -> float:
+    return 0.0
+
+
+def _message(printed: list[str]) -> str:
+    """ngspice's own error lines, in order, without chatter and repeats."""
+    kept: list[str] = []
+    for line in printed:
+        text = line.split(" ", 1)[1] if line.startswith(("stdout ", "stderr ")) else line
+        text = text.strip()
+        if not text or _CHATTER.search(text):
+            continue
+        if line.startswith("stderr ") or _ERROR_LINE.search(text):
+            if not kept or kept[-1] != text:
+                kept.append(text)
+    return "\n".join(kept[-40:])
+
+
+_SESSION: NgspiceSession | None = None
+_SESSION_LOCK = threading.Lock()
+
+
+def get_session() -> NgspiceSession:
+    """The process's ngspice session, created on first use."""
+    global _SESSION
+    with _SESSION_LOCK:
+        if _SESSION is None:
+            if NgSpiceShared._instances:
+                raise SessionBusyError(
+                    "PySpice's own NgSpiceShared already holds ngspice in this process "
+                    "(only one ngspice can exist per process): create switchsim's session first"
+                )
+            _SESSION = NgspiceSession(find_library())
+        return _SESSION

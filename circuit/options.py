@@ -1,0 +1,65 @@
+"""Transient-analysis options shared by the stepping API and the one-shot runs."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from .validation import check_range
+
+_METHODS = ("trap", "gear")
+
+
+@dataclass(frozen=True)
+class SimulationOptions:
+    """ngspice transient settings (SI units). Defaults are ngspice's own.
+
+    max_step: largest internal time step, s (``None``: ngspice's default, t_end / 50).
+        ngspice still shortens steps by its truncation-error control.
+    reltol: relative tolerance (ngspice RELTOL, default 1e-3).
+    abstol: absolute current tolerance, A (ABSTOL, default 1e-12).
+    vntol: absolute voltage tolerance, V (VNTOL, default 1e-6).
+    chgtol: absolute charge tolerance, C (CHGTOL, default 1e-14).
+    method: 'trap' (ngspice's default; keeps physical LC ringing undamped) or 'gear'
+        (damps it, and damps the numerical ringing trap can show after hard switching).
+    temperature: circuit temperature, degC (TEMP, default 27).
+    wall_timeout: wall-clock limit of one run or one macro step, s (``None``: no limit).
+        On expiry the run is aborted and SimulationTimeout raised.
+    """
+
+    max_step: float | None = None
+    reltol: float = 1e-3
+    abstol: float = 1e-12
+    vntol: float = 1e-6
+    chgtol: float = 1e-14
+    method: str = "trap"
+    temperature: float = 27.0
+    wall_timeout: float | None = 600.0
+
+    def __post_init__(self) -> None:
+        name = "SimulationOptions"
+        if self.max_step is not None:
+            check_range(name, "max_step", self.max_step, "s", 0.0, 1.0, low_open=True)
+        check_range(name, "reltol", self.reltol, "", 1e-9, 0.1)
+        check_range(name, "abstol", self.abstol, "A", 1e-18, 1e-3, low_open=False)
+        check_range(name, "vntol", self.vntol, "V", 1e-12, 1e-1)
+        check_range(name, "chgtol", self.chgtol, "C", 1e-20, 1e-6)
+        check_range(name, "temperature", self.temperature, "degC", -273.15, 1000.0)
+        if self.method not in _METHODS:
+            raise ValueError(f"SimulationOptions.method = {self.method!r}: allowed {', '.join(_METHODS)}")
+        if self.wall_timeout is not None:
+            check_range(name, "wall_timeout", self.wall_timeout, "s", 0.0, math.inf, low_open=True, allow_inf=True)
+
+    def deck_lines(self, t_end: float) -> list[str]:
+        """``.options`` and ``.tran`` lines for a transient from 0 to ``t_end`` (s)."""
+        tmax = self.max_step if self.max_step is not None else t_end / 50.0
+        # TSTEP only sets ngspice's first step (min(TSTEP, TSTOP/100) / 10) and the
+        # default TMAX; both are pinned here so that a run is fully specified.
+        tstep = min(tmax, t_end / 100.0)
+        return [
+            # noinit/noacct: no operating-point table and no statistics in the output
+            # stream, which would otherwise cross into Python line by line.
+            f".options reltol={self.reltol!r} abstol={self.abstol!r} vntol={self.vntol!r} "
+            f"chgtol={self.chgtol!r} method={self.method} temp={self.temperature!r} noinit noacct",
+            f".tran {tstep!r} {t_end!r} 0 {tmax!r}",
+        ]

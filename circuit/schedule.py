@@ -1,0 +1,165 @@
+"""Prescribed make/break schedules of the contact: usable as G(t) with breakpoints, or as a PWL source.
+
+A schedule is a list of closed intervals ``(t_make, t_break)``. While closed the contact
+has the closed resistance (constant, or a function of the time since make); at each
+make and each break the conductance ramps linearly over ``edge_time``::
+
+    G(t) = w(t) / R_closed(t - t_make),  w: 0 -> 1 on [t_make, t_make + edge],
+                                          1 -> 0 on [t_break - edge, t_break]
+
+Example, a make at 0.1 ms followed by bounces::
+
+    schedule = ContactSchedule.from_events(
+        make=[0.1e-3, 0.3e-3, 0.55e-3], brk=[0.25e-3, 0.5e-3], closed_resistance=0.01)
+    schedule(0.2e-3)            # 100.0 S
+    schedule.breakpoints()      # every ramp corner, for Stepper.advance / ngspice
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from dataclasses import dataclass
+from typing import Callable, Sequence
+
+import numpy as np
+
+from .validation import check_range
+
+Resistance = Callable[[float], float]
+
+
+@dataclass(frozen=True)
+class ContactSchedule:
+    """Prescribed contact states. SI units.
+
+    intervals: closed intervals ((t_make, t_break), ...), s, increasing and disjoint;
+        t_make <= 0 means closed from the start (no make ramp), t_break = inf never opens.
+    closed_resistance: ohm while closed; a float, or a function of the time since
+        make (s) -> ohm (e.g. a film resistance decaying as the force builds up).
+    edge_time: duration of the linear conductance ramp at each make and break, s
+        (0: ideal jumps; a PWL description needs edge_time > 0).
+    """
+
+    intervals: tuple[tuple[float, float], ...]
+    closed_resistance: float | Resistance = 0.01
+    edge_time: float = 10e-9
+
+    def __post_init__(self) -> None:
+        name = "ContactSchedule"
+        check_range(name, "edge_time", self.edge_time, "s", 0.0, 1e-3)
+        if not callable(self.closed_resistance):
+            check_range(name, "closed_resistance", self.closed_resistance, "ohm", 1e-9, 1e9, low_open=True)
+        try:
+            pairs = tuple((float(a), float(b)) for a, b in self.intervals)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name}.intervals = {self.intervals!r}: must be pairs (t_make, t_break) in s") from None
+        object.__setattr__(self, "intervals", pairs)
+        previous_break = -math.inf
+        for i, (make, brk) in enumerate(pairs):
+            if math.isnan(make) or math.isnan(brk) or math.isinf(make):
+                raise ValueError(f"{name}.intervals[{i}] = {(make, brk)!r}: t_make must be finite, t_break a number or inf")
+            if make < previous_break or (i > 0 and make <= 0):
+                raise ValueError(
+                    f"{name}.intervals[{i}] = {(make, brk)!r}: intervals must increase and not overlap "
+                    f"(previous break at {previous_break!r} s)"
+                )
+            ramps = (0.0 if make <= 0 else self.edge_time) + (0.0 if math.isinf(brk) else self.edge_time)
+            if brk - make < ramps or brk <= max(make, 0.0):
+                raise ValueError(
+                    f"{name}.intervals[{i}] = {(make, brk)!r}: a closed interval must last at least "
+                    f"its ramps ({ramps!r} s) and end after it starts"
+                )
+            previous_break = brk
+
+    @classmethod
+    def from_events(
+        cls,
+        make: Sequence[float],
+        brk: Sequence[float],
+        closed_resistance: float | Resistance = 0.01,
+        edge_time: float = 10e-9,
+    ) -> "ContactSchedule":
+        """From make instants and break instants (s); one more make than breaks leaves it closed."""
+        make, brk = list(make), list(brk)
+        if len(brk) not in (len(make), len(make) - 1):
+            raise ValueError(
+                f"ContactSchedule.from_events: {len(make)} makes need {len(make)} or {len(make) - 1} breaks, got {len(brk)}"
+            )
+        ends = brk + [math.inf] * (len(make) - len(brk))
+        return cls(tuple(zip(make, ends)), closed_resistance, edge_time)
+
+    # -- as a function of time --
+
+    def _closed_conductance(self, since_make: float) -> float:
+        if callable(self.closed_resistance):
+            r = float(self.closed_resistance(since_make))
+            if not (r > 0.0 and math.isfinite(r)):
+                raise ValueError(f"closed_resistance({since_make!r} s) = {r!r} ohm: must be finite and > 0")
+            return 1.0 / r
+        return 1.0 / self.closed_resistance
+
+    def conductance(self, t: float) -> float:
+        """G(t), S. Right-continuous at ideal jumps (edge_time = 0)."""
+        i = bisect.bisect_right(self._makes, t) - 1
+        if i < 0:
+            return 0.0
+        make, brk = self.intervals[i]
+        if t >= brk:
+            return 0.0
+        e = self.edge_time
+        weight = 1.0
+        if make > 0 and e > 0 and t < make + e:
+            weight = (t - make) / e
+        if not math.isinf(brk) and e > 0 and t > brk - e:
+            weight = min(weight, (brk - t) / e)
+        return weight * self._closed_conductance(t - make)
+
+    __call__ = conductance
+
+    @property
+    def _makes(self) -> list[float]:
+        cached = self.__dict__.get("_makes_cache")
+        if cached is None:
+            cached = [m for m, _ in self.intervals]
+            object.__setattr__(self, "_makes_cache", cached)
+        return cached
+
+    def breakpoints(self, t_start: float = 0.0, t_end: float = math.inf) -> tuple[float, ...]:
+        """Every ramp corner in (t_start, t_end], s: where G(t) has a kink or a jump."""
+        points: set[float] = set()
+        e = self.edge_time
+        for make, brk in self.intervals:
+            if make > 0:
+                points.update((make, make + e))
+            if not math.isinf(brk):
+                points.update((brk - e, brk))
+        return tuple(sorted(p for p in points if t_start < p <= t_end))
+
+    def is_closed(self, t: float) -> bool:
+        return self.conductance(t) > 0.0
+
+    # -- as a PWL --
+
+    def pwl_points(self, t_end: float, resistance_step: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Times (s) and conductances (S) of a PWL description on [0, t_end].
+
+        Exact for a constant closed resistance. A resistance function is sampled every
+        ``resistance_step`` s while closed (required then), linear in G in between.
+        """
+        if self.edge_time <= 0:
+            raise ValueError("ContactSchedule.edge_time = 0: a PWL description needs edge_time > 0 (ramps)")
+        if callable(self.closed_resistance):
+            if resistance_step is None or not resistance_step > 0:
+                raise ValueError("pwl_points: a closed_resistance function needs resistance_step > 0 (s)")
+        times = {0.0, float(t_end)}
+        times.update(self.breakpoints(0.0, t_end))
+        if callable(self.closed_resistance):
+            for make, brk in self.intervals:
+                lo, hi = max(make, 0.0), min(brk, t_end)
+                if hi > lo:
+                    times.update(np.arange(lo, hi, resistance_step).tolist())
+        grid = np.array(sorted(t for t in times if 0.0 <= t <= t_end))
+        # With ramps, G is continuous, so its value at each corner is the PWL vertex.
+        values = np.array([self.conductance(t) for t in grid])
+        return grid, values

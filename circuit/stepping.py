@@ -1,0 +1,283 @@
+"""Co-simulation stepping: advance one ngspice transient macro step by macro step.
+
+For each macro step [t_n, t_next] the caller supplies the contact conductance as a
+Python function of time, G(t) >= 0 in S, and the make/break instants inside the step.
+ngspice integrates to exactly t_next (its steps are shortened to land there, without the
+order reset a breakpoint causes) and pauses; the contact and load quantities are read
+back. One run is one ngspice transient, so results do not depend on the macro step
+except through G and the breakpoints. Repeated runs are bit-identical.
+
+Example::
+
+    circuit = SwitchCircuit(DCSource(24.0), InductiveLoad(24.0, 10e-3), arc=ArcModel())
+    with Stepper(circuit, t_end=2e-3, options=SimulationOptions(max_step=1e-6)) as stepper:
+        t = 0.0
+        while t < 2e-3:
+            t_next = min(t + 2e-6, 2e-3)
+            step = stepper.advance(t_next, conductance=lambda s: schedule(s),
+                                   breakpoints=schedule.breakpoints(t, t_next))
+            current = step.contact_current          # A, at t_next
+            t = t_next
+        waveform = stepper.results()                # pandas DataFrame, whole run
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import time as _time
+from dataclasses import dataclass, field
+from typing import Callable, Iterable
+
+import numpy as np
+import pandas as pd
+
+from .contact import Conductance, checked_breakpoints, left_limited
+from .deck import CircuitLike, build_deck
+from .errors import SessionBusyError
+from .ngspice import NgspiceSession, get_session
+from .options import SimulationOptions
+from .probes import COLUMNS, Probes
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """One macro step. Scalars are the values at ``t_end`` (SI: V, A).
+
+    ``arrays()`` / ``frame()`` give every accepted ngspice point of the closed interval
+    [t_start, t_end] (the first point is the previous step's last).
+    """
+
+    t_start: float
+    t_end: float
+    contact_voltage: float
+    contact_current: float
+    load_current: float
+    arc_current: float
+    points: int  # accepted ngspice points in (t_start, t_end]
+    _read: Callable[[str], np.ndarray] = field(repr=False, compare=False)
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        return {name: self._read(name) for name in COLUMNS}
+
+    def frame(self) -> pd.DataFrame:
+        return pd.DataFrame(self.arrays())
+
+
+class Stepper:
+    """Step a switch circuit through a transient of length ``t_end`` (s).
+
+    circuit: a ``SwitchCircuit``, a ``NetlistCircuit`` or a PySpice ``Circuit`` with a
+        contact (``add_contact``).
+    options: ``SimulationOptions`` (max internal step, tolerances, wall-clock limit).
+
+    Holds this process's ngspice until ``close()`` (or the end of a ``with`` block);
+    another Stepper or run meanwhile raises SessionBusyError.
+    """
+
+    def __init__(self, circuit: CircuitLike, t_end: float, options: SimulationOptions | None = None):
+        self.options = options if options is not None else SimulationOptions()
+        if not isinstance(self.options, SimulationOptions):
+            raise TypeError(f"options must be a SimulationOptions, got {type(self.options).__name__}")
+        lines, self.probes = build_deck(circuit, t_end, self.options, "external")
+        self.t_end = float(t_end)
+        self.deck = tuple(lines)
+        self._session: NgspiceSession | None = None
+        self._t = 0.0
+        self._started = False
+        self._finished = False
+        self._failure: BaseException | None = None
+        self._final: pd.DataFrame | None = None
+        self._steps = 0
+        self._ngspice_seconds = 0.0
+        session = get_session()
+        with session.exclusive():
+            session.claim(self)
+            try:
+                session.load(list(lines))
+            except BaseException:
+                session.release(self)
+                raise
+        self._session = session
+
+    # -- stepping --
+
+    def advance(
+        self, t_next: float, conductance: Conductance | float, breakpoints: Iterable[float] = ()
+    ) -> StepResult:
+        """Integrate from the current time to ``t_next`` (s).
+
+        conductance: G(t) in S for t in [t_current, t_next], a function of time only
+            (ngspice calls it at Newton iterations and rejected trial points too), exactly
+            0 for an open contact; or a constant.
+        breakpoints: make/break instants (s) in (t_current, t_next]; ngspice lands on
+            each, and uses the left limit of G there (the pre-event state).
+        """
+        session = self._active()
+        t0 = self._t
+        t_next = float(t_next)
+        if self._finished:
+            raise ValueError(f"the run is finished (t_end = {self.t_end!r} s)")
+        tol = 1e-12 * self.t_end
+        if not (t_next > t0 and t_next <= self.t_end + tol):
+            raise ValueError(
+                f"t_next = {t_next!r} s: must satisfy {t0!r} < t_next <= t_end = {self.t_end!r} s"
+            )
+        final = t_next >= self.t_end - tol
+        if final:
+            t_next = self.t_end
+        source = _as_function(conductance)
+        points = checked_breakpoints(breakpoints, t0, t_next)
+        with session.exclusive():
+            session.set_source(left_limited(source, points, t_next - t0))
+            for b in points:
+                session.set_breakpoint(b)
+            first_index = max(session.length() - 1, 0)
+            clock = _time.perf_counter()
+            try:
+                session.transient(None if final else t_next, not self._started, self.options.wall_timeout)
+            except BaseException as exc:
+                self._failure = exc
+                raise
+            finally:
+                self._started = True
+                self._ngspice_seconds += _time.perf_counter() - clock
+            last_index = session.length()
+            landed = session.last_time()
+            scalars = self._scalars(session)
+        self._t = t_next
+        self._finished = final
+        self._steps += 1
+        return StepResult(
+            t_start=t0,
+            t_end=landed,
+            points=last_index - first_index - 1,
+            _read=self._reader(first_index, last_index),
+            **scalars,
+        )
+
+    def _scalars(self, session: NgspiceSession) -> dict[str, float]:
+        p = self.probes
+
+        def node(name: str) -> float:
+            return 0.0 if name.lower() in ("0", "gnd") else session.last_value(name.lower())
+
+        return {
+            "contact_voltage": node(p.node_a) - node(p.node_b),
+            "contact_current": session.last_value(p.contact_current.lower()),
+            "load_current": session.last_value(p.load_current.lower()) if p.load_current else math.nan,
+            "arc_current": session.last_value(p.arc_current.lower()) if p.arc_current else 0.0,
+        }
+
+    def _reader(self, start: int, stop: int) -> Callable[[str], np.ndarray]:
+        def read(column: str) -> np.ndarray:
+            if self._final is not None:
+                return self._final[column].to_numpy()[start:stop].copy()
+            session = self._active()
+            return self.probes.columns(lambda name: session.vector(name, start, stop), (column,))[column]
+
+        return read
+
+    # -- state --
+
+    @property
+    def time(self) -> float:
+        """Time reached, s."""
+        return self._t
+
+    @property
+    def finished(self) -> bool:
+        return self._finished
+
+    @property
+    def contact_current(self) -> float:
+        """Latest contact current, A (metallic conduction, positive from node a to node b)."""
+        return self._latest("contact_current")
+
+    @property
+    def contact_voltage(self) -> float:
+        """Latest contact voltage V(a) - V(b), V."""
+        return self._latest("contact_voltage")
+
+    @property
+    def load_current(self) -> float:
+        return self._latest("load_current")
+
+    @property
+    def arc_current(self) -> float:
+        return self._latest("arc_current")
+
+    def _latest(self, column: str) -> float:
+        if self._final is not None:
+            return float(self._final[column].iloc[-1]) if len(self._final) else math.nan
+        if not self._started:
+            return math.nan
+        return self._scalars(self._active())[column]
+
+    @property
+    def stats(self) -> dict[str, float]:
+        """Macro steps, accepted ngspice points, conductance evaluations, seconds inside ngspice."""
+        points = len(self._final) if self._final is not None else (self._active().length() if self._started else 0)
+        calls = self._session.source_calls if self._session is not None else 0
+        return {"steps": self._steps, "points": points, "conductance_calls": calls, "ngspice_seconds": self._ngspice_seconds}
+
+    def results(self, extra: tuple[str, ...] = ()) -> pd.DataFrame:
+        """The whole run so far: columns ``COLUMNS`` (SI) plus raw ngspice vectors named in ``extra``."""
+        if self._final is not None and not extra:
+            return self._final.copy()
+        session = self._active()
+        if not self._started:
+            return pd.DataFrame({name: np.empty(0) for name in COLUMNS + tuple(extra)})
+        return self.probes.frame(session.vector, tuple(extra))
+
+    def vector(self, name: str) -> np.ndarray:
+        """Any raw ngspice vector of the run (node name, 'element#branch'), while open."""
+        return self._active().vector(name.lower())
+
+    # -- lifetime --
+
+    def _active(self) -> NgspiceSession:
+        session = self._session
+        if session is None:
+            raise RuntimeError("this Stepper is closed")
+        owner = session.owner() if session.owner is not None else None
+        if owner is not self:
+            raise SessionBusyError("this Stepper's ngspice was taken over by another run")
+        return session
+
+    def close(self) -> None:
+        """Keep the results, then free ngspice for the next run."""
+        session = self._session
+        if session is None:
+            return
+        try:
+            owner = session.owner() if session.owner is not None else None
+            if owner is self:
+                if self._started and self._final is None:
+                    try:
+                        self._final = self.probes.frame(session.vector)
+                    except KeyError:
+                        self._final = None
+                with session.exclusive():
+                    session.clear()
+        finally:
+            session.release(self)
+            self._session = None
+
+    def __enter__(self) -> "Stepper":
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self.close()
+
+
+def _as_function(conductance: Conductance | float) -> Conductance:
+    if callable(conductance):
+        return conductance
+    if isinstance(conductance, numbers.Real) and not isinstance(conductance, bool):
+        value = float(conductance)
+        if not (0.0 <= value < math.inf):
+            raise ValueError(f"conductance = {conductance!r} S: must be finite and >= 0")
+        return lambda t: value
+    raise TypeError(f"conductance must be a function of time or a number (S), got {type(conductance).__name__}")
+

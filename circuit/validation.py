@@ -1,0 +1,36 @@
+"""Range checks for parameter dataclasses: errors name the class, the field, the value and the allowed range."""
+
+from __future__ import annotations
+
+import math
+import numbers
+
+
+def check_range(
+    owner: str,
+    field: str,
+    value: object,
+    unit: str,
+    low: float,
+    high: float,
+    *,
+    low_open: bool = False,
+    allow_inf: bool = False,
+) -> float:
+    """Return ``value`` as float if ``low <= value <= high`` (``low < value`` when ``low_open``).
+
+    Ranges are wide on purpose: they catch unit slips (100 instead of 100e-12 F) and
+    non-physical signs, not unusual designs.
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ValueError(f"{owner}.{field} = {value!r}: must be a real number in {unit}")
+    number = float(value)
+    if math.isnan(number) or (math.isinf(number) and not allow_inf):
+        raise ValueError(f"{owner}.{field} = {value!r} {unit}: must be finite")
+    too_low = number <= low if low_open else number < low
+    if too_low or number > high:
+        lower = f"{low:g} < value" if low_open else f"{low:g} <= value"
+        raise ValueError(
+            f"{owner}.{field} = {number:g} {unit} is out of range: allowed {lower} <= {high:g} {unit}"
+        )
+    return number
