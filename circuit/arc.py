@@ -28,8 +28,9 @@ a dead-zone conductor. The switch is the arc's on/off state; its control voltage
 so it stays on while either the arc current exceeds I_min, or the contact is (or has
 just been) closed, or the gap voltage exceeds V_bd. ngspice's SW model limits the time
 step as its control approaches the threshold, which locates extinction and breakdown
-in time independently of the maximum step (K_I = 100 / I_min V/A: the 0.05 V resolution
-of that step control is 0.05 % of I_min). "armed" is the closed indicator (G > 0)
+in time independently of the maximum step (K_I = 1000 / I_min V/A: the 0.05 V resolution
+of that step control is 0.005 % of I_min; with 100 / I_min the extinction current
+still varied by 0.08 % with the maximum step). "armed" is the closed indicator (G > 0)
 low-pass filtered so that it stays above 1/2 for ``formation_time`` after parting.
 """
 
@@ -46,7 +47,7 @@ from .validation import check_range
 SENSE_SOURCE = "Varc"
 SWITCH_MODEL = "switchsim_arc"
 _ARM_CAPACITANCE = 1e-9  # F; the arming RC filter's capacitor, its resistor sets the time
-_SWITCH_HYSTERESIS = 0.01  # V of control voltage, i.e. 1e-4 * I_min of arc current
+_SWITCH_HYSTERESIS = 0.01  # V of control voltage, i.e. 1e-5 * I_min of arc current
 _CLOSED_GAIN = 10.0  # V per unit of the armed indicator
 
 
@@ -106,7 +107,7 @@ def add_arc(circuit: Circuit, arc: ArcModel, node_a: str, node_b: str) -> None:
     # The filtered indicator falls from 1 to 1/2 in R C ln 2 = formation_time.
     circuit.R("arc_arm", "arc_cl0", "arc_cl", arc.formation_time / (math.log(2.0) * _ARM_CAPACITANCE))
     circuit.C("arc_arm", "arc_cl", circuit.gnd, _ARM_CAPACITANCE)
-    k_i = 100.0 / arc.min_current
+    k_i = 1000.0 / arc.min_current
     control = (
         f"max({k_i!r}*(abs(i({SENSE_SOURCE}))-{float(arc.min_current)!r}),"
         f"{_CLOSED_GAIN!r}*(V(arc_cl)-0.5))"

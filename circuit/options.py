@@ -12,27 +12,33 @@ _METHODS = ("trap", "gear")
 
 @dataclass(frozen=True)
 class SimulationOptions:
-    """ngspice transient settings (SI units). Defaults are ngspice's own.
+    """ngspice transient settings (SI units). Defaults are ngspice's own, except ``method`` and ``reltol``.
 
     max_step: largest internal time step, s (``None``: ngspice's default, t_end / 50).
         ngspice still shortens steps by its truncation-error control.
-    reltol: relative tolerance (ngspice RELTOL, default 1e-3).
+    reltol: relative tolerance (ngspice RELTOL; default here 1e-4, ngspice's is 1e-3:
+        with gear at 1e-3 the ringing after an arc extinction came out 2.6 % low and
+        dependent on max_step, at 1e-4 within 0.3 % for max_step 0.1-10 us).
     abstol: absolute current tolerance, A (ABSTOL, default 1e-12).
     vntol: absolute voltage tolerance, V (VNTOL, default 1e-6).
     chgtol: absolute charge tolerance, C (CHGTOL, default 1e-14).
-    method: 'trap' (ngspice's default; keeps physical LC ringing undamped) or 'gear'
-        (damps it, and damps the numerical ringing trap can show after hard switching).
+    method: 'gear' (default here: second-order BDF) or 'trap' (ngspice's default).
+        After the hard switching of a contact or an arc, trap leaves a point-to-point
+        oscillation in capacitor currents that does not decay (measured: +-1.8 % on the
+        arc current of a burning DC arc, up to amperes on the closed-contact current of
+        an inductive load); gear damps it, at the price of some damping of resolved LC
+        ringing (hence the tighter reltol).
     temperature: circuit temperature, degC (TEMP, default 27).
     wall_timeout: wall-clock limit of one run or one macro step, s (``None``: no limit).
         On expiry the run is aborted and SimulationTimeout raised.
     """
 
     max_step: float | None = None
-    reltol: float = 1e-3
+    reltol: float = 1e-4
     abstol: float = 1e-12
     vntol: float = 1e-6
     chgtol: float = 1e-14
-    method: str = "trap"
+    method: str = "gear"
     temperature: float = 27.0
     wall_timeout: float | None = 600.0
 

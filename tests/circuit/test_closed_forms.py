@@ -39,14 +39,14 @@ def rc_exact(t: np.ndarray) -> np.ndarray:
     return np.where(t > T_BREAK, v_break * np.exp(-(t - T_BREAK) / (R_BLEED * C_LOAD)), charging)
 
 
-def run_rc(max_step: float):
+def run_rc(max_step: float, method: str = "gear"):
     schedule = ContactSchedule(((T_MAKE, T_BREAK),), closed_resistance=R_CONTACT, edge_time=0.0)
-    options = SimulationOptions(max_step=max_step, reltol=1e-4)
+    options = SimulationOptions(max_step=max_step, reltol=1e-4, method=method)
     return run_transient(rc_circuit(), schedule, T_END, options=options, extra=("load_c",))
 
 
 def test_rc_charge_on_make_and_discharge_on_break():
-    df = run_rc(max_step=1e-7)  # tau / 20
+    df = run_rc(max_step=5e-8)  # tau / 40
     t = df.time.to_numpy()
     v = df.load_c.to_numpy()
     assert np.max(np.abs(v - rc_exact(t))) < 2e-4 * E
@@ -61,11 +61,12 @@ def test_rc_charge_on_make_and_discharge_on_break():
     assert np.allclose(df.contact_resistance.to_numpy()[closed], R_CONTACT)
 
 
-def test_rc_error_converges_at_second_order():
-    """Trapezoidal integration: halving the maximum step divides the error by about 4."""
+@pytest.mark.parametrize("method", ["gear", "trap"])
+def test_rc_error_converges_at_second_order(method):
+    """Gear-2 and trapezoidal integration: halving the maximum step divides the error by about 4."""
     errors = []
-    for max_step in (4e-7, 2e-7, 1e-7):
-        df = run_rc(max_step)
+    for max_step in (2e-7, 1e-7, 5e-8):
+        df = run_rc(max_step, method)
         t = df.time.to_numpy()
         errors.append(np.max(np.abs(df.load_c.to_numpy() - rc_exact(t))))
     orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
@@ -75,7 +76,7 @@ def test_rc_error_converges_at_second_order():
 def test_left_limit_at_breakpoints_matters():
     """The same jump without a declared breakpoint time is applied over a whole ngspice step."""
     schedule = ContactSchedule(((T_MAKE, T_BREAK),), closed_resistance=R_CONTACT, edge_time=0.0)
-    options = SimulationOptions(max_step=1e-7, reltol=1e-4)
+    options = SimulationOptions(max_step=5e-8, reltol=1e-4)
     with_breakpoints = run_transient(rc_circuit(), schedule, T_END, options=options, extra=("load_c",))
     t = with_breakpoints.time.to_numpy()
     assert np.max(np.abs(with_breakpoints.load_c.to_numpy() - rc_exact(t))) < 2e-4 * E
@@ -106,7 +107,7 @@ Lcoil c1 0 {L_COIL}
 def test_rl_current_rise_on_make_and_decay_on_break():
     t_make, t_break, t_end = 0.1e-3, 2.1e-3, 2.6e-3
     schedule = ContactSchedule(((t_make, t_break),), closed_resistance=R_CONTACT, edge_time=0.0)
-    options = SimulationOptions(max_step=5e-6, reltol=1e-4)
+    options = SimulationOptions(max_step=1e-6)  # tau_open / 38
     df = run_transient(rl_netlist(), schedule, t_end, options=options)
     t = df.time.to_numpy()
     i = df.load_current.to_numpy()
