@@ -114,6 +114,10 @@ class Stepper:
             each, and uses the left limit of G there (the pre-event state).
         """
         session = self._active()
+        if self._failure is not None:
+            raise RuntimeError(
+                f"this Stepper failed at t = {self._t!r} s ({type(self._failure).__name__}); start a new one"
+            ) from self._failure
         t0 = self._t
         t_next = float(t_next)
         if self._finished:
