@@ -22,6 +22,7 @@ first-order step. At a breakpoint the conductance used is the left limit ``G(t_b
 from __future__ import annotations
 
 import math
+from bisect import bisect_right
 from typing import Callable, Iterable, Sequence
 
 from PySpice.Spice.Netlist import Circuit
@@ -62,15 +63,18 @@ def left_limited(conductance: Conductance, breakpoints: Sequence[float], span: f
     breakpoint count as the breakpoint (ngspice lands on it up to rounding); the left
     limit is taken ``1e-9 * span`` before it (``span``: the macro step length, s).
     """
-    points = tuple(sorted(float(b) for b in breakpoints))
+    points = sorted(float(b) for b in breakpoints)
     if not points:
         return conductance
-    windows = tuple((b, 64.0 * math.ulp(b) + 1e-300, b - max(1e-9 * span, 64.0 * math.ulp(b))) for b in points)
+    # Nearest breakpoint by bisection: one comparison per call whatever their number.
+    lows = [b - (64.0 * math.ulp(b) + 1e-300) for b in points]
+    highs = [b + (64.0 * math.ulp(b) + 1e-300) for b in points]
+    befores = [b - max(1e-9 * span, 64.0 * math.ulp(b)) for b in points]
 
     def source(t: float) -> float:
-        for b, tol, before in windows:
-            if abs(t - b) <= tol:
-                return conductance(before)
+        i = bisect_right(lows, t) - 1
+        if i >= 0 and t <= highs[i]:
+            return conductance(befores[i])
         return conductance(t)
 
     return source

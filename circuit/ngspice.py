@@ -135,6 +135,7 @@ class NgspiceSession(NgSpiceShared):
         self._deadline = math.inf
         self._failure: BaseException | None = None
         self._commands_sent = 0
+        self._encoded: dict[str, bytes] = {}
         self.source_calls = 0
         self.owner: weakref.ref | None = None
         self.lock = threading.Lock()
@@ -169,13 +170,12 @@ class NgspiceSession(NgSpiceShared):
     @staticmethod
     def _send_char(message_c, ngspice_id, user_data):
         self = ffi.from_handle(user_data)
-        message = ffi.string(message_c).decode("utf-8", "replace")
-        prefix, _, content = message.partition(" ")
-        if prefix not in ("stdout", "stderr"):
-            content = message
-        self._lines.append(f"{prefix} {content.rstrip()}" if prefix in ("stdout", "stderr") else content.rstrip())
+        # Lines arrive as "stdout ..." / "stderr ..."; kept whole, parsed only on failure.
+        message = ffi.string(message_c).decode("utf-8", "replace").rstrip()
+        self._lines.append(message)
         if self._feed_pyspice:
             # PySpice's version parsing during __init__ reads these two lists.
+            prefix, _, content = message.partition(" ")
             (self._stderr if prefix == "stderr" else self._stdout).append(content)
         return 0
 
@@ -237,11 +237,13 @@ class NgspiceSession(NgSpiceShared):
         remaining = self._target - ckttime
         if remaining > 0.0:
             delta = pdelta[0]
-            if delta >= remaining:
+            if delta >= remaining * (1.0 - 1e-9):  # equal up to rounding: land, no extra point
                 pdelta[0] = remaining
-            elif remaining - delta < 0.25 * delta:
-                # Avoid a sliver step before the target; shortening is always safe,
-                # lengthening could jump over a breakpoint we do not know of.
+            elif remaining < 2.0 * delta:
+                # Two equal steps instead of a full one and a sliver: ngspice grows its
+                # step by at most 2x per point, so a sliver before the target would cost
+                # several points after it. Shortening is always safe; lengthening could
+                # jump over a breakpoint we do not know of.
                 pdelta[0] = 0.5 * remaining
         return 0
 
@@ -330,19 +332,20 @@ class NgspiceSession(NgSpiceShared):
             if first:
                 # 'stop when time >= x' given before 'run' also becomes a breakpoint at x,
                 # which would cut the step below the target: pause on the first point.
-                self.command("stop when time > 0")
-                printed = self.command("run")
-                self.command("delete all")
+                printed = self.command("stop when time > 0; run; delete all")
                 self._raise_if_failed(printed, target)
             # ngspice parses the number itself; the margin keeps its rounding harmless.
             threshold = target - max(1e-12 * abs(target), 1e-300)
+            if first and self.last_time() >= threshold:
+                return
             for _ in range(8):
+                # One command line per pause (ngspice runs ';'-separated commands in turn).
+                printed = self.command(f"stop when time >= {threshold!r}; resume; delete all")
+                self._raise_if_failed(printed, target)
+                # A point can fall inside the margin just before the target (a breakpoint
+                # there): then resume again, the step clipping lands on the target.
                 if self.last_time() >= threshold:
                     return
-                self.command(f"stop when time >= {threshold!r}")
-                printed = self.command("resume")
-                self.command("delete all")
-                self._raise_if_failed(printed, target)
             raise SimulationAborted(f"ngspice did not reach t = {target!r} s after repeated resumes")
         finally:
             self._target = math.inf
@@ -350,7 +353,7 @@ class NgspiceSession(NgSpiceShared):
 
     def _raise_if_failed(self, printed: list[str], target: float | None) -> None:
         failure, self._failure = self._failure, None
-        aborted = any(re.search(r"aborted|Error:", line) for line in printed)
+        aborted = any("aborted" in line or "Error:" in line for line in printed)
         if failure is not None:
             if isinstance(failure, SimulationTimeout):
                 raise SimulationTimeout(str(failure), _message(printed)) from None
@@ -368,9 +371,24 @@ class NgspiceSession(NgSpiceShared):
     # -- results --
 
     def vector_info(self, name: str):
-        info = self._ngspice_shared.ngGet_Vec_Info(name.encode("ascii"))
-        self._lines = []
+        encoded = self._encoded.get(name)
+        if encoded is None:
+            encoded = self._encoded[name] = name.encode("ascii")
+        info = self._ngspice_shared.ngGet_Vec_Info(encoded)
         return None if info == ffi.NULL else info
+
+    def last_values(self, names: tuple[str, ...]) -> tuple[int, list[float]]:
+        """Number of points and the last value of each named vector (one look-up each)."""
+        values = []
+        length = 0
+        for name in names:
+            info = self.vector_info(name)
+            if info is None or info.v_length == 0:
+                raise KeyError(f"ngspice has no data for {name!r}")
+            length = info.v_length
+            data = info.v_realdata
+            values.append(float(data[length - 1]) if data != ffi.NULL else float(info.v_compdata[length - 1].cx_real))
+        return int(length), values
 
     def vector(self, name: str, start: int = 0, stop: int | None = None) -> np.ndarray:
         """Copy of a real vector of the current plot (node name, 'xxx#branch', 'time')."""

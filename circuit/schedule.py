@@ -71,6 +71,15 @@ class ContactSchedule:
                     f"its ramps ({ramps!r} s) and end after it starts"
                 )
             previous_break = brk
+        # Lookup tables for the hot paths (G(t) runs inside ngspice's Newton loop).
+        object.__setattr__(self, "_makes", [m for m, _ in pairs])
+        corners: set[float] = set()
+        for make, brk in pairs:
+            if make > 0:
+                corners.update((make, make + self.edge_time))
+            if not math.isinf(brk):
+                corners.update((brk - self.edge_time, brk))
+        object.__setattr__(self, "_corners", sorted(corners))
 
     @classmethod
     def from_events(
@@ -117,24 +126,10 @@ class ContactSchedule:
 
     __call__ = conductance
 
-    @property
-    def _makes(self) -> list[float]:
-        cached = self.__dict__.get("_makes_cache")
-        if cached is None:
-            cached = [m for m, _ in self.intervals]
-            object.__setattr__(self, "_makes_cache", cached)
-        return cached
-
     def breakpoints(self, t_start: float = 0.0, t_end: float = math.inf) -> tuple[float, ...]:
         """Every ramp corner in (t_start, t_end], s: where G(t) has a kink or a jump."""
-        points: set[float] = set()
-        e = self.edge_time
-        for make, brk in self.intervals:
-            if make > 0:
-                points.update((make, make + e))
-            if not math.isinf(brk):
-                points.update((brk - e, brk))
-        return tuple(sorted(p for p in points if t_start < p <= t_end))
+        corners = self._corners
+        return tuple(corners[bisect.bisect_right(corners, t_start) : bisect.bisect_right(corners, t_end)])
 
     def is_closed(self, t: float) -> bool:
         return self.conductance(t) > 0.0

@@ -26,8 +26,7 @@ from __future__ import annotations
 import math
 import numbers
 import time as _time
-from dataclasses import dataclass, field
-from typing import Callable, Iterable
+from typing import Callable, Iterable, NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -40,12 +39,12 @@ from .options import SimulationOptions
 from .probes import COLUMNS, Probes
 
 
-@dataclass(frozen=True)
-class StepResult:
-    """One macro step. Scalars are the values at ``t_end`` (SI: V, A).
+class StepResult(NamedTuple):
+    """One macro step. Scalars are the values at ``t_end`` (SI: s, V, A).
 
     ``arrays()`` / ``frame()`` give every accepted ngspice point of the closed interval
-    [t_start, t_end] (the first point is the previous step's last).
+    [t_start, t_end] (the first point is the previous step's last). Immutable; a
+    NamedTuple because one is made per macro step, thousands per run.
     """
 
     t_start: float
@@ -55,10 +54,10 @@ class StepResult:
     load_current: float
     arc_current: float
     points: int  # accepted ngspice points in (t_start, t_end]
-    _read: Callable[[str], np.ndarray] = field(repr=False, compare=False)
+    reader: Callable[[str], np.ndarray]
 
     def arrays(self) -> dict[str, np.ndarray]:
-        return {name: self._read(name) for name in COLUMNS}
+        return {name: self.reader(name) for name in COLUMNS}
 
     def frame(self) -> pd.DataFrame:
         return pd.DataFrame(self.arrays())
@@ -89,7 +88,11 @@ class Stepper:
         self._failure: BaseException | None = None
         self._final: pd.DataFrame | None = None
         self._steps = 0
+        self._length = 0
         self._ngspice_seconds = 0.0
+        p = self.probes
+        names = ["time", p.contact_current, p.node_a, p.node_b, p.load_current, p.arc_current]
+        self._last_names = tuple(dict.fromkeys(n.lower() for n in names if n and n.lower() not in ("0", "gnd")))
         session = get_session()
         with session.exclusive():
             session.claim(self)
@@ -132,11 +135,13 @@ class Stepper:
             t_next = self.t_end
         source = _as_function(conductance)
         points = checked_breakpoints(breakpoints, t0, t_next)
-        with session.exclusive():
+        if not session.lock.acquire(blocking=False):
+            raise SessionBusyError("ngspice is in use by another thread of this process")
+        try:
             session.set_source(left_limited(source, points, t_next - t0))
             for b in points:
                 session.set_breakpoint(b)
-            first_index = max(session.length() - 1, 0)
+            first_index = max(self._length - 1, 0)
             clock = _time.perf_counter()
             try:
                 session.transient(None if final else t_next, not self._started, self.options.wall_timeout)
@@ -146,9 +151,10 @@ class Stepper:
             finally:
                 self._started = True
                 self._ngspice_seconds += _time.perf_counter() - clock
-            last_index = session.length()
-            landed = session.last_time()
-            scalars = self._scalars(session)
+            last_index, landed, scalars = self._read_last(session)
+            self._length = last_index
+        finally:
+            session.lock.release()
         self._t = t_next
         self._finished = final
         self._steps += 1
@@ -156,22 +162,26 @@ class Stepper:
             t_start=t0,
             t_end=landed,
             points=last_index - first_index - 1,
-            _read=self._reader(first_index, last_index),
+            reader=self._reader(first_index, last_index),
             **scalars,
         )
 
-    def _scalars(self, session: NgspiceSession) -> dict[str, float]:
+    def _read_last(self, session: NgspiceSession) -> tuple[int, float, dict[str, float]]:
+        """Points so far, the last time (s) and the last contact/load values (V, A)."""
+        length, values = session.last_values(self._last_names)
+        last = dict(zip(self._last_names, values))
         p = self.probes
 
         def node(name: str) -> float:
-            return 0.0 if name.lower() in ("0", "gnd") else session.last_value(name.lower())
+            return 0.0 if name.lower() in ("0", "gnd") else last[name.lower()]
 
-        return {
+        scalars = {
             "contact_voltage": node(p.node_a) - node(p.node_b),
-            "contact_current": session.last_value(p.contact_current.lower()),
-            "load_current": session.last_value(p.load_current.lower()) if p.load_current else math.nan,
-            "arc_current": session.last_value(p.arc_current.lower()) if p.arc_current else 0.0,
+            "contact_current": last[p.contact_current.lower()],
+            "load_current": last[p.load_current.lower()] if p.load_current else math.nan,
+            "arc_current": last[p.arc_current.lower()] if p.arc_current else 0.0,
         }
+        return length, last["time"], scalars
 
     def _reader(self, start: int, stop: int) -> Callable[[str], np.ndarray]:
         def read(column: str) -> np.ndarray:
@@ -216,7 +226,7 @@ class Stepper:
             return float(self._final[column].iloc[-1]) if len(self._final) else math.nan
         if not self._started:
             return math.nan
-        return self._scalars(self._active())[column]
+        return self._read_last(self._active())[2][column]
 
     @property
     def stats(self) -> dict[str, float]:
