@@ -154,9 +154,17 @@ class NgspiceSession(NgSpiceShared):
         # PySpice's own simulator (circuit.simulator()) asks new_instance() for an
         # instance; handing it this one avoids a second cffi declaration (an error).
         NgSpiceShared._instances[0] = self
-        self._vsrc_c = ffi.callback("int(double *, double, char *, int, void *)", self._on_vsrc)
-        self._isrc_c = ffi.callback("int(double *, double, char *, int, void *)", self._on_isrc)
-        self._sync_c = ffi.callback("int(double, double *, double, int, int, int, void *)", self._on_sync)
+        # onerror: an exception escaping a callback (e.g. KeyboardInterrupt) is kept and
+        # re-raised after ngspice stops, instead of being printed and lost by cffi.
+        self._vsrc_c = ffi.callback(
+            "int(double *, double, char *, int, void *)", self._on_vsrc, onerror=self._on_callback_error
+        )
+        self._isrc_c = ffi.callback(
+            "int(double *, double, char *, int, void *)", self._on_isrc, onerror=self._on_callback_error
+        )
+        self._sync_c = ffi.callback(
+            "int(double, double *, double, int, int, int, void *)", self._on_sync, onerror=self._on_callback_error
+        )
         self._ident_c = ffi.new("int *", 0)
         rc = self._ngspice_shared.ngSpice_Init_Sync(
             self._vsrc_c, self._isrc_c, self._sync_c, self._ident_c, self._self_c
@@ -221,6 +229,11 @@ class NgspiceSession(NgSpiceShared):
         self._last_value = value
         out[0] = value
         return 0
+
+    def _on_callback_error(self, exc_type, exc_value, traceback):
+        if self._failure is None:
+            self._failure = exc_value if exc_value is not None else exc_type()
+        return None
 
     def _on_isrc(self, out, t, name, ident, user):
         out[0] = 0.0
@@ -314,26 +327,29 @@ class NgspiceSession(NgSpiceShared):
         if not ok:
             raise NgspiceError(f"ngspice refused a breakpoint at t = {t!r} s", _message(printed))
 
-    def transient(self, target: float | None, first: bool, wall_timeout: float | None) -> None:
-        """Start (``first``) or resume the loaded transient and pause exactly at ``target``.
+    def transient(self, target: float | None, first: bool, wall_timeout: float | None, t_end: float) -> None:
+        """Start (``first``) or resume the loaded transient and pause exactly at ``target`` (s).
 
-        ``target=None`` runs to the end time of the ``.tran`` line (a stop condition at
-        the final time would leave ngspice paused for the next run, so none is set).
-        Raises the ngspice error, or the exception a callback raised, after ngspice has
-        stopped.
+        ``target=None`` runs to ``t_end``, the end time of the ``.tran`` line (a stop
+        condition at the final time would leave ngspice paused for the next run, so none
+        is set). Raises the ngspice error, or the exception a callback raised, after
+        ngspice has stopped; KeyboardInterrupt if Ctrl-C paused ngspice (ngspice installs
+        its own SIGINT handler while it runs, which pauses instead of raising).
         """
         self._deadline = math.inf if wall_timeout is None else time.monotonic() + wall_timeout
         self._target = math.inf if target is None else float(target)
         try:
             if target is None:
                 printed = self.command("run" if first else "resume")
-                self._raise_if_failed(printed, target)
+                self._raise_if_failed(printed)
+                self._check_reached(printed, t_end - 1e-9 * t_end)
                 return
             if first:
                 # 'stop when time >= x' given before 'run' also becomes a breakpoint at x,
                 # which would cut the step below the target: pause on the first point.
                 printed = self.command("stop when time > 0; run; delete all")
-                self._raise_if_failed(printed, target)
+                self._raise_if_failed(printed)
+                self._check_reached(printed, -math.inf)
             # ngspice parses the number itself; the margin keeps its rounding harmless.
             threshold = target - max(1e-12 * abs(target), 1e-300)
             if first and self.last_time() >= threshold:
@@ -341,17 +357,32 @@ class NgspiceSession(NgSpiceShared):
             for _ in range(8):
                 # One command line per pause (ngspice runs ';'-separated commands in turn).
                 printed = self.command(f"stop when time >= {threshold!r}; resume; delete all")
-                self._raise_if_failed(printed, target)
+                self._raise_if_failed(printed)
                 # A point can fall inside the margin just before the target (a breakpoint
                 # there): then resume again, the step clipping lands on the target.
-                if self.last_time() >= threshold:
+                if self._check_reached(printed, threshold):
                     return
             raise SimulationAborted(f"ngspice did not reach t = {target!r} s after repeated resumes")
         finally:
             self._target = math.inf
             self._deadline = math.inf
 
-    def _raise_if_failed(self, printed: list[str], target: float | None) -> None:
+    def _check_reached(self, printed: list[str], threshold: float) -> bool:
+        """True if ngspice got to ``threshold``; a pause that was not ours is a user interrupt."""
+        if self.last_time() >= threshold:
+            return True
+        ours = any("condition met" in line for line in printed)
+        if not ours and any("interrupted" in line for line in printed):
+            raise KeyboardInterrupt(f"ngspice paused by an interrupt at t = {self.last_time()!r} s")
+        if threshold == -math.inf:
+            return True
+        if not ours:
+            raise SimulationAborted(
+                f"ngspice stopped at t = {self.last_time()!r} s before {threshold!r} s", _message(printed)
+            )
+        return False
+
+    def _raise_if_failed(self, printed: list[str]) -> None:
         failure, self._failure = self._failure, None
         aborted = any("aborted" in line or "Error:" in line for line in printed)
         if failure is not None:

@@ -64,7 +64,7 @@ def run_pwl_reference(
         session.claim(owner)
         try:
             session.load(lines)
-            session.transient(None, True, options.wall_timeout)
+            session.transient(None, True, options.wall_timeout, t_end)
             return probes.frame(session.vector, tuple(extra))
         finally:
             session.clear()

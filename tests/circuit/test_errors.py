@@ -159,3 +159,22 @@ def test_a_fresh_process_prints_nothing():
     assert done.returncode == 0, done.stderr
     assert done.stdout == ""
     assert done.stderr == ""
+
+
+def test_ctrl_c_interrupts_a_run():
+    """ngspice swaps in its own SIGINT handler while it runs (it pauses); either way Python sees KeyboardInterrupt."""
+    import signal
+
+    sent = []
+
+    def conductance(t):
+        if t > 5e-6 and not sent:
+            sent.append(t)
+            os.kill(os.getpid(), signal.SIGINT)
+        return 1.0
+
+    started = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        run_transient(GOOD, conductance, 1.0, options=OPTIONS)
+    assert time.monotonic() - started < 5.0
+    still_works()
