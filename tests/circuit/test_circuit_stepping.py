@@ -10,7 +10,7 @@ import pytest
 
 from circuit import COLUMNS, SessionBusyError, Stepper, run_pwl_reference, run_transient
 
-from conftest import BOUNCE_BREAKS, BOUNCE_T_END
+from circuit_scenes import BOUNCE_BREAKS, BOUNCE_T_END
 
 
 def step_through(circuit, schedule, options, macro_step):

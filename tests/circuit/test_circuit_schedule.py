@@ -9,7 +9,7 @@ import pytest
 
 from circuit import ContactSchedule, SimulationOptions, run_pwl_reference, run_transient, left_limited
 
-from conftest import BOUNCE_BREAKS, BOUNCE_MAKES
+from circuit_scenes import BOUNCE_BREAKS, BOUNCE_MAKES
 
 
 def test_conductance_ramps_and_plateaus():
