@@ -36,7 +36,7 @@ from .deck import CircuitLike, build_deck
 from .errors import SessionBusyError
 from .ngspice import NgspiceSession, get_session
 from .options import SimulationOptions
-from .probes import COLUMNS, Probes
+from .probes import COLUMNS
 
 
 class StepResult(NamedTuple):

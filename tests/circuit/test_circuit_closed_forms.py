@@ -9,7 +9,6 @@ from circuit import (
     CapacitiveLoad,
     ContactSchedule,
     DCSource,
-    InductiveLoad,
     NetlistCircuit,
     SimulationOptions,
     SwitchCircuit,
