@@ -144,7 +144,8 @@ class NgspiceSession(NgSpiceShared):
         pyspice_logger = logging.getLogger("PySpice.Spice.NgSpice.Shared.NgSpiceShared")
         previous = pyspice_logger.level
         # PySpice warns "Unsupported Ngspice version" for every version after 34; the
-        # vector-type enumeration it falls back to is the one ngspice 35-42 still use.
+        # vector-type enumeration it falls back to is ngspice 39's (time, voltage and
+        # current types checked).
         pyspice_logger.setLevel(logging.ERROR)
         try:
             super().__init__(ngspice_id=0, send_data=False, verbose=False)
@@ -215,7 +216,7 @@ class NgspiceSession(NgSpiceShared):
         self.source_calls += 1
         try:
             value = float(self._source(t))
-        except BaseException as exc:  # noqa: BLE001 - re-raised after ngspice has stopped
+        except BaseException as exc:  # re-raised after ngspice has stopped
             self._failure = exc
             out[0] = self._last_value
             return 0
