@@ -1,0 +1,382 @@
+"""Compiled Dormand-Prince 5(4) loop with dense output and event location.
+
+One call integrates until ``t_stop``, the first event, a full record buffer or a
+failure, and returns to Python, which switches regimes and restarts. Events are
+located on the 4th-order continuous extension by the Illinois method; the returned
+time is the end of the final bracket, so the state is on the new side of the event.
+
+Why compiled: NOTES.md measured 40-150 us of Python per solve_ivp step against ~1 us
+for this right-hand side; benchmarks/bench_mech.py re-measures the ratio.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .kernel import (
+    A_FN, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_CONTACT, EV_SLIP, EV_STICK,
+    F_BETA, F_C, F_K, FRICTION_EXACT, I_FRICTION, NEV_TIP, SLIP, STICK, dynamics,
+)
+
+DONE, EVENT, BUFFER_FULL, STEP_TOO_SMALL, NOT_FINITE, MAX_STEPS = range(6)
+STATUS_TEXT = ("done", "event", "buffer full", "step size too small", "non-finite state", "too many steps")
+
+# Dormand-Prince tableau (Hairer, Norsett & Wanner, Solving ODEs I, Table 5.2).
+C2, C3, C4, C5 = 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0
+A21 = 1.0 / 5.0
+A31, A32 = 3.0 / 40.0, 9.0 / 40.0
+A41, A42, A43 = 44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0
+A51, A52, A53, A54 = 19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0
+A61, A62, A63, A64, A65 = 9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0
+A71, A73, A74, A75, A76 = 35.0 / 384.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0
+E1, E3, E4, E5, E6, E7 = 71.0 / 57600.0, -71.0 / 16695.0, 71.0 / 1920.0, -17253.0 / 339200.0, 22.0 / 525.0, -1.0 / 40.0
+D1, D3, D4 = -12715105075.0 / 11282082432.0, 87487479700.0 / 32700410799.0, -10690763975.0 / 1880347072.0
+D5, D6, D7 = 701980252875.0 / 199316789632.0, -1453857185.0 / 822651844.0, 69997945.0 / 29380423.0
+
+
+@njit(cache=True)
+def dense_eval(coef, theta, out):
+    """State at fraction ``theta`` of a step from its 5 x N continuous-extension coefficients."""
+    t1 = 1.0 - theta
+    for i in range(coef.shape[1]):
+        out[i] = coef[0, i] + theta * (coef[1, i] + t1 * (coef[2, i] + theta * (coef[3, i] + t1 * coef[4, i])))
+
+
+@njit(cache=True)
+def events_from_aux(aux, eref, fpar, g):
+    """Event function values (see kernel.event_values) from a dynamics evaluation's aux."""
+    k_h = fpar[F_K]
+    c_h = fpar[F_C]
+    beta = fpar[F_BETA]
+    for i in range(2):
+        pen = aux[i, A_Y]
+        pp = pen if pen > 0.0 else 0.0
+        g[NEV_TIP * i + EV_CONTACT] = pen
+        g[NEV_TIP * i + EV_CLIP] = k_h * pp ** (1.5 - beta) + c_h * aux[i, A_YDOT]
+        g[NEV_TIP * i + EV_SLIP] = aux[i, A_VTX] * eref[i, 0] + aux[i, A_VTY] * eref[i, 1]
+        g[NEV_TIP * i + EV_STICK] = aux[i, A_MARGIN]
+
+
+@njit(cache=True)
+def _active(k, g_old, g_new, regime, fmodel):
+    """Whether event k is watched in a step with end values g_old, g_new."""
+    i = k // NEV_TIP
+    kind = k % NEV_TIP
+    if kind == EV_CONTACT:
+        return True
+    in_contact = g_old[NEV_TIP * i] > 0.0 and g_new[NEV_TIP * i] > 0.0
+    if kind == EV_CLIP:
+        return in_contact
+    if fmodel != FRICTION_EXACT or not in_contact:
+        return False
+    if kind == EV_SLIP:
+        return regime[i] == SLIP
+    return regime[i] == STICK
+
+
+@njit(cache=True)
+def _rk_stages(t, y, h, k1, k2, k3, k4, k5, k6, k7, ytmp, ynew, fpar, ipar, J0, sp_ptr, sp_idx, sp_val,
+               psi, theta, xc, regime, eref, aux_stage, aux_new, work):
+    """One Dormand-Prince step of size h from (t, y) with k1 = f(t, y): ynew and the stages;
+    k7 = f(t + h, ynew) with its aux in aux_new (first-same-as-last)."""
+    N = y.shape[0]
+    for i in range(N):
+        ytmp[i] = y[i] + h * A21 * k1[i]
+    dynamics(t + C2 * h, ytmp, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, k2, aux_stage, work)
+    for i in range(N):
+        ytmp[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i])
+    dynamics(t + C3 * h, ytmp, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, k3, aux_stage, work)
+    for i in range(N):
+        ytmp[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
+    dynamics(t + C4 * h, ytmp, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, k4, aux_stage, work)
+    for i in range(N):
+        ytmp[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
+    dynamics(t + C5 * h, ytmp, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, k5, aux_stage, work)
+    for i in range(N):
+        ytmp[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
+    dynamics(t + h, ytmp, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, k6, aux_stage, work)
+    for i in range(N):
+        ynew[i] = y[i] + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i])
+    dynamics(t + h, ynew, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, k7, aux_new, work)
+
+
+@njit(cache=True)
+def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
+              fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, ev_sign,
+              rec_t, rec_y, rec_aux, rec_fmax, dense_t0, dense_h, dense_coef, store_dense,
+              max_steps, work, stats):
+    """Advance y (in place) from t towards t_stop.
+
+    Returns (status, t, h_next, n_records, event_index); after an event, h_next is the
+    step size in use before the step was cut at the event. Every accepted step is recorded
+    (time, state, per-tip aux and the largest normal force seen at the step's ends and
+    three interior points); with store_dense, also the step's dense-output coefficients.
+    stats (int64[4]) accumulates: accepted steps, rejected steps, rhs evaluations, events.
+    """
+    N = y.shape[0]
+    nev = 2 * NEV_TIP
+    fmodel = ipar[I_FRICTION]
+    k1 = np.empty(N)
+    k2 = np.empty(N)
+    k3 = np.empty(N)
+    k4 = np.empty(N)
+    k5 = np.empty(N)
+    k6 = np.empty(N)
+    k7 = np.empty(N)
+    ytmp = np.empty(N)
+    ynew = np.empty(N)
+    coef = np.empty((5, N))
+    aux_stage = np.empty((2, 8))
+    aux_old = np.empty((2, 8))
+    aux_new = np.empty((2, 8))
+    g_old = np.empty(nev)
+    g_new = np.empty(nev)
+    g_mid = np.empty(nev)
+    ymid = np.empty(N)
+    max_rec = rec_t.shape[0]
+    n_rec = 0
+    facold = 1e-4
+
+    dynamics(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, k1, aux_old, work)
+    stats[2] += 1
+    events_from_aux(aux_old, eref, fpar, g_old)
+    if h <= 0.0:  # initial step from the derivative scale (Hairer's heuristic, simplified)
+        d0 = 0.0
+        d1 = 0.0
+        for i in range(N):
+            sc = atol[i] + rtol * relmask[i] * abs(y[i])
+            d0 += (y[i] / sc) ** 2
+            d1 += (k1[i] / sc) ** 2
+        d0 = math.sqrt(d0 / N)
+        d1 = math.sqrt(d1 / N)
+        h = 0.01 * d0 / d1 if (d0 > 1e-5 and d1 > 1e-5) else 1e-6
+        h = min(h, hmax)
+    reject = False
+    while True:
+        if t >= t_stop:
+            return DONE, t, h, n_rec, -1
+        if n_rec >= max_rec:
+            return BUFFER_FULL, t, h, n_rec, -1
+        if stats[0] + stats[1] >= max_steps:
+            return MAX_STEPS, t, h, n_rec, -1
+        if h > hmax:
+            h = hmax
+        last = False
+        if t + h >= t_stop:
+            h = t_stop - t
+            last = True
+        if h < 1e-15 * max(1.0, abs(t)) or h < 1e-18:
+            return STEP_TOO_SMALL, t, h, n_rec, -1
+        _rk_stages(t, y, h, k1, k2, k3, k4, k5, k6, k7, ytmp, ynew, fpar, ipar, J0, sp_ptr, sp_idx, sp_val,
+                   psi, theta, xc, regime, eref, aux_stage, aux_new, work)
+        stats[2] += 6
+        err = 0.0
+        finite = True
+        for i in range(N):
+            e = h * (E1 * k1[i] + E3 * k3[i] + E4 * k4[i] + E5 * k5[i] + E6 * k6[i] + E7 * k7[i])
+            big = abs(y[i]) if abs(y[i]) > abs(ynew[i]) else abs(ynew[i])
+            sc = atol[i] + rtol * relmask[i] * big
+            err += (e / sc) ** 2
+            if not math.isfinite(ynew[i]):
+                finite = False
+        if not finite:
+            if h < 1e-14:
+                return NOT_FINITE, t, h, n_rec, -1
+            h *= 0.1
+            reject = True
+            stats[1] += 1
+            continue
+        err = math.sqrt(err / N)
+        # PI step-size control (Hairer's DOPRI5 constants)
+        fac11 = err ** 0.17 if err > 0.0 else 0.0
+        fac = fac11 / facold ** 0.04 if facold > 0.0 else fac11
+        fac = max(0.1, min(5.0, fac / 0.9))
+        hnew = h / fac
+        if err > 1.0:
+            hnew = h / min(5.0, fac11 / 0.9)
+            reject = True
+            stats[1] += 1
+            h = hnew
+            continue
+        # accepted: events
+        facold = max(err, 1e-4)
+        events_from_aux(aux_new, eref, fpar, g_new)
+        for i in range(N):
+            coef[0, i] = y[i]
+            coef[1, i] = ynew[i] - y[i]
+            coef[2, i] = h * k1[i] - coef[1, i]
+            coef[3, i] = coef[1, i] - h * k7[i] - coef[2, i]
+            coef[4, i] = h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i])
+        first_k = -1
+        h_continue = h
+        first_theta = 2.0
+        first_theta_lo = 0.0
+        g_lo_dense = 0.0
+        for k in range(nev):
+            if not _active(k, g_old, g_new, regime, fmodel):
+                continue
+            s = ev_sign[k]
+            if s == 0.0 or not (s * g_new[k] < 0.0 or g_new[k] == 0.0):
+                continue
+            # Illinois on theta in [0, 1]; keep (a, ga) on the old side, (b, gb) on the new side.
+            a = 0.0
+            ga = g_old[k] if s * g_old[k] > 0.0 else s * 1e-300
+            b = 1.0
+            gb = g_new[k]
+            side = 0
+            for _ in range(200):
+                if (b - a) * h <= 4e-16 * max(abs(t), 1e-9) + 1e-18:
+                    break
+                tc = b - gb * (b - a) / (gb - ga) if gb != ga else 0.5 * (a + b)
+                if not (a < tc < b):
+                    tc = 0.5 * (a + b)
+                dense_eval(coef, tc, ymid)
+                dynamics(t + tc * h, ymid, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, ytmp, aux_stage, work)
+                stats[2] += 1
+                events_from_aux(aux_stage, eref, fpar, g_mid)
+                gc = g_mid[k]
+                if s * gc > 0.0:
+                    a = tc
+                    ga = gc
+                    if side == -1:
+                        gb *= 0.5
+                    side = -1
+                else:
+                    b = tc
+                    gb = gc
+                    if side == 1:
+                        ga *= 0.5
+                    side = 1
+            if b < first_theta:
+                first_theta = b
+                first_k = k
+                first_theta_lo = a
+                g_lo_dense = ga if s * ga > 0.0 else s * 1e-300
+        if first_k >= 0:
+            tev = t + first_theta * h
+            if first_theta >= 1.0:
+                tev = t + h
+                for i in range(N):
+                    ymid[i] = ynew[i]
+            else:
+                # Retake the step so that it ends at the event: the dense output carries the
+                # error of a step that straddles a kink (e.g. the Hertz force at y = 0). The
+                # retaken step's own end must be on the new side, so the root is refined on
+                # G(theta) = g(RK step of theta h) between the dense root and the full step.
+                s_ev = ev_sign[first_k]
+                lo = first_theta_lo
+                g_lo = g_lo_dense
+                hi = 1.0
+                g_hi = g_new[first_k]
+                trial = first_theta
+                side = 0
+                found = False
+                for _ in range(40):
+                    _rk_stages(t, y, trial * h, k1, k2, k3, k4, k5, k6, k7, ytmp, ymid, fpar, ipar,
+                               J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, aux_stage, aux_new, work)
+                    stats[2] += 6
+                    events_from_aux(aux_new, eref, fpar, g_mid)
+                    gt = g_mid[first_k]
+                    if s_ev * gt < 0.0:
+                        hi = trial
+                        g_hi = gt
+                        found = True
+                        if (hi - lo) * h <= 1e-3 * h * 1e-6 + 4e-16 * max(abs(t), 1e-9) or side == 0:
+                            break
+                        if side == 1:
+                            g_lo *= 0.5
+                        side = 1
+                    else:
+                        lo = trial
+                        g_lo = gt
+                        found = False
+                        if side == -1:
+                            g_hi *= 0.5
+                        side = -1
+                    if (hi - lo) * h <= 4e-16 * max(abs(t), 1e-9) + 1e-18:
+                        break
+                    trial = hi - g_hi * (hi - lo) / (g_hi - g_lo) if g_hi != g_lo else 0.5 * (lo + hi)
+                    if not (lo < trial < hi):
+                        trial = 0.5 * (lo + hi)
+                if not found:  # the last trial ended on the old side: retake at hi
+                    _rk_stages(t, y, hi * h, k1, k2, k3, k4, k5, k6, k7, ytmp, ymid, fpar, ipar,
+                               J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, aux_stage, aux_new, work)
+                    stats[2] += 6
+                hh = hi * h
+                h_continue = h
+                tev = t + hh
+                for i in range(N):
+                    coef[0, i] = y[i]
+                    coef[1, i] = ymid[i] - y[i]
+                    coef[2, i] = hh * k1[i] - coef[1, i]
+                    coef[3, i] = coef[1, i] - hh * k7[i] - coef[2, i]
+                    coef[4, i] = hh * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i])
+                h = hh
+                first_theta = 1.0
+            dynamics(tev, ymid, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, ytmp, aux_new, work)
+            stats[2] += 1
+            _record(n_rec, tev, ymid, aux_new, aux_old, coef, rec_t, rec_y, rec_aux, rec_fmax,
+                    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, work, ytmp, aux_stage, first_theta)
+            if store_dense:
+                dense_t0[n_rec] = t
+                dense_h[n_rec] = h
+                for a_ in range(5):
+                    for i in range(N):
+                        dense_coef[n_rec, a_, i] = coef[a_, i]
+            n_rec += 1
+            for i in range(N):
+                y[i] = ymid[i]
+            stats[0] += 1
+            stats[3] += 1
+            return EVENT, tev, h_continue, n_rec, first_k
+        _record(n_rec, t + h, ynew, aux_new, aux_old, coef, rec_t, rec_y, rec_aux, rec_fmax,
+                fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, work, ytmp, aux_stage, 1.0)
+        if store_dense:
+            dense_t0[n_rec] = t
+            dense_h[n_rec] = h
+            for a_ in range(5):
+                for i in range(N):
+                    dense_coef[n_rec, a_, i] = coef[a_, i]
+        n_rec += 1
+        stats[0] += 1
+        for k in range(nev):
+            if g_new[k] != 0.0:
+                ev_sign[k] = 1.0 if g_new[k] > 0.0 else -1.0
+        for i in range(N):
+            y[i] = ynew[i]
+            k1[i] = k7[i]
+        for i in range(2):
+            for c_ in range(8):
+                aux_old[i, c_] = aux_new[i, c_]
+        for k in range(nev):
+            g_old[k] = g_new[k]
+        t = t + h if not last else t_stop
+        if reject:
+            hnew = min(hnew, h)
+            reject = False
+        h = hnew
+
+
+@njit(cache=True)
+def _record(n_rec, t_end, y_end, aux_end, aux_start, coef, rec_t, rec_y, rec_aux, rec_fmax,
+            fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, work, scratch, aux_scratch, theta_end):
+    """Store an accepted step; its peak normal force is sampled at both ends and 3 interior points."""
+    rec_t[n_rec] = t_end
+    N = y_end.shape[0]
+    for i in range(N):
+        rec_y[n_rec, i] = y_end[i]
+    for i in range(2):
+        for c_ in range(8):
+            rec_aux[n_rec, i, c_] = aux_end[i, c_]
+        rec_fmax[n_rec, i] = max(aux_end[i, A_FN], aux_start[i, A_FN])
+    if aux_end[0, A_Y] > 0.0 or aux_end[1, A_Y] > 0.0 or aux_start[0, A_Y] > 0.0 or aux_start[1, A_Y] > 0.0:
+        ymid = np.empty(N)
+        for f in (0.25, 0.5, 0.75):
+            dense_eval(coef, f * theta_end, ymid)
+            dynamics(0.0, ymid, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, scratch, aux_scratch, work)
+            for i in range(2):
+                if aux_scratch[i, A_FN] > rec_fmax[n_rec, i]:
+                    rec_fmax[n_rec, i] = aux_scratch[i, A_FN]

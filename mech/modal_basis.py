@@ -1,0 +1,201 @@
+"""The bar's modal basis and the inertia invariants of the floating-frame model.
+
+Body frame: origin at the undeformed centroid, b1 along the bar, x in [-L/2, L/2].
+A point's body position is s(x) = x b1 + sum_j Psi_j(x) q_j, with Psi_j = d_j phi_j(x)
+(d_j = b1 for axial, b2 or b3 for bending). All integrals are Gauss-Legendre
+quadratures computed once per bar:
+
+    J(q)   = J0 + sum_j J1_j q_j + sum_jk J2_jk q_j q_k  inertia tensor about the centroid
+    S_jk   = int rho A Psi_j x Psi_k dx                  gyroscopic coupling
+    B(q)_j = sum_k q_k S_kj                              angular momentum h = J w + B eta
+    M_ee   = m I                                          (mean-square-1 shapes)
+
+J2_jk = int rho A (Psi_j.Psi_k I - Psi_j Psi_k^T) vanishes for two modes of the same
+family (orthogonality) but not across families (an axial and a bending shape are not
+orthogonal), so the kernel receives every invariant as a sparse list of its non-zero
+entries (``sparse_invariants``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .modes import axial_shape, bending_shape, free_free_roots
+from .parameters import Bar
+
+FAMILY_DIRECTION = {"axial": 0, "bend2": 1, "bend3": 2}
+_QUAD_POINTS = 400
+
+
+@dataclass(frozen=True)
+class ModalBasis:
+    """Modes and invariants of one bar (SI: kg, m, N/m).
+
+    families: family of each modal coordinate ("axial", "bend2", "bend3").
+    orders: mode number within its family (1-based).
+    frequencies: Hz, undamped natural frequencies sqrt(K_jj/m)/(2 pi) of the basis.
+    mass: kg. J0: kg m^2 (3, 3). J1: kg m (n, 3, 3). J2: kg (n, 3, 3). S: kg (n, n, 3).
+    stiffness: N/m (n, n). damping: N s/m (n, n).
+    psi_tip, theta_tip: (2, n, 3) mode displacement (-) and section rotation (1/m) at the
+    two tip-sphere centres x = -L/2 + R and x = L/2 - R.
+    x_centre: (2,) body x of the tip-sphere centres, m.
+    """
+
+    families: tuple[str, ...]
+    orders: tuple[int, ...]
+    frequencies: np.ndarray
+    mass: float
+    J0: np.ndarray
+    J1: np.ndarray
+    J2: np.ndarray
+    S: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    psi_tip: np.ndarray
+    theta_tip: np.ndarray
+    x_centre: np.ndarray
+
+    @property
+    def n(self) -> int:
+        return len(self.families)
+
+
+def _quadrature(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights on xi in [0, 1]."""
+    t, w = np.polynomial.legendre.leggauss(n)
+    return 0.5 * (t + 1.0), 0.5 * w
+
+
+def mode_list(bar: Bar, planar: bool) -> list[tuple[str, int]]:
+    """(family, order) of every modal coordinate; planar models keep b3-plane bending only."""
+    modes = [("axial", k) for k in range(1, bar.axial_modes + 1)]
+    bend_families = ("bend3",) if planar else ("bend2", "bend3")
+    for fam in bend_families:
+        modes += [(fam, k) for k in range(1, bar.bending_modes + 1)]
+    return modes
+
+
+def shape_values(bar: Bar, modes, xi: np.ndarray, derivative: int = 0) -> np.ndarray:
+    """(n, len(xi)) scalar shapes phi_j (derivative w.r.t. x in SI, 1/m^derivative)."""
+    roots = free_free_roots(bar.bending_modes) if bar.bending_modes else np.array([])
+    out = np.empty((len(modes), len(xi)))
+    for j, (fam, k) in enumerate(modes):
+        if fam == "axial":
+            out[j] = axial_shape(k, xi, derivative)
+        else:
+            out[j] = bending_shape(roots[k - 1], xi, derivative)
+    return out / bar.length**derivative
+
+
+def build_modal_basis(bar: Bar, planar: bool) -> ModalBasis:
+    """Modes, stiffness and the inertia invariants of ``bar`` (planar: axial + b3 bending)."""
+    modes = mode_list(bar, planar)
+    n = len(modes)
+    L = bar.length
+    m = bar.mass
+    rho_a = bar.density * bar.area
+    xi, w = _quadrature(_QUAD_POINTS)
+    x = L * (xi - 0.5)
+    dx = L * w
+
+    phi = shape_values(bar, modes, xi)
+    d1 = shape_values(bar, modes, xi, 1)
+    dirs = np.zeros((n, 3))
+    for j, (fam, _) in enumerate(modes):
+        dirs[j, FAMILY_DIRECTION[fam]] = 1.0
+    psi = phi[:, :, None] * dirs[:, None, :]  # (n, points, 3)
+
+    i22, i33 = bar.second_moments
+    J0 = np.diag([
+        bar.density * L * (i22 + i33),  # polar: rotation about the axis
+        m * L**2 / 12.0 + bar.density * L * i22,
+        m * L**2 / 12.0 + bar.density * L * i33,
+    ])
+    e1 = np.array([1.0, 0.0, 0.0])
+    eye = np.eye(3)
+    J1 = np.zeros((n, 3, 3))
+    J2 = np.zeros((n, n, 3, 3))
+    S = np.zeros((n, n, 3))
+    for j in range(n):
+        pj = psi[j]
+        # d/dq_j of int rho A (s.s I - s s^T) at q = 0, with s = x e1.
+        axial_part = np.sum(rho_a * dx * x * pj[:, 0])
+        outer = np.einsum("p,p,i,pj->ij", rho_a * dx, x, e1, pj)
+        J1[j] = 2.0 * axial_part * eye - (outer + outer.T)
+        for k in range(n):
+            pk = psi[k]
+            dot = np.sum(rho_a * dx * np.sum(pj * pk, axis=1))
+            J2[j, k] = dot * eye - np.einsum("p,pi,pj->ij", rho_a * dx, pj, pk)
+            S[j, k] = np.sum(rho_a * dx[:, None] * np.cross(pj, pk), axis=0)
+
+    K = np.zeros((n, n))
+    for j, (fam_j, _) in enumerate(modes):
+        for k, (fam_k, _) in enumerate(modes):
+            if fam_j != fam_k:
+                continue
+            if fam_j == "axial":
+                K[j, k] = np.sum(bar.youngs_modulus * bar.area * d1[j] * d1[k] * dx)
+            elif bar.bending == "euler_bernoulli":
+                d2 = shape_values(bar, [modes[j], modes[k]], xi, 2)
+                second = i33 if fam_j == "bend2" else i22
+                K[j, k] = np.sum(bar.youngs_modulus * second * d2[0] * d2[1] * dx)
+            else:  # the paper's shear-type energy (G/nu) A (d delta/dx)^2
+                K[j, k] = np.sum(bar.shear_modulus / bar.poisson_ratio * bar.area * d1[j] * d1[k] * dx)
+    # Exact eigenmodes give a diagonal K; quadrature leaves round-off off the diagonal.
+    if bar.bending == "euler_bernoulli":
+        K = np.diag(np.diag(K))
+    omega = np.sqrt(np.diag(K) / m) if n else np.zeros(0)
+    C = np.diag(2.0 * bar.modal_damping * m * omega) if n else np.zeros((0, 0))
+
+    x_centre = np.array([-0.5 * L + bar.tip_radius, 0.5 * L - bar.tip_radius])
+    xi_c = x_centre / L + 0.5
+    phi_c = shape_values(bar, modes, xi_c)
+    slope_c = shape_values(bar, modes, xi_c, 1)
+    psi_tip = np.zeros((2, n, 3))
+    theta_tip = np.zeros((2, n, 3))
+    for j, (fam, _) in enumerate(modes):
+        psi_tip[:, j, FAMILY_DIRECTION[fam]] = phi_c[j]
+        # Small section rotation: delta2' turns the section about b3, delta3' about -b2.
+        if fam == "bend2":
+            theta_tip[:, j, 2] = slope_c[j]
+        elif fam == "bend3":
+            theta_tip[:, j, 1] = -slope_c[j]
+
+    return ModalBasis(
+        families=tuple(f for f, _ in modes),
+        orders=tuple(k for _, k in modes),
+        frequencies=omega / (2.0 * np.pi),
+        mass=m,
+        J0=J0,
+        J1=J1,
+        J2=J2,
+        S=S,
+        stiffness=K,
+        damping=C,
+        psi_tip=psi_tip,
+        theta_tip=theta_tip,
+        x_centre=x_centre,
+    )
+
+
+def sparse_invariants(basis: ModalBasis, rel_tol: float = 1e-12):
+    """The invariants J1, J2, S, K, C as one list of non-zero entries for the kernel.
+
+    Returns (ptr, idx, val): entries ptr[0]:ptr[1] are J1 (j, a, b), ptr[1]:ptr[2] J2
+    (j, k, a, b), ptr[2]:ptr[3] S (j, k, a), ptr[3]:ptr[4] K (j, k), ptr[4]:ptr[5] C (j, k).
+    Entries below rel_tol of their array's largest magnitude are quadrature round-off of
+    exact zeros (orthogonality) and are dropped.
+    """
+    idx_parts, val_parts, ptr = [], [], [0]
+    for arr in (basis.J1, basis.J2, basis.S, basis.stiffness, basis.damping):
+        big = np.max(np.abs(arr)) if arr.size else 0.0
+        nz = np.argwhere(np.abs(arr) > rel_tol * big) if big > 0 else np.zeros((0, arr.ndim), int)
+        idx = np.zeros((len(nz), 4), dtype=np.int64)
+        idx[:, : arr.ndim] = nz
+        idx_parts.append(idx)
+        val_parts.append(arr[tuple(nz.T)] if len(nz) else np.zeros(0))
+        ptr.append(ptr[-1] + len(nz))
+    return (np.array(ptr, dtype=np.int64), np.concatenate(idx_parts).astype(np.int64),
+            np.concatenate(val_parts).astype(float))

@@ -1,0 +1,280 @@
+"""From a scene to the compiled model: arrays, initial state, error scales, step bound.
+
+Leaves out what the scene does not need: a scene whose motion stays in one vertical
+plane gets the planar model (x, z, pitch, axial and in-plane bending modes), zero modes
+give the rigid bar, and zero friction switches the tangential machinery off.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .contact_laws import (
+    calibrate_damping, damping_formula, hertz_impact, hertz_stiffness,
+)
+from .kernel import (
+    F_BAUM, F_BETA, F_C, F_G, F_GAMMA, F_K, F_MASS, F_MAX_RATIO, F_MU0, F_MU_SLOPE, F_RTIP,
+    F_T_MU, F_VREG, FRICTION_EXACT, FRICTION_NONE, FRICTION_REGULARIZED, I_FRICTION, I_N,
+    I_PLANAR, N_FPAR, NQ, layout,
+)
+from .modal_basis import ModalBasis, build_modal_basis, sparse_invariants
+from .parameters import MechScene
+
+
+def rotation_z(angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def rotation_y(angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def matrix_to_quaternion(R: np.ndarray) -> np.ndarray:
+    """Unit quaternion (w, x, y, z) of a rotation matrix (Shepperd's method)."""
+    tr = np.trace(R)
+    if tr > 0:
+        s = 2.0 * math.sqrt(tr + 1.0)
+        q = [0.25 * s, (R[2, 1] - R[1, 2]) / s, (R[0, 2] - R[2, 0]) / s, (R[1, 0] - R[0, 1]) / s]
+    elif R[0, 0] > R[1, 1] and R[0, 0] > R[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + R[0, 0] - R[1, 1] - R[2, 2])
+        q = [(R[2, 1] - R[1, 2]) / s, 0.25 * s, (R[0, 1] + R[1, 0]) / s, (R[0, 2] + R[2, 0]) / s]
+    elif R[1, 1] > R[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + R[1, 1] - R[0, 0] - R[2, 2])
+        q = [(R[0, 2] - R[2, 0]) / s, (R[0, 1] + R[1, 0]) / s, 0.25 * s, (R[1, 2] + R[2, 1]) / s]
+    else:
+        s = 2.0 * math.sqrt(1.0 + R[2, 2] - R[0, 0] - R[1, 1])
+        q = [(R[1, 0] - R[0, 1]) / s, (R[0, 2] + R[2, 0]) / s, (R[1, 2] + R[2, 1]) / s, 0.25 * s]
+    q = np.array(q)
+    return q / np.linalg.norm(q)
+
+
+def is_planar(scene: MechScene, tol: float = 1e-12) -> bool:
+    """True when the initial state keeps the motion in the bar's vertical plane.
+
+    Gravity, the plane block and isotropic friction keep such a motion planar; what
+    must hold initially is a centre-of-mass velocity in the plane and an angular
+    velocity normal to it.
+    """
+    ini = scene.initial
+    psi = math.radians(ini.azimuth_deg)
+    normal = np.array([-math.sin(psi), math.cos(psi), 0.0])
+    v = np.array(ini.velocity)
+    w = np.array(ini.angular_velocity)
+    scale_v = max(1.0, np.linalg.norm(v))
+    scale_w = max(1.0, np.linalg.norm(w))
+    return abs(v @ normal) <= tol * scale_v and np.linalg.norm(w - (w @ normal) * normal) <= tol * scale_w
+
+
+@dataclass(frozen=True)
+class ContactScales:
+    """Contact constants and the scales the error control and step bound use (SI)."""
+
+    stiffness: float  # N/m^1.5
+    damping: float  # c
+    beta: float
+    reference_speed: float  # m/s
+    reference_mass: float  # kg, effective normal mass of the first-impacting tip
+    penetration_scale: float  # m, Hertz delta_max at the reference impact
+    shortest_contact: float  # s, Hertz contact time lower bound
+    energy_scale: float  # J
+
+
+def _first_impact(scene: MechScene) -> tuple[float, float]:
+    """Normal speed (m/s) and effective normal mass (kg) of the first tip impact, from a
+    rigid-bar free flight of the initial state (gravity only)."""
+    bar, ini = scene.bar, scene.initial
+    m = bar.mass
+    theta = math.radians(ini.angle_deg)
+    a = 0.5 * bar.length - bar.tip_radius
+    # tip normal speed from translation and rotation about the horizontal axis
+    psi = math.radians(ini.azimuth_deg)
+    axis = np.array([math.cos(theta) * math.cos(psi), math.cos(theta) * math.sin(psi), math.sin(theta)])
+    low_sign = -1.0 if theta > 0 else 1.0
+    w = np.array(ini.angular_velocity)
+    v_tip = np.array(ini.velocity) + np.cross(w, low_sign * a * axis)
+    vn = -v_tip[2]
+    g = scene.gravity
+    speed = math.sqrt(max(vn, 0.0) ** 2 + 2.0 * g * ini.height)
+    if speed <= 0.0:
+        speed = max(math.sqrt(2.0 * g * max(ini.height, 1e-4)), 1e-3)
+    i_t = bar.density * bar.length * bar.second_moments[0] + m * bar.length**2 / 12.0
+    m_eff = m / (1.0 + m * (a * math.cos(theta)) ** 2 / i_t)
+    return speed, m_eff
+
+
+def contact_scales(scene: MechScene, n_modes: int) -> ContactScales:
+    bar, blk, con = scene.bar, scene.block, scene.contact
+    k = con.stiffness or hertz_stiffness(bar.tip_radius, bar.youngs_modulus, bar.poisson_ratio,
+                                         blk.youngs_modulus, blk.poisson_ratio)
+    speed_est, m_eff = _first_impact(scene)
+    v_ref = con.reference_speed or speed_est
+    if con.damping is not None:
+        c = con.damping
+    elif con.calibration == "formula":
+        c = damping_formula(con.law, con.restitution, v_ref, k)
+    else:
+        c = calibrate_damping(con.law, con.restitution, v_ref, k, m_eff)
+    ini = scene.initial
+    m = bar.mass
+    ke0 = 0.5 * m * float(np.dot(ini.velocity, ini.velocity)) + 0.5 * m * bar.length**2 / 12.0 * float(
+        np.dot(ini.angular_velocity, ini.angular_velocity))
+    # fastest normal approach any tip can reach: all energy into one tip's normal motion
+    e_avail = ke0 + m * scene.gravity * (ini.height + bar.length)
+    m_min = m / (4.0 * (1.0 + n_modes))  # 1/m_eff <= (1 + 3 + 4 n)/m: |phi_j| <= 2 at the tips
+    v_max = math.sqrt(2.0 * e_avail / m_min) + v_ref
+    t_short = hertz_impact(m_min, k, v_max).contact_time
+    return ContactScales(
+        stiffness=k, damping=c, beta=con.beta, reference_speed=v_ref, reference_mass=m_eff,
+        penetration_scale=hertz_impact(m_eff, k, v_ref).max_penetration,
+        shortest_contact=t_short, energy_scale=max(e_avail, 1e-12),
+    )
+
+
+@dataclass
+class BarModel:
+    """The compiled model's arrays plus what Python needs to interpret the state."""
+
+    scene: MechScene
+    planar: bool
+    basis: ModalBasis
+    contact: ContactScales
+    fpar: np.ndarray
+    ipar: np.ndarray
+    azimuth: float  # rad: planar models are solved in the plane rotated by -azimuth
+    atol: np.ndarray
+    relmask: np.ndarray
+    max_step: float
+
+    @property
+    def n(self) -> int:
+        return self.basis.n
+
+    sparse: tuple = ()
+
+    @property
+    def arrays(self) -> tuple:
+        """The compiled kernel's model arguments, in its order."""
+        b = self.basis
+        ptr, idx, val = self.sparse
+        return (self.fpar, self.ipar, b.J0, ptr, idx, val, b.psi_tip, b.theta_tip, b.x_centre)
+
+    @property
+    def state_size(self) -> int:
+        npos, nvel = layout(self.n, self.planar)
+        return npos + nvel + NQ
+
+    def slices(self) -> dict:
+        """Named slices of the state vector."""
+        n = self.n
+        if self.planar:
+            return {"pos": slice(0, 2), "angle": slice(2, 3), "q": slice(3, 3 + n),
+                    "vel": slice(3 + n, 5 + n), "omega": slice(5 + n, 6 + n),
+                    "eta": slice(6 + n, 6 + 2 * n), "quad": slice(6 + 2 * n, 6 + 2 * n + NQ)}
+        return {"pos": slice(0, 3), "quat": slice(3, 7), "q": slice(7, 7 + n),
+                "vel": slice(7 + n, 10 + n), "omega": slice(10 + n, 13 + n),
+                "eta": slice(13 + n, 13 + 2 * n), "quad": slice(13 + 2 * n, 13 + 2 * n + NQ)}
+
+    def initial_state(self) -> np.ndarray:
+        ini, bar = self.scene.initial, self.scene.bar
+        theta = math.radians(ini.angle_deg)
+        a = 0.5 * bar.length - bar.tip_radius
+        z0 = ini.height + bar.tip_radius + a * abs(math.sin(theta))
+        y = np.zeros(self.state_size)
+        sl = self.slices()
+        v = np.array(ini.velocity, dtype=float)
+        w_world = np.array(ini.angular_velocity, dtype=float)
+        if self.planar:
+            Rz = rotation_z(self.azimuth)
+            v_p = Rz.T @ v
+            w_p = Rz.T @ w_world
+            y[sl["pos"]] = [0.0, z0]
+            y[sl["angle"]] = -theta
+            y[sl["vel"]] = [v_p[0], v_p[2]]
+            y[sl["omega"]] = w_p[1]  # body y = world y' for rotations about y'
+        else:
+            R0 = rotation_z(self.azimuth) @ rotation_y(-theta)
+            y[sl["pos"]] = [0.0, 0.0, z0]
+            y[sl["quat"]] = matrix_to_quaternion(R0)
+            y[sl["vel"]] = v
+            y[sl["omega"]] = R0.T @ w_world
+        return y
+
+
+def build_model(scene: MechScene) -> BarModel:
+    """Assemble the compiled model of ``scene`` (planar or 3D as the scene needs)."""
+    mode = scene.solver.model
+    planar_ok = is_planar(scene)
+    if mode == "planar" and not planar_ok:
+        raise ValueError(
+            "solver.model = 'planar': the initial velocity or angular velocity leaves the bar's "
+            "vertical plane; use 'auto' or '3d'"
+        )
+    planar = planar_ok if mode == "auto" else mode == "planar"
+    basis = build_modal_basis(scene.bar, planar)
+    n = basis.n
+    cs = contact_scales(scene, n)
+    fr = scene.friction
+    fpar = np.zeros(N_FPAR)
+    fpar[F_MASS] = scene.bar.mass
+    fpar[F_G] = scene.gravity
+    fpar[F_K] = cs.stiffness
+    fpar[F_C] = cs.damping
+    fpar[F_BETA] = cs.beta
+    fpar[F_GAMMA] = fr.gamma
+    fpar[F_MU0] = fr.mu_at(0.0) if fr.active else 0.0
+    fpar[F_MU_SLOPE] = 0.0
+    fpar[F_T_MU] = 0.0
+    fpar[F_MAX_RATIO] = fr.max_ratio if math.isfinite(fr.max_ratio) else 1e300
+    fpar[F_RTIP] = scene.bar.tip_radius
+    fpar[F_VREG] = fr.regularization_speed
+    # Stick drift correction: slip velocity decays on a time scale of a few contact times.
+    fpar[F_BAUM] = 1.0 / cs.shortest_contact
+    if not fr.active:
+        fmodel = FRICTION_NONE
+    elif fr.model == "regularized":
+        fmodel = FRICTION_REGULARIZED
+    else:
+        fmodel = FRICTION_EXACT
+    ipar = np.zeros(3, dtype=np.int64)
+    ipar[I_N] = n
+    ipar[I_PLANAR] = int(planar)
+    ipar[I_FRICTION] = fmodel
+
+    # Error scales: positions and angles absolutely, against the Hertz penetration, so
+    # the contact geometry is resolved at every height; speeds and energies relatively.
+    rtol = scene.solver.rtol
+    L = scene.bar.length
+    dstar = cs.penetration_scale
+    vstar = cs.reference_speed
+    npos, nvel = layout(n, planar)
+    atol = np.empty(npos + nvel + NQ)
+    rel = np.zeros_like(atol)
+    sl_model = BarModel(scene, planar, basis, cs, fpar, ipar, math.radians(scene.initial.azimuth_deg),
+                        atol, rel, 0.0)
+    sl = sl_model.slices()
+    atol[sl["pos"]] = rtol * dstar
+    atol[sl["angle" if planar else "quat"]] = rtol * dstar / L
+    atol[sl["q"]] = rtol * dstar
+    atol[sl["vel"]] = rtol * vstar
+    atol[sl["omega"]] = rtol * vstar / L
+    atol[sl["eta"]] = rtol * vstar
+    atol[sl["quad"]] = rtol * cs.energy_scale
+    rel[sl["q"]] = 1.0
+    rel[sl["vel"]] = 1.0
+    rel[sl["omega"]] = 1.0
+    rel[sl["eta"]] = 1.0
+    rel[sl["quad"]] = 1.0
+    # Quadrature of the impulse is in N s, not J: scale it by the reference momentum.
+    quad0 = sl["quad"].start
+    atol[quad0 + 7: quad0 + 9] = rtol * cs.reference_mass * vstar
+    max_step = 0.25 * cs.shortest_contact
+    if scene.solver.max_step is not None:
+        max_step = min(max_step, scene.solver.max_step)
+    sl_model.max_step = max_step
+    sl_model.sparse = sparse_invariants(basis)
+    return sl_model

@@ -1,0 +1,333 @@
+"""Results of an impact run: pandas history, contact intervals, phases, restitution, energy audit.
+
+All quantities SI; the history is in the world frame (z up) for planar and 3D runs alike.
+Energy audit (paper eqs. 21-23 with elastic strain energy added):
+    E0 = K + U_elastic + (V - V0) + U_contact + D_normal + D_friction + D_modal + residual
+where D_normal = int (F_n - k y^1.5) dy/dt dt is the normal-contact work not stored in
+the Hertz spring, and D_friction = -int F_t . v_slip dt.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from numba import njit
+
+from .kernel import (
+    A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_Y, A_YDOT, NQ, Q_DFRICTION, Q_DMODAL, Q_DNORMAL,
+    Q_IMPULSE, Q_WCOMP, energies, make_work,
+)
+from .model import BarModel, matrix_to_quaternion, rotation_y, rotation_z
+
+REGIME_NAMES = ("free", "slip", "stick")
+
+
+@njit(cache=True)
+def _energy_table(Y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, xc):
+    n = ipar[0]
+    work = make_work(n)
+    out = np.empty((Y.shape[0], 4))
+    e = np.empty(4)
+    for k in range(Y.shape[0]):
+        energies(Y[k], fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, xc, work, e)
+        out[k] = e
+    return out
+
+
+@dataclass
+class ImpactResult:
+    """Outcome of ``ImpactSolver.run``. Build tables with the properties; ``save`` writes them."""
+
+    model: BarModel
+    t: np.ndarray
+    states: np.ndarray
+    aux: np.ndarray
+    peak_force: np.ndarray
+    regimes: np.ndarray
+    events: list
+    stats: dict
+    projection_energy: float = 0.0
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    # --- frames -------------------------------------------------------------------------
+
+    def _world(self):
+        """(position, quaternion, velocity, world angular velocity) per record."""
+        m = self.model
+        sl = m.slices()
+        Y = self.states
+        if not m.planar:
+            pos = Y[:, sl["pos"]]
+            quat = Y[:, sl["quat"]] / np.linalg.norm(Y[:, sl["quat"]], axis=1)[:, None]
+            vel = Y[:, sl["vel"]]
+            w_body = Y[:, sl["omega"]]
+            w, x, yq, z = quat.T
+            # rotate body angular velocity to world: R(q) w_body
+            R = np.empty((len(Y), 3, 3))
+            R[:, 0, 0] = 1 - 2 * (yq * yq + z * z)
+            R[:, 0, 1] = 2 * (x * yq - z * w)
+            R[:, 0, 2] = 2 * (x * z + yq * w)
+            R[:, 1, 0] = 2 * (x * yq + z * w)
+            R[:, 1, 1] = 1 - 2 * (x * x + z * z)
+            R[:, 1, 2] = 2 * (yq * z - x * w)
+            R[:, 2, 0] = 2 * (x * z - yq * w)
+            R[:, 2, 1] = 2 * (yq * z + x * w)
+            R[:, 2, 2] = 1 - 2 * (x * x + yq * yq)
+            omega = np.einsum("kij,kj->ki", R, w_body)
+            return pos, quat, vel, omega
+        Rz = rotation_z(m.azimuth)
+        xz = Y[:, sl["pos"]]
+        pos = np.column_stack([xz[:, 0], np.zeros(len(Y)), xz[:, 1]]) @ Rz.T
+        v = Y[:, sl["vel"]]
+        vel = np.column_stack([v[:, 0], np.zeros(len(Y)), v[:, 1]]) @ Rz.T
+        wy = Y[:, sl["omega"]][:, 0]
+        omega = np.column_stack([np.zeros(len(Y)), wy, np.zeros(len(Y))]) @ Rz.T
+        quat = np.array([matrix_to_quaternion(Rz @ rotation_y(phi)) for phi in Y[:, sl["angle"]][:, 0]])
+        return pos, quat, vel, omega
+
+    def _horizontal(self, xy: np.ndarray) -> np.ndarray:
+        """Tangential (x, y) vectors of the solver frame to the world frame."""
+        if not self.model.planar:
+            return xy
+        c, s = math.cos(self.model.azimuth), math.sin(self.model.azimuth)
+        return np.column_stack([c * xy[:, 0] - s * xy[:, 1], s * xy[:, 0] + c * xy[:, 1]])
+
+    # --- tables ---------------------------------------------------------------------------
+
+    @property
+    def energy_table(self) -> pd.DataFrame:
+        """Per record: kinetic, elastic, potential (change), contact_stored, dissipations, residual (J)."""
+        if "energy" not in self._cache:
+            m = self.model
+            b = m.basis
+            ptr, idx, val = m.sparse
+            E = _energy_table(self.states, m.fpar, m.ipar, b.J0, ptr, idx, val, b.psi_tip, b.x_centre)
+            qd = self.states[:, m.slices()["quad"]]
+            df = pd.DataFrame({
+                "time": self.t,
+                "kinetic": E[:, 0],
+                "elastic": E[:, 1],
+                "potential": E[:, 2] - E[0, 2],
+                "contact_stored": E[:, 3],
+                "normal_dissipation": qd[:, Q_DNORMAL],
+                "friction_dissipation": qd[:, Q_DFRICTION],
+                "modal_dissipation": qd[:, Q_DMODAL],
+            })
+            e0 = E[0, 0] + E[0, 1] + E[0, 3]
+            total = (df.kinetic + df.elastic + df.potential + df.contact_stored + df.normal_dissipation
+                     + df.friction_dissipation + df.modal_dissipation)
+            df["residual"] = e0 - total + self._projection_series()
+            self._cache["energy"] = df
+        return self._cache["energy"]
+
+    def _projection_series(self) -> np.ndarray:
+        # Kinetic energy removed by stick projections (below the stick tolerance), credited
+        # so the residual measures integration error only. Spread as a step at the end.
+        out = np.zeros(len(self.t))
+        out[-1:] = self.projection_energy
+        return out
+
+    @property
+    def history(self) -> pd.DataFrame:
+        """Time history at every accepted step (SI, world frame)."""
+        if "history" not in self._cache:
+            m = self.model
+            pos, quat, vel, omega = self._world()
+            data = {"time": self.t,
+                    "x": pos[:, 0], "y": pos[:, 1], "z": pos[:, 2],
+                    "qw": quat[:, 0], "qx": quat[:, 1], "qy": quat[:, 2], "qz": quat[:, 3],
+                    "vx": vel[:, 0], "vy": vel[:, 1], "vz": vel[:, 2],
+                    "wx": omega[:, 0], "wy": omega[:, 1], "wz": omega[:, 2]}
+            sl = m.slices()
+            for j, (fam, order) in enumerate(zip(m.basis.families, m.basis.orders)):
+                data[f"q_{fam}{order}"] = self.states[:, sl["q"]][:, j]
+                data[f"eta_{fam}{order}"] = self.states[:, sl["eta"]][:, j]
+            for i in range(2):
+                a = self.aux[:, i, :]
+                ft = self._horizontal(a[:, [A_FTX, A_FTY]])
+                vs = self._horizontal(a[:, [A_VTX, A_VTY]])
+                data[f"tip_height_{i}"] = -a[:, A_Y]
+                data[f"penetration_{i}"] = np.maximum(a[:, A_Y], 0.0)
+                data[f"penetration_rate_{i}"] = a[:, A_YDOT]
+                data[f"normal_force_{i}"] = a[:, A_FN]
+                data[f"friction_x_{i}"] = ft[:, 0]
+                data[f"friction_y_{i}"] = ft[:, 1]
+                data[f"slip_vx_{i}"] = vs[:, 0]
+                data[f"slip_vy_{i}"] = vs[:, 1]
+                data[f"slip_speed_{i}"] = np.hypot(vs[:, 0], vs[:, 1])
+                data[f"regime_{i}"] = pd.Categorical.from_codes(self.regimes[:, i], REGIME_NAMES)
+            df = pd.DataFrame(data)
+            en = self.energy_table
+            for col in en.columns[1:]:
+                df[col] = en[col].to_numpy()
+            self._cache["history"] = df
+        return self._cache["history"]
+
+    @property
+    def contacts(self) -> pd.DataFrame:
+        """One row per contact interval: tip, t_start, t_end (s), peak_force (N), impulse (N s),
+        normal speeds in/out (m/s), kinematic and energetic (Stronge) restitution."""
+        if "contacts" in self._cache:
+            return self._cache["contacts"]
+        rows = []
+        quad0 = self.model.slices()["quad"].start
+        for i in range(2):
+            start = None
+            if self.aux[0, i, A_Y] > 0.0:
+                start = dict(time=self.t[0], penetration_rate=self.aux[0, i, A_YDOT])
+            for ev in self.events:
+                if ev["tip"] != i:
+                    continue
+                if ev["kind"] == "contact_start":
+                    start = ev
+                elif ev["kind"] == "contact_end" and start is not None:
+                    rows.append(self._contact_row(i, start, ev, quad0))
+                    start = None
+            if start is not None:  # still in contact at the end of the run
+                end = dict(time=self.t[-1], penetration_rate=self.aux[-1, i, A_YDOT], open=True)
+                rows.append(self._contact_row(i, start, end, quad0))
+        cols = ["tip", "t_start", "t_end", "peak_force", "impulse", "normal_speed_in", "normal_speed_out",
+                "kinematic_restitution", "energetic_restitution", "complete"]
+        df = pd.DataFrame(rows, columns=cols).sort_values("t_start", kind="stable").reset_index(drop=True)
+        self._cache["contacts"] = df
+        return df
+
+    def _state_at(self, t: float) -> np.ndarray:
+        k = int(np.searchsorted(self.t, t - 1e-15))
+        return self.states[min(k, len(self.t) - 1)]
+
+    def _contact_row(self, tip: int, start: dict, end: dict, quad0: int) -> dict:
+        t0, t1 = start["time"], end["time"]
+        y0, y1 = self._state_at(t0), self._state_at(t1)
+        mask = (self.t >= t0) & (self.t <= t1)
+        peak = float(self.peak_force[mask, tip].max()) if mask.any() else 0.0
+        impulse = y1[quad0 + Q_IMPULSE + tip] - y0[quad0 + Q_IMPULSE + tip]
+        w_comp = y1[quad0 + Q_WCOMP + 2 * tip] - y0[quad0 + Q_WCOMP + 2 * tip]
+        w_rest = y1[quad0 + Q_WCOMP + 2 * tip + 1] - y0[quad0 + Q_WCOMP + 2 * tip + 1]
+        v_in = float(start["penetration_rate"])
+        v_out = float(-end["penetration_rate"])
+        complete = not end.get("open", False)
+        return dict(
+            tip=tip, t_start=float(t0), t_end=float(t1), peak_force=peak, impulse=float(impulse),
+            normal_speed_in=v_in, normal_speed_out=v_out,
+            kinematic_restitution=v_out / v_in if (complete and v_in > 0) else float("nan"),
+            energetic_restitution=math.sqrt(max(-w_rest, 0.0) / w_comp) if (complete and w_comp > 0) else float("nan"),
+            complete=complete,
+        )
+
+    @property
+    def phases(self) -> pd.DataFrame:
+        """Intervals of constant regime per tip: tip, regime, t_start, t_end (s)."""
+        if "phases" in self._cache:
+            return self._cache["phases"]
+        rows = []
+        for i in range(2):
+            codes = self.regimes[:, i]
+            start = 0
+            for k in range(1, len(codes) + 1):
+                if k == len(codes) or codes[k] != codes[start]:
+                    t_start = self.t[start - 1] if start > 0 else self.t[0]
+                    rows.append(dict(tip=i, regime=REGIME_NAMES[codes[start]], t_start=float(t_start),
+                                     t_end=float(self.t[k - 1])))
+                    start = k
+        df = pd.DataFrame(rows, columns=["tip", "regime", "t_start", "t_end"])
+        self._cache["phases"] = df
+        return df
+
+    @property
+    def event_table(self) -> pd.DataFrame:
+        return pd.DataFrame(self.events)
+
+    @property
+    def restitution(self) -> dict:
+        """Kinematic and energetic restitution of the first complete contact (nan if none)."""
+        c = self.contacts
+        c = c[c.complete]
+        if c.empty:
+            return {"kinematic": float("nan"), "energetic": float("nan")}
+        first = c.iloc[0]
+        return {"kinematic": float(first.kinematic_restitution), "energetic": float(first.energetic_restitution)}
+
+    @property
+    def energy(self) -> dict:
+        """Energy audit at the end of the run (J), plus the largest relative residual."""
+        en = self.energy_table
+        last = en.iloc[-1]
+        e0 = float(en.kinetic.iloc[0] + en.elastic.iloc[0] + en.contact_stored.iloc[0])
+        scale = self.energy_scale
+        return {
+            "initial": e0,
+            "kinetic": float(last.kinetic),
+            "elastic": float(last.elastic),
+            "potential_change": float(last.potential),
+            "contact_stored": float(last.contact_stored),
+            "normal_dissipation": float(last.normal_dissipation),
+            "friction_dissipation": float(last.friction_dissipation),
+            "modal_dissipation": float(last.modal_dissipation),
+            "residual": float(last.residual),
+            "relative_residual": float(np.max(np.abs(en.residual)) / scale),
+        }
+
+    @property
+    def energy_scale(self) -> float:
+        """J: the energy the audit is judged against, the largest kinetic energy of the run."""
+        en = self.energy_table
+        return float(max(en.kinetic.max(), en.elastic.max(), 1e-300))
+
+    @property
+    def flags(self) -> list[str]:
+        """Warnings about this result (energy residual above tolerance, invalid contact geometry)."""
+        out = []
+        tol = self.model.scene.solver.energy_tolerance
+        rel = self.energy["relative_residual"]
+        if not rel <= tol:
+            out.append(f"energy residual {rel:.3g} of the largest kinetic energy exceeds "
+                       f"solver.energy_tolerance = {tol:g}")
+        for ev in self.events:
+            if ev["kind"] == "invalid_contact_geometry":
+                out.append(f"t = {ev['time']:.6g} s, tip {ev['tip']}: {ev['note']}")
+        return out
+
+    @property
+    def solver(self) -> dict:
+        m = self.model
+        return dict(self.stats, model="planar" if m.planar else "3d", modes=m.n, states=m.state_size,
+                    friction=("none", "exact", "regularized")[int(m.ipar[2])],
+                    damping=m.contact.damping, stiffness=m.contact.stiffness)
+
+    def to_summary(self) -> dict:
+        """The JSON summary: contacts, restitution, energy, solver, flags."""
+        c = self.contacts
+        return {
+            "contacts": [
+                {k: (int(r[k]) if k == "tip" else (bool(r[k]) if k == "complete" else _num(r[k])))
+                 for k in c.columns}
+                for _, r in c.iterrows()
+            ],
+            "restitution": {k: _num(v) for k, v in self.restitution.items()},
+            "energy": {k: _num(v) for k, v in self.energy.items()},
+            "solver": {k: (_num(v) if isinstance(v, float) else v) for k, v in self.solver.items()},
+            "flags": self.flags,
+        }
+
+    def save(self, out_dir) -> Path:
+        """Write summary.json, history.csv, contacts.csv, phases.csv, events.csv into out_dir."""
+        out = Path(out_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "summary.json").write_text(json.dumps(self.to_summary(), indent=2))
+        self.history.to_csv(out / "history.csv", index=False)
+        self.contacts.to_csv(out / "contacts.csv", index=False)
+        self.phases.to_csv(out / "phases.csv", index=False)
+        self.event_table.to_csv(out / "events.csv", index=False)
+        return out
+
+
+def _num(v):
+    """JSON-safe float (NaN -> None)."""
+    v = float(v)
+    return None if not math.isfinite(v) else v

@@ -1,0 +1,97 @@
+"""scipy.integrate.solve_ivp as an alternative stepper for the same model and regimes.
+
+Same right-hand side, same events, same regime logic as the compiled DOPRI5 loop; only
+the stepping differs. Used as the speed baseline (Radau, benchmarks/bench_mech.py) and as
+an independent integration route in the tests (DOP853, Radau).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .integrator import DONE, EVENT, NOT_FINITE, events_from_aux
+from .kernel import A_FN, FRICTION_EXACT, I_FRICTION, NAUX, NEV_TIP, EV_SLIP, EV_STICK, SLIP, STICK, dynamics
+
+METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
+
+
+def scipy_segment(solver, t_target: float, method: str):
+    """Integrate ``solver`` (an ImpactSolver) from its state towards t_target with solve_ivp.
+
+    Returns (status, t_new, h_next, n_records, event_index) like the compiled loop and
+    writes the accepted steps into the solver's record buffers.
+    """
+    if method not in METHODS:
+        raise ValueError(f"backend method = {method!r}: allowed values are {', '.join(METHODS)}")
+    m = solver.model
+    arrays = m.arrays
+    regime = solver.regime.copy()
+    eref = solver.eref.copy()
+    work = solver._work
+    aux = np.empty((2, NAUX))
+    g = np.empty(2 * NEV_TIP)
+    N = m.state_size
+    counter = {"nfev": 0}
+
+    def fun(t, y):
+        dy = np.empty(N)
+        dynamics(t, y, *arrays, regime, eref, dy, aux, work)
+        counter["nfev"] += 1
+        return dy
+
+    counter_events = counter  # event evaluations count as right-hand-side evaluations too
+
+    fexact = m.ipar[I_FRICTION] == FRICTION_EXACT
+
+    def make_event(k):
+        i, kind = divmod(k, NEV_TIP)
+
+        def ev(t, y):
+            dy = np.empty(N)
+            dynamics(t, y, *arrays, regime, eref, dy, aux, work)
+            counter_events["nfev"] += 1
+            events_from_aux(aux, eref, m.fpar, g)
+            if kind == EV_SLIP and not (fexact and regime[i] == SLIP):
+                return solver.ev_sign[k]
+            if kind == EV_STICK and not (fexact and regime[i] == STICK):
+                return solver.ev_sign[k]
+            return g[k]
+
+        ev.terminal = True
+        ev.direction = -solver.ev_sign[k]
+        return ev
+
+    events = [make_event(k) for k in range(2 * NEV_TIP)]
+    rtol = solver.scene.solver.rtol
+    # solve_ivp's error test is |err| <= atol + rtol |y| for every component, so positions
+    # also get a relative share (the compiled loop holds them to atol alone): the baseline
+    # is, if anything, given a looser tolerance than the compiled loop.
+    sol = solve_ivp(fun, (solver.t, t_target), solver.y.copy(), method=method, rtol=rtol,
+                    atol=m.atol, max_step=m.max_step, events=events,
+                    first_step=min(solver.h, m.max_step) if solver.h > 0 else None)
+    solver.stats[2] += counter["nfev"]
+    n_new = len(sol.t) - 1
+    while solver._n + n_new + 1 >= solver._cap:
+        solver._grow()
+    n0 = solver._n
+    for k in range(1, len(sol.t)):
+        y = sol.y[:, k]
+        dy = np.empty(N)
+        dynamics(sol.t[k], y, *arrays, regime, eref, dy, aux, work)
+        r = n0 + k - 1
+        solver._rec_t[r] = sol.t[k]
+        solver._rec_y[r] = y
+        solver._rec_aux[r] = aux
+        solver._rec_fmax[r] = aux[:, A_FN]
+    solver.stats[0] += n_new
+    if not sol.success:
+        solver.y[:] = sol.y[:, -1]
+        return NOT_FINITE, float(sol.t[-1]), 0.0, n_new, -1
+    solver.y[:] = sol.y[:, -1]
+    h_next = float(sol.t[-1] - sol.t[-2]) if len(sol.t) > 1 else solver.h
+    if sol.status == 1:
+        hit = [k for k, te in enumerate(sol.t_events) if len(te)]
+        solver.stats[3] += 1
+        return EVENT, float(sol.t[-1]), h_next, n_new, hit[0]
+    return DONE, float(t_target), h_next, n_new, -1

@@ -1,0 +1,427 @@
+"""The impact solver: advances the compiled integrator, switches regimes at events.
+
+``ImpactSolver(scene).run()`` integrates a whole scene. For co-simulation,
+``advance(t, mu=...)`` integrates to ``t`` and returns a ``Segment`` whose dense
+output gives the state and contact forces at any time inside the step; the solver
+then resumes from where it stopped, without starting over.
+
+Regimes per tip: free, slip, stick. At every event the integration stops exactly at
+the event (located on the dense output), the regimes are resolved for the new state,
+and the integration restarts:
+- contact start/end (penetration crosses zero) and force clip (F_n would go negative);
+- slip: the slip velocity's component along the slip direction at the last restart
+  crosses zero. If the slip speed is then below ``stick_velocity_tol`` the tip sticks
+  when the friction needed to hold it is within the limit, otherwise it slips the other
+  way (reversal); a larger speed means the slip direction turned, and slip goes on
+  along the new direction;
+- stick: the friction needed to hold the tip reaches the limit mu F_n^(1-gamma); slip
+  starts along the direction that friction was resisting.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .integrator import (
+    BUFFER_FULL, DONE, EVENT, STATUS_TEXT, dense_eval, events_from_aux, integrate,
+)
+from .kernel import (
+    A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_CONTACT, EV_SLIP,
+    EV_STICK, F_MU0, F_MU_SLOPE, F_T_MU, FREE, FRICTION_EXACT, I_FRICTION, NAUX, NEV_TIP, SLIP,
+    STICK, dynamics, make_work, project_to_stick,
+)
+from .contact_laws import hertz_impact
+from .model import BarModel, build_model
+from .parameters import MechScene
+from .scipy_backend import METHODS as SCIPY_METHODS, scipy_segment
+
+REGIME_NAMES = ("free", "slip", "stick")
+EVENT_KINDS = ("contact", "clip", "slip", "stick")
+
+
+class MechSolverError(RuntimeError):
+    """The integration failed; carries the time (s), the named state and the partial result."""
+
+    def __init__(self, message: str, t: float, state: dict, partial=None):
+        super().__init__(message)
+        self.t = t
+        self.state = state
+        self.partial_result = partial
+
+
+@dataclass
+class Segment:
+    """Dense trajectory over one ``advance`` call: state and contact quantities at any t.
+
+    events: the events inside the segment, as dicts with time (s), tip, kind, regimes.
+    """
+
+    t_start: float
+    t_end: float
+    events: list
+    _model: BarModel
+    _t0: np.ndarray
+    _h: np.ndarray
+    _t_valid: np.ndarray
+    _coef: np.ndarray
+    _start_state: np.ndarray
+    _regime: np.ndarray
+    _eref: np.ndarray
+    _work: tuple = field(repr=False, default=None)
+
+    def state(self, t: float) -> np.ndarray:
+        """State vector at time t (s) in [t_start, t_end] (4th-order dense output)."""
+        if not (self.t_start - 1e-15 <= t <= self.t_end + 1e-15):
+            raise ValueError(f"t = {t!r}: outside the segment [{self.t_start!r}, {self.t_end!r}] s")
+        if len(self._t_valid) == 0 or t <= self.t_start:
+            return self._start_state.copy()
+        k = int(np.searchsorted(self._t_valid, t))
+        k = min(k, len(self._t_valid) - 1)
+        out = np.empty(self._coef.shape[2])
+        dense_eval(self._coef[k], (t - self._t0[k]) / self._h[k], out)
+        return out
+
+    def contact(self, t: float) -> np.ndarray:
+        """(2, 3) per tip: penetration (m), penetration rate (m/s), normal force (N) at t."""
+        y = self.state(t)
+        if self._work is None:
+            self._work = make_work(self._model.n)
+        dy = np.empty_like(y)
+        aux = np.empty((2, NAUX))
+        k = int(np.searchsorted(self._t_valid, t)) if len(self._t_valid) else 0
+        k = min(k, max(len(self._regime) - 1, 0))
+        regime = self._regime[k] if len(self._regime) else np.zeros(2, np.int64)
+        dynamics(t, y, *self._model.arrays, regime, self._eref, dy, aux, self._work)
+        return aux[:, [A_Y, A_YDOT, A_FN]].copy()
+
+    def normal_force(self, t: float) -> float:
+        """N: total normal force of both tips at t."""
+        return float(self.contact(t)[:, 2].sum())
+
+
+class ImpactSolver:
+    """Integrates one mechanics scene; see the module docstring for the regimes."""
+
+    def __init__(self, scene: MechScene, *, keep_dense: bool = False, capacity: int = 4096,
+                 backend: str = "dopri5"):
+        """backend: "dopri5" (the compiled loop) or "scipy:<method>" (solve_ivp with
+        RK45, DOP853, Radau, BDF or LSODA on the same right-hand side and events)."""
+        if backend != "dopri5" and not (backend.startswith("scipy:") and backend[6:] in SCIPY_METHODS):
+            raise ValueError(f"backend = {backend!r}: allowed values are 'dopri5' or 'scipy:<method>' with "
+                             f"<method> one of {', '.join(SCIPY_METHODS)}")
+        if keep_dense and backend != "dopri5":
+            raise ValueError("keep_dense: dense output is provided by the 'dopri5' backend only")
+        self.backend = backend
+        self.scene = scene
+        self.model = build_model(scene)
+        self.keep_dense = keep_dense
+        m = self.model
+        self.t = 0.0
+        self.y = m.initial_state()
+        self.h = 0.0
+        self.regime = np.zeros(2, dtype=np.int64)
+        self.eref = np.zeros((2, 2))
+        self.eref[:, 0] = 1.0
+        self.ev_sign = np.zeros(2 * NEV_TIP)
+        self.stats = np.zeros(4, dtype=np.int64)
+        self.events: list[dict] = []
+        self.wall_time = 0.0
+        self.projection_energy = 0.0
+        self._work = make_work(m.n)
+        self._aux = np.empty((2, NAUX))
+        self._dy = np.empty(m.state_size)
+        N = m.state_size
+        self._cap = capacity
+        self._n = 0
+        self._rec_t = np.empty(capacity)
+        self._rec_y = np.empty((capacity, N))
+        self._rec_aux = np.empty((capacity, 2, NAUX))
+        self._rec_fmax = np.empty((capacity, 2))
+        self._rec_regime = np.empty((capacity, 2), dtype=np.int64)
+        dcap = capacity if keep_dense else 1
+        self._dense_t0 = np.empty(dcap)
+        self._dense_h = np.empty(dcap)
+        self._dense_coef = np.empty((dcap, 5, N))
+        self._initial_state = self.y.copy()
+        hz = hertz_impact(m.contact.reference_mass, m.contact.stiffness, m.contact.reference_speed)
+        self._onset_step = hz.contact_time * scene.solver.rtol ** (2.0 / 7.0)
+        self._resolve(triggered=None)
+        self._record_point()
+
+    # --- public API -------------------------------------------------------------------
+
+    @property
+    def planar(self) -> bool:
+        return self.model.planar
+
+    def set_friction_coefficient(self, mu_start: float, mu_end: float | None = None,
+                                 t_end: float | None = None) -> None:
+        """Friction coefficient (N^gamma) from now on: constant, or linear to ``mu_end`` at ``t_end``."""
+        fpar = self.model.fpar
+        fpar[F_MU0] = max(float(mu_start), 0.0)
+        fpar[F_T_MU] = self.t
+        if mu_end is None or t_end is None or t_end <= self.t:
+            fpar[F_MU_SLOPE] = 0.0
+        else:
+            fpar[F_MU_SLOPE] = (float(mu_end) - float(mu_start)) / (t_end - self.t)
+
+    def advance(self, t_target: float, mu=None) -> Segment:
+        """Integrate to ``t_target`` (s); ``mu`` = number or (mu_start, mu_end) over the step."""
+        if not math.isfinite(t_target) or t_target < self.t:
+            raise ValueError(f"t_target = {t_target!r}: must be a finite time >= the current {self.t!r} s")
+        if mu is not None:
+            if np.ndim(mu) == 0:
+                self.set_friction_coefficient(float(mu))
+            else:
+                self.set_friction_coefficient(float(mu[0]), float(mu[1]), t_target)
+            if self.model.ipar[I_FRICTION] == FRICTION_EXACT:
+                self._resolve(triggered=None)  # a new mu may change what can stick
+        n_first = self._n
+        ev_first = len(self.events)
+        start_state = self.y.copy()
+        t_start = self.t
+        tick = time.perf_counter()
+        m = self.model
+        while self.t < t_target:
+            if self._n >= self._cap - 1:
+                self._grow()
+            n0 = self._n
+            if self.backend != "dopri5":
+                status, t_new, h, n_rec, ev = scipy_segment(self, t_target, self.backend[6:])
+            else:
+                status, t_new, h, n_rec, ev = integrate(
+                    self.t, self.y, t_target, self.h, m.max_step, self.scene.solver.rtol, m.atol, m.relmask,
+                    *m.arrays, self.regime, self.eref, self.ev_sign,
+                    self._rec_t[n0:], self._rec_y[n0:], self._rec_aux[n0:], self._rec_fmax[n0:],
+                    self._dense_t0[n0:] if self.keep_dense else self._dense_t0,
+                    self._dense_h[n0:] if self.keep_dense else self._dense_h,
+                    self._dense_coef[n0:] if self.keep_dense else self._dense_coef,
+                    self.keep_dense, self.scene.solver.max_steps, self._work, self.stats,
+                )
+            self._rec_regime[n0:n0 + n_rec] = self.regime
+            self._n += n_rec
+            self.t = t_new
+            self.h = h
+            if status == DONE:
+                self.t = t_target
+                break
+            if status == BUFFER_FULL:
+                continue
+            if status == EVENT:
+                self._handle_event(ev)
+                continue
+            self.wall_time += time.perf_counter() - tick
+            raise MechSolverError(
+                f"mechanics integration failed at t = {self.t!r} s: {STATUS_TEXT[status]} "
+                f"(step {self.h!r} s, regimes {[REGIME_NAMES[r] for r in self.regime]})",
+                self.t, self.named_state(), partial=self.result(),
+            )
+        self.wall_time += time.perf_counter() - tick
+        n_last = self._n
+        if self.keep_dense:
+            t0 = self._dense_t0[n_first:n_last].copy()
+            hh = self._dense_h[n_first:n_last].copy()
+            coef = self._dense_coef[n_first:n_last].copy()
+        else:
+            t0 = hh = np.empty(0)
+            coef = np.empty((0, 5, m.state_size))
+        return Segment(t_start, self.t, self.events[ev_first:], m, t0, hh,
+                       self._rec_t[n_first:n_last].copy(), coef, start_state,
+                       self._rec_regime[n_first:n_last].copy(), self.eref.copy())
+
+    def run(self):
+        """Integrate to ``solver.t_end`` and return the ``ImpactResult``."""
+        self.advance(self.scene.solver.t_end)
+        return self.result()
+
+    def result(self):
+        from .results import ImpactResult
+
+        n = self._n
+        return ImpactResult(
+            model=self.model,
+            t=self._rec_t[:n].copy(),
+            states=self._rec_y[:n].copy(),
+            aux=self._rec_aux[:n].copy(),
+            peak_force=self._rec_fmax[:n].copy(),
+            regimes=self._rec_regime[:n].copy(),
+            events=list(self.events),
+            stats=dict(steps=int(self.stats[0]), rejected_steps=int(self.stats[1]),
+                       rhs_evals=int(self.stats[2]), events=int(self.stats[3]),
+                       wall_time=self.wall_time),
+            projection_energy=self.projection_energy,
+        )
+
+    def contact_now(self) -> np.ndarray:
+        """(2, 3) per tip: penetration (m), rate (m/s), normal force (N) at the current time."""
+        aux = self._evaluate()
+        return aux[:, [A_Y, A_YDOT, A_FN]].copy()
+
+    def named_state(self) -> dict:
+        """The current state by name (SI), for error messages and inspection."""
+        sl = self.model.slices()
+        return {name: self.y[s].tolist() for name, s in sl.items() if name != "quad"}
+
+    # --- internals ------------------------------------------------------------------
+
+    def _evaluate(self) -> np.ndarray:
+        dynamics(self.t, self.y, *self.model.arrays, self.regime, self.eref, self._dy, self._aux, self._work)
+        return self._aux
+
+    def _grow(self) -> None:
+        cap = 2 * self._cap
+        def grown(a):
+            b = np.empty((cap,) + a.shape[1:], dtype=a.dtype)
+            b[: self._n] = a[: self._n]
+            return b
+        self._rec_t, self._rec_y = grown(self._rec_t), grown(self._rec_y)
+        self._rec_aux, self._rec_fmax = grown(self._rec_aux), grown(self._rec_fmax)
+        self._rec_regime = grown(self._rec_regime)
+        if self.keep_dense:
+            self._dense_t0, self._dense_h = grown(self._dense_t0), grown(self._dense_h)
+            self._dense_coef = grown(self._dense_coef)
+        self._cap = cap
+
+    def _record_point(self) -> None:
+        """Record the current state as a history row (start of the run)."""
+        if self._n >= self._cap - 1:
+            self._grow()
+        aux = self._evaluate()
+        k = self._n
+        self._rec_t[k] = self.t
+        self._rec_y[k] = self.y
+        self._rec_aux[k] = aux
+        self._rec_fmax[k] = aux[:, A_FN]
+        self._rec_regime[k] = self.regime
+        if self.keep_dense:  # a zero-length step: evaluates to the state itself
+            self._dense_t0[k] = self.t
+            self._dense_h[k] = 1.0
+            self._dense_coef[k] = 0.0
+            self._dense_coef[k, 0] = self.y
+        self._n += 1
+
+    def _handle_event(self, ev: int) -> None:
+        tip, kind = divmod(ev, NEV_TIP)
+        old = self.regime.copy()
+        old_sign = self.ev_sign[ev]
+        self._resolve(triggered=ev)
+        aux = self._aux
+        if kind == EV_CONTACT:
+            name = "contact_start" if old_sign < 0 else "contact_end"
+            if name == "contact_start":
+                self._check_cap(tip)
+                # F_n ~ y^1.5 is not smooth at y = 0: the first step's local error goes as
+                # (h/t_c)^3.5, which the embedded estimate underrates; start small.
+                self.h = min(self.h, self._onset_step)
+        elif kind == EV_CLIP:
+            name = "force_clip_start" if old_sign > 0 else "force_clip_end"
+        elif kind == EV_SLIP:
+            if self.regime[tip] == STICK:
+                name = "stick_start"
+            elif self.regime[tip] != SLIP:
+                name = "slip_end"
+            elif math.hypot(aux[tip, A_VTX], aux[tip, A_VTY]) > self.scene.solver.stick_velocity_tol:
+                name = "slip_turn"  # the slip direction swept past 90 deg of the reference
+            else:
+                name = "slip_reversal"
+        else:
+            name = "stick_end"
+        self.events.append(dict(
+            time=self.t, tip=tip, kind=name,
+            regime_before=REGIME_NAMES[old[tip]], regime_after=REGIME_NAMES[self.regime[tip]],
+            penetration=float(aux[tip, A_Y]), penetration_rate=float(aux[tip, A_YDOT]),
+            normal_force=float(aux[tip, A_FN]),
+            slip_speed=float(math.hypot(aux[tip, A_VTX], aux[tip, A_VTY])),
+        ))
+
+    def _check_cap(self, tip: int) -> None:
+        """Flag contacts whose normal leaves the spherical cap (the model then does not hold)."""
+        from .kernel import quat_to_matrix
+
+        R = np.empty((3, 3))
+        if self.model.planar:
+            phi = self.y[2]
+            b1z = -math.sin(phi)
+        else:
+            quat_to_matrix(*self.y[3:7], R)
+            b1z = R[2, 0]
+        outward_z = b1z if tip == 1 else -b1z  # z of the tip's outward axis
+        angle = math.acos(max(-1.0, min(1.0, -outward_z)))  # between outward axis and -z
+        if angle > self.scene.bar.cap_half_angle + 1e-9:
+            self.events.append(dict(
+                time=self.t, tip=tip, kind="invalid_contact_geometry", regime_before="", regime_after="",
+                penetration=0.0, penetration_rate=0.0, normal_force=0.0, slip_speed=0.0,
+                note=f"contact normal {math.degrees(angle):.1f} deg from the tip axis, beyond the cap's "
+                     f"{math.degrees(self.scene.bar.cap_half_angle):.1f} deg: the bar's side would touch",
+            ))
+
+    def _resolve(self, triggered: int | None) -> None:
+        """Set each tip's regime for the current state and the event signs to watch."""
+        fexact = self.model.ipar[I_FRICTION] == FRICTION_EXACT
+        tol = self.scene.solver.stick_velocity_tol
+        aux = self._evaluate()
+        new = self.regime.copy()
+        # A triggered event's state can sit a round-off away from the root on either side
+        # (solve_ivp does not say which); its crossing direction decides there.
+        tiny = 1e-9 * self.model.contact.penetration_scale
+        for i in range(2):
+            pen = aux[i, A_Y]
+            if triggered == NEV_TIP * i + EV_CONTACT and abs(pen) <= tiny:
+                in_contact = self.ev_sign[triggered] < 0.0  # crossing upwards: contact starts
+            else:
+                in_contact = pen > 0.0
+            if not in_contact:
+                new[i] = FREE
+                continue
+            vt = np.array([aux[i, A_VTX], aux[i, A_VTY]])
+            speed = float(np.hypot(*vt))
+            if not fexact or aux[i, A_FN] <= 0.0:
+                new[i] = SLIP
+                if speed > 0.0:
+                    self.eref[i] = vt / speed
+                continue
+            if new[i] == STICK:
+                continue
+            if speed > tol:
+                new[i] = SLIP
+                self.eref[i] = vt / speed
+            else:
+                new[i] = STICK  # provisional: kept if the holding force is within the limit
+        # Stick needs the holding force within the limit; the tips are coupled through the bar.
+        for _ in range(3):
+            self.regime[:] = new
+            aux = self._evaluate()
+            changed = False
+            for i in range(2):
+                if new[i] != STICK:
+                    continue
+                ft = np.array([aux[i, A_FTX], aux[i, A_FTY]])
+                fmag = float(np.hypot(*ft))
+                limit = aux[i, A_MARGIN] + fmag
+                if aux[i, A_MARGIN] < -1e-9 * max(limit, 1e-12):
+                    new[i] = SLIP
+                    self.eref[i] = -ft / fmag
+                    changed = True
+            if not changed:
+                break
+        self.regime[:] = new
+        if fexact and np.any(new == STICK):
+            self.projection_energy += project_to_stick(
+                self.t, self.y, *self.model.arrays, self.regime, self.eref, self._aux, self._work)
+        aux = self._evaluate()
+        g = np.empty(2 * NEV_TIP)
+        events_from_aux(aux, self.eref, self.model.fpar, g)
+        for i in range(2):
+            b = NEV_TIP * i
+            self.ev_sign[b + EV_CONTACT] = -1.0 if new[i] == FREE else 1.0
+            gc = g[b + EV_CLIP]
+            if triggered == b + EV_CLIP:
+                self.ev_sign[b + EV_CLIP] = -self.ev_sign[b + EV_CLIP]  # now on the new side
+            else:
+                self.ev_sign[b + EV_CLIP] = 1.0 if gc >= 0.0 else -1.0
+            self.ev_sign[b + EV_SLIP] = 1.0
+            self.ev_sign[b + EV_STICK] = 1.0
