@@ -120,16 +120,6 @@ def unpack(y, n, planar, r, R, q, V, w, eta):
 
 
 @njit(cache=True)
-def cross(a, b, out):
-    x = a[1] * b[2] - a[2] * b[1]
-    yv = a[2] * b[0] - a[0] * b[2]
-    z = a[0] * b[1] - a[1] * b[0]
-    out[0] = x
-    out[1] = yv
-    out[2] = z
-
-
-@njit(cache=True)
 def inverse3(A, out):
     """Inverse of a 3x3 matrix by cofactors (the Schur complement is symmetric positive definite)."""
     c00 = A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1]

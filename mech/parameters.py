@@ -332,7 +332,7 @@ class SolverOptions:
     model: Literal["auto", "planar", "3d"] = "auto"
     max_step: float | None = None
     stick_velocity_tol: float = 1e-6
-    energy_tolerance: float = 1e-4
+    energy_tolerance: float = 1e-3
     max_steps: int = 5_000_000
 
     def __post_init__(self):

@@ -52,6 +52,7 @@ class ImpactResult:
     events: list
     stats: dict
     projection_energy: float = 0.0
+    extra_states: np.ndarray | None = None  # (records, size) of CoupledStates, if any
     _cache: dict = field(default_factory=dict, repr=False)
 
     # --- frames -------------------------------------------------------------------------

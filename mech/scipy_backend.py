@@ -11,7 +11,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .integrator import DONE, EVENT, NOT_FINITE, events_from_aux
-from .kernel import A_FN, FRICTION_EXACT, I_FRICTION, NAUX, NEV_TIP, EV_SLIP, EV_STICK, SLIP, STICK, dynamics
+from .kernel import A_FN, A_Y, A_YDOT, F_MU0, FRICTION_EXACT, I_FRICTION, NAUX, NEV_TIP, EV_SLIP, EV_STICK, SLIP, STICK, dynamics
 
 METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
 
@@ -33,10 +33,16 @@ def scipy_segment(solver, t_target: float, method: str):
     g = np.empty(2 * NEV_TIP)
     N = m.state_size
     counter = {"nfev": 0}
+    coupled = solver.coupled
+    n_ext = coupled.size if coupled is not None else 0
 
     def fun(t, y):
-        dy = np.empty(N)
-        dynamics(t, y, *arrays, regime, eref, dy, aux, work)
+        dy = np.empty(N + n_ext)
+        if coupled is not None:
+            m.fpar[F_MU0] = coupled.friction_coefficient(t, y[N:])
+        dynamics(t, y[:N], *arrays, regime, eref, dy[:N], aux, work)
+        if coupled is not None:
+            dy[N:] = coupled.rhs(t, y[N:], aux[:, [A_Y, A_YDOT, A_FN]])
         counter["nfev"] += 1
         return dy
 
@@ -49,7 +55,9 @@ def scipy_segment(solver, t_target: float, method: str):
 
         def ev(t, y):
             dy = np.empty(N)
-            dynamics(t, y, *arrays, regime, eref, dy, aux, work)
+            if coupled is not None:
+                m.fpar[F_MU0] = coupled.friction_coefficient(t, y[N:])
+            dynamics(t, y[:N], *arrays, regime, eref, dy, aux, work)
             counter_events["nfev"] += 1
             events_from_aux(aux, eref, m.fpar, g)
             if kind == EV_SLIP and not (fexact and regime[i] == SLIP):
@@ -67,8 +75,10 @@ def scipy_segment(solver, t_target: float, method: str):
     # solve_ivp's error test is |err| <= atol + rtol |y| for every component, so positions
     # also get a relative share (the compiled loop holds them to atol alone): the baseline
     # is, if anything, given a looser tolerance than the compiled loop.
-    sol = solve_ivp(fun, (solver.t, t_target), solver.y.copy(), method=method, rtol=rtol,
-                    atol=m.atol, max_step=m.max_step, events=events,
+    y0 = solver.y.copy() if coupled is None else np.concatenate([solver.y, solver.z])
+    atol = m.atol if coupled is None else np.concatenate([m.atol, coupled.atol])
+    sol = solve_ivp(fun, (solver.t, t_target), y0, method=method, rtol=rtol,
+                    atol=atol, max_step=m.max_step, events=events,
                     first_step=min(solver.h, m.max_step) if solver.h > 0 else None)
     solver.stats[2] += counter["nfev"]
     n_new = len(sol.t) - 1
@@ -76,8 +86,11 @@ def scipy_segment(solver, t_target: float, method: str):
         solver._grow()
     n0 = solver._n
     for k in range(1, len(sol.t)):
-        y = sol.y[:, k]
+        y = sol.y[:N, k]
         dy = np.empty(N)
+        if coupled is not None:
+            m.fpar[F_MU0] = coupled.friction_coefficient(sol.t[k], sol.y[N:, k])
+            solver._rec_ext[n0 + k - 1] = sol.y[N:, k]
         dynamics(sol.t[k], y, *arrays, regime, eref, dy, aux, work)
         r = n0 + k - 1
         solver._rec_t[r] = sol.t[k]
@@ -85,10 +98,12 @@ def scipy_segment(solver, t_target: float, method: str):
         solver._rec_aux[r] = aux
         solver._rec_fmax[r] = aux[:, A_FN]
     solver.stats[0] += n_new
+    solver.y[:] = sol.y[:N, -1]
+    if coupled is not None:
+        solver.z[:] = sol.y[N:, -1]
+        m.fpar[F_MU0] = coupled.friction_coefficient(sol.t[-1], solver.z)
     if not sol.success:
-        solver.y[:] = sol.y[:, -1]
         return NOT_FINITE, float(sol.t[-1]), 0.0, n_new, -1
-    solver.y[:] = sol.y[:, -1]
     h_next = float(sol.t[-1] - sol.t[-2]) if len(sol.t) > 1 else solver.h
     if sol.status == 1:
         hit = [k for k, te in enumerate(sol.t_events) if len(te)]

@@ -53,6 +53,29 @@ class MechSolverError(RuntimeError):
         self.partial_result = partial
 
 
+@dataclass(frozen=True)
+class CoupledStates:
+    """Extra states integrated in the same solve as the mechanics (scipy backends only).
+
+    The mechanics gives them the contact quantities; they give back the friction
+    coefficient. A monolithic co-simulation reference is built this way without the
+    mechanics knowing what the states are.
+    initial: (size,) initial values; atol: (size,) absolute tolerances.
+    rhs(t, z, contact) -> dz/dt, with contact (2, 3): per tip penetration (m),
+    penetration rate (m/s), normal force (N).
+    friction_coefficient(t, z) -> mu (N^gamma).
+    """
+
+    initial: np.ndarray
+    atol: np.ndarray
+    rhs: object
+    friction_coefficient: object
+
+    @property
+    def size(self) -> int:
+        return len(self.initial)
+
+
 @dataclass
 class Segment:
     """Dense trajectory over one ``advance`` call: state and contact quantities at any t.
@@ -107,7 +130,7 @@ class ImpactSolver:
     """Integrates one mechanics scene; see the module docstring for the regimes."""
 
     def __init__(self, scene: MechScene, *, keep_dense: bool = False, capacity: int = 4096,
-                 backend: str = "dopri5"):
+                 backend: str = "dopri5", coupled: CoupledStates | None = None):
         """backend: "dopri5" (the compiled loop) or "scipy:<method>" (solve_ivp with
         RK45, DOP853, Radau, BDF or LSODA on the same right-hand side and events)."""
         if backend != "dopri5" and not (backend.startswith("scipy:") and backend[6:] in SCIPY_METHODS):
@@ -115,7 +138,11 @@ class ImpactSolver:
                              f"<method> one of {', '.join(SCIPY_METHODS)}")
         if keep_dense and backend != "dopri5":
             raise ValueError("keep_dense: dense output is provided by the 'dopri5' backend only")
+        if coupled is not None and backend == "dopri5":
+            raise ValueError("coupled: extra states need a stiff scipy backend, e.g. 'scipy:Radau'")
         self.backend = backend
+        self.coupled = coupled
+        self.z = np.array(coupled.initial, dtype=float) if coupled is not None else np.zeros(0)
         self.scene = scene
         self.model = build_model(scene)
         self.keep_dense = keep_dense
@@ -142,6 +169,9 @@ class ImpactSolver:
         self._rec_aux = np.empty((capacity, 2, NAUX))
         self._rec_fmax = np.empty((capacity, 2))
         self._rec_regime = np.empty((capacity, 2), dtype=np.int64)
+        self._rec_ext = np.empty((capacity, len(self.z)))
+        if coupled is not None:
+            self.model.fpar[F_MU0] = coupled.friction_coefficient(0.0, self.z)
         dcap = capacity if keep_dense else 1
         self._dense_t0 = np.empty(dcap)
         self._dense_h = np.empty(dcap)
@@ -254,6 +284,7 @@ class ImpactSolver:
                        rhs_evals=int(self.stats[2]), events=int(self.stats[3]),
                        wall_time=self.wall_time),
             projection_energy=self.projection_energy,
+            extra_states=self._rec_ext[:n].copy(),
         )
 
     def contact_now(self) -> np.ndarray:
@@ -281,6 +312,7 @@ class ImpactSolver:
         self._rec_t, self._rec_y = grown(self._rec_t), grown(self._rec_y)
         self._rec_aux, self._rec_fmax = grown(self._rec_aux), grown(self._rec_fmax)
         self._rec_regime = grown(self._rec_regime)
+        self._rec_ext = grown(self._rec_ext)
         if self.keep_dense:
             self._dense_t0, self._dense_h = grown(self._dense_t0), grown(self._dense_h)
             self._dense_coef = grown(self._dense_coef)
@@ -297,6 +329,7 @@ class ImpactSolver:
         self._rec_aux[k] = aux
         self._rec_fmax[k] = aux[:, A_FN]
         self._rec_regime[k] = self.regime
+        self._rec_ext[k] = self.z
         if self.keep_dense:  # a zero-length step: evaluates to the state itself
             self._dense_t0[k] = self.t
             self._dense_h[k] = 1.0
