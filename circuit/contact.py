@@ -17,11 +17,23 @@ EXTERNAL source jumps, and lands exactly on breakpoints, restarting there with a
 first-order step. At a breakpoint the conductance used is the left limit ``G(t_b-)``
 (the state before the event), so a jump acts from the breakpoint on; see
 ``left_limited``.
+
+Current-dependent contacts: a contact resistance that also depends on the current
+through it (film breakdown, heating) is given as a factor g(I) > 0, an ngspice
+expression of the contact current ``I`` (A). The element is then::
+
+    Bcontact_geff contact_geff 0 V=V(contact_g)/(g(i(Vcontact)))
+    Bcontact      contact_s b   I=V(contact_s,b)*(V(contact_geff)+G_leak)
+
+so Python supplies only the time-dependent part G(t) and ngspice's Newton iteration
+solves I = V G(t)/g(I) within each time point: no lag between current and resistance.
+The effective conductance G(t)/g(I) is node ``contact_geff``.
 """
 
 from __future__ import annotations
 
 import math
+import re
 from bisect import bisect_right
 from typing import Callable, Iterable, Sequence
 
@@ -29,6 +41,7 @@ from PySpice.Spice.Netlist import Circuit
 
 CONDUCTANCE_SOURCE = "Vcontact_g"
 CONDUCTANCE_NODE = "contact_g"
+EFFECTIVE_NODE = "contact_geff"
 SENSE_SOURCE = "Vcontact"
 SENSE_NODE = "contact_s"
 ELEMENT = "Bcontact"
@@ -37,20 +50,45 @@ DEFAULT_LEAKAGE = 1e-12  # S
 Conductance = Callable[[float], float]
 
 
-def add_contact(circuit: Circuit, node_a: str, node_b: str, leakage_conductance: float = DEFAULT_LEAKAGE) -> None:
+_CURRENT_TOKEN = re.compile(r"\bI\b")
+
+
+def check_current_factor(where: str, expression: str | None) -> str | None:
+    """Validate a current-factor expression: a one-line ngspice expression using ``I``."""
+    if expression is None:
+        return None
+    if not isinstance(expression, str) or not expression.strip() or "\n" in expression:
+        raise ValueError(f"{where}.contact_current_factor = {expression!r}: must be a one-line ngspice "
+                         "expression of the contact current I (A), e.g. '0.6+0.4*exp(-abs(I)/1.7)'")
+    if expression.count("(") != expression.count(")"):
+        raise ValueError(f"{where}.contact_current_factor = {expression!r}: unbalanced parentheses")
+    return expression
+
+
+def add_contact(circuit: Circuit, node_a: str, node_b: str, leakage_conductance: float = DEFAULT_LEAKAGE,
+                current_factor: str | None = None) -> str:
     """Add the contact between ``node_a`` and ``node_b`` to a PySpice circuit.
 
     The contact current (A, positive from a to b) is the branch current of
-    ``Vcontact``; the conductance (S) is the voltage of node ``contact_g``.
+    ``Vcontact``; the prescribed conductance G(t) (S) is the voltage of node
+    ``contact_g``. With ``current_factor`` (an ngspice expression of the contact current
+    ``I``, see the module docstring) the conductance is G(t)/g(I). Returns the node
+    whose voltage is the effective conductance (S).
     """
     circuit.V(SENSE_SOURCE[1:], node_a, SENSE_NODE, 0)
+    conductance = CONDUCTANCE_NODE
+    if current_factor is not None:
+        g = _CURRENT_TOKEN.sub(f"i({SENSE_SOURCE})", current_factor)
+        circuit.B(EFFECTIVE_NODE, EFFECTIVE_NODE, circuit.gnd, voltage_expression=f"V({CONDUCTANCE_NODE})/({g})")
+        conductance = EFFECTIVE_NODE
     circuit.B(
         ELEMENT[1:],
         SENSE_NODE,
         node_b,
-        current_expression=f"V({SENSE_NODE},{node_b})*(V({CONDUCTANCE_NODE})+{float(leakage_conductance)!r})",
+        current_expression=f"V({SENSE_NODE},{node_b})*(V({conductance})+{float(leakage_conductance)!r})",
     )
     circuit.V(CONDUCTANCE_SOURCE[1:], CONDUCTANCE_NODE, circuit.gnd, "external")
+    return conductance
 
 
 def left_limited(conductance: Conductance, breakpoints: Sequence[float], span: float) -> Conductance:

@@ -32,12 +32,14 @@ from pathlib import Path
 from PySpice.Spice.Netlist import Circuit
 
 from .arc import ArcModel, add_arc
-from .contact import CONDUCTANCE_NODE, DEFAULT_LEAKAGE, SENSE_SOURCE, add_contact
+from .contact import (
+    CONDUCTANCE_NODE, DEFAULT_LEAKAGE, EFFECTIVE_NODE, SENSE_SOURCE, add_contact, check_current_factor,
+)
 from .probes import Probes
 from .validation import check_range
 
-_RESERVED_ELEMENTS = re.compile(r"^(vcontact|bcontact|vcontact_g|varc|sarc|barc\w*|rarc_arm|carc_arm)$", re.I)
-_RESERVED_NODES = re.compile(r"^(contact_s|contact_g|arc_\w+)$", re.I)
+_RESERVED_ELEMENTS = re.compile(r"^(vcontact|bcontact|bcontact_geff|vcontact_g|varc|sarc|barc\w*|rarc_arm|carc_arm)$", re.I)
+_RESERVED_NODES = re.compile(r"^(contact_s|contact_g|contact_geff|arc_\w+)$", re.I)
 _ANALYSIS = re.compile(r"^\.(tran|op|ac|dc|noise|tf|disto|sens|pz|control|endc|end)\b", re.I)
 
 
@@ -48,12 +50,15 @@ class NetlistCircuit:
     load_probe: name of the 0 V source in series with the load, or None.
     arc: optional ArcModel across the contact.
     leakage_conductance: open-contact conductance, S.
+    contact_current_factor: optional ngspice expression g(I) of the contact current I (A);
+        the contact conductance is then G(t)/g(I) (see contact.py).
     """
 
     text: str
     load_probe: str | None = "VLOAD"
     arc: ArcModel | None = None
     leakage_conductance: float = DEFAULT_LEAKAGE
+    contact_current_factor: str | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.text, str) or not self.text.strip():
@@ -61,6 +66,7 @@ class NetlistCircuit:
         if self.arc is not None and not isinstance(self.arc, ArcModel):
             raise ValueError(f"NetlistCircuit.arc = {self.arc!r}: must be an ArcModel or None")
         check_range("NetlistCircuit", "leakage_conductance", self.leakage_conductance, "S", 0.0, 1e-3)
+        check_current_factor("NetlistCircuit", self.contact_current_factor)
         self._parse()  # fail early, before anything runs
 
     @classmethod
@@ -110,7 +116,7 @@ class NetlistCircuit:
             node_a=node_a,
             node_b=node_b,
             contact_current=f"{SENSE_SOURCE}#branch",
-            conductance_node=CONDUCTANCE_NODE,
+            conductance_node=CONDUCTANCE_NODE if self.contact_current_factor is None else EFFECTIVE_NODE,
             load_current=f"{self.load_probe}#branch" if has_load_probe else None,
             arc_current=None if self.arc is None else "Varc#branch",
         )
@@ -119,7 +125,7 @@ class NetlistCircuit:
         """The netlist with the XCONTACT line expanded (title first, no analysis, no .end)."""
         lines, row, node_a, node_b, _ = self._parse()
         scratch = Circuit("contact")
-        add_contact(scratch, node_a, node_b, self.leakage_conductance)
+        add_contact(scratch, node_a, node_b, self.leakage_conductance, self.contact_current_factor)
         if self.arc is not None:
             add_arc(scratch, self.arc, node_a, node_b)
         expansion = [line for line in str(scratch).splitlines()[1:] if line.strip()]

@@ -22,7 +22,9 @@ from typing import Union
 from PySpice.Spice.Netlist import Circuit
 
 from .arc import ArcModel, add_arc
-from .contact import CONDUCTANCE_NODE, DEFAULT_LEAKAGE, SENSE_SOURCE, add_contact
+from .contact import (
+    CONDUCTANCE_NODE, DEFAULT_LEAKAGE, EFFECTIVE_NODE, SENSE_SOURCE, add_contact, check_current_factor,
+)
 from .probes import Probes
 from .validation import check_range
 
@@ -132,6 +134,8 @@ class SwitchCircuit:
         wiring stray capacitance). It bounds the opening dv/dt; 0 is allowed but then
         an inductive load without an arc model gives a numerics-set spike.
     leakage_conductance: conductance of the open contact, S (insulation).
+    contact_current_factor: optional ngspice expression g(I) of the contact current I
+        (A): the contact conductance is then G(t)/g(I), solved by ngspice (see contact.py).
 
     Example::
 
@@ -147,6 +151,7 @@ class SwitchCircuit:
     flyback: FlybackDiode | None = None
     arc: ArcModel | None = None
     leakage_conductance: float = DEFAULT_LEAKAGE
+    contact_current_factor: str | None = None
     title: str = "switchsim contact circuit"
 
     def __post_init__(self) -> None:
@@ -169,6 +174,7 @@ class SwitchCircuit:
             )
         check_range(name, "contact_capacitance", self.contact_capacitance, "F", 0.0, 1e-6)
         check_range(name, "leakage_conductance", self.leakage_conductance, "S", 0.0, 1e-3)
+        check_current_factor(name, self.contact_current_factor)
         if not isinstance(self.title, str) or "\n" in self.title:
             raise ValueError(f"{name}.title = {self.title!r}: must be a one-line string")
 
@@ -178,7 +184,7 @@ class SwitchCircuit:
             node_a=NODE_A,
             node_b=NODE_B,
             contact_current=f"{SENSE_SOURCE}#branch",
-            conductance_node=CONDUCTANCE_NODE,
+            conductance_node=CONDUCTANCE_NODE if self.contact_current_factor is None else EFFECTIVE_NODE,
             load_current=f"{LOAD_PROBE}#branch",
             arc_current=None if self.arc is None else "Varc#branch",
         )
@@ -206,7 +212,7 @@ class SwitchCircuit:
             next_node = NODE_A if i == len(series) - 1 else next(inner_nodes)
             getattr(c, kind)(name, node, next_node, float(value))
             node = next_node
-        add_contact(c, NODE_A, NODE_B, self.leakage_conductance)
+        add_contact(c, NODE_A, NODE_B, self.leakage_conductance, self.contact_current_factor)
         if self.contact_capacitance > 0:
             c.C("contact", NODE_A, NODE_B, float(self.contact_capacitance))
         if self.snubber is not None:
