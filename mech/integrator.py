@@ -156,8 +156,8 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
         h = min(h, hmax)
     reject = False
     while True:
-        if t >= t_stop:
-            return DONE, t, h, n_rec, -1
+        if t >= t_stop or t_stop - t <= 4e-16 * max(1.0, abs(t)):
+            return DONE, t_stop, h, n_rec, -1  # what is left is below round-off of t
         if n_rec >= max_rec:
             return BUFFER_FULL, t, h, n_rec, -1
         if stats[0] + stats[1] >= max_steps:
@@ -380,3 +380,26 @@ def _record(n_rec, t_end, y_end, aux_end, aux_start, coef, rec_t, rec_y, rec_aux
             for i in range(2):
                 if aux_scratch[i, A_FN] > rec_fmax[n_rec, i]:
                     rec_fmax[n_rec, i] = aux_scratch[i, A_FN]
+
+
+@njit(cache=True)
+def dense_contact(times, t_valid, dense_t0, dense_h, dense_coef, regimes, fpar, ipar, J0, sp_ptr, sp_idx,
+                  sp_val, psi, theta, xc, eref, work, out):
+    """Per tip penetration (m), rate (m/s) and normal force (N) at sorted ``times`` from the
+    stored dense output; out has shape (len(times), 2, 3)."""
+    N = dense_coef.shape[2]
+    y = np.empty(N)
+    dy = np.empty(N)
+    aux = np.empty((2, 8))
+    k = 0
+    n = t_valid.shape[0]
+    for m in range(times.shape[0]):
+        t = times[m]
+        while k < n - 1 and t_valid[k] < t:
+            k += 1
+        dense_eval(dense_coef[k], (t - dense_t0[k]) / dense_h[k], y)
+        dynamics(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regimes[k], eref, dy, aux, work)
+        for i in range(2):
+            out[m, i, 0] = aux[i, A_Y]
+            out[m, i, 1] = aux[i, A_YDOT]
+            out[m, i, 2] = aux[i, A_FN]

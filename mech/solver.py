@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .integrator import (
-    BUFFER_FULL, DONE, EVENT, STATUS_TEXT, dense_eval, events_from_aux, integrate,
+    BUFFER_FULL, DONE, EVENT, STATUS_TEXT, dense_contact, dense_eval, events_from_aux, integrate,
 )
 from .kernel import (
     A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_CONTACT, EV_SLIP,
@@ -286,6 +286,45 @@ class ImpactSolver:
             projection_energy=self.projection_energy,
             extra_states=self._rec_ext[:n].copy(),
         )
+
+    def checkpoint(self) -> dict:
+        """Everything needed to return to this instant with ``restore`` (records after it are dropped)."""
+        return dict(t=self.t, y=self.y.copy(), z=self.z.copy(), h=self.h, regime=self.regime.copy(),
+                    eref=self.eref.copy(), ev_sign=self.ev_sign.copy(), stats=self.stats.copy(),
+                    n=self._n, n_events=len(self.events), projection_energy=self.projection_energy,
+                    fpar=self.model.fpar.copy())
+
+    def restore(self, cp: dict) -> None:
+        """Return to a ``checkpoint`` (e.g. to redo a coupling step so it ends at an event)."""
+        self.t, self.h = cp["t"], cp["h"]
+        self.y[:] = cp["y"]
+        self.z[:] = cp["z"]
+        self.regime[:] = cp["regime"]
+        self.eref[:] = cp["eref"]
+        self.ev_sign[:] = cp["ev_sign"]
+        self.stats[:] = cp["stats"]
+        self._n = cp["n"]
+        del self.events[cp["n_events"]:]
+        self.projection_energy = cp["projection_energy"]
+        self.model.fpar[:] = cp["fpar"]
+
+    def contact_series(self, times) -> np.ndarray:
+        """(len(times), 2, 3): per tip penetration (m), rate (m/s), normal force (N) at the
+        given times (s, within the integrated span), from the dense output (keep_dense=True)."""
+        if not self.keep_dense:
+            raise ValueError("contact_series needs the dense output: build the solver with keep_dense=True")
+        times = np.asarray(times, dtype=float)
+        order = np.argsort(times, kind="stable")
+        n = self._n
+        if len(times) and (times[order[0]] < self._rec_t[0] - 1e-15 or times[order[-1]] > self.t + 1e-15):
+            raise ValueError(f"times must lie in [{self._rec_t[0]!r}, {self.t!r}] s")
+        out = np.empty((len(times), 2, 3))
+        dense_contact(times[order], self._rec_t[:n], self._dense_t0[:n], self._dense_h[:n],
+                      self._dense_coef[:n], self._rec_regime[:n], *self.model.arrays, self.eref,
+                      self._work, out)
+        result = np.empty_like(out)
+        result[order] = out
+        return result
 
     def contact_now(self) -> np.ndarray:
         """(2, 3) per tip: penetration (m), rate (m/s), normal force (N) at the current time."""
