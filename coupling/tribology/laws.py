@@ -200,6 +200,29 @@ class ResistanceLaw:
         """1 / R_c, siemens: exactly 0 for F_n <= 0, -> 0 continuously as F_n -> 0+."""
         return constriction_film_conductance(normal_force_N, *self._load) / self.current_factor(current_A)
 
+    def force_conductance(self, normal_force_N):
+        """The load part G_F(F_n) = 1/(R_f + R_1 F^-m), siemens: conductance at I = 0.
+
+        The conductance is G_F(F_n) / g(|I|); a circuit can take G_F from the mechanics
+        and apply g itself (``current_factor_expression``).
+        """
+        return constriction_film_conductance(normal_force_N, *self._load)
+
+    def current_factor_expression(self, current: str = "I") -> str:
+        """g(|I|) as an ngspice expression of the variable ``current`` (A), with |I| held
+        inside current_range_A as ``current_factor`` does; dimensionless and > 0."""
+        lo, hi = self.current_range_A
+        i = f"min(max(abs({current}),{lo!r}),{hi!r})"
+        p = dict(self.params)
+        if self.current_model == "none":
+            return "1"
+        if self.current_model == "hyperbolic":
+            return f"(1/(1+{i}/{p['current_scale_A']!r}))"
+        if self.current_model == "exponential_floor":
+            r = p["floor_fraction"]
+            return f"({r!r}+{1.0 - r!r}*exp(-{i}/{p['current_scale_A']!r}))"
+        raise ValueError(f"resistance law: no ngspice form for current_model {self.current_model!r}")
+
     def resistance(self, normal_force_N, current_A):
         """R_c, ohm: +inf for F_n <= 0 (open contact)."""
         g = self.conductance(normal_force_N, current_A)
