@@ -8,8 +8,10 @@ Physics kept (short arcs between contact metals, the bounce regime):
 - An arc needs at least the minimum arc current I_min (~0.3-1 A) to sustain its
   cathode spot: it extinguishes as soon as its current falls below I_min.
 - When a current-carrying contact parts, a molten bridge and then the arc form: the
-  gap is "armed" while closed and for ``formation_time`` after parting; if in that
-  window the gap voltage reaches U_min and the arc takes at least I_min, it burns.
+  gap is "armed" while closed and for ``formation_time`` after parting (the closed
+  indicator low-pass filtered, above 1/2; a make arms it ``formation_time`` after
+  closing); if in that window the gap voltage reaches U_min and the arc takes at least
+  I_min, it burns.
   Otherwise (gap voltage stays below U_min, e.g. a supply below U_min with a resistive
   load, or the current goes into a snubber) no arc forms.
 - Optionally, an extinguished gap re-ignites when its voltage reaches the breakdown
@@ -20,35 +22,57 @@ E > U_min and load current > I_min burns for as long as the contact stays open),
 V_bd growing with gap distance, make arcs (pre-strike on closing), erosion, and the
 glow discharge regime.
 
-Netlist: the arc path across the gap is a hysteretic switch (ngspice SW) in series with
-a dead-zone conductor. The switch is the arc's on/off state; its control voltage is
+Netlist: the arc path across the gap is one behavioural conductor, a dead zone
+(conducts beyond +-U_min with slope 1/R_arc) enabled by the arc state e in {0, 1},
+plus the 1 GOhm of an extinguished gap::
 
-    max(K_I * (|i_arc| - I_min), K_c * (armed - 1/2), |v_gap| - V_bd)
+    Varc    a arc_p 0                                   (arc current probe)
+    Barc    arc_p b I=V(arc_on)*(uramp(v-U_min)-uramp(-v-U_min))/R_arc + 1e-9*v
+    Iarc_on 0 arc_on external                           (the arc state e, from Python)
+    Rarc_on arc_on 0 1                                  (so V(arc_on) = e)
 
-so it stays on while either the arc current exceeds I_min, or the contact is (or has
-just been) closed, or the gap voltage exceeds V_bd. ngspice's SW model limits the time
-step as its control approaches the threshold, which locates extinction and breakdown
-in time independently of the maximum step (K_I = 1000 / I_min V/A: the 0.05 V resolution
-of that step control is 0.005 % of I_min; with 100 / I_min the extinction current
-still varied by 0.08 % with the maximum step). "armed" is the closed indicator (G > 0)
-low-pass filtered so that it stays above 1/2 for ``formation_time`` after parting.
+(an EXTERNAL current source: ngspice asks for its value through its own callback, so
+the contact's EXTERNAL voltage source and the arc state need no name look-up).
+
+The state is not decided inside ngspice's Newton iteration: ``ArcState`` holds it and
+changes it only at accepted time points (from the accepted solution), so within a
+step the arc is a fixed, monotone conductor and every time point has one solution.
+An earlier version used ngspice's hysteretic switch (SW) with the control
+max(K_I (|i| - I_min), K_c (armed - 1/2), |v| - V_bd); it failed in three ways
+(measured, see docs/circuit.md): SW decides its state at the start of a time point from
+the previous Newton solution, which after a rejected trial step is the rejected
+point's, so a trial step that reached a make tens of us ahead put out a burning 1 A arc
+at the retry (an extinguished arc carries no current, so "off" is then self-consistent);
+SW's step control, aiming at its threshold with a control slope of 6e14 V/s at a make,
+asked for 2e-16 s steps (timestep too small); and its 1 mOhm on-resistance in series
+with a dead zone left the arc branch current to round-off (1e-11 A, above ABSTOL), so a
+nonlinear contact (current factor) never converged while closed.
+
+ArcState locates its own events in time, as SW's step control did: it shortens the
+next step so that |i| approaches I_min (burning) or |v| approaches V_bd (extinguished)
+by at most 3/4 of the remaining distance plus 1e-5 of the threshold, predicted from
+the last accepted step, and lands exactly where the armed filter crosses 1/2.
 """
 
 from __future__ import annotations
 
 import math
+from bisect import bisect_left, insort
 from dataclasses import dataclass
+from typing import Callable, Sequence
 
 from PySpice.Spice.Netlist import Circuit
 
-from .contact import CONDUCTANCE_NODE
 from .validation import check_range
 
 SENSE_SOURCE = "Varc"
-SWITCH_MODEL = "switchsim_arc"
-_ARM_CAPACITANCE = 1e-9  # F; the arming RC filter's capacitor, its resistor sets the time
-_SWITCH_HYSTERESIS = 0.01  # V of control voltage, i.e. 1e-5 * I_min of arc current
-_CLOSED_GAIN = 10.0  # V per unit of the armed indicator
+STATE_SOURCE = "Iarc_on"
+STATE_NODE = "arc_on"
+OFF_CONDUCTANCE = 1e-9  # S: an extinguished gap (and the path's floor when burning)
+RESOLUTION = 1e-5  # events located to this fraction of I_min or V_bd
+_APPROACH = 0.75  # fraction of the remaining distance to a threshold one step may cover
+_LEVEL_TOLERANCE = 1e-9  # of the armed filter's level, when landing on its crossing of 1/2
+_ATTRIBUTE = "_switchsim_arc"  # where add_arc records the model on a PySpice Circuit
 
 
 @dataclass(frozen=True)
@@ -86,32 +110,153 @@ class ArcModel:
 def add_arc(circuit: Circuit, arc: ArcModel, node_a: str, node_b: str) -> None:
     """Add the arc path across the contact (``node_a``, ``node_b``) of a PySpice circuit.
 
-    The arc current (A, positive from a to b) is the branch current of ``Varc``. Needs
-    the contact's conductance node (``add_contact`` first).
+    The arc current (A, positive from a to b) is the branch current of ``Varc``; the arc
+    state (1 burning or armed, 0 extinguished) is the voltage of node ``arc_on``, set by
+    ``ArcState`` between time points through the EXTERNAL current source ``Iarc_on``. The model is recorded on the circuit, so a run
+    of a PySpice ``Circuit`` finds it.
     """
-    r_on = min(1e-3, arc.resistance / 10.0)
-    slope = arc.resistance - r_on
     u = float(arc.min_voltage)
+    v = f"V(arc_p,{node_b})"
     circuit.V(SENSE_SOURCE[1:], node_a, "arc_p", 0)
-    circuit.S("arc", "arc_p", "arc_q", "arc_ctl", circuit.gnd, model=SWITCH_MODEL)
-    circuit.model(
-        SWITCH_MODEL, "SW", vt=0.0, vh=_SWITCH_HYSTERESIS, ron=r_on, roff=r_on * 1e12
-    )
     circuit.B(
         "arc",
-        "arc_q",
+        "arc_p",
         node_b,
-        current_expression=f"(uramp(V(arc_q,{node_b})-{u!r})-uramp(-V(arc_q,{node_b})-{u!r}))/{slope!r}",
+        current_expression=(
+            f"V({STATE_NODE})*(uramp({v}-{u!r})-uramp(-{v}-{u!r}))/{float(arc.resistance)!r}"
+            f"+{OFF_CONDUCTANCE!r}*{v}"
+        ),
     )
-    circuit.B("arc_closed", "arc_cl0", circuit.gnd, voltage_expression=f"V({CONDUCTANCE_NODE}) > 0 ? 1 : 0")
-    # The filtered indicator falls from 1 to 1/2 in R C ln 2 = formation_time.
-    circuit.R("arc_arm", "arc_cl0", "arc_cl", arc.formation_time / (math.log(2.0) * _ARM_CAPACITANCE))
-    circuit.C("arc_arm", "arc_cl", circuit.gnd, _ARM_CAPACITANCE)
-    k_i = 1000.0 / arc.min_current
-    control = (
-        f"max({k_i!r}*(abs(i({SENSE_SOURCE}))-{float(arc.min_current)!r}),"
-        f"{_CLOSED_GAIN!r}*(V(arc_cl)-0.5))"
-    )
-    if arc.breakdown_voltage is not None:
-        control = f"max({control},abs(V({node_a},{node_b}))-{float(arc.breakdown_voltage)!r})"
-    circuit.B("arc_ctl", "arc_ctl", circuit.gnd, voltage_expression=control)
+    # No value after 'external' (a value segfaults ngspice 38-40 on V sources).
+    circuit.I(STATE_SOURCE[1:], circuit.gnd, STATE_NODE, "external")
+    circuit.R("arc_on", STATE_NODE, circuit.gnd, 1)
+    setattr(circuit, _ATTRIBUTE, (arc, str(node_a), str(node_b)))
+
+
+def recorded_arc(circuit: Circuit) -> ArcModel | None:
+    """The ArcModel that ``add_arc`` put on a PySpice circuit, or None."""
+    found = getattr(circuit, _ATTRIBUTE, None)
+    return None if found is None else found[0]
+
+
+#: Reads the last accepted values of ngspice vectors: names -> values (same order).
+Reader = Callable[[Sequence[str]], Sequence[float]]
+
+
+class ArcState:
+    """The arc's on/off state, decided at ngspice's accepted time points.
+
+    After each accepted point ngspice's step callback calls ``accepted``; the state it
+    returns holds for the whole next step (the EXTERNAL source ``Iarc_on`` reads
+    ``value``), so a rejected or retried trial step never changes it. Rules, at an
+    accepted point t with arc current i, gap voltage v and contact conductance G:
+
+    - armed: the closed indicator (G > 0) low-pass filtered with the time constant
+      formation_time / ln 2 is above 1/2 (the filter is integrated exactly between
+      accepted points; G changes only at breakpoints, so the indicator switches at the
+      last breakpoint inside the interval, else right after the earlier point). A contact
+      closed for a while stays armed for formation_time after parting, and a make arms
+      the gap only formation_time later, once the contact has taken the current (no
+      make arc);
+    - burning next = armed, or (burning and |i| >= I_min), or (V_bd set and |v| >= V_bd).
+
+    Names are ngspice vector names: ``current`` the arc current ("varc#branch"),
+    ``node_a``/``node_b`` the contact nodes, ``conductance`` the node whose voltage is
+    the contact conductance G(t).
+    """
+
+    def __init__(self, arc: ArcModel, current: str, node_a: str, node_b: str, conductance: str):
+        self.arc = arc
+        self._tau = arc.formation_time / math.log(2.0)
+        ground = ("0", "gnd")
+        self._conductance = (conductance.lower(),)
+        self._names_on = (current.lower(),)
+        nodes = tuple(n.lower() for n in (node_a, node_b) if n.lower() not in ground)
+        self._names_off = self._names_on + nodes
+        self._sign_b = node_b.lower() not in ground  # v = V(a) - V(b); a grounded node reads 0
+        self._sign_a = node_a.lower() not in ground
+        self.start(False)
+
+    def start(self, closed: bool) -> None:
+        """Before the run: the state at the operating point (burning/armed iff closed at t = 0)."""
+        self.burning = bool(closed)
+        self.value = 1.0 if closed else 0.0
+        self.level = 1.0 if closed else 0.0  # the filtered closed indicator
+        self.switches = 0
+        self._closed = self.level
+        self._breakpoints: list[float] = []
+        self._t = -math.inf
+        self._previous: tuple[float, float] | None = None  # (t, |i| or |v|) at the last point, same state
+
+    def add_breakpoints(self, times: Sequence[float]) -> None:
+        """Instants (s) where G may change (make/break, ramp corners, PWL vertices)."""
+        for b in times:
+            b = float(b)
+            if b > self._t:
+                insort(self._breakpoints, b)
+
+    def accepted(self, t: float, conductance: float | None, read: Reader) -> tuple[float, float]:
+        """Update from the accepted point at ``t`` (s); returns (max next step s, time to land on s or inf).
+
+        conductance: G at ``t`` (S) if the caller knows it, else None (read from ngspice).
+        """
+        arc = self.arc
+        if not t > self._t:
+            return math.inf, math.inf  # the same point again (a resume after a pause)
+        previous_t, self._t = self._t, t
+        if conductance is None:
+            conductance = read(self._conductance)[0]
+        closed = 1.0 if conductance > 0.0 else 0.0
+        level = self.level
+        if previous_t > -math.inf:
+            switch = previous_t
+            if closed != self._closed:
+                k = bisect_left(self._breakpoints, t) - 1
+                if k >= 0 and self._breakpoints[k] > previous_t:
+                    switch = self._breakpoints[k]
+                level = self._closed + (level - self._closed) * math.exp(-(switch - previous_t) / self._tau)
+            level = closed + (level - closed) * math.exp(-(t - switch) / self._tau)
+            del self._breakpoints[: bisect_left(self._breakpoints, t)]
+        self.level = level
+        self._closed = closed
+        # Landing on a crossing of 1/2 can fall an ulp short: within 1e-9 it has crossed.
+        armed = level > 0.5 - _LEVEL_TOLERANCE if closed else level > 0.5 + _LEVEL_TOLERANCE
+        breakdown = arc.breakdown_voltage is not None and not self.burning
+        current = voltage = 0.0
+        if self.burning or breakdown:
+            values = read(self._names_off if breakdown else self._names_on)
+            current = abs(values[0])
+            if breakdown:
+                voltage = abs((values[1] if self._sign_a else 0.0) - (values[-1] if self._sign_b else 0.0))
+        burning = armed or (self.burning and current >= arc.min_current) or (breakdown and voltage >= arc.breakdown_voltage)
+        if burning != self.burning:
+            self.switches += 1
+            self._previous = None
+        self.burning = burning
+        self.value = 1.0 if burning else 0.0
+        # The next crossing of 1/2 by the filter if the contact stays as it is: land on it.
+        land = math.inf
+        if closed and not armed:
+            land = t + self._tau * math.log(2.0 * (1.0 - level))
+        elif armed and not closed:
+            land = t + self._tau * math.log(2.0 * level)
+        floor = max(1e-12, 256.0 * math.ulp(t))
+        if armed:
+            # Keep the current's history: the first step after the window needs its rate.
+            self._approach(t, current, arc.min_current, -1.0, floor)
+            return math.inf, land
+        if burning:  # |i| falling towards I_min
+            return self._approach(t, current, arc.min_current, -1.0, floor), land
+        if breakdown:  # |v| rising towards V_bd
+            return self._approach(t, voltage, arc.breakdown_voltage, 1.0, floor), land
+        return math.inf, land
+
+    def _approach(self, t: float, x: float, threshold: float, direction: float, floor: float) -> float:
+        previous, self._previous = self._previous, (t, x)
+        if previous is None or not t > previous[0]:
+            return math.inf
+        rate = direction * (x - previous[1]) / (t - previous[0])  # > 0: moving towards the threshold
+        distance = direction * (threshold - x)
+        if rate <= 0.0 or distance < 0.0:
+            return math.inf
+        return max((_APPROACH * distance + RESOLUTION * threshold) / rate, floor)

@@ -7,6 +7,7 @@ from typing import Union
 import numpy as np
 from PySpice.Spice.Netlist import Circuit
 
+from .arc import STATE_SOURCE, ArcModel, ArcState, recorded_arc
 from .contact import CONDUCTANCE_NODE, CONDUCTANCE_SOURCE, SENSE_SOURCE
 from .netlist import NetlistCircuit
 from .options import SimulationOptions
@@ -46,6 +47,24 @@ def circuit_netlist(circuit: CircuitLike) -> tuple[str, Probes]:
     )
 
 
+def circuit_arc(circuit: CircuitLike) -> ArcModel | None:
+    """The circuit's ArcModel, or None without an arc path."""
+    if isinstance(circuit, (SwitchCircuit, NetlistCircuit)):
+        return circuit.arc
+    arc = recorded_arc(circuit)
+    if arc is None and "varc" in {name.lower() for name in circuit.element_names}:
+        raise ValueError("the PySpice circuit has an element Varc but no arc model: add the arc with add_arc")
+    return arc
+
+
+def arc_state(circuit: CircuitLike, probes: Probes) -> ArcState | None:
+    """The state machine of the circuit's arc (decided at accepted points), or None."""
+    arc = circuit_arc(circuit)
+    if arc is None:
+        return None
+    return ArcState(arc, probes.arc_current, probes.node_a, probes.node_b, CONDUCTANCE_NODE)
+
+
 def _node_of(circuit: Circuit, element: str, index: int) -> str:
     for name in circuit.element_names:
         if name.lower() == element.lower():
@@ -69,9 +88,9 @@ def build_deck(
         if head == CONDUCTANCE_SOURCE.lower():
             lines[i] = "\n".join(_source_lines(drive))
             replaced = True
-        elif head[0] in "vi" and "external" in (t.lower() for t in tokens[3:]):
+        elif head[0] in "vi" and head != STATE_SOURCE.lower() and "external" in (t.lower() for t in tokens[3:]):
             raise ValueError(
-                f"netlist line {line!r}: only the contact's conductance source may be EXTERNAL"
+                f"netlist line {line!r}: only the contact's conductance source (and the arc state) may be EXTERNAL"
             )
         elif head == ".end":
             lines[i] = ""

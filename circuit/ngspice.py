@@ -23,6 +23,7 @@ from typing import Callable
 import numpy as np
 from PySpice.Spice.NgSpice.Shared import NgSpiceShared, ffi
 
+from .contact import LANDING_TOLERANCE
 from .errors import (
     ConductanceError,
     ConvergenceError,
@@ -134,6 +135,10 @@ class NgspiceSession(NgSpiceShared):
         self._target = math.inf
         self._deadline = math.inf
         self._failure: BaseException | None = None
+        self._arc = None  # ArcState of the loaded circuit, or None
+        self._arc_from = math.nan  # accepted time the arc's step bounds below apply from
+        self._arc_step = math.inf
+        self._arc_land = math.inf
         self._commands_sent = 0
         self._encoded: dict[str, bytes] = {}
         self.source_calls = 0
@@ -237,7 +242,10 @@ class NgspiceSession(NgSpiceShared):
         return None
 
     def _on_isrc(self, out, t, name, ident, user):
-        out[0] = 0.0
+        # The only EXTERNAL current source is the arc state (arc.py): constant over a
+        # step, ArcState changes it only between accepted points.
+        arc = self._arc
+        out[0] = arc.value if arc is not None else 0.0
         return 0
 
     def _on_sync(self, ckttime, pdelta, olddelta, redostep, ident, loc, user):
@@ -248,10 +256,23 @@ class NgspiceSession(NgSpiceShared):
             # small': the only way to stop a synchronous run from a callback.
             pdelta[0] = 0.0
             return 1
-        remaining = self._target - ckttime
+        target = self._target
+        if self._arc is not None:
+            if loc == 0:
+                # loc 0: after a point was accepted (and stored), before the next step.
+                # The contact source was last evaluated at that point (if it is EXTERNAL).
+                known = self._last_value if self._last_t == ckttime else None
+                self._arc_step, self._arc_land = self._arc.accepted(ckttime, known, self._read_last)
+                self._arc_from = ckttime
+            if ckttime == self._arc_from:  # the step (or its retry) from that accepted point
+                if pdelta[0] > self._arc_step:
+                    pdelta[0] = self._arc_step
+                if self._arc_land < target:
+                    target = self._arc_land
+        remaining = target - ckttime
         if remaining > 0.0:
             delta = pdelta[0]
-            if delta >= remaining * (1.0 - 1e-9):  # equal up to rounding: land, no extra point
+            if delta >= remaining * (1.0 - LANDING_TOLERANCE):  # equal up to rounding: land, no extra point
                 pdelta[0] = remaining
             elif remaining < 2.0 * delta:
                 # Two equal steps instead of a full one and a sliver: ngspice grows its
@@ -260,6 +281,9 @@ class NgspiceSession(NgSpiceShared):
                 # jump over a breakpoint we do not know of.
                 pdelta[0] = 0.5 * remaining
         return 0
+
+    def _read_last(self, names):
+        return self.last_values(names)[1]
 
     # -- commands --
 
@@ -299,6 +323,10 @@ class NgspiceSession(NgSpiceShared):
         self._target = math.inf
         self._deadline = math.inf
         self._failure = None
+        self._arc = None
+        self._arc_from = math.nan
+        self._arc_step = math.inf
+        self._arc_land = math.inf
         self.source_calls = 0
 
     def load(self, lines: list[str]) -> None:
@@ -318,6 +346,13 @@ class NgspiceSession(NgSpiceShared):
         """The function of time (s) whose value ngspice reads from the EXTERNAL source."""
         self._source = source
         self._last_t = math.nan
+
+    def set_arc(self, arc) -> None:
+        """The ``ArcState`` of the loaded circuit (it drives ``Iarc_on``), or None without an arc."""
+        self._arc = arc
+        self._arc_from = math.nan
+        self._arc_step = math.inf
+        self._arc_land = math.inf
 
     def set_breakpoint(self, t: float) -> None:
         """A transient breakpoint: ngspice lands on t and restarts with a small first-order step."""

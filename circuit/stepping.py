@@ -31,8 +31,8 @@ from typing import Callable, Iterable, NamedTuple
 import numpy as np
 import pandas as pd
 
-from .contact import Conductance, checked_breakpoints, left_limited
-from .deck import CircuitLike, build_deck
+from .contact import Conductance, checked_breakpoints, left_limited, snapped
+from .deck import CircuitLike, arc_state, build_deck
 from .errors import SessionBusyError
 from .ngspice import NgspiceSession, get_session
 from .options import SimulationOptions
@@ -79,6 +79,7 @@ class Stepper:
         if not isinstance(self.options, SimulationOptions):
             raise TypeError(f"options must be a SimulationOptions, got {type(self.options).__name__}")
         lines, self.probes = build_deck(circuit, t_end, self.options, "external")
+        self._arc = arc_state(circuit, self.probes)
         self.t_end = float(t_end)
         self.deck = tuple(lines)
         self._session: NgspiceSession | None = None
@@ -98,6 +99,7 @@ class Stepper:
             session.claim(self)
             try:
                 session.load(list(lines))
+                session.set_arc(self._arc)
             except BaseException:
                 session.release(self)
                 raise
@@ -138,9 +140,15 @@ class Stepper:
         if not session.lock.acquire(blocking=False):
             raise SessionBusyError("ngspice is in use by another thread of this process")
         try:
-            session.set_source(left_limited(source, points, t_next - t0))
-            for b in points:
+            if not self._started and self._arc is not None:
+                # The operating point: an arc path closed at t = 0 is armed.
+                self._arc.start(float(source(0.0)) > 0.0)
+            session.set_source(left_limited(source, points, t_next - t0, t_next))
+            landings = snapped(points, t_next, t_next - t0)
+            for b in landings:
                 session.set_breakpoint(b)
+            if self._arc is not None:
+                self._arc.add_breakpoints(landings)
             first_index = max(self._length - 1, 0)
             clock = _time.perf_counter()
             try:
@@ -230,10 +238,11 @@ class Stepper:
 
     @property
     def stats(self) -> dict[str, float]:
-        """Macro steps, accepted ngspice points, conductance evaluations, seconds inside ngspice."""
+        """Macro steps, accepted ngspice points, conductance evaluations, seconds inside ngspice, arc state changes."""
         points = len(self._final) if self._final is not None else (self._active().length() if self._started else 0)
         calls = self._session.source_calls if self._session is not None else 0
-        return {"steps": self._steps, "points": points, "conductance_calls": calls, "ngspice_seconds": self._ngspice_seconds}
+        return {"steps": self._steps, "points": points, "conductance_calls": calls,
+                "ngspice_seconds": self._ngspice_seconds, "arc_switches": self._arc.switches if self._arc else 0}
 
     def results(self, extra: tuple[str, ...] = ()) -> pd.DataFrame:
         """The whole run so far: columns ``COLUMNS`` (SI) plus raw ngspice vectors named in ``extra``."""

@@ -7,7 +7,7 @@ from typing import Iterable
 import pandas as pd
 
 from .contact import Conductance
-from .deck import CircuitLike, build_deck
+from .deck import CircuitLike, arc_state, build_deck
 from .ngspice import get_session
 from .options import SimulationOptions
 from .schedule import ContactSchedule
@@ -58,12 +58,17 @@ def run_pwl_reference(
     options = options if options is not None else SimulationOptions()
     drive = schedule.pwl_points(t_end, resistance_step)
     lines, probes = build_deck(circuit, t_end, options, drive)
+    arc = arc_state(circuit, probes)
+    if arc is not None:
+        arc.start(float(drive[1][0]) > 0.0)
+        arc.add_breakpoints(drive[0])  # ngspice lands on the PWL vertices
     session = get_session()
     owner = _Run()
     with session.exclusive():
         session.claim(owner)
         try:
             session.load(lines)
+            session.set_arc(arc)
             session.transient(None, True, options.wall_timeout, t_end)
             return probes.frame(session.vector, tuple(extra))
         finally:
