@@ -114,9 +114,11 @@ def left_limited(conductance: Conductance, breakpoints: Sequence[float], span: f
     ngspice evaluates the source at the breakpoint time itself, and that value closes
     the step that ends there. Using the value after a jump would apply the new contact
     state over the whole preceding step (measured on an RC charge: 3.3 % of the
-    final voltage wrong, against 0.025 % with the left limit). Times within 64 ulp of a
-    breakpoint count as the breakpoint (ngspice lands on it up to rounding); the left
-    limit is taken ``1e-9 * span`` before it (``span``: the macro step length, s). With
+    final voltage wrong, against 0.025 % with the left limit). Times within 1e-12
+    relative (at least 64 ulp) of a breakpoint count as the breakpoint: ngspice lands on
+    it up to rounding, and ends a run at t_end (1 - 2.2e-13) whatever t_end (measured),
+    so a make at t_end was otherwise missed. The left limit is taken ``1e-9 * span``
+    before it (``span``: the macro step length, s). With
     ``t_stop`` (the macro time), breakpoints moved onto it by ``snapped`` keep their own
     left limit.
     """
@@ -129,8 +131,8 @@ def left_limited(conductance: Conductance, breakpoints: Sequence[float], span: f
         return conductance
     points = sorted(befores)
     # Nearest breakpoint by bisection: one comparison per call whatever their number.
-    lows = [b - (64.0 * math.ulp(b) + 1e-300) for b in points]
-    highs = [b + (64.0 * math.ulp(b) + 1e-300) for b in points]
+    lows = [b - _same_instant(b) for b in points]
+    highs = [b + _same_instant(b) for b in points]
     values = [befores[b] for b in points]
 
     def source(t: float) -> float:
@@ -140,6 +142,11 @@ def left_limited(conductance: Conductance, breakpoints: Sequence[float], span: f
         return conductance(t)
 
     return source
+
+
+def _same_instant(b: float) -> float:
+    """Half-width (s) of the window of times that ngspice's landing on ``b`` may hit."""
+    return max(1e-12 * abs(b), 64.0 * math.ulp(b)) + 1e-300
 
 
 def checked_breakpoints(breakpoints: Iterable[float], t_start: float, t_stop: float) -> tuple[float, ...]:

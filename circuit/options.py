@@ -56,9 +56,18 @@ class SimulationOptions:
         if self.wall_timeout is not None:
             check_range(name, "wall_timeout", self.wall_timeout, "s", 0.0, math.inf, low_open=True, allow_inf=True)
 
+    def tmax(self, t_end: float) -> float:
+        """ngspice's maximum internal step (TMAX) for a run to ``t_end`` (s)."""
+        return self.max_step if self.max_step is not None else t_end / 50.0
+
+    def end_tolerance(self, t_end: float) -> float:
+        """How early (s) ngspice may end a run to ``t_end``: within CKTminBreak = 5e-5 TMAX
+        of the end it stops (after rejected steps near the end its last point can be there)."""
+        return 5e-5 * self.tmax(t_end)
+
     def deck_lines(self, t_end: float) -> list[str]:
         """``.options`` and ``.tran`` lines for a transient from 0 to ``t_end`` (s)."""
-        tmax = self.max_step if self.max_step is not None else t_end / 50.0
+        tmax = self.tmax(t_end)
         # TSTEP only sets ngspice's first step (min(TSTEP, TSTOP/100) / 10) and the
         # default TMAX; both are pinned here so that a run is fully specified.
         tstep = min(tmax, t_end / 100.0)

@@ -152,7 +152,8 @@ class Stepper:
             first_index = max(self._length - 1, 0)
             clock = _time.perf_counter()
             try:
-                session.transient(None if final else t_next, not self._started, self.options.wall_timeout, self.t_end)
+                session.transient(None if final else t_next, not self._started, self.options.wall_timeout, self.t_end,
+                                  self.options.end_tolerance(self.t_end))
             except BaseException as exc:
                 self._failure = exc
                 raise

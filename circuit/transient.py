@@ -69,7 +69,7 @@ def run_pwl_reference(
         try:
             session.load(lines)
             session.set_arc(arc)
-            session.transient(None, True, options.wall_timeout, t_end)
+            session.transient(None, True, options.wall_timeout, t_end, options.end_tolerance(t_end))
             return probes.frame(session.vector, tuple(extra))
         finally:
             session.clear()
