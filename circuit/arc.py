@@ -223,7 +223,8 @@ class ArcState:
         armed = level > 0.5 - _LEVEL_TOLERANCE if closed else level > 0.5 + _LEVEL_TOLERANCE
         breakdown = arc.breakdown_voltage is not None and not self.burning
         current = voltage = 0.0
-        if self.burning or breakdown:
+        # Armed and closed, nothing depends on the current (one vector read less).
+        if (self.burning and not (armed and closed)) or breakdown:
             values = read(self._names_off if breakdown else self._names_on)
             current = abs(values[0])
             if breakdown:
@@ -243,7 +244,10 @@ class ArcState:
         floor = max(1e-12, 256.0 * math.ulp(t))
         if armed:
             # Keep the current's history: the first step after the window needs its rate.
-            self._approach(t, current, arc.min_current, -1.0, floor)
+            if closed:
+                self._previous = None
+            else:
+                self._approach(t, current, arc.min_current, -1.0, floor)
             return math.inf, land
         if burning:  # |i| falling towards I_min
             return self._approach(t, current, arc.min_current, -1.0, floor), land
