@@ -17,8 +17,8 @@ import numpy as np
 from numba import njit
 
 from .kernel import (
-    A_FN, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_CONTACT, EV_SLIP, EV_STICK,
-    F_BETA, F_C, F_K, FRICTION_EXACT, I_FRICTION, NEV_TIP, SLIP, STICK, dynamics,
+    A_FN, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_COMPRESSION, EV_CONTACT, EV_SLIP, EV_STICK,
+    F_BETA, F_C, F_K, F_VBOUND, FRICTION_EXACT, I_FRICTION, NEV_TIP, SLIP, STICK, dynamics,
 )
 
 DONE, EVENT, BUFFER_FULL, STEP_TOO_SMALL, NOT_FINITE, MAX_STEPS = range(6)
@@ -58,6 +58,7 @@ def events_from_aux(aux, eref, fpar, g):
         g[NEV_TIP * i + EV_CLIP] = k_h * pp ** (1.5 - beta) + c_h * aux[i, A_YDOT]
         g[NEV_TIP * i + EV_SLIP] = aux[i, A_VTX] * eref[i, 0] + aux[i, A_VTY] * eref[i, 1]
         g[NEV_TIP * i + EV_STICK] = aux[i, A_MARGIN]
+        g[NEV_TIP * i + EV_COMPRESSION] = aux[i, A_YDOT]
 
 
 @njit(cache=True)
@@ -68,7 +69,7 @@ def _active(k, g_old, g_new, regime, fmodel):
     if kind == EV_CONTACT:
         return True
     in_contact = g_old[NEV_TIP * i] > 0.0 and g_new[NEV_TIP * i] > 0.0
-    if kind == EV_CLIP:
+    if kind == EV_CLIP or kind == EV_COMPRESSION:
         return in_contact
     if fmodel != FRICTION_EXACT or not in_contact:
         return False
@@ -162,8 +163,15 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
             return BUFFER_FULL, t, h, n_rec, -1
         if stats[0] + stats[1] >= max_steps:
             return MAX_STEPS, t, h, n_rec, -1
-        if h > hmax:
-            h = hmax
+        # The contact-time bound on the step matters only where a tip could reach the
+        # block within the step: far above it, a tip needs gap / v_bound to arrive
+        # (v_bound bounds every tip's approach speed from the energy available).
+        gap = -aux_old[0, A_Y] if aux_old[0, A_Y] < aux_old[1, A_Y] else -aux_old[1, A_Y]
+        hcap = hmax
+        if gap > 0.0 and 0.5 * gap / fpar[F_VBOUND] > hmax:
+            hcap = 0.5 * gap / fpar[F_VBOUND]
+        if h > hcap:
+            h = hcap
         last = False
         if t + h >= t_stop:
             h = t_stop - t

@@ -30,8 +30,8 @@ from .contact_laws import normal_force
 from .friction import friction_limit, regularized_scale
 
 # fpar indices
-F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MU0, F_MU_SLOPE, F_T_MU, F_MAX_RATIO, F_RTIP, F_VREG, F_BAUM = range(13)
-N_FPAR = 13
+F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MU0, F_MU_SLOPE, F_T_MU, F_MAX_RATIO, F_RTIP, F_VREG, F_BAUM, F_VBOUND = range(14)
+N_FPAR = 14
 # ipar indices
 I_N, I_PLANAR, I_FRICTION = range(3)
 FRICTION_NONE, FRICTION_EXACT, FRICTION_REGULARIZED = 0, 1, 2
@@ -44,9 +44,10 @@ NQ = 9
 # aux columns per tip
 A_Y, A_YDOT, A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_MARGIN = range(8)
 NAUX = 8
-# events per tip: contact (y), force clip, slip direction, stick margin
-EV_CONTACT, EV_CLIP, EV_SLIP, EV_STICK = range(4)
-NEV_TIP = 4
+# events per tip: contact (y), force clip, slip direction, stick margin, compression
+# turn (dy/dt = 0: splits the normal work into compression and restitution exactly)
+EV_CONTACT, EV_CLIP, EV_SLIP, EV_STICK, EV_COMPRESSION = range(5)
+NEV_TIP = 5
 
 
 @njit(cache=True)
@@ -376,11 +377,17 @@ def dynamics(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regim
             ftx = 0.0
             fty = 0.0
             if fmodel == FRICTION_EXACT and regime[i] == SLIP:
+                # Friction opposes the slip velocity while it points to the side of the
+                # reference direction; past that (v_t . e_ref <= 0, only in trial stages
+                # of a step that crosses the slip event) it keeps the reference direction,
+                # so the slip speed goes through zero and the event sees it. Following the
+                # actual direction there would pin v_t at zero inside the step (measured:
+                # 1e-10 s steps, 1.3 M steps for 1 ms).
                 vt = math.sqrt(vP[i, 0] ** 2 + vP[i, 1] ** 2)
-                if vt > 1e-14:
+                if vt > 1e-14 and vP[i, 0] * eref[i, 0] + vP[i, 1] * eref[i, 1] > 0.0:
                     ftx = -lim * vP[i, 0] / vt
                     fty = -lim * vP[i, 1] / vt
-                else:  # leaving stick: slip starts along the reference direction
+                else:
                     ftx = -lim * eref[i, 0]
                     fty = -lim * eref[i, 1]
             elif fmodel == FRICTION_REGULARIZED:
@@ -467,6 +474,18 @@ def _sticking_tips(regime, aux):
 
 
 @njit(cache=True)
+def _min_norm_solve(W, rhs):
+    """Least-squares, minimum-norm solution of W x = rhs.
+
+    Two stick points of a rigid bar along its axis constrain the same motion: W is then
+    singular and the holding forces are statically indeterminate; the minimum-norm
+    choice shares them equally (a flexible bar's axial modes make W regular).
+    """
+    x, _res, _rank, _sv = np.linalg.lstsq(W, rhs, 1e-10)
+    return x
+
+
+@njit(cache=True)
 def _stick_matrix(n, planar, R, s_tip, psi, theta, Ainv, B, m, Rtip, tips, ns, u_Vdot, u_wdot, u_etadot):
     """W = G M^-1 G^T for the sticking contact points; columns of M^-1 G^T into u_*."""
     ndir = 1 if planar else 2
@@ -537,7 +556,7 @@ def _apply_stick(fpar, n, planar, R, w, eta, s_tip, sd_tip, th_tip, vP, regime, 
         rhs[b_k * ndir] = -(a0 + baum * vP[k, 0])
         if ndir == 2:
             rhs[b_k * ndir + 1] = -(a1 + baum * vP[k, 1])
-    lam = np.linalg.solve(W, rhs)
+    lam = _min_norm_solve(W, rhs)
     for col in range(ns * ndir):
         lc = lam[col]
         for a in range(3):
@@ -575,7 +594,7 @@ def project_to_stick(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, x
     for b_k in range(ns):
         for d in range(ndir):
             rhs[b_k * ndir + d] = -vP[tips[b_k], d]
-    lam = np.linalg.solve(W, rhs)
+    lam = _min_norm_solve(W, rhs)
     dV = np.zeros(3)
     dw = np.zeros(3)
     de = np.zeros(n)

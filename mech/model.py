@@ -16,7 +16,7 @@ from .contact_laws import (
     calibrate_damping, damping_formula, hertz_impact, hertz_stiffness,
 )
 from .kernel import (
-    F_BAUM, F_BETA, F_C, F_G, F_GAMMA, F_K, F_MASS, F_MAX_RATIO, F_MU0, F_MU_SLOPE, F_RTIP,
+    F_BAUM, F_BETA, F_C, F_G, F_GAMMA, F_VBOUND, F_K, F_MASS, F_MAX_RATIO, F_MU0, F_MU_SLOPE, F_RTIP,
     F_T_MU, F_VREG, FRICTION_EXACT, FRICTION_NONE, FRICTION_REGULARIZED, I_FRICTION, I_N,
     I_PLANAR, N_FPAR, NQ, layout,
 )
@@ -82,6 +82,7 @@ class ContactScales:
     penetration_scale: float  # m, Hertz delta_max at the reference impact
     shortest_contact: float  # s, Hertz contact time lower bound
     energy_scale: float  # J
+    speed_bound: float  # m/s, no tip approaches the block faster (energy available, lightest mass)
 
 
 def _first_impact(scene: MechScene) -> tuple[float, float]:
@@ -101,7 +102,9 @@ def _first_impact(scene: MechScene) -> tuple[float, float]:
     g = scene.gravity
     speed = math.sqrt(max(vn, 0.0) ** 2 + 2.0 * g * ini.height)
     if speed <= 0.0:
-        speed = max(math.sqrt(2.0 * g * max(ini.height, 1e-4)), 1e-3)
+        # nothing approaches the block yet: the scale of the motion there is instead
+        motion = float(np.linalg.norm(ini.velocity)) + float(np.linalg.norm(w)) * 0.5 * bar.length
+        speed = max(motion, 1e-3)
     i_t = bar.density * bar.length * bar.second_moments[0] + m * bar.length**2 / 12.0
     m_eff = m / (1.0 + m * (a * math.cos(theta)) ** 2 / i_t)
     return speed, m_eff
@@ -131,7 +134,7 @@ def contact_scales(scene: MechScene, n_modes: int) -> ContactScales:
     return ContactScales(
         stiffness=k, damping=c, beta=con.beta, reference_speed=v_ref, reference_mass=m_eff,
         penetration_scale=hertz_impact(m_eff, k, v_ref).max_penetration,
-        shortest_contact=t_short, energy_scale=max(e_avail, 1e-12),
+        shortest_contact=t_short, energy_scale=max(e_avail, 1e-12), speed_bound=v_max,
     )
 
 
@@ -234,6 +237,7 @@ def build_model(scene: MechScene) -> BarModel:
     fpar[F_VREG] = fr.regularization_speed
     # Stick drift correction: slip velocity decays on a time scale of a few contact times.
     fpar[F_BAUM] = 1.0 / cs.shortest_contact
+    fpar[F_VBOUND] = cs.speed_bound
     if not fr.active:
         fmodel = FRICTION_NONE
     elif fr.model == "regularized":

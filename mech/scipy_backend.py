@@ -11,7 +11,10 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .integrator import DONE, EVENT, NOT_FINITE, events_from_aux
-from .kernel import A_FN, A_Y, A_YDOT, F_MU0, FRICTION_EXACT, I_FRICTION, NAUX, NEV_TIP, EV_SLIP, EV_STICK, SLIP, STICK, dynamics
+from .kernel import (
+    A_FN, A_Y, A_YDOT, EV_CLIP, EV_COMPRESSION, EV_SLIP, EV_STICK, F_MU0, FRICTION_EXACT, I_FRICTION, NAUX,
+    NEV_TIP, SLIP, STICK, dynamics,
+)
 
 METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
 
@@ -30,6 +33,7 @@ def scipy_segment(solver, t_target: float, method: str):
     eref = solver.eref.copy()
     work = solver._work
     aux = np.empty((2, NAUX))
+    aux_mid = np.empty((2, NAUX))
     g = np.empty(2 * NEV_TIP)
     N = m.state_size
     counter = {"nfev": 0}
@@ -64,12 +68,19 @@ def scipy_segment(solver, t_target: float, method: str):
                 return solver.ev_sign[k]
             if kind == EV_STICK and not (fexact and regime[i] == STICK):
                 return solver.ev_sign[k]
+            if kind in (EV_CLIP, EV_COMPRESSION) and aux[i, A_Y] <= 0.0:
+                return solver.ev_sign[k]  # watched only while the tip touches
+            if g[k] == 0.0 and t == t_start:
+                # solve_ivp counts a zero at t0 as a crossing there and would stop at t0
+                # again on every restart; we are on the side the solver's sign says.
+                return solver.ev_sign[k] * 1e-300
             return g[k]
 
         ev.terminal = True
         ev.direction = -solver.ev_sign[k]
         return ev
 
+    t_start = solver.t
     events = [make_event(k) for k in range(2 * NEV_TIP)]
     rtol = solver.scene.solver.rtol
     # solve_ivp's error test is |err| <= atol + rtol |y| for every component, so positions
@@ -77,9 +88,9 @@ def scipy_segment(solver, t_target: float, method: str):
     # is, if anything, given a looser tolerance than the compiled loop.
     y0 = solver.y.copy() if coupled is None else np.concatenate([solver.y, solver.z])
     atol = m.atol if coupled is None else np.concatenate([m.atol, coupled.atol])
-    sol = solve_ivp(fun, (solver.t, t_target), y0, method=method, rtol=rtol,
+    sol = solve_ivp(fun, (solver.t, t_target), y0, method=method, rtol=rtol, dense_output=True,
                     atol=atol, max_step=m.max_step, events=events,
-                    first_step=min(solver.h, m.max_step) if solver.h > 0 else None)
+                    first_step=min(solver.h, m.max_step, t_target - solver.t) if solver.h > 0 else None)
     solver.stats[2] += counter["nfev"]
     n_new = len(sol.t) - 1
     while solver._n + n_new + 1 >= solver._cap:
@@ -97,6 +108,12 @@ def scipy_segment(solver, t_target: float, method: str):
         solver._rec_y[r] = y
         solver._rec_aux[r] = aux
         solver._rec_fmax[r] = aux[:, A_FN]
+        if np.any(aux[:, A_Y] > 0.0) or np.any(solver._rec_aux[r - 1, :, A_Y] > 0.0 if r > 0 else False):
+            # the peak force lies inside a step: sample the dense output as the compiled loop does
+            for f in (0.25, 0.5, 0.75):
+                tm = sol.t[k - 1] + f * (sol.t[k] - sol.t[k - 1])
+                dynamics(tm, sol.sol(tm)[:N], *arrays, regime, eref, dy, aux_mid, work)
+                solver._rec_fmax[r] = np.maximum(solver._rec_fmax[r], aux_mid[:, A_FN])
     solver.stats[0] += n_new
     solver.y[:] = sol.y[:N, -1]
     if coupled is not None:

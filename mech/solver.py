@@ -30,8 +30,8 @@ from .integrator import (
     BUFFER_FULL, DONE, EVENT, STATUS_TEXT, dense_contact, dense_eval, events_from_aux, integrate,
 )
 from .kernel import (
-    A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_CONTACT, EV_SLIP,
-    EV_STICK, F_MU0, F_MU_SLOPE, F_T_MU, FREE, FRICTION_EXACT, I_FRICTION, NAUX, NEV_TIP, SLIP,
+    A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_COMPRESSION, EV_CONTACT,
+    EV_SLIP, EV_STICK, F_MU0, F_MU_SLOPE, F_T_MU, FREE, FRICTION_EXACT, I_FRICTION, NAUX, NEV_TIP, SLIP,
     STICK, dynamics, make_work, project_to_stick,
 )
 from .contact_laws import hertz_impact
@@ -40,7 +40,8 @@ from .parameters import MechScene
 from .scipy_backend import METHODS as SCIPY_METHODS, scipy_segment
 
 REGIME_NAMES = ("free", "slip", "stick")
-EVENT_KINDS = ("contact", "clip", "slip", "stick")
+EVENT_KINDS = ("contact", "clip", "slip", "stick", "compression")
+CHATTER_LIMIT = 200  # events at one instant (within round-off) before the run is stopped
 
 
 class MechSolverError(RuntimeError):
@@ -156,6 +157,8 @@ class ImpactSolver:
         self.ev_sign = np.zeros(2 * NEV_TIP)
         self.stats = np.zeros(4, dtype=np.int64)
         self.events: list[dict] = []
+        self._last_event_time = -1.0
+        self._chatter = 0
         self.wall_time = 0.0
         self.projection_energy = 0.0
         self._work = make_work(m.n)
@@ -220,18 +223,12 @@ class ImpactSolver:
             if self._n >= self._cap - 1:
                 self._grow()
             n0 = self._n
-            if self.backend != "dopri5":
-                status, t_new, h, n_rec, ev = scipy_segment(self, t_target, self.backend[6:])
-            else:
-                status, t_new, h, n_rec, ev = integrate(
-                    self.t, self.y, t_target, self.h, m.max_step, self.scene.solver.rtol, m.atol, m.relmask,
-                    *m.arrays, self.regime, self.eref, self.ev_sign,
-                    self._rec_t[n0:], self._rec_y[n0:], self._rec_aux[n0:], self._rec_fmax[n0:],
-                    self._dense_t0[n0:] if self.keep_dense else self._dense_t0,
-                    self._dense_h[n0:] if self.keep_dense else self._dense_h,
-                    self._dense_coef[n0:] if self.keep_dense else self._dense_coef,
-                    self.keep_dense, self.scene.solver.max_steps, self._work, self.stats,
-                )
+            try:
+                status, t_new, h, n_rec, ev = self._segment(t_target, n0)
+            except np.linalg.LinAlgError as err:
+                self.wall_time += time.perf_counter() - tick
+                raise MechSolverError(f"mechanics integration failed at t = {self.t!r} s: {err}",
+                                      self.t, self.named_state(), partial=self.result()) from err
             self._rec_regime[n0:n0 + n_rec] = self.regime
             self._n += n_rec
             self.t = t_new
@@ -263,6 +260,21 @@ class ImpactSolver:
                        self._rec_t[n_first:n_last].copy(), coef, start_state,
                        self._rec_regime[n_first:n_last].copy(), self.eref.copy())
 
+    def _segment(self, t_target: float, n0: int):
+        """One call of the stepper backend from the current state towards t_target."""
+        if self.backend != "dopri5":
+            return scipy_segment(self, t_target, self.backend[6:])
+        m = self.model
+        return integrate(
+            self.t, self.y, t_target, self.h, m.max_step, self.scene.solver.rtol, m.atol, m.relmask,
+            *m.arrays, self.regime, self.eref, self.ev_sign,
+            self._rec_t[n0:], self._rec_y[n0:], self._rec_aux[n0:], self._rec_fmax[n0:],
+            self._dense_t0[n0:] if self.keep_dense else self._dense_t0,
+            self._dense_h[n0:] if self.keep_dense else self._dense_h,
+            self._dense_coef[n0:] if self.keep_dense else self._dense_coef,
+            self.keep_dense, self.scene.solver.max_steps, self._work, self.stats,
+        )
+
     def run(self):
         """Integrate to ``solver.t_end`` and return the ``ImpactResult``."""
         self.advance(self.scene.solver.t_end)
@@ -286,6 +298,28 @@ class ImpactSolver:
             projection_energy=self.projection_energy,
             extra_states=self._rec_ext[:n].copy(),
         )
+
+    def set_modal_state(self, q=None, eta=None) -> None:
+        """Start from given modal coordinates q (m) and speeds eta (m/s), before integrating.
+
+        Order of the modes: ``self.model.basis.families``/``orders``. The run's first
+        record and the regimes are redone for the new state.
+        """
+        if self.t != 0.0 or self._n != 1:
+            raise ValueError("set_modal_state: only before the first advance")
+        sl = self.model.slices()
+        n = self.model.n
+        for name, value in (("q", q), ("eta", eta)):
+            if value is None:
+                continue
+            arr = np.asarray(value, dtype=float)
+            if arr.shape != (n,) or not np.all(np.isfinite(arr)):
+                raise ValueError(f"{name}: expected {n} finite numbers (one per mode), got {value!r}")
+            self.y[sl[name]] = arr
+        self._initial_state = self.y.copy()
+        self._n = 0
+        self._resolve(triggered=None)
+        self._record_point()
 
     def checkpoint(self) -> dict:
         """Everything needed to return to this instant with ``restore`` (records after it are dropped)."""
@@ -378,10 +412,20 @@ class ImpactSolver:
 
     def _handle_event(self, ev: int) -> None:
         tip, kind = divmod(ev, NEV_TIP)
+        same_instant = abs(self.t - self._last_event_time) <= 1e-12 * max(abs(self.t), 1e-6)
+        self._chatter = self._chatter + 1 if same_instant else 0
+        self._last_event_time = self.t
+        if self._chatter > CHATTER_LIMIT:
+            raise MechSolverError(
+                f"regime switching does not settle at t = {self.t!r} s: {self._chatter} events at one "
+                f"instant (last: tip {tip} {EVENT_KINDS[kind]}, regimes "
+                f"{[REGIME_NAMES[r] for r in self.regime]})", self.t, self.named_state(), partial=self.result())
         old = self.regime.copy()
         old_sign = self.ev_sign[ev]
         self._resolve(triggered=ev)
         aux = self._aux
+        if kind == EV_COMPRESSION:
+            return  # a restart for the work split only; the time of maximum compression is in the history
         if kind == EV_CONTACT:
             name = "contact_start" if old_sign < 0 else "contact_end"
             if name == "contact_start":
@@ -402,9 +446,20 @@ class ImpactSolver:
                 name = "slip_reversal"
         else:
             name = "stick_end"
+        self._log(tip, name, old[tip], aux)
+        # The other tip may have crossed at the same instant (a symmetric landing): its
+        # regime changed at this restart without an event of its own.
+        other = 1 - tip
+        if (old[other] == FREE) != (self.regime[other] == FREE):
+            if self.regime[other] != FREE:
+                self._check_cap(other)
+                self.h = min(self.h, self._onset_step)
+            self._log(other, "contact_start" if old[other] == FREE else "contact_end", old[other], aux)
+
+    def _log(self, tip: int, kind: str, before: int, aux: np.ndarray) -> None:
         self.events.append(dict(
-            time=self.t, tip=tip, kind=name,
-            regime_before=REGIME_NAMES[old[tip]], regime_after=REGIME_NAMES[self.regime[tip]],
+            time=self.t, tip=tip, kind=kind,
+            regime_before=REGIME_NAMES[before], regime_after=REGIME_NAMES[self.regime[tip]],
             penetration=float(aux[tip, A_Y]), penetration_rate=float(aux[tip, A_YDOT]),
             normal_force=float(aux[tip, A_FN]),
             slip_speed=float(math.hypot(aux[tip, A_VTX], aux[tip, A_VTY])),
@@ -464,6 +519,16 @@ class ImpactSolver:
             else:
                 new[i] = STICK  # provisional: kept if the holding force is within the limit
         # Stick needs the holding force within the limit; the tips are coupled through the bar.
+        # A tip whose own stick-limit event fired slips: the located state can sit a
+        # round-off inside the limit, and keeping the tip stuck would re-fire the event.
+        for i in range(2):
+            if triggered == NEV_TIP * i + EV_STICK and new[i] == STICK:
+                aux = self._evaluate()
+                ft = np.array([aux[i, A_FTX], aux[i, A_FTY]])
+                fmag = float(np.hypot(*ft))
+                if fmag > 0.0:
+                    new[i] = SLIP
+                    self.eref[i] = -ft / fmag
         for _ in range(3):
             self.regime[:] = new
             aux = self._evaluate()
@@ -497,3 +562,8 @@ class ImpactSolver:
                 self.ev_sign[b + EV_CLIP] = 1.0 if gc >= 0.0 else -1.0
             self.ev_sign[b + EV_SLIP] = 1.0
             self.ev_sign[b + EV_STICK] = 1.0
+            gd = g[b + EV_COMPRESSION]
+            if triggered == b + EV_COMPRESSION:
+                self.ev_sign[b + EV_COMPRESSION] = -self.ev_sign[b + EV_COMPRESSION]
+            else:
+                self.ev_sign[b + EV_COMPRESSION] = 1.0 if gd >= 0.0 else -1.0
