@@ -60,10 +60,14 @@ class SimulationOptions:
         """ngspice's maximum internal step (TMAX) for a run to ``t_end`` (s)."""
         return self.max_step if self.max_step is not None else t_end / 50.0
 
+    def min_break(self, t_end: float) -> float:
+        """ngspice's CKTminBreak = 5e-5 TMAX (s): breakpoints closer than this merge."""
+        return 5e-5 * self.tmax(t_end)
+
     def end_tolerance(self, t_end: float) -> float:
         """How early (s) ngspice may end a run to ``t_end``: within CKTminBreak = 5e-5 TMAX
         of the end it stops (after rejected steps near the end its last point can be there)."""
-        return 5e-5 * self.tmax(t_end)
+        return self.min_break(t_end)
 
     def deck_lines(self, t_end: float) -> list[str]:
         """``.options`` and ``.tran`` lines for a transient from 0 to ``t_end`` (s)."""

@@ -145,6 +145,13 @@ class Stepper:
                 self._arc.start(float(source(0.0)) > 0.0)
             session.set_source(left_limited(source, points, t_next - t0, t_next))
             landings = snapped(points, t_next, t_next - t0)
+            if self._started and landings and landings[0] - t0 <= self.options.min_break(self.t_end):
+                # ngspice drops a breakpoint within CKTminBreak after its current time
+                # (measured at TMAX 1 us: 4e-11 s after it dropped, 1e-10 s landed), so a make
+                # 2.6e-17 s after a macro time accumulated as t + H had its 10 ns ramp taken in
+                # one step. A breakpoint at the current time itself makes ngspice restart there
+                # (order 1, short first step), as it would at the make.
+                session.set_breakpoint(session.last_time())
             for b in landings:
                 session.set_breakpoint(b)
             if self._arc is not None:

@@ -148,3 +148,23 @@ def test_one_ngspice_per_process_is_guarded(ringing_circuit, bounce_options):
     forgotten = Stepper(ringing_circuit, 100e-6, bounce_options)
     del forgotten
     assert len(run_transient(ringing_circuit, 1.0, 100e-6, options=bounce_options)) > 10
+
+
+@pytest.mark.parametrize("delta", [2.6e-17, 1e-13, 4e-11, 1e-10, 1e-9])
+def test_a_make_just_after_the_macro_time_restarts_the_integration(ringing_circuit, delta):
+    """ngspice drops a breakpoint closer than CKTminBreak = 5e-5 TMAX (5e-11 s here) after
+    its current time. A make 2.6e-17 s after a macro time (t accumulated as t + H) had its
+    10 ns ramp taken in one step; now ngspice restarts at the macro time (a breakpoint
+    there), as at the make itself: the first step is a fraction of the ramp."""
+    from circuit import ContactSchedule, SimulationOptions
+
+    t0 = 0.4e-3
+    schedule = ContactSchedule(((0.0, 0.1e-3), (t0 + delta, math.inf)), closed_resistance=0.01)
+    with Stepper(ringing_circuit, 0.41e-3, SimulationOptions(max_step=1e-6)) as stepper:
+        stepper.advance(t0, schedule, schedule.breakpoints(0.0, t0))
+        step = stepper.advance(0.41e-3, schedule, schedule.breakpoints(t0, 0.41e-3))
+        times = step.frame().time.to_numpy()
+    assert times[0] == t0
+    assert times[1] - t0 < 2e-9  # measured 0.87 ns (2.6e-17 to 4e-11), 0.1 and 1 ns; was 10 ns
+    # The ramp is resolved: several points inside it.
+    assert np.sum((times > t0) & (times < t0 + delta + 10e-9)) >= 3
