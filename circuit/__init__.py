@@ -6,7 +6,7 @@ The contact is a time-varying conductance driven from Python. SI units throughou
 - ``run_transient`` / ``run_pwl_reference``: one-shot runs.
 - ``ContactSchedule``: prescribed make/break instants.
 - ``SwitchCircuit`` and its parts, ``NetlistCircuit``: the circuit.
-- ``ArcModel``: arc/breakdown of the opening gap.
+- ``ArcModel``: arc/breakdown of the opening gap (optionally growing with the gap distance).
 """
 
 from .arc import ArcModel, add_arc
@@ -14,6 +14,7 @@ from .contact import add_contact, left_limited
 from .errors import (
     ConductanceError,
     ConvergenceError,
+    GapError,
     LibraryNotFoundError,
     NetlistError,
     NgspiceError,
@@ -49,6 +50,7 @@ __all__ = [
     "ConvergenceError",
     "DCSource",
     "FlybackDiode",
+    "GapError",
     "InductiveLoad",
     "LibraryNotFoundError",
     "NetlistCircuit",

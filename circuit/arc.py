@@ -16,11 +16,17 @@ Physics kept (short arcs between contact metals, the bounce regime):
   load, or the current goes into a snubber) no arc forms.
 - Optionally, an extinguished gap re-ignites when its voltage reaches the breakdown
   voltage V_bd (repeated re-ignitions give the "showering arc" of inductive loads).
+- Optionally the burning voltage grows with the gap distance d(t) >= 0 (m), given
+  from Python like G(t): U_arc = U_min + E_col d + R_arc |i| (``column_gradient``
+  E_col, V/m: the arc column's field, a few V/mm for short arcs in air at a few
+  amperes), so a DC arc whose supply exceeds U_min goes out as the gap lengthens; and
+  the re-ignition voltage may grow too: V_bd(d) = V_bd0 + E_bd d (``breakdown_gradient``).
+  Both default to 0: a constant U_min and V_bd, no gap needed.
 
-Not modelled: arc elongation with gap growth (U_min is constant, so a DC arc with
-E > U_min and load current > I_min burns for as long as the contact stays open),
-V_bd growing with gap distance, make arcs (pre-strike on closing), erosion, and the
-glow discharge regime.
+Not modelled: arc elongation beyond the straight column (magnetic blow-out, arc
+runners), make arcs (pre-strike on closing), erosion, and the glow discharge regime.
+Without ``column_gradient`` a DC arc with E > U_min and load current > I_min burns for
+as long as the contact stays open.
 
 Netlist: the arc path across the gap is one behavioural conductor, a dead zone
 (conducts beyond +-U_min with slope 1/R_arc) enabled by the arc state e in {0, 1},
@@ -33,6 +39,13 @@ plus the 1 GOhm of an extinguished gap::
 
 (an EXTERNAL current source: ngspice asks for its value through its own callback, so
 the contact's EXTERNAL voltage source and the arc state need no name look-up).
+
+With a gap dependence (``column_gradient`` or ``breakdown_gradient`` > 0) a second
+EXTERNAL voltage source gives the gap distance, and U_min in the dead zone becomes
+U_min + E_col V(arc_gap)::
+
+    Varc_gap arc_gap 0 external                         (d(t) in volts = metres)
+    Barc    arc_p b I=V(arc_on)*(uramp(v-U)-uramp(-v-U))/R_arc + 1e-9*v,  U = U_min+E_col*V(arc_gap)
 
 The state is not decided inside ngspice's Newton iteration: ``ArcState`` holds it and
 changes it only at accepted time points (from the accepted solution), so within a
@@ -68,6 +81,8 @@ from .validation import check_range
 SENSE_SOURCE = "Varc"
 STATE_SOURCE = "Iarc_on"
 STATE_NODE = "arc_on"
+GAP_SOURCE = "Varc_gap"  # EXTERNAL: the gap distance d(t), m (volts), only with a gap dependence
+GAP_NODE = "arc_gap"
 OFF_CONDUCTANCE = 1e-9  # S: an extinguished gap (and the path's floor when burning)
 RESOLUTION = 1e-5  # events located to this fraction of I_min or V_bd
 _APPROACH = 0.75  # fraction of the remaining distance to a threshold one step may cover
@@ -87,6 +102,18 @@ class ArcModel:
         (order of the molten-bridge lifetime at ampere currents).
     breakdown_voltage: gap voltage at which an extinguished gap re-ignites, V, or None
         for a gap that never re-ignites (the voltage is then limited only by the circuit).
+        With ``breakdown_gradient`` it is the value at zero gap, V_bd0.
+    column_gradient: growth of the burning voltage with the gap distance d, V/m:
+        U_arc = U_min + column_gradient * d + resistance * |i|. 0 (default): constant
+        U_min, no gap needed. Illustrative order of magnitude for short arcs in air at a
+        few amperes: 1-5 V/mm (1e3-5e3 V/m), from general contact-physics knowledge,
+        not a measured value for a particular contact. With a value > 0 every run needs
+        the gap d(t) (``Stepper.advance(..., gap=...)``).
+    breakdown_gradient: growth of the re-ignition voltage with the gap, V/m:
+        V_bd(d) = breakdown_voltage + breakdown_gradient * d (needs ``breakdown_voltage``;
+        0 default). Illustrative: air breaks down at ~3 kV/mm at mm gaps (3e6 V/m); keep
+        it above ``column_gradient``, else beyond d = (V_bd0 - U_min) / (E_col - E_bd) a
+        re-ignited arc cannot conduct and goes out again at the next point.
     """
 
     min_voltage: float = 12.0
@@ -94,6 +121,8 @@ class ArcModel:
     resistance: float = 0.05
     formation_time: float = 1e-6
     breakdown_voltage: float | None = None
+    column_gradient: float = 0.0
+    breakdown_gradient: float = 0.0
 
     def __post_init__(self) -> None:
         name = "ArcModel"
@@ -105,6 +134,19 @@ class ArcModel:
             check_range(
                 name, "breakdown_voltage", self.breakdown_voltage, "V", self.min_voltage, 1e6, low_open=True
             )
+        # Wide ranges: they catch a sign or a unit slip (V/mm is 1e3 V/m), not unusual arcs.
+        check_range(name, "column_gradient", self.column_gradient, "V/m", 0.0, 1e6)
+        check_range(name, "breakdown_gradient", self.breakdown_gradient, "V/m", 0.0, 1e9)
+        if self.breakdown_gradient > 0 and self.breakdown_voltage is None:
+            raise ValueError(
+                f"{name}.breakdown_gradient = {self.breakdown_gradient:g} V/m needs breakdown_voltage "
+                "(the re-ignition voltage at zero gap, V)"
+            )
+
+    @property
+    def uses_gap(self) -> bool:
+        """True if the model depends on the gap distance: every run then needs d(t)."""
+        return self.column_gradient > 0.0 or self.breakdown_gradient > 0.0
 
 
 def add_arc(circuit: Circuit, arc: ArcModel, node_a: str, node_b: str) -> None:
@@ -113,9 +155,13 @@ def add_arc(circuit: Circuit, arc: ArcModel, node_a: str, node_b: str) -> None:
     The arc current (A, positive from a to b) is the branch current of ``Varc``; the arc
     state (1 burning or armed, 0 extinguished) is the voltage of node ``arc_on``, set by
     ``ArcState`` between time points through the EXTERNAL current source ``Iarc_on``. The model is recorded on the circuit, so a run
-    of a PySpice ``Circuit`` finds it.
+    of a PySpice ``Circuit`` finds it. With a gap dependence (``arc.uses_gap``) the gap
+    distance d(t) (m) is the voltage of node ``arc_gap``, set by the EXTERNAL source
+    ``Varc_gap`` (every run then needs a gap).
     """
-    u = float(arc.min_voltage)
+    u = repr(float(arc.min_voltage))
+    if arc.column_gradient > 0.0:
+        u = f"({u}+{float(arc.column_gradient)!r}*V({GAP_NODE}))"
     v = f"V(arc_p,{node_b})"
     circuit.V(SENSE_SOURCE[1:], node_a, "arc_p", 0)
     circuit.B(
@@ -123,13 +169,16 @@ def add_arc(circuit: Circuit, arc: ArcModel, node_a: str, node_b: str) -> None:
         "arc_p",
         node_b,
         current_expression=(
-            f"V({STATE_NODE})*(uramp({v}-{u!r})-uramp(-{v}-{u!r}))/{float(arc.resistance)!r}"
+            f"V({STATE_NODE})*(uramp({v}-{u})-uramp(-{v}-{u}))/{float(arc.resistance)!r}"
             f"+{OFF_CONDUCTANCE!r}*{v}"
         ),
     )
     # No value after 'external' (a value segfaults ngspice 38-40 on V sources).
     circuit.I(STATE_SOURCE[1:], circuit.gnd, STATE_NODE, "external")
     circuit.R("arc_on", STATE_NODE, circuit.gnd, 1)
+    if arc.uses_gap:
+        # No value after 'external' here either.
+        circuit.V(GAP_SOURCE[1:], GAP_NODE, circuit.gnd, "external")
     setattr(circuit, _ATTRIBUTE, (arc, str(node_a), str(node_b)))
 
 
@@ -158,14 +207,17 @@ class ArcState:
       closed for a while stays armed for formation_time after parting, and a make arms
       the gap only formation_time later, once the contact has taken the current (no
       make arc);
-    - burning next = armed, or (burning and |i| >= I_min), or (V_bd set and |v| >= V_bd).
+    - burning next = armed, or (burning and |i| >= I_min), or (V_bd set and
+      |v| >= V_bd(d) = V_bd0 + E_bd d, with d the gap distance at t).
 
     Names are ngspice vector names: ``current`` the arc current ("varc#branch"),
     ``node_a``/``node_b`` the contact nodes, ``conductance`` the node whose voltage is
-    the contact conductance G(t).
+    the contact conductance G(t), ``gap`` the node whose voltage is the gap distance
+    (needed only with a breakdown gradient).
     """
 
-    def __init__(self, arc: ArcModel, current: str, node_a: str, node_b: str, conductance: str):
+    def __init__(self, arc: ArcModel, current: str, node_a: str, node_b: str, conductance: str,
+                 gap: str = GAP_NODE):
         self.arc = arc
         self._tau = arc.formation_time / math.log(2.0)
         ground = ("0", "gnd")
@@ -173,6 +225,9 @@ class ArcState:
         self._names_on = (current.lower(),)
         nodes = tuple(n.lower() for n in (node_a, node_b) if n.lower() not in ground)
         self._names_off = self._names_on + nodes
+        self._gap_gradient = float(arc.breakdown_gradient) if arc.breakdown_voltage is not None else 0.0
+        if self._gap_gradient > 0.0:
+            self._names_off += (gap.lower(),)
         self._sign_b = node_b.lower() not in ground  # v = V(a) - V(b); a grounded node reads 0
         self._sign_a = node_a.lower() not in ground
         self.start(False)
@@ -228,7 +283,11 @@ class ArcState:
             values = read(self._names_off if breakdown else self._names_on)
             current = abs(values[0])
             if breakdown:
-                voltage = abs((values[1] if self._sign_a else 0.0) - (values[-1] if self._sign_b else 0.0))
+                va = values[1] if self._sign_a else 0.0
+                vb = values[1 + self._sign_a] if self._sign_b else 0.0
+                # The margin to breakdown, |v| - E_bd d >= V_bd0: a fixed threshold, so the
+                # step control below sees the gap's growth in the rate.
+                voltage = abs(va - vb) - (self._gap_gradient * values[-1] if self._gap_gradient > 0.0 else 0.0)
         burning = armed or (self.burning and current >= arc.min_current) or (breakdown and voltage >= arc.breakdown_voltage)
         if burning != self.burning:
             self.switches += 1
@@ -251,7 +310,7 @@ class ArcState:
             return math.inf, land
         if burning:  # |i| falling towards I_min
             return self._approach(t, current, arc.min_current, -1.0, floor), land
-        if breakdown:  # |v| rising towards V_bd
+        if breakdown:  # |v| (less E_bd d) rising towards V_bd0
             return self._approach(t, voltage, arc.breakdown_voltage, 1.0, floor), land
         return math.inf, land
 

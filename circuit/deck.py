@@ -7,7 +7,7 @@ from typing import Union
 import numpy as np
 from PySpice.Spice.Netlist import Circuit
 
-from .arc import STATE_SOURCE, ArcModel, ArcState, recorded_arc
+from .arc import GAP_NODE, GAP_SOURCE, STATE_SOURCE, ArcModel, ArcState, recorded_arc
 from .contact import CONDUCTANCE_NODE, CONDUCTANCE_SOURCE, SENSE_SOURCE
 from .netlist import NetlistCircuit
 from .options import SimulationOptions
@@ -17,7 +17,8 @@ from .validation import check_range
 
 CircuitLike = Union[SwitchCircuit, NetlistCircuit, Circuit]
 
-#: Drive of the conductance source: "external" (Python callback) or PWL vertices (times s, values S).
+#: Drive of the conductance source (or of the gap source): "external" (Python callback)
+#: or PWL vertices (times s, values S or m).
 Drive = Union[str, tuple[np.ndarray, np.ndarray]]
 
 
@@ -62,7 +63,7 @@ def arc_state(circuit: CircuitLike, probes: Probes) -> ArcState | None:
     arc = circuit_arc(circuit)
     if arc is None:
         return None
-    return ArcState(arc, probes.arc_current, probes.node_a, probes.node_b, CONDUCTANCE_NODE)
+    return ArcState(arc, probes.arc_current, probes.node_a, probes.node_b, CONDUCTANCE_NODE, GAP_NODE)
 
 
 def _node_of(circuit: Circuit, element: str, index: int) -> str:
@@ -73,9 +74,11 @@ def _node_of(circuit: Circuit, element: str, index: int) -> str:
 
 
 def build_deck(
-    circuit: CircuitLike, t_end: float, options: SimulationOptions, drive: Drive = "external"
+    circuit: CircuitLike, t_end: float, options: SimulationOptions, drive: Drive = "external",
+    gap_drive: Drive = "external",
 ) -> tuple[list[str], Probes]:
-    """Deck lines for a transient 0..t_end (s), the conductance source driven by ``drive``."""
+    """Deck lines for a transient 0..t_end (s), the conductance source driven by ``drive``
+    and, with a gap-dependent arc model, the gap source by ``gap_drive``."""
     check_range("transient", "t_end", t_end, "s", 0.0, 1e3, low_open=True)
     text, probes = circuit_netlist(circuit)
     lines = [line for line in text.splitlines() if line.strip()]
@@ -88,9 +91,11 @@ def build_deck(
         if head == CONDUCTANCE_SOURCE.lower():
             lines[i] = "\n".join(_source_lines(drive))
             replaced = True
+        elif head == GAP_SOURCE.lower():
+            lines[i] = "\n".join(_source_lines(gap_drive, f"{GAP_SOURCE} {GAP_NODE} 0", "gap"))
         elif head[0] in "vi" and head != STATE_SOURCE.lower() and "external" in (t.lower() for t in tokens[3:]):
             raise ValueError(
-                f"netlist line {line!r}: only the contact's conductance source (and the arc state) may be EXTERNAL"
+                f"netlist line {line!r}: only the contact's conductance source (and the arc state and gap) may be EXTERNAL"
             )
         elif head == ".end":
             lines[i] = ""
@@ -102,8 +107,8 @@ def build_deck(
     return lines, probes
 
 
-def _source_lines(drive: Drive) -> list[str]:
-    head = f"{CONDUCTANCE_SOURCE} {CONDUCTANCE_NODE} 0"
+def _source_lines(drive: Drive, head: str = f"{CONDUCTANCE_SOURCE} {CONDUCTANCE_NODE} 0",
+                  what: str = "conductance") -> list[str]:
     if isinstance(drive, str):
         if drive != "external":
             raise ValueError(f"drive = {drive!r}: 'external' or PWL vertices")
@@ -111,9 +116,13 @@ def _source_lines(drive: Drive) -> list[str]:
         return [f"{head} external"]
     times, values = (np.asarray(a, dtype=float) for a in drive)
     if times.ndim != 1 or times.shape != values.shape or times.size < 2:
-        raise ValueError("PWL drive: times and values must be 1-D arrays of equal length >= 2")
-    if np.any(np.diff(times) <= 0) or not np.all(np.isfinite(values)) or np.any(values < 0):
-        raise ValueError("PWL drive: times must increase strictly and values be finite and >= 0")
+        raise ValueError(f"PWL {what}: times and values must be 1-D arrays of equal length >= 2")
+    if not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
+        raise ValueError(f"PWL {what}: times must be finite and increase strictly")
+    if not np.all(np.isfinite(values)) or np.any(values < 0):
+        bad = int(np.argmax(~np.isfinite(values) | (values < 0)))
+        raise ValueError(f"PWL {what}: values must be finite and >= 0 (vertex {bad}: {values[bad]!r} at "
+                         f"t = {times[bad]!r} s)")
     pairs = [f"{float(t)!r} {float(v)!r}" for t, v in zip(times, values)]
     # Continuation lines keep each physical line short for ngspice's reader.
     chunks = [" ".join(pairs[i : i + 8]) for i in range(0, len(pairs), 8)]

@@ -48,3 +48,7 @@ class SessionBusyError(RuntimeError):
 
 class ConductanceError(ValueError):
     """The contact conductance callable returned a value that is not finite and >= 0."""
+
+
+class GapError(ValueError):
+    """The gap-distance callable returned a value that is not finite and >= 0 (m)."""

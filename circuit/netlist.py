@@ -19,8 +19,8 @@ switchsim replaces that line by its contact element (and the arc path, when an
     Rcoil coil c1 240
     Lcoil c1 0 50m
 
-Reserved (do not use): elements Vcontact, Bcontact, Bcontact_geff, Vcontact_g, Varc,
-Barc*, Iarc_on, Rarc_on; nodes contact_s, contact_g, contact_geff, arc_*.
+Reserved (do not use): elements Vcontact, Bcontact, Bcontact_geff, Vcontact_g, Varc*
+(Varc, Varc_gap), Barc*, Iarc_on, Rarc_on; nodes contact_s, contact_g, contact_geff, arc_*.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ from .contact import (
 from .probes import Probes
 from .validation import check_range
 
-_RESERVED_ELEMENTS = re.compile(r"^(vcontact|bcontact|bcontact_geff|vcontact_g|varc|barc\w*|iarc_on|rarc_on)$", re.I)
+_RESERVED_ELEMENTS = re.compile(r"^(vcontact|bcontact|bcontact_geff|vcontact_g|varc\w*|barc\w*|iarc_on|rarc_on)$", re.I)
 _RESERVED_NODES = re.compile(r"^(contact_s|contact_g|contact_geff|arc_\w+)$", re.I)
 _ANALYSIS = re.compile(r"^\.(tran|op|ac|dc|noise|tf|disto|sens|pz|control|endc|end)\b", re.I)
 

@@ -23,10 +23,12 @@ from typing import Callable
 import numpy as np
 from PySpice.Spice.NgSpice.Shared import NgSpiceShared, ffi
 
+from .arc import GAP_SOURCE
 from .contact import LANDING_TOLERANCE
 from .errors import (
     ConductanceError,
     ConvergenceError,
+    GapError,
     LibraryNotFoundError,
     NetlistError,
     NgspiceError,
@@ -132,6 +134,15 @@ class NgspiceSession(NgSpiceShared):
         self._source: Callable[[float], float] = _zero
         self._last_t = math.nan
         self._last_value = 0.0
+        # The gap source (arc model with a gap dependence), a second EXTERNAL voltage
+        # source told apart by its name pointer (ngspice passes the instance's own name
+        # string, so the pointer is learned once per loaded circuit).
+        self._gap: Callable[[float], float] | None = None
+        self._gap_last_t = math.nan
+        self._gap_last_value = 0.0
+        self._name_g = ffi.NULL
+        self._name_d = ffi.NULL
+        self.gap_calls = 0
         self._target = math.inf
         self._deadline = math.inf
         self._failure: BaseException | None = None
@@ -212,6 +223,8 @@ class NgspiceSession(NgSpiceShared):
     def _on_vsrc(self, out, t, name, ident, user):
         # Called at every Newton iteration and on rejected trial points: the value must
         # depend on t only. Repeated calls at the same t skip the Python function.
+        if self._gap is not None and name != self._name_g and (name == self._name_d or self._is_gap(name)):
+            return self._on_gap(out, t)
         if t == self._last_t:
             out[0] = self._last_value
             return 0
@@ -233,6 +246,34 @@ class NgspiceSession(NgSpiceShared):
             return 0
         self._last_t = t
         self._last_value = value
+        out[0] = value
+        return 0
+
+    def _is_gap(self, name) -> bool:
+        """Classify an EXTERNAL voltage source seen for the first time (gap or conductance)."""
+        if ffi.string(name).decode("ascii", "replace").lower() == GAP_SOURCE.lower():
+            self._name_d = name
+            return True
+        self._name_g = name
+        return False
+
+    def _on_gap(self, out, t):
+        if t == self._gap_last_t or self._failure is not None:
+            out[0] = self._gap_last_value
+            return 0
+        self.gap_calls += 1
+        try:
+            value = float(self._gap(t))
+        except BaseException as exc:  # re-raised after ngspice has stopped
+            self._failure = exc
+            out[0] = self._gap_last_value
+            return 0
+        if not (0.0 <= value < math.inf):
+            self._failure = GapError(f"contact gap at t = {t!r} s is {value!r} m; it must be finite and >= 0")
+            out[0] = self._gap_last_value
+            return 0
+        self._gap_last_t = t
+        self._gap_last_value = value
         out[0] = value
         return 0
 
@@ -320,6 +361,12 @@ class NgspiceSession(NgSpiceShared):
         self._source = _zero
         self._last_t = math.nan
         self._last_value = 0.0
+        self._gap = None
+        self._gap_last_t = math.nan
+        self._gap_last_value = 0.0
+        self._name_g = ffi.NULL
+        self._name_d = ffi.NULL
+        self.gap_calls = 0
         self._target = math.inf
         self._deadline = math.inf
         self._failure = None
@@ -342,10 +389,13 @@ class NgspiceSession(NgSpiceShared):
         if rc or errors:
             raise NetlistError("ngspice could not parse the netlist", _message(printed))
 
-    def set_source(self, source: Callable[[float], float]) -> None:
-        """The function of time (s) whose value ngspice reads from the EXTERNAL source."""
+    def set_source(self, source: Callable[[float], float], gap: Callable[[float], float] | None = None) -> None:
+        """The function of time (s) whose value ngspice reads from the EXTERNAL conductance
+        source, and the gap distance d(t) (m) for the EXTERNAL gap source (None: no gap source)."""
         self._source = source
         self._last_t = math.nan
+        self._gap = gap
+        self._gap_last_t = math.nan
 
     def set_arc(self, arc) -> None:
         """The ``ArcState`` of the loaded circuit (it drives ``Iarc_on``), or None without an arc."""

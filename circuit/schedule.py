@@ -7,6 +7,13 @@ make and each break the conductance ramps linearly over ``edge_time``::
     G(t) = w(t) / R_closed(t - t_make),  w: 0 -> 1 on [t_make, t_make + edge],
                                           1 -> 0 on [t_break - edge, t_break]
 
+Optionally (``opening_speed`` v, m/s) the schedule also gives a simple gap distance
+d(t) >= 0 (m) for an arc model that depends on it: 0 while closed, opening at v after
+each break and closing at v towards the next make (a triangle, apex halfway), opening
+at v for ever after the last break, and closing at v towards the first make::
+
+    d(t) = v min(t - t_break, t_next_make - t)   in each open interval
+
 Example, a make at 0.1 ms followed by bounces::
 
     schedule = ContactSchedule.from_events(
@@ -39,15 +46,23 @@ class ContactSchedule:
         make (s) -> ohm (e.g. a film resistance decaying as the force builds up).
     edge_time: duration of the linear conductance ramp at each make and break, s
         (0: ideal jumps; a PWL description needs edge_time > 0).
+    opening_speed: m/s, or None (default): the speed of the simple gap d(t) (``gap``,
+        module docstring), for an arc model whose voltage grows with the gap.
     """
 
     intervals: tuple[tuple[float, float], ...]
     closed_resistance: float | Resistance = 0.01
     edge_time: float = 10e-9
+    opening_speed: float | None = None
 
     def __post_init__(self) -> None:
         name = "ContactSchedule"
         check_range(name, "edge_time", self.edge_time, "s", 0.0, 1e-3)
+        if self.opening_speed is not None:
+            check_range(name, "opening_speed", self.opening_speed, "m/s", 0.0, 1e3, low_open=True)
+            if not self.intervals:
+                raise ValueError(f"{name}.opening_speed: the gap needs at least one closed interval "
+                                 "(it is measured from the breaks and makes)")
         if not callable(self.closed_resistance):
             check_range(name, "closed_resistance", self.closed_resistance, "ohm", 1e-9, 1e9, low_open=True)
         try:
@@ -79,6 +94,9 @@ class ContactSchedule:
                 corners.update((make, make + self.edge_time))
             if not math.isinf(brk):
                 corners.update((brk - self.edge_time, brk))
+        if self.opening_speed is not None:
+            # The gap's apexes: halfway between a break and the next make.
+            corners.update(0.5 * (brk + make) for (_, brk), (make, _) in zip(pairs[:-1], pairs[1:]))
         object.__setattr__(self, "_corners", sorted(corners))
 
     @classmethod
@@ -88,6 +106,7 @@ class ContactSchedule:
         brk: Sequence[float],
         closed_resistance: float | Resistance = 0.01,
         edge_time: float = 10e-9,
+        opening_speed: float | None = None,
     ) -> "ContactSchedule":
         """From make instants and break instants (s); one more make than breaks leaves it closed."""
         make, brk = list(make), list(brk)
@@ -96,7 +115,7 @@ class ContactSchedule:
                 f"ContactSchedule.from_events: {len(make)} makes need {len(make)} or {len(make) - 1} breaks, got {len(brk)}"
             )
         ends = brk + [math.inf] * (len(make) - len(brk))
-        return cls(tuple(zip(make, ends)), closed_resistance, edge_time)
+        return cls(tuple(zip(make, ends)), closed_resistance, edge_time, opening_speed)
 
     # -- as a function of time --
 
@@ -126,8 +145,24 @@ class ContactSchedule:
 
     __call__ = conductance
 
+    def gap(self, t: float) -> float:
+        """The simple gap distance d(t), m (module docstring); needs ``opening_speed``."""
+        v = self.opening_speed
+        if v is None:
+            raise ValueError("ContactSchedule.gap: set opening_speed (m/s) for the schedule to give a gap")
+        i = bisect.bisect_right(self._makes, t) - 1
+        if i < 0:
+            return v * (self.intervals[0][0] - t)  # closing towards the first make
+        brk = self.intervals[i][1]
+        if t <= brk:
+            return 0.0
+        if i + 1 < len(self.intervals):
+            return v * min(t - brk, self.intervals[i + 1][0] - t)
+        return v * (t - brk)
+
     def breakpoints(self, t_start: float = 0.0, t_end: float = math.inf) -> tuple[float, ...]:
-        """Every ramp corner in (t_start, t_end], s: where G(t) has a kink or a jump."""
+        """Every ramp corner in (t_start, t_end], s: where G(t) has a kink or a jump (with
+        ``opening_speed`` also the gap's apexes, where d(t) turns)."""
         corners = self._corners
         return tuple(corners[bisect.bisect_right(corners, t_start) : bisect.bisect_right(corners, t_end)])
 
@@ -158,3 +193,10 @@ class ContactSchedule:
         # With ramps, G is continuous, so its value at each corner is the PWL vertex.
         values = np.array([self.conductance(t) for t in grid])
         return grid, values
+
+    def gap_pwl_points(self, t_end: float) -> tuple[np.ndarray, np.ndarray]:
+        """Times (s) and gap distances (m) of a PWL description of ``gap`` on [0, t_end] (exact)."""
+        times = {0.0, float(t_end)}
+        times.update(self.breakpoints(0.0, t_end))
+        grid = np.array(sorted(t for t in times if 0.0 <= t <= t_end))
+        return grid, np.array([self.gap(t) for t in grid])

@@ -5,7 +5,10 @@ Python function of time, G(t) >= 0 in S, and the make/break instants inside the 
 ngspice integrates to exactly t_next (its steps are shortened to land there, without the
 order reset a breakpoint causes) and pauses; the contact and load quantities are read
 back. One run is one ngspice transient, so results do not depend on the macro step
-except through G and the breakpoints. Repeated runs are bit-identical.
+except through G and the breakpoints. Repeated runs are bit-identical. With an arc model
+whose voltage grows with the gap (``ArcModel.column_gradient`` > 0, or
+``breakdown_gradient``) the gap distance d(t) >= 0 in m is supplied the same way
+(``gap=``).
 
 Example::
 
@@ -32,11 +35,14 @@ import numpy as np
 import pandas as pd
 
 from .contact import Conductance, checked_breakpoints, left_limited, snapped
-from .deck import CircuitLike, arc_state, build_deck
+from .deck import CircuitLike, arc_state, build_deck, circuit_arc
 from .errors import SessionBusyError
 from .ngspice import NgspiceSession, get_session
 from .options import SimulationOptions
 from .probes import COLUMNS
+
+#: The gap distance d(t) >= 0 (m) as a function of time (s).
+Gap = Callable[[float], float]
 
 
 class StepResult(NamedTuple):
@@ -70,6 +76,10 @@ class Stepper:
         contact (``add_contact``).
     options: ``SimulationOptions`` (max internal step, tolerances, wall-clock limit).
 
+    ``uses_gap``: True if the circuit's arc model depends on the gap distance
+    (``ArcModel.column_gradient`` or ``breakdown_gradient`` > 0): every ``advance`` then
+    needs ``gap``.
+
     Holds this process's ngspice until ``close()`` (or the end of a ``with`` block);
     another Stepper or run meanwhile raises SessionBusyError.
     """
@@ -80,6 +90,9 @@ class Stepper:
             raise TypeError(f"options must be a SimulationOptions, got {type(self.options).__name__}")
         lines, self.probes = build_deck(circuit, t_end, self.options, "external")
         self._arc = arc_state(circuit, self.probes)
+        model = circuit_arc(circuit)
+        self.uses_gap = model is not None and model.uses_gap
+        self._arc_model = model
         self.t_end = float(t_end)
         self.deck = tuple(lines)
         self._session: NgspiceSession | None = None
@@ -108,7 +121,8 @@ class Stepper:
     # -- stepping --
 
     def advance(
-        self, t_next: float, conductance: Conductance | float, breakpoints: Iterable[float] = ()
+        self, t_next: float, conductance: Conductance | float, breakpoints: Iterable[float] = (),
+        gap: Gap | float | None = None,
     ) -> StepResult:
         """Integrate from the current time to ``t_next`` (s).
 
@@ -117,6 +131,11 @@ class Stepper:
             0 for an open contact; or a constant.
         breakpoints: make/break instants (s) in (t_current, t_next]; ngspice lands on
             each, and uses the left limit of G there (the pre-event state).
+        gap: the gap distance d(t) >= 0 in m on [t_current, t_next], a function of time
+            only (called like G: Newton iterations, rejected trials, left limit at the
+            breakpoints), or a constant. Required when the arc model depends on the gap
+            (``uses_gap``: ``column_gradient`` or ``breakdown_gradient`` > 0; without it
+            ValueError before anything runs); otherwise ignored (a number is still checked).
         """
         session = self._active()
         if self._failure is not None:
@@ -136,6 +155,7 @@ class Stepper:
         if final:
             t_next = self.t_end
         source = _as_function(conductance)
+        gap_source = self._gap_function(gap)
         points = checked_breakpoints(breakpoints, t0, t_next)
         if not session.lock.acquire(blocking=False):
             raise SessionBusyError("ngspice is in use by another thread of this process")
@@ -143,7 +163,11 @@ class Stepper:
             if not self._started and self._arc is not None:
                 # The operating point: an arc path closed at t = 0 is armed.
                 self._arc.start(float(source(0.0)) > 0.0)
-            session.set_source(left_limited(source, points, t_next - t0, t_next))
+            span = t_next - t0
+            session.set_source(
+                left_limited(source, points, span, t_next),
+                None if gap_source is None else left_limited(gap_source, points, span, t_next),
+            )
             landings = snapped(points, t_next, t_next - t0)
             if self._started and landings and landings[0] - t0 <= self.options.min_break(self.t_end):
                 # ngspice drops a breakpoint within CKTminBreak after its current time
@@ -181,6 +205,20 @@ class Stepper:
             reader=self._reader(first_index, last_index),
             **scalars,
         )
+
+    def _gap_function(self, gap: Gap | float | None) -> Gap | None:
+        """The gap as a function of time if the arc model uses it (None otherwise)."""
+        if gap is None:
+            if self.uses_gap:
+                arc = self._arc_model
+                raise ValueError(
+                    f"the arc model depends on the gap (column_gradient = {arc.column_gradient:g} V/m, "
+                    f"breakdown_gradient = {arc.breakdown_gradient:g} V/m): pass the gap distance d(t) >= 0 "
+                    "in m, advance(t_next, conductance, breakpoints, gap=function_of_time_or_number)"
+                )
+            return None
+        function = _as_function(gap, "gap", "m")
+        return function if self.uses_gap else None
 
     def _read_last(self, session: NgspiceSession) -> tuple[int, float, dict[str, float]]:
         """Points so far, the last time (s) and the last contact/load values (V, A)."""
@@ -246,10 +284,11 @@ class Stepper:
 
     @property
     def stats(self) -> dict[str, float]:
-        """Macro steps, accepted ngspice points, conductance evaluations, seconds inside ngspice, arc state changes."""
+        """Macro steps, accepted ngspice points, conductance and gap evaluations, seconds inside ngspice, arc state changes."""
         points = len(self._final) if self._final is not None else (self._active().length() if self._started else 0)
         calls = self._session.source_calls if self._session is not None else 0
-        return {"steps": self._steps, "points": points, "conductance_calls": calls,
+        gap_calls = self._session.gap_calls if self._session is not None else 0
+        return {"steps": self._steps, "points": points, "conductance_calls": calls, "gap_calls": gap_calls,
                 "ngspice_seconds": self._ngspice_seconds, "arc_switches": self._arc.switches if self._arc else 0}
 
     def results(self, extra: tuple[str, ...] = ()) -> pd.DataFrame:
@@ -302,13 +341,13 @@ class Stepper:
         self.close()
 
 
-def _as_function(conductance: Conductance | float) -> Conductance:
-    if callable(conductance):
-        return conductance
-    if isinstance(conductance, numbers.Real) and not isinstance(conductance, bool):
-        value = float(conductance)
-        if not (0.0 <= value < math.inf):
-            raise ValueError(f"conductance = {conductance!r} S: must be finite and >= 0")
-        return lambda t: value
-    raise TypeError(f"conductance must be a function of time or a number (S), got {type(conductance).__name__}")
+def _as_function(value: Conductance | float, what: str = "conductance", unit: str = "S") -> Conductance:
+    if callable(value):
+        return value
+    if isinstance(value, numbers.Real) and not isinstance(value, bool):
+        number = float(value)
+        if not (0.0 <= number < math.inf):
+            raise ValueError(f"{what} = {value!r} {unit}: must be finite and >= 0")
+        return lambda t: number
+    raise TypeError(f"{what} must be a function of time or a number ({unit}), got {type(value).__name__}")
 

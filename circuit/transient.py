@@ -2,16 +2,18 @@
 
 from __future__ import annotations
 
-from typing import Iterable
+import numbers
+from typing import Iterable, Union
 
+import numpy as np
 import pandas as pd
 
 from .contact import Conductance
-from .deck import CircuitLike, arc_state, build_deck
+from .deck import CircuitLike, arc_state, build_deck, circuit_arc
 from .ngspice import get_session
 from .options import SimulationOptions
 from .schedule import ContactSchedule
-from .stepping import Stepper
+from .stepping import Gap, Stepper
 
 
 def run_transient(
@@ -22,20 +24,40 @@ def run_transient(
     options: SimulationOptions | None = None,
     breakpoints: Iterable[float] = (),
     extra: tuple[str, ...] = (),
+    gap: Gap | float | None = None,
 ) -> pd.DataFrame:
     """Run 0..t_end (s) with the contact conductance from Python; returns the waveform (SI columns).
 
     contact: a ``ContactSchedule`` (its ramp corners become breakpoints), a function
         G(t) in S (pass its make/break instants as ``breakpoints``), or a constant in S.
-    extra: raw ngspice vectors to add as columns (e.g. 'load', 'vsource#branch').
+    extra: raw ngspice vectors to add as columns (e.g. 'load', 'vsource#branch', 'arc_gap').
+    gap: the gap distance d(t) >= 0 in m (function of time or constant) for an arc
+        model that depends on it (``ArcModel.column_gradient``/``breakdown_gradient``);
+        None: a schedule's own ``gap`` if it has an ``opening_speed``. Missing while
+        needed: ValueError before anything runs.
     """
     points = set(float(b) for b in breakpoints)
     if isinstance(contact, ContactSchedule):
         points.update(contact.breakpoints(0.0, t_end))
+        if gap is None and contact.opening_speed is not None:
+            gap = contact.gap
         contact = contact.conductance
+    _require_gap(circuit, gap, "run_transient(..., gap=function_of_time_or_number)")
     with Stepper(circuit, t_end, options) as stepper:
-        stepper.advance(t_end, contact, sorted(p for p in points if 0.0 < p <= t_end))
+        stepper.advance(t_end, contact, sorted(p for p in points if 0.0 < p <= t_end), gap=gap)
         return stepper.results(extra)
+
+
+def _require_gap(circuit: CircuitLike, gap: object, how: str) -> None:
+    arc = circuit_arc(circuit)
+    if gap is None and arc is not None and arc.uses_gap:
+        raise ValueError(
+            f"the arc model depends on the gap (column_gradient = {arc.column_gradient:g} V/m, "
+            f"breakdown_gradient = {arc.breakdown_gradient:g} V/m): pass the gap distance d(t) >= 0 in m, {how}"
+        )
+
+
+GapVertices = Union[tuple[np.ndarray, np.ndarray], float]
 
 
 def run_pwl_reference(
@@ -46,18 +68,25 @@ def run_pwl_reference(
     options: SimulationOptions | None = None,
     resistance_step: float | None = None,
     extra: tuple[str, ...] = (),
+    gap: GapVertices | None = None,
 ) -> pd.DataFrame:
     """The same run with the schedule written into the netlist as a PWL conductance source.
 
     No Python in ngspice's loop: the reference that the callback and stepping forms are
     checked against. ngspice sets breakpoints at the PWL vertices itself.
     resistance_step: sampling step (s) of a closed-resistance function (constant: unused).
+    gap: for an arc model that depends on the gap, the gap as PWL vertices (times s,
+        distances m) or a constant (m); None: the schedule's own ``gap`` (its
+        ``opening_speed``), written exactly as a PWL. Missing while needed: ValueError.
     """
     if not isinstance(schedule, ContactSchedule):
         raise TypeError(f"run_pwl_reference needs a ContactSchedule, got {type(schedule).__name__}")
     options = options if options is not None else SimulationOptions()
     drive = schedule.pwl_points(t_end, resistance_step)
-    lines, probes = build_deck(circuit, t_end, options, drive)
+    gap_drive = _gap_vertices(gap, schedule, t_end)
+    _require_gap(circuit, gap_drive, "run_pwl_reference(..., gap=(times, distances)) or a schedule "
+                 "with opening_speed")
+    lines, probes = build_deck(circuit, t_end, options, drive, "external" if gap_drive is None else gap_drive)
     arc = arc_state(circuit, probes)
     if arc is not None:
         arc.start(float(drive[1][0]) > 0.0)
@@ -74,6 +103,22 @@ def run_pwl_reference(
         finally:
             session.clear()
             session.release(owner)
+
+
+def _gap_vertices(gap: GapVertices | None, schedule: ContactSchedule, t_end: float):
+    """PWL vertices of the gap (times s, distances m), or None if there is none."""
+    if gap is None:
+        return schedule.gap_pwl_points(t_end) if schedule.opening_speed is not None else None
+    if callable(gap):
+        raise TypeError("run_pwl_reference: the gap must be PWL vertices (times s, distances m) or a number (m), "
+                        "not a function (use run_transient for a gap function)")
+    if isinstance(gap, numbers.Real) and not isinstance(gap, bool):
+        value = float(gap)
+        if not (0.0 <= value < np.inf):
+            raise ValueError(f"gap = {gap!r} m: must be finite and >= 0")
+        return np.array([0.0, float(t_end)]), np.array([value, value])
+    times, values = gap
+    return np.asarray(times, dtype=float), np.asarray(values, dtype=float)
 
 
 class _Run:
