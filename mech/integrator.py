@@ -176,8 +176,8 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
         if t + h >= t_stop:
             h = t_stop - t
             last = True
-        if h < 1e-15 * max(1.0, abs(t)) or h < 1e-18:
-            return STEP_TOO_SMALL, t, h, n_rec, -1
+        if not last and (h < 1e-15 * max(1.0, abs(t)) or h < 1e-18):
+            return STEP_TOO_SMALL, t, h, n_rec, -1  # (a last step clipped to t_stop may be tiny)
         _rk_stages(t, y, h, k1, k2, k3, k4, k5, k6, k7, ytmp, ynew, fpar, ipar, J0, sp_ptr, sp_idx, sp_val,
                    psi, theta, xc, regime, eref, aux_stage, aux_new, work)
         stats[2] += 6

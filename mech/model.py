@@ -182,12 +182,43 @@ class BarModel:
                 "vel": slice(7 + n, 10 + n), "omega": slice(10 + n, 13 + n),
                 "eta": slice(13 + n, 13 + 2 * n), "quad": slice(13 + 2 * n, 13 + 2 * n + NQ)}
 
+    def _resting(self, R0: np.ndarray) -> tuple[float, np.ndarray]:
+        """Centre height (m) and modal coordinates (m) of the bar resting on the block.
+
+        The weight is carried by both tips (lying flat) or by the lower one (standing);
+        each loaded tip is pressed in by the Hertz penetration (F/k)^(2/3), and the tip
+        forces bend the modes statically: K q = sum_i Psi_i . (R0^T F_i). Gravity itself
+        loads no mode (their mean is zero), so this is the whole static equilibrium.
+        """
+        ini, bar = self.scene.initial, self.scene.bar
+        weight = bar.mass * self.scene.gravity
+        if abs(ini.angle_deg) < 1e-9:
+            loads = {0: 0.5 * weight, 1: 0.5 * weight}
+        else:
+            loads = {0 if ini.angle_deg > 0 else 1: weight}
+        b = self.basis
+        q = np.zeros(b.n)
+        if b.n:
+            Q = np.zeros(b.n)
+            for i, f in loads.items():
+                Q += b.psi_tip[i] @ (R0.T @ np.array([0.0, 0.0, f]))
+            q = np.linalg.solve(b.stiffness, Q)
+        k = self.contact.stiffness
+        i, f = next(iter(loads.items()))
+        pen = (f / k) ** (2.0 / 3.0) if f > 0 else 0.0
+        s_i = np.array([b.x_centre[i], 0.0, 0.0]) + (b.psi_tip[i].T @ q if b.n else 0.0)
+        z0 = self.scene.bar.tip_radius - pen - float((R0 @ s_i)[2])
+        return z0, q
+
     def initial_state(self) -> np.ndarray:
         ini, bar = self.scene.initial, self.scene.bar
         theta = math.radians(ini.angle_deg)
         a = 0.5 * bar.length - bar.tip_radius
         z0 = ini.height + bar.tip_radius + a * abs(math.sin(theta))
         y = np.zeros(self.state_size)
+        if ini.resting:
+            z0, q_rest = self._resting(rotation_z(self.azimuth) @ rotation_y(-theta))
+            y[self.slices()["q"]] = q_rest
         sl = self.slices()
         v = np.array(ini.velocity, dtype=float)
         w_world = np.array(ini.angular_velocity, dtype=float)

@@ -292,6 +292,9 @@ class Initial:
     azimuth_deg: deg, direction of the bar's horizontal projection about the vertical.
     velocity: m/s, centre of mass, world frame (x, y horizontal, z up).
     angular_velocity: rad/s, world frame.
+    resting: start in static equilibrium on the block (a contact already closed): lying
+    flat on both tips (angle_deg = 0) or standing on one (angle_deg = +-90), pressed in by
+    its weight, with the static sag of its modes; height is then not used.
     """
 
     height: float = 1e-3
@@ -299,6 +302,7 @@ class Initial:
     azimuth_deg: float = 0.0
     velocity: tuple[float, float, float] = (0.2, 0.0, -1.0)
     angular_velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    resting: bool = False
 
     def __post_init__(self):
         h = check_finite("initial.height", self.height)
@@ -312,6 +316,13 @@ class Initial:
         object.__setattr__(
             self, "angular_velocity", check_vector3("initial.angular_velocity", self.angular_velocity)
         )
+        if not isinstance(self.resting, bool):
+            raise ValueError(f"initial.resting = {self.resting!r}: expected true or false")
+        if self.resting and not (abs(self.angle_deg) < 1e-9 or abs(abs(self.angle_deg) - 90.0) < 1e-9):
+            raise ValueError(
+                f"initial.resting with angle_deg = {self.angle_deg!r}: a bar rests in static equilibrium only "
+                "lying flat (angle_deg = 0, on both tips) or standing (angle_deg = 90 or -90, on one tip)"
+            )
 
 
 @dataclass(frozen=True)

@@ -88,7 +88,33 @@ def scipy_segment(solver, t_target: float, method: str):
     # is, if anything, given a looser tolerance than the compiled loop.
     y0 = solver.y.copy() if coupled is None else np.concatenate([solver.y, solver.z])
     atol = m.atol if coupled is None else np.concatenate([m.atol, coupled.atol])
-    sol = solve_ivp(fun, (solver.t, t_target), y0, method=method, rtol=rtol, dense_output=True,
+    jac = None
+    if coupled is not None and method in ("Radau", "BDF", "LSODA"):
+        # Block Jacobian by finite differences: mechanics over its states with steps set by
+        # the model's own error scales (sqrt(eps) of atol/rtol: ~1e-12 m for positions,
+        # where solve_ivp's sqrt(eps)|y| would be ~1e-10 m and cross the contact boundary
+        # near touchdown, sending through G(F(y)) entries of ~1e16 into the stiff circuit
+        # rows), and the extra states over themselves. The cross blocks are left to
+        # Newton's iteration: the extra states follow the mechanics one way, and mu acts
+        # back only weakly.
+        scale = np.maximum(np.abs(y0), atol / rtol)
+        sqrt_eps = np.sqrt(np.finfo(float).eps)
+
+        def jac(t, y):
+            f0 = fun(t, y)
+            J = np.zeros((N + n_ext, N + n_ext))
+            for block in (range(N), range(N, N + n_ext)):
+                for j in block:
+                    h = sqrt_eps * max(abs(y[j]), scale[j])
+                    yp = y.copy()
+                    yp[j] += h
+                    fj = fun(t, yp)
+                    rows = slice(0, N) if j < N else slice(N, N + n_ext)
+                    J[rows, j] = (fj[rows] - f0[rows]) / h
+            return J
+
+    extra = {"jac": jac} if jac is not None else {}
+    sol = solve_ivp(fun, (solver.t, t_target), y0, method=method, rtol=rtol, dense_output=True, **extra,
                     atol=atol, max_step=m.max_step, events=events,
                     first_step=min(solver.h, m.max_step, t_target - solver.t) if solver.h > 0 else None)
     solver.stats[2] += counter["nfev"]
