@@ -7,7 +7,7 @@ intervals), SI units:
     bounces                    re-closures after the first make (makes - 1)
     total_bounce_time          s, last_make - first_make
     final_state                "closed" or "open" at the end of the run
-    peak_contact_voltage       V, largest |contact voltage| from the first make on
+    peak_contact_voltage       V, largest |contact voltage| after the first make
     arc_energy                 J, integral of |contact voltage x arc current| dt
 """
 
@@ -51,8 +51,9 @@ def bounce_metrics(intervals, t_end: float, waveforms: pd.DataFrame | None, clos
     if waveforms is not None and len(waveforms):
         t = waveforms.time.to_numpy()
         v = waveforms.contact_voltage.to_numpy()
-        start = iv[0][0] if iv else t[0]
-        mask = t >= start
+        # strictly after the first make: at the make instant itself ngspice still has the
+        # open contact (left limit at the breakpoint), i.e. the full supply voltage
+        mask = t > iv[0][0] if iv else np.ones(len(t), bool)
         out["peak_contact_voltage"] = float(np.max(np.abs(v[mask]))) if mask.any() else None
         if "arc_current" in waveforms:
             p = np.abs(v * waveforms.arc_current.to_numpy())
