@@ -164,9 +164,10 @@ class CoSimulation:
         self.stats["mech_seconds"] += time.perf_counter() - tick
         self.mu_log.append((t, t_next, mu0, self._mu(current_at(t_next))))
         breakpoints = sorted({s for s in switching if t < s <= t_next})
-        conductance = self._conductance(seg, rl, touching)
+        conductance, gap = self._conductance(seg, rl, touching)
         tick = time.perf_counter()
-        step = stepper.advance(t_next, conductance, breakpoints=breakpoints)
+        step = stepper.advance(t_next, conductance, breakpoints=breakpoints,
+                               gap=gap if stepper.uses_gap else None)
         self.stats["circuit_seconds"] += time.perf_counter() - tick
         # a step cut at a make/break ends at a current jump even when the re-run mechanics
         # stops a round-off short of the event (it is then found at the next step's start)
@@ -174,14 +175,15 @@ class CoSimulation:
 
     def _jacobi_step(self, mech, stepper, rl, t, t_next, i_now):
         mu = self._mu(i_now)
-        forces = mech.contact_now()[:, 2]
-        g = float(np.sum(rl.force_conductance(forces)))
+        contact = mech.contact_now()
+        g = float(np.sum(rl.force_conductance(contact[:, 2])))
+        gap = float(max(0.0, -np.max(contact[:, 0])))
         tick = time.perf_counter()
         mech.advance(t_next, mu=mu)
         self.stats["mech_seconds"] += time.perf_counter() - tick
         self.mu_log.append((t, t_next, mu, mu))
         tick = time.perf_counter()
-        step = stepper.advance(t_next, g)
+        step = stepper.advance(t_next, g, gap=gap if stepper.uses_gap else None)
         self.stats["circuit_seconds"] += time.perf_counter() - tick
         return i_now, t, _coupling_current(step), t_next
 
@@ -193,24 +195,18 @@ class CoSimulation:
         delimit them, the same instants ngspice gets as breakpoints: the interpolant may
         show a round-off penetration just before a located make.
         """
-        intervals = []
-        for i in range(2):
-            start = seg.t_start if touching_at_start[i] else None
-            spans = []
-            for e in seg.events:
-                if e["tip"] != i:
-                    continue
-                if e["kind"] == "contact_start":
-                    start = e["time"]
-                elif e["kind"] == "contact_end" and start is not None:
-                    spans.append((start, e["time"]))
-                    start = None
-            if start is not None:
-                spans.append((start, seg.t_end))
-            intervals.append(spans)
-        if not intervals[0] and not intervals[1]:
-            return 0.0  # open throughout: no Python callback needed
+        intervals = _contact_intervals(seg, touching_at_start)
         force = rl.force_conductance
+
+        def gap(s: float) -> float:
+            """m: the arc's length, the smaller tip height; 0 while a tip touches."""
+            s = min(max(s, seg.t_start), seg.t_end)
+            if any(a <= s <= b for spans in intervals for a, b in spans):
+                return 0.0
+            return float(max(0.0, -np.max(seg.contact(s)[:, 0])))
+
+        if not intervals[0] and not intervals[1]:
+            return 0.0, gap  # open throughout: no conductance callback needed
 
         def g(s: float) -> float:
             s = min(max(s, seg.t_start), seg.t_end)
@@ -223,7 +219,8 @@ class CoSimulation:
                     total += float(force(c[i, 2]))
             return total
 
-        return g
+        return g, gap
+
 
     # --- results -------------------------------------------------------------------------
 
@@ -248,6 +245,26 @@ class CoSimulation:
         t0, t1, m0, m1 = log[k].T
         frac = np.where(t1 > t0, (times - t0) / np.where(t1 > t0, t1 - t0, 1.0), 0.0)
         return m0 + (m1 - m0) * np.clip(frac, 0.0, 1.0)
+
+
+def _contact_intervals(seg, touching_at_start) -> list[list[tuple[float, float]]]:
+    """Per tip, the contact intervals inside the segment as its events delimit them."""
+    intervals = []
+    for i in range(2):
+        start = seg.t_start if touching_at_start[i] else None
+        spans = []
+        for e in seg.events:
+            if e["tip"] != i:
+                continue
+            if e["kind"] == "contact_start":
+                start = e["time"]
+            elif e["kind"] == "contact_end" and start is not None:
+                spans.append((start, e["time"]))
+                start = None
+        if start is not None:
+            spans.append((start, seg.t_end))
+        intervals.append(spans)
+    return intervals
 
 
 def _coupling_current(step) -> float:

@@ -27,8 +27,9 @@ def _window(result) -> tuple[float, float]:
     return max(0.0, a - pad) * 1e3, min(t_end, b + pad) * 1e3
 
 
-def plot_waveforms(result):
-    """Contact voltage and current vs time, closed intervals shaded, over the bounce window."""
+def plot_waveforms(result, whole_run: bool = False):
+    """Contact voltage and current vs time, closed intervals shaded, over the bounce window
+    (or the whole run)."""
     w = result.waveforms
     fig, (ax_v, ax_i) = plt.subplots(2, 1, sharex=True, figsize=(9, 6))
     t = w.time.to_numpy() * 1e3
@@ -44,7 +45,7 @@ def plot_waveforms(result):
     for ax in (ax_v, ax_i):
         _shade(ax, result.closed_intervals)
         ax.grid(alpha=0.3)
-    ax_i.set_xlim(*_window(result))
+    ax_i.set_xlim(*((0.0, result.scene.t_end * 1e3) if whole_run else _window(result)))
     ax_i.legend(loc="best", fontsize=8)
     b = result.bounce
     ax_v.set_title(f"bounce waveform: {b.get('bounces', 0)} bounce(s), "
@@ -109,6 +110,7 @@ def save_plots(result, out_dir) -> list[Path]:
     figures = []
     if result.waveforms is not None:
         figures.append(("waveforms.png", plot_waveforms))
+        figures.append(("waveforms_whole_run.png", lambda r: plot_waveforms(r, whole_run=True)))
     if result.mechanics is not None:
         figures += [("normal_force.png", plot_normal_force), ("tip_heights.png", plot_tip_heights),
                     ("energy.png", plot_energy)]
