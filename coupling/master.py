@@ -93,6 +93,7 @@ class CoSimulation:
         t = 0.0
         i_now, i_prev, t_prev = 0.0, None, None
         jump_since_prev = False
+        t_jump = 0.0
         try:
             with stepper:
                 while t < t_end * (1.0 - 1e-14):
@@ -110,13 +111,17 @@ class CoSimulation:
                     if opts.scheme == "jacobi":
                         i_prev, t_prev, i_now, t = self._jacobi_step(mech, stepper, rl, t, t_next, i_now)
                     else:
+                        # linear extrapolation needs two samples after the last current jump
+                        # (the sample at a make/break instant is still the value before it)
                         slope = 0.0
-                        if not jump_since_prev and i_prev is not None and t_prev is not None and t > t_prev:
+                        if t_prev is not None and t_prev > t_jump and t > t_prev:
                             slope = (i_now - i_prev) / (t - t_prev)
                         t_new, current, jumped = self._mechanics_first_step(mech, stepper, rl, t, t_next,
                                                                             i_now, slope)
                         i_prev, t_prev, i_now, t = i_now, t, current, t_new
                         jump_since_prev = jumped
+                        if jumped:
+                            t_jump = t
                     self.stats["macro_steps"] += 1
                     self.stats["contact_steps"] += int(touching)
                     self.progress(t)

@@ -1,0 +1,135 @@
+"""Runs end to end: the command, its files, what each kind of scene builds, failures."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from coupling import default_scene, run
+from coupling.cli import main
+from coupling.scene import scene_from_dict
+
+SUMMARY_KEYS = {"contacts", "restitution", "energy", "solver", "bounce"}
+BOUNCE_KEYS = {"first_make", "last_make", "bounces", "total_bounce_time", "peak_contact_voltage", "arc_energy"}
+WAVE_COLUMNS = {"time", "contact_voltage", "contact_current", "contact_resistance", "normal_force", "mu"}
+
+
+def test_default_scene_runs_end_to_end_through_the_command(tmp_path, capsys):
+    scene = tmp_path / "short_default.toml"
+    from coupling.scene import default_scene_text
+
+    scene.write_text(default_scene_text().replace("t_end = 0.01", "t_end = 0.003"))
+    assert main(["run", str(scene), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    out = tmp_path / "out"
+    summary = json.loads((out / "summary.json").read_text())
+    assert SUMMARY_KEYS <= set(summary) and BOUNCE_KEYS <= set(summary["bounce"])
+    assert summary["status"] == "ok"
+    for c in summary["contacts"]:
+        assert {"tip", "t_start", "t_end", "peak_force", "impulse"} <= set(c)
+    assert set(summary["energy"]) >= {"initial", "kinetic", "elastic", "potential_change", "normal_dissipation",
+                                      "friction_dissipation", "residual"}
+    assert set(summary["solver"]) >= {"steps", "rhs_evals", "events", "wall_time"}
+    waves_csv = pd.read_csv(out / "waveforms.csv")
+    waves_pq = pd.read_parquet(out / "waveforms.parquet")
+    assert WAVE_COLUMNS <= set(waves_csv.columns)
+    pd.testing.assert_frame_equal(waves_csv, waves_pq, check_exact=False, rtol=1e-12)
+    for name in ("waveforms.png", "waveforms_whole_run.png", "normal_force.png", "tip_heights.png", "energy.png"):
+        assert (out / name).stat().st_size > 10_000
+    b = summary["bounce"]
+    # the bounce summary agrees with the mechanics' contact intervals
+    starts = sorted(c["t_start"] for c in summary["contacts"])
+    assert b["first_make"] == pytest.approx(starts[0]) and b["bounces"] == len(starts) - 1
+    # arcs burn at U_min + E d + R i during the open intervals: the peak is at least U_min
+    assert b["peak_contact_voltage"] >= 12.0 and b["arc_energy"] > 0.0
+
+
+def test_mechanics_only_scene_starts_no_ngspice(tmp_path):
+    """Leave out what the scene does not need: no circuit, no ngspice (checked in a fresh process)."""
+    scene = tmp_path / "mech.toml"
+    scene.write_text(textwrap.dedent("""
+        [bar]
+        modes = 0
+        [initial]
+        height = 0.001
+        angle_deg = 90.0
+        velocity = [0.0, 0.0, -0.5]
+        [solver]
+        t_end = 0.004
+        """))
+    code = textwrap.dedent(f"""
+        import sys
+        from coupling.cli import main
+        rc = main(["run", {str(scene)!r}, "--out", {str(tmp_path / 'out')!r}, "--quiet"])
+        import circuit.ngspice as ng
+        print(rc, ng._SESSION is None)
+        """)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    rc, no_ngspice = out.stdout.split()
+    assert rc == "0" and no_ngspice == "True"
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["kind"] == "mechanics" and "bounce" not in summary
+    assert summary["solver"]["model"] == "planar" and summary["solver"]["modes"] == 0
+    assert not (tmp_path / "out" / "waveforms.csv").exists()
+
+
+def test_circuit_only_scene_reproduces_the_one_shot_pwl_reference():
+    """A prescribed schedule runs no mechanics and gives the circuit package's own result."""
+    from circuit import run_pwl_reference
+
+    doc = {"circuit": {"template": "inductive", "load_resistance": 24.0, "load_inductance": 10e-3,
+                       "voltage": 24.0, "arc": True,
+                       "schedule": {"make": [1e-4, 4e-4, 7e-4], "break": [3e-4, 6e-4, 1.5e-3],
+                                    "closed_resistance": 0.01}},
+           "solver": {"t_end": 2e-3}}
+    scene = scene_from_dict(doc)
+    res = run(scene)
+    assert res.mechanics is None and scene.kind == "circuit"
+    ref = run_pwl_reference(scene.circuit.circuit, scene.circuit.schedule, scene.t_end, options=scene.circuit.options)
+    t = np.linspace(5e-5, 1.9e-3, 800)
+    for col in ("load_current", "contact_voltage"):
+        scale = np.max(np.abs(ref[col]))
+        np.testing.assert_allclose(np.interp(t, res.waveforms.time, res.waveforms[col]),
+                                   np.interp(t, ref.time, ref[col]), atol=2e-3 * scale)
+    b = res.bounce
+    assert b["first_make"] == pytest.approx(1e-4) and b["last_make"] == pytest.approx(7e-4) and b["bounces"] == 2
+    # an inductive load carries ~1 A at the final break: the arc takes it (arc energy > 0)
+    assert b["arc_energy"] > 0.0
+
+
+def test_planar_scene_uses_the_planar_model_and_zero_modes_the_rigid_bar():
+    base = default_scene().set("solver.t_end", 1.2e-3)
+    planar = base.set("initial.velocity", [0.2, 0.0, -1.0]).set("bar.modes", 0)
+    res = run(planar)
+    assert res.mechanics.solver["model"] == "planar" and res.mechanics.solver["modes"] == 0
+    full = run(base)
+    assert full.mechanics.solver["model"] == "3d" and full.mechanics.solver["modes"] == 9
+
+
+def test_a_failed_run_writes_what_it_has_and_says_why(tmp_path, capsys):
+    from coupling.scene import default_scene_text
+
+    scene = tmp_path / "fails.toml"
+    scene.write_text(default_scene_text().replace("t_end = 0.01", "t_end = 0.003\nmax_steps = 300"))
+    rc = main(["run", str(scene), "--out", str(tmp_path / "out"), "--quiet"])
+    assert rc == 1
+    err = capsys.readouterr().err
+    assert "failed" in err and "too many steps" in err
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["status"].startswith("failed")
+    assert (tmp_path / "out" / "history.csv").exists() and (tmp_path / "out" / "waveforms.csv").exists()
+
+
+def test_bad_scene_file_gives_one_line_error_and_exit_2(tmp_path, capsys):
+    scene = tmp_path / "bad.toml"
+    scene.write_text("[circuit]\ntemplate = 'resistive'\n[bar]\nlength = -1\n[tribology]\nsource = 'illustrative'\n")
+    assert main(["run", str(scene), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "bar.length" in err[0] and "must be > 0" in err[0]
+    assert not (tmp_path / "out").exists()

@@ -1,0 +1,90 @@
+"""Coupled scenes: kinds, only the named parts built, and a clear error for each bad scene before anything runs."""
+
+from __future__ import annotations
+
+import textwrap
+
+import pytest
+
+from coupling import default_scene, load_scene
+from coupling.scene import scene_from_dict
+
+MECH = {"bar": {"modes": 0}, "initial": {"height": 1e-3, "angle_deg": 90.0, "velocity": [0, 0, -0.5]}}
+TRIB = {"tribology": {"source": "illustrative"}}
+CIRCUIT = {"circuit": {"template": "resistive", "load_resistance": 12.0}}
+
+
+def test_default_scene_is_coupled_and_3d():
+    sc = default_scene()
+    assert sc.kind == "coupled"
+    assert sc.mech.friction.gamma == pytest.approx(sc.tribology.laws.gamma)
+    assert sc.circuit.circuit.contact_current_factor is not None
+    assert sc.circuit.circuit.arc.column_gradient > 0
+
+
+def test_kinds_follow_the_sections():
+    assert scene_from_dict(dict(MECH)).kind == "mechanics"
+    assert scene_from_dict({**MECH, **TRIB}).kind == "mechanics"
+    assert scene_from_dict({**MECH, **TRIB, **CIRCUIT}).kind == "coupled"
+    sched = {"circuit": {"template": "resistive", "schedule": {"make": [1e-4], "break": [2e-4]}},
+             "solver": {"t_end": 1e-3}}
+    sc = scene_from_dict(sched)
+    assert sc.kind == "circuit" and sc.mech is None and sc.t_end == pytest.approx(1e-3)
+
+
+def test_set_revalidates_and_keeps_the_original():
+    sc = default_scene()
+    changed = sc.set("initial.angle_deg", 45).set("circuit.load_resistance", 6.0)
+    assert changed.mech.initial.angle_deg == 45 and changed.circuit.circuit.load.resistance == 6.0
+    assert sc.mech.initial.angle_deg == 30.0
+    with pytest.raises(ValueError, match="initial.height"):
+        sc.set("initial.height", -1e-3)
+
+
+@pytest.mark.parametrize("doc, message", [
+    ({**MECH, **TRIB, "circuit": {"template": "capacitor"}}, "template = 'capacitor': allowed values"),
+    ({**MECH, "tribology": {"fit": "missing.json"}, **CIRCUIT}, "missing.json"),
+    ({**MECH, **CIRCUIT}, "needs \\[tribology\\]"),
+    ({**MECH, **TRIB, **CIRCUIT, "friction": {"mu": 0.3}}, "friction.mu and \\[tribology\\]"),
+    ({**MECH, **TRIB, **CIRCUIT, "friction": {"gamma": 0.3}}, "friction.gamma and \\[tribology\\]"),
+    ({**MECH, "coupling": {"macro_step": 1e-6}}, "\\[coupling\\] settings need"),
+    ({**MECH, "circuit": {"schedule": {"make": [1e-4], "break": [2e-4]}}}, "runs no mechanics"),
+    ({"circuit": {"schedule": {"make": [1e-4], "break": [2e-4]}}, **TRIB}, "\\[tribology\\] is unused"),
+    ({**MECH, **TRIB, "circuit": {"template": "resistive", "load_inductance": 1e-3}}, "load_inductance"),
+    ({**MECH, **TRIB, "circuit": {"template": "netlist"}}, "needs netlist"),
+    ({**MECH, **TRIB, "circuit": {"load_resistnce": 3.0}}, "did you mean 'load_resistance'"),
+    ({**MECH, "circuitry": {}}, "unknown section \\[circuitry\\]"),
+    ({**MECH, **TRIB, **CIRCUIT, "coupling": {"scheme": "gauss_seidel"}}, "coupling.scheme"),
+    ({**MECH, **TRIB, **CIRCUIT, "coupling": {"macro_step": 1e-5, "max_macro_step": 1e-6}}, "max_macro_step"),
+    ({**MECH, "tribology": {"source": "illustrative", "fit": "x.json"}}, "exactly one of"),
+    ({**MECH, "tribology": {"source": "paper"}}, "only built-in source"),
+    ({**MECH, **TRIB, "circuit": {"voltage": -5.0}}, "voltage"),
+    ({**MECH, "output": {"plots": "yes"}}, "expected true or false"),
+])
+def test_bad_scene_gives_a_clear_error_before_running(doc, message):
+    with pytest.raises((ValueError, FileNotFoundError), match=message):
+        scene_from_dict(doc)
+
+
+def test_scene_files_resolve_paths_next_to_them(tmp_path):
+    from coupling.tribology import default_fit
+
+    default_fit().to_json(tmp_path / "fit.json")
+    (tmp_path / "scene.toml").write_text(textwrap.dedent("""
+        [bar]
+        modes = 0
+        [tribology]
+        fit = "fit.json"
+        [circuit]
+        template = "inductive"
+        load_resistance = 24.0
+        load_inductance = 0.01
+        arc = true
+        """))
+    sc = load_scene(tmp_path / "scene.toml")
+    assert sc.kind == "coupled" and "fit.json" in sc.tribology.source
+    with pytest.raises(FileNotFoundError, match="not found"):
+        load_scene(tmp_path / "absent.toml")
+    (tmp_path / "bad.toml").write_text("[bar\nlength = 1")
+    with pytest.raises(ValueError, match="not valid TOML"):
+        load_scene(tmp_path / "bad.toml")
