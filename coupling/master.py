@@ -201,27 +201,28 @@ class CoSimulation:
         show a round-off penetration just before a located make.
         """
         intervals = _contact_intervals(seg, touching_at_start)
-        force = rl.force_conductance
+        force = rl.scalar_force_conductance
+        lo, hi = seg.t_start, seg.t_end
 
         def gap(s: float) -> float:
             """m: the arc's length, the smaller tip height; 0 while a tip touches."""
-            s = min(max(s, seg.t_start), seg.t_end)
+            s = lo if s < lo else (hi if s > hi else s)
             if any(a <= s <= b for spans in intervals for a, b in spans):
                 return 0.0
-            return float(max(0.0, -np.max(seg.contact(s)[:, 0])))
+            return seg.tip_forces(s)[2]
 
         if not intervals[0] and not intervals[1]:
             return 0.0, gap  # open throughout: no conductance callback needed
 
         def g(s: float) -> float:
-            s = min(max(s, seg.t_start), seg.t_end)
+            s = lo if s < lo else (hi if s > hi else s)
             total = 0.0
-            c = None
+            forces = None
             for i in range(2):
                 if any(a <= s <= b for a, b in intervals[i]):
-                    if c is None:
-                        c = seg.contact(s)
-                    total += float(force(c[i, 2]))
+                    if forces is None:
+                        forces = seg.tip_forces(s)
+                    total += force(forces[i])
             return total
 
         return g, gap

@@ -14,7 +14,8 @@ A scene names only what it needs, and only that is built:
                   contact_capacitance, leakage_conductance, snubber = {resistance, capacitance},
                   flyback = true | {...}, arc = true | false | {min_voltage, min_current, ...},
                   netlist = "file.cir", load_probe, max_step, reltol, method, wall_timeout
-    [circuit.schedule]  make = [...], break = [...], closed_resistance  (s, s, ohm)
+    [circuit.schedule]  make = [...], break = [...], closed_resistance, opening_speed
+                        (s, s, ohm, m/s: the gap for an arc whose voltage grows with it)
     [coupling]    scheme = "mechanics_first" | "jacobi", macro_step, max_macro_step (s),
                   align_events = true
     [output]      csv, parquet, plots, history = true | false
@@ -317,13 +318,13 @@ def _circuit(table: dict, base_dir: Path, where: str, current_factor: str | None
     schedule = None
     if "schedule" in table:
         st = _table(f"{where}.schedule", table["schedule"])
-        allowed = {"make", "break", "closed_resistance", "edge_time"}
+        allowed = {"make", "break", "closed_resistance", "edge_time", "opening_speed"}
         for key in st:
             if key not in allowed:
                 raise _unknown(f"{where}.schedule", key, allowed)
         if "make" not in st or "break" not in st:
             raise ValueError(f"{where}.schedule: needs make = [...] and break = [...] (s)")
-        kw = {k: st[k] for k in ("closed_resistance", "edge_time") if k in st}
+        kw = {k: st[k] for k in ("closed_resistance", "edge_time", "opening_speed") if k in st}
         schedule = ck.ContactSchedule.from_events(st["make"], st["break"], **kw)
     return CircuitSpec(circ, options, schedule, template)
 

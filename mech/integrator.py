@@ -18,8 +18,10 @@ from numba import njit
 
 from .kernel import (
     A_FN, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_COMPRESSION, EV_CONTACT, EV_SLIP, EV_STICK,
-    F_BETA, F_C, F_K, F_VBOUND, FRICTION_EXACT, I_FRICTION, NEV_TIP, SLIP, STICK, dynamics,
+    F_BETA, F_C, F_K, F_RTIP, F_VBOUND, FRICTION_EXACT, I_FRICTION, I_N, I_PLANAR, NEV_TIP, SLIP, STICK,
+    dynamics, unpack,
 )
+from .contact_laws import normal_force
 
 DONE, EVENT, BUFFER_FULL, STEP_TOO_SMALL, NOT_FINITE, MAX_STEPS = range(6)
 STATUS_TEXT = ("done", "event", "buffer full", "step size too small", "non-finite state", "too many steps")
@@ -411,3 +413,58 @@ def dense_contact(times, t_valid, dense_t0, dense_h, dense_coef, regimes, fpar, 
             out[m, i, 0] = aux[i, A_Y]
             out[m, i, 1] = aux[i, A_YDOT]
             out[m, i, 2] = aux[i, A_FN]
+
+
+@njit(cache=True)
+def dense_tip_forces(t, t_valid, dense_t0, dense_h, dense_coef, fpar, ipar, psi, xc, out):
+    """Normal force (N) of each tip and the gap (m) of the nearer tip at time t from the
+    dense output, into out = (F_0, F_1, gap): only what a circuit needs, without the full
+    right-hand side (the ngspice callbacks ask for it thousands of times per run)."""
+    n_steps = t_valid.shape[0]
+    lo = 0
+    hi = n_steps - 1
+    while lo < hi:  # first step whose validity ends at or after t
+        mid = (lo + hi) // 2
+        if t_valid[mid] < t:
+            lo = mid + 1
+        else:
+            hi = mid
+    k = lo
+    N = dense_coef.shape[2]
+    y = np.empty(N)
+    dense_eval(dense_coef[k], (t - dense_t0[k]) / dense_h[k], y)
+    n = ipar[I_N]
+    planar = ipar[I_PLANAR]
+    r = np.empty(3)
+    R = np.empty((3, 3))
+    q = np.empty(n)
+    V = np.empty(3)
+    w = np.empty(3)
+    eta = np.empty(n)
+    unpack(y, n, planar, r, R, q, V, w, eta)
+    rtip = fpar[F_RTIP]
+    gap = 1e300
+    for i in range(2):
+        s0 = xc[i]
+        s1 = 0.0
+        s2 = 0.0
+        d0 = 0.0
+        d1 = 0.0
+        d2 = 0.0
+        for j in range(n):
+            s0 += psi[i, j, 0] * q[j]
+            s1 += psi[i, j, 1] * q[j]
+            s2 += psi[i, j, 2] * q[j]
+            d0 += psi[i, j, 0] * eta[j]
+            d1 += psi[i, j, 1] * eta[j]
+            d2 += psi[i, j, 2] * eta[j]
+        zc = r[2] + R[2, 0] * s0 + R[2, 1] * s1 + R[2, 2] * s2
+        vb0 = w[1] * s2 - w[2] * s1 + d0
+        vb1 = w[2] * s0 - w[0] * s2 + d1
+        vb2 = w[0] * s1 - w[1] * s0 + d2
+        vz = V[2] + R[2, 0] * vb0 + R[2, 1] * vb1 + R[2, 2] * vb2
+        pen = rtip - zc
+        out[i] = normal_force(pen, -vz, fpar[F_K], fpar[F_C], fpar[F_BETA])
+        if -pen < gap:
+            gap = -pen
+    out[2] = gap if gap > 0.0 else 0.0

@@ -208,6 +208,15 @@ class ResistanceLaw:
         """
         return constriction_film_conductance(normal_force_N, *self._load)
 
+    def scalar_force_conductance(self, normal_force_N: float) -> float:
+        """``force_conductance`` for one float, without numpy: the circuit callbacks call it
+        thousands of times per run. Siemens; 0 for F_n <= 0."""
+        if normal_force_N <= 0.0:
+            return 0.0
+        r_film, r_1, m = self._load
+        fm = normal_force_N**m
+        return fm / (r_film * fm + r_1)
+
     def current_factor_expression(self, current: str = "I") -> str:
         """g(|I|) as an ngspice expression of the variable ``current`` (A), with |I| held
         inside current_range_A as ``current_factor`` does; dimensionless and > 0."""
