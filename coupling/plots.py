@@ -54,33 +54,31 @@ def plot_waveforms(result, whole_run: bool = False):
     return fig
 
 
-def plot_normal_force(result):
-    """Normal force of each tip vs time (mechanics history)."""
+def _per_tip(result, column: str, scale: float, ylabel: str, window: bool):
+    """A history column of both tips against time (ms)."""
     h = result.mechanics.history
     fig, ax = plt.subplots(figsize=(9, 4))
     for i in range(2):
-        ax.plot(h.time * 1e3, h[f"normal_force_{i}"], lw=0.9, label=f"tip {i}")
+        ax.plot(h.time * 1e3, h[f"{column}_{i}"] * scale, lw=0.9, label=f"tip {i}")
     ax.set_xlabel("time (ms)")
-    ax.set_ylabel("normal force (N)")
-    ax.set_xlim(*_window(result))
+    ax.set_ylabel(ylabel)
+    if window:
+        ax.set_xlim(*_window(result))
     ax.grid(alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    return fig
+    return fig, ax
+
+
+def plot_normal_force(result):
+    """Normal force of each tip vs time (mechanics history), over the bounce window."""
+    return _per_tip(result, "normal_force", 1.0, "normal force (N)", window=True)[0]
 
 
 def plot_tip_heights(result):
     """Height of each tip's lowest point above the block vs time (negative: penetration)."""
-    h = result.mechanics.history
-    fig, ax = plt.subplots(figsize=(9, 4))
-    for i in range(2):
-        ax.plot(h.time * 1e3, h[f"tip_height_{i}"] * 1e3, lw=0.9, label=f"tip {i}")
+    fig, ax = _per_tip(result, "tip_height", 1e3, "tip height (mm)", window=False)
     ax.axhline(0.0, color="k", lw=0.6)
-    ax.set_xlabel("time (ms)")
-    ax.set_ylabel("tip height (mm)")
-    ax.grid(alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
     return fig
 
 

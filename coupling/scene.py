@@ -36,6 +36,7 @@ from typing import Any
 
 from mech.parameters import Friction, MechScene, check_positive
 from mech.scene import SECTIONS as MECH_SECTIONS
+from mech.scene import read_toml
 from mech.scene import scene_from_dict as mech_scene_from_dict
 
 COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output")
@@ -413,13 +414,7 @@ def _known(table, cls, where: str) -> dict:
 def load_scene(path) -> Scene:
     """Read and validate a scene TOML file (SI units; paths inside are relative to it)."""
     path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"scene file {str(path)!r} not found")
-    try:
-        doc = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as err:
-        raise ValueError(f"{path}: not valid TOML: {err}") from None
-    return scene_from_dict(doc, base_dir=path.parent, name=str(path))
+    return scene_from_dict(read_toml(path), base_dir=path.parent, name=str(path))
 
 
 def default_scene_text() -> str:

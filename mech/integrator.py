@@ -19,7 +19,7 @@ from numba import njit
 from .kernel import (
     A_FN, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_COMPRESSION, EV_CONTACT, EV_SLIP, EV_STICK,
     F_BETA, F_C, F_K, F_RTIP, F_VBOUND, FRICTION_EXACT, I_FRICTION, I_N, I_PLANAR, NEV_TIP, SLIP, STICK,
-    dynamics, unpack,
+    dynamics, tip_offset, unpack,
 )
 from .contact_laws import normal_force
 
@@ -45,6 +45,17 @@ def dense_eval(coef, theta, out):
     t1 = 1.0 - theta
     for i in range(coef.shape[1]):
         out[i] = coef[0, i] + theta * (coef[1, i] + t1 * (coef[2, i] + theta * (coef[3, i] + t1 * coef[4, i])))
+
+
+@njit(cache=True)
+def _dense_coefficients(y, ynew, h, k1, k3, k4, k5, k6, k7, coef):
+    """Continuous-extension coefficients of a step from y to ynew (Hairer's contd5)."""
+    for i in range(y.shape[0]):
+        coef[0, i] = y[i]
+        coef[1, i] = ynew[i] - y[i]
+        coef[2, i] = h * k1[i] - coef[1, i]
+        coef[3, i] = coef[1, i] - h * k7[i] - coef[2, i]
+        coef[4, i] = h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i])
 
 
 @njit(cache=True)
@@ -214,12 +225,7 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
         # accepted: events
         facold = max(err, 1e-4)
         events_from_aux(aux_new, eref, fpar, g_new)
-        for i in range(N):
-            coef[0, i] = y[i]
-            coef[1, i] = ynew[i] - y[i]
-            coef[2, i] = h * k1[i] - coef[1, i]
-            coef[3, i] = coef[1, i] - h * k7[i] - coef[2, i]
-            coef[4, i] = h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i])
+        _dense_coefficients(y, ynew, h, k1, k3, k4, k5, k6, k7, coef)
         first_k = -1
         h_continue = h
         first_theta = 2.0
@@ -318,38 +324,23 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
                 hh = hi * h
                 h_continue = h
                 tev = t + hh
-                for i in range(N):
-                    coef[0, i] = y[i]
-                    coef[1, i] = ymid[i] - y[i]
-                    coef[2, i] = hh * k1[i] - coef[1, i]
-                    coef[3, i] = coef[1, i] - hh * k7[i] - coef[2, i]
-                    coef[4, i] = hh * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i])
+                _dense_coefficients(y, ymid, hh, k1, k3, k4, k5, k6, k7, coef)
                 h = hh
                 first_theta = 1.0
             dynamics(tev, ymid, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, ytmp, aux_new, work)
             stats[2] += 1
-            _record(n_rec, tev, ymid, aux_new, aux_old, coef, rec_t, rec_y, rec_aux, rec_fmax,
+            _record(n_rec, t, h, tev, ymid, aux_new, aux_old, coef, rec_t, rec_y, rec_aux, rec_fmax,
+                    dense_t0, dense_h, dense_coef, store_dense,
                     fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, work, ytmp, aux_stage, first_theta)
-            if store_dense:
-                dense_t0[n_rec] = t
-                dense_h[n_rec] = h
-                for a_ in range(5):
-                    for i in range(N):
-                        dense_coef[n_rec, a_, i] = coef[a_, i]
             n_rec += 1
             for i in range(N):
                 y[i] = ymid[i]
             stats[0] += 1
             stats[3] += 1
             return EVENT, tev, h_continue, n_rec, first_k
-        _record(n_rec, t + h, ynew, aux_new, aux_old, coef, rec_t, rec_y, rec_aux, rec_fmax,
+        _record(n_rec, t, h, t + h, ynew, aux_new, aux_old, coef, rec_t, rec_y, rec_aux, rec_fmax,
+                dense_t0, dense_h, dense_coef, store_dense,
                 fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, work, ytmp, aux_stage, 1.0)
-        if store_dense:
-            dense_t0[n_rec] = t
-            dense_h[n_rec] = h
-            for a_ in range(5):
-                for i in range(N):
-                    dense_coef[n_rec, a_, i] = coef[a_, i]
         n_rec += 1
         stats[0] += 1
         for k in range(nev):
@@ -371,9 +362,17 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
 
 
 @njit(cache=True)
-def _record(n_rec, t_end, y_end, aux_end, aux_start, coef, rec_t, rec_y, rec_aux, rec_fmax,
+def _record(n_rec, t_start, h, t_end, y_end, aux_end, aux_start, coef, rec_t, rec_y, rec_aux, rec_fmax,
+            dense_t0, dense_h, dense_coef, store_dense,
             fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, work, scratch, aux_scratch, theta_end):
-    """Store an accepted step; its peak normal force is sampled at both ends and 3 interior points."""
+    """Store an accepted step (and its dense-output coefficients when kept); its peak normal
+    force is sampled at both ends and 3 interior points."""
+    if store_dense:
+        dense_t0[n_rec] = t_start
+        dense_h[n_rec] = h
+        for a_ in range(5):
+            for i in range(coef.shape[1]):
+                dense_coef[n_rec, a_, i] = coef[a_, i]
     rec_t[n_rec] = t_end
     N = y_end.shape[0]
     for i in range(N):
@@ -444,24 +443,16 @@ def dense_tip_forces(t, t_valid, dense_t0, dense_h, dense_coef, fpar, ipar, psi,
     unpack(y, n, planar, r, R, q, V, w, eta)
     rtip = fpar[F_RTIP]
     gap = 1e300
+    s = np.empty(3)
+    d = np.empty(3)
+    no_axis = np.zeros(2)
     for i in range(2):
-        s0 = xc[i]
-        s1 = 0.0
-        s2 = 0.0
-        d0 = 0.0
-        d1 = 0.0
-        d2 = 0.0
-        for j in range(n):
-            s0 += psi[i, j, 0] * q[j]
-            s1 += psi[i, j, 1] * q[j]
-            s2 += psi[i, j, 2] * q[j]
-            d0 += psi[i, j, 0] * eta[j]
-            d1 += psi[i, j, 1] * eta[j]
-            d2 += psi[i, j, 2] * eta[j]
-        zc = r[2] + R[2, 0] * s0 + R[2, 1] * s1 + R[2, 2] * s2
-        vb0 = w[1] * s2 - w[2] * s1 + d0
-        vb1 = w[2] * s0 - w[0] * s2 + d1
-        vb2 = w[0] * s1 - w[1] * s0 + d2
+        tip_offset(i, xc, psi, q, n, s)
+        tip_offset(i, no_axis, psi, eta, n, d)
+        zc = r[2] + R[2, 0] * s[0] + R[2, 1] * s[1] + R[2, 2] * s[2]
+        vb0 = w[1] * s[2] - w[2] * s[1] + d[0]
+        vb1 = w[2] * s[0] - w[0] * s[2] + d[1]
+        vb2 = w[0] * s[1] - w[1] * s[0] + d[2]
         vz = V[2] + R[2, 0] * vb0 + R[2, 1] * vb1 + R[2, 2] * vb2
         pen = rtip - zc
         out[i] = normal_force(pen, -vz, fpar[F_K], fpar[F_C], fpar[F_BETA])

@@ -155,6 +155,19 @@ def make_work(n):
 
 
 @njit(cache=True)
+def tip_offset(i, xc, psi, modal, n, out):
+    """Body-frame offset of tip sphere i from the centroid, x_i b1 + sum_j Psi_ij modal_j
+    (with modal = q: the position; with modal = eta, and xc zero: its rate)."""
+    out[0] = xc[i]
+    out[1] = 0.0
+    out[2] = 0.0
+    for j in range(n):
+        out[0] += psi[i, j, 0] * modal[j]
+        out[1] += psi[i, j, 1] * modal[j]
+        out[2] += psi[i, j, 2] * modal[j]
+
+
+@njit(cache=True)
 def mu_at(t, fpar):
     """N^gamma: friction coefficient, linear in time within a coupling step."""
     mu = fpar[F_MU0] + fpar[F_MU_SLOPE] * (t - fpar[F_T_MU])
@@ -654,15 +667,10 @@ def energies(y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, xc, work, out):
     for e in range(sp_ptr[3], sp_ptr[4]):
         el += 0.5 * q[sp_idx[e, 0]] * sp_val[e] * q[sp_idx[e, 1]]
     hz = 0.0
+    s = np.empty(3)
     for i in range(2):
-        s0 = xc[i]
-        s1 = 0.0
-        s2 = 0.0
-        for j in range(n):
-            s0 += psi[i, j, 0] * q[j]
-            s1 += psi[i, j, 1] * q[j]
-            s2 += psi[i, j, 2] * q[j]
-        pen = fpar[F_RTIP] - (r[2] + R[2, 0] * s0 + R[2, 1] * s1 + R[2, 2] * s2)
+        tip_offset(i, xc, psi, q, n, s)
+        pen = fpar[F_RTIP] - (r[2] + R[2, 0] * s[0] + R[2, 1] * s[1] + R[2, 2] * s[2])
         if pen > 0.0:
             hz += 0.4 * fpar[F_K] * pen * pen * math.sqrt(pen)
     out[0] = kin

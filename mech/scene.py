@@ -148,16 +148,20 @@ def scene_from_dict(doc: dict, *, where: str = "scene", extra_sections=()) -> Me
     return MechScene(**kwargs)
 
 
-def load_scene(path) -> MechScene:
-    """Read a mechanics scene TOML file (SI units)."""
+def read_toml(path) -> dict:
+    """The parsed TOML document of a scene file, or a clear error (missing file, bad TOML)."""
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"scene file {str(path)!r} not found")
     try:
-        doc = tomllib.loads(path.read_text())
+        return tomllib.loads(path.read_text())
     except tomllib.TOMLDecodeError as err:
         raise ValueError(f"{path}: not valid TOML: {err}") from None
-    return scene_from_dict(doc, where=str(path))
+
+
+def load_scene(path) -> MechScene:
+    """Read a mechanics scene TOML file (SI units)."""
+    return scene_from_dict(read_toml(path), where=str(path))
 
 
 def default_scene() -> MechScene:
