@@ -192,6 +192,11 @@ class Scene:
         node[parts[-1]] = value
         return scene_from_dict(raw, base_dir=self.base_dir, name=self.name)
 
+    def __reduce__(self):
+        # A scene travels between processes as its document (one ngspice per process:
+        # parallel sweeps need separate processes); it is rebuilt and validated there.
+        return (_rebuild_scene, (copy.deepcopy(self.raw), str(self.base_dir), self.name))
+
     def without(self, *sections: str) -> "Scene":
         """A new scene without these top-level sections, e.g. ``without("circuit", "coupling")``
         for the mechanics alone."""
@@ -409,6 +414,10 @@ def _known(table, cls, where: str) -> dict:
         if key not in allowed:
             raise _unknown(where, key, allowed)
     return dict(table)
+
+
+def _rebuild_scene(raw: dict, base_dir: str, name: str) -> Scene:
+    return scene_from_dict(raw, base_dir=Path(base_dir), name=name)
 
 
 def load_scene(path) -> Scene:

@@ -88,3 +88,22 @@ def test_scene_files_resolve_paths_next_to_them(tmp_path):
     (tmp_path / "bad.toml").write_text("[bar\nlength = 1")
     with pytest.raises(ValueError, match="not valid TOML"):
         load_scene(tmp_path / "bad.toml")
+
+
+def test_scene_pickles_as_its_document_for_other_processes():
+    """ngspice is one instance per process, so parallel sweeps ship scenes to other
+    processes: a scene travels as its document and is rebuilt (and validated) there."""
+    import pickle
+    from concurrent.futures import ProcessPoolExecutor
+
+    sc = default_scene().set("initial.angle_deg", 40.0)
+    back = pickle.loads(pickle.dumps(sc))
+    assert back.raw == sc.raw and back.name == sc.name and back.mech.initial.angle_deg == 40.0
+    assert back.mech.friction.mu_at(2.0) == sc.mech.friction.mu_at(2.0)
+    with ProcessPoolExecutor(max_workers=1) as pool:
+        angle = pool.submit(_angle_of, sc).result(timeout=120)
+    assert angle == 40.0
+
+
+def _angle_of(scene):
+    return scene.mech.initial.angle_deg
