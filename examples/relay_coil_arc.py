@@ -31,6 +31,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 import sys
 from pathlib import Path
 
@@ -190,7 +191,8 @@ def plot(results: dict, numbers: dict, out: Path) -> list[Path]:
 
 
 def _slug(name: str) -> str:
-    return "".join(ch if ch.isalnum() else "_" for ch in name).strip("_").replace("__", "_")
+    """A directory name: 'arc + flyback diode' -> 'arc_flyback_diode'."""
+    return re.sub(r"[^0-9A-Za-z]+", "_", name).strip("_")
 
 
 def main(fast: bool = False, out: str | Path | None = None) -> dict:
