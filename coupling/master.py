@@ -1,9 +1,10 @@
 """The co-simulation master: mechanics and ngspice advanced in macro steps.
 
 Exchange per macro step [t_n, t_n+1] (scheme "mechanics_first", the default):
-1. The loop current is extrapolated linearly from the last two step ends (a zero-order
-   hold right after a make or break, where it jumps) and gives mu(I) at both ends of
-   the step; the mechanics integrates the step with mu linear in time.
+1. The loop current is extrapolated linearly with the circuit's own slope at the step
+   start (a short zero-order-hold step right after a make or break, where it jumps; steps
+   no longer than half the current's time scale |dI/dt|/|d2I/dt2|) and gives mu(I) at both
+   ends of the step; the mechanics integrates the step with mu linear in time.
 2. If a tip makes or breaks inside the step, the mechanics returns to the step start
    and integrates only up to that instant: the step ends there (``align_events``).
 3. ngspice integrates the same step with the contact conductance G_F(F_n(t)) taken from
@@ -19,6 +20,7 @@ t_n, held: mu(I_n) and the conductance G(F_n(t_n)).
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 
@@ -75,6 +77,8 @@ class CoSimulation:
         self.mu_log: list[tuple[float, float, float, float]] = []
         self.stats = dict(macro_steps=0, aligned_steps=0, contact_steps=0, mech_seconds=0.0,
                           circuit_seconds=0.0)
+        self._tail_t = np.zeros(0)
+        self._tail_i = np.zeros(0)
 
     def _mu(self, current: float) -> float:
         return float(self.laws.mu(current)) if self.feedback else float(self.laws.mu(0.0))
@@ -91,37 +95,41 @@ class CoSimulation:
         stepper = Stepper(sc.circuit.circuit, t_end, sc.circuit.options)
         self.mech, self.stepper = mech, stepper
         t = 0.0
-        i_now, i_prev, t_prev = 0.0, None, None
-        jump_since_prev = False
-        t_jump = 0.0
+        i_now = 0.0
+        # a contact closed at t = 0 (a resting start): the circuit's operating point carries
+        # a current not known yet, so the first step is a short one, as after a make
+        jump_since_prev = bool(np.any(mech.contact_now()[:, 0] > 0.0))
+        rate, scale = 0.0, math.inf  # dI/dt of the loop current at t (A/s) and its time scale (s)
         try:
             with stepper:
                 while t < t_end * (1.0 - 1e-14):
-                    touching = (jump_since_prev and t > 0.0) or bool(np.any(mech.regime != FREE)) or bool(
+                    touching = jump_since_prev or bool(np.any(mech.regime != FREE)) or bool(
                         np.any(mech.contact_now()[:, 0] > 0.0))
-                    h = opts.macro_step if touching else opts.free_step
-                    if jump_since_prev and t > 0.0 and opts.scheme == "mechanics_first":
-                        # Right after a make/break the current has jumped and is known only
-                        # at the jump: a short step (H^2 / H_free) fetches it, so the
-                        # zero-order hold costs O(H^2), not O(H), and the scheme stays second order.
-                        h = min(h, opts.macro_step ** 2 / opts.free_step)
-                    t_next = min(t + h, t_end)
+                    t_next = min(t + (opts.macro_step if touching else opts.free_step), t_end)
                     if t_end - t_next < 1e-3 * opts.macro_step:
                         t_next = t_end  # no sliver step at the end
                     if opts.scheme == "jacobi":
-                        i_prev, t_prev, i_now, t = self._jacobi_step(mech, stepper, rl, t, t_next, i_now)
+                        i_now, t = self._jacobi_step(mech, stepper, rl, t, t_next, i_now)
                     else:
-                        # linear extrapolation needs two samples after the last current jump
-                        # (the sample at a make/break instant is still the value before it)
-                        slope = 0.0
-                        if t_prev is not None and t_prev > t_jump and t > t_prev:
-                            slope = (i_now - i_prev) / (t - t_prev)
-                        t_new, current, jumped = self._mechanics_first_step(mech, stepper, rl, t, t_next,
-                                                                            i_now, slope)
-                        i_prev, t_prev, i_now, t = i_now, t, current, t_new
+                        probe = opts.macro_step ** 2 / opts.free_step
+                        if jump_since_prev:
+                            # Right after a make/break the current has jumped and is known only
+                            # at the jump: a short step (H^2 / H_free) fetches it, so the
+                            # zero-order hold costs O(H^2), not O(H): still second order.
+                            t_next = min(t + probe, t_end)
+                            slope = 0.0
+                        else:
+                            # Taylor step with the circuit's own slope at t. While the current
+                            # moves on a time scale shorter than the step (an L/R rise after a
+                            # make is ~100 ns) no slope extrapolates over it: the step shrinks
+                            # to half that time scale, at least the probe length.
+                            slope = rate
+                            if touching:
+                                t_next = min(t_next, t + max(probe, TIME_SCALE_FRACTION * scale))
+                        t_new, current, jumped, (rate, scale) = self._mechanics_first_step(
+                            mech, stepper, rl, t, t_next, i_now, slope)
+                        i_now, t = current, t_new
                         jump_since_prev = jumped
-                        if jumped:
-                            t_jump = t
                     self.stats["macro_steps"] += 1
                     self.stats["contact_steps"] += int(touching)
                     self.progress(t)
@@ -174,14 +182,24 @@ class CoSimulation:
         step = stepper.advance(t_next, conductance, breakpoints=breakpoints,
                                gap=gap if stepper.uses_gap else None)
         self.stats["circuit_seconds"] += time.perf_counter() - tick
+        # the circuit's last points, kept across steps for the slope and its time scale
+        self._tail_t = np.concatenate([self._tail_t, step.reader("time")])[-TAIL_POINTS:]
+        self._tail_i = np.concatenate([self._tail_i, step.reader("load_current")])[-TAIL_POINTS:]
+        keep = np.concatenate([[True], np.diff(self._tail_t) > 0])
+        self._tail_t, self._tail_i = self._tail_t[keep], self._tail_i[keep]
+        jumped = bool(switching) or aligned
+        if jumped:  # points before a jump say nothing of the current after it
+            self._tail_t, self._tail_i = self._tail_t[-1:], self._tail_i[-1:]
         # a step cut at a make/break ends at a current jump even when the re-run mechanics
         # stops a round-off short of the event (it is then found at the next step's start)
-        return t_next, _coupling_current(step), bool(switching) or aligned
+        return t_next, _coupling_current(step), jumped, _end_rate(self._tail_t, self._tail_i,
+                                                                  self.scene.coupling.macro_step)
 
     def _jacobi_step(self, mech, stepper, rl, t, t_next, i_now):
         mu = self._mu(i_now)
         contact = mech.contact_now()
-        g = float(np.sum(rl.force_conductance(contact[:, 2])))
+        onset = self.scene.coupling.onset_penetration
+        g = sum(rl.scalar_force_conductance(contact[i, 2]) * conduction_onset(contact[i, 0], onset) for i in range(2))
         gap = float(max(0.0, -np.max(contact[:, 0])))
         tick = time.perf_counter()
         mech.advance(t_next, mu=mu)
@@ -190,10 +208,9 @@ class CoSimulation:
         tick = time.perf_counter()
         step = stepper.advance(t_next, g, gap=gap if stepper.uses_gap else None)
         self.stats["circuit_seconds"] += time.perf_counter() - tick
-        return i_now, t, _coupling_current(step), t_next
+        return _coupling_current(step), t_next
 
-    @staticmethod
-    def _conductance(seg, rl, touching_at_start):
+    def _conductance(self, seg, rl, touching_at_start):
         """G_F(F_n(t)) summed over both tips (they touch the same block), S, from the dense output.
 
         Each tip conducts only inside its contact intervals as the mechanics' events
@@ -202,6 +219,7 @@ class CoSimulation:
         """
         intervals = _contact_intervals(seg, touching_at_start)
         force = rl.scalar_force_conductance
+        onset = self.scene.coupling.onset_penetration
         lo, hi = seg.t_start, seg.t_end
 
         def gap(s: float) -> float:
@@ -222,7 +240,7 @@ class CoSimulation:
                 if any(a <= s <= b for a, b in intervals[i]):
                     if forces is None:
                         forces = seg.tip_forces(s)
-                    total += force(forces[i])
+                    total += force(forces[i]) * conduction_onset(forces[3 + i], onset)
             return total
 
         return g, gap
@@ -238,6 +256,9 @@ class CoSimulation:
             waves[f"normal_force_{i}"] = contact[:, i, 2]
             waves[f"penetration_{i}"] = np.maximum(contact[:, i, 0], 0.0)
         waves["normal_force"] = contact[:, 0, 2] + contact[:, 1, 2]
+        # the arc's length as given to ngspice: the nearer tip's height, 0 while a tip touches
+        waves["gap"] = np.where(waves["normal_force"] > 0.0, 0.0,
+                                np.maximum(0.0, -np.max(contact[:, :, 0], axis=1)))
         waves["mu"] = self._mu_series(waves.time.to_numpy())
         return CoupledResult(scene=self.scene, mechanics=mech.result(), waveforms=waves,
                              stats=dict(self.stats, circuit=stepper.stats), status=status)
@@ -251,6 +272,24 @@ class CoSimulation:
         t0, t1, m0, m1 = log[k].T
         frac = np.where(t1 > t0, (times - t0) / np.where(t1 > t0, t1 - t0, 1.0), 0.0)
         return m0 + (m1 - m0) * np.clip(frac, 0.0, 1.0)
+
+
+def conduction_onset(penetration: float, onset: float) -> float:
+    """Fraction (0..1) of the law's conductance a tip carries at penetration y (m).
+
+    s = 3 x^2 - 2 x^3, x = y / onset, for 0 <= y < onset; 1 beyond; 0 out of contact. Over
+    the first `onset` metres (default 10 nm, a surface-roughness scale: 10 ns at 1 m/s) the
+    continuum Hertz and Holm laws do not hold, and G_F ~ y^0.4 has an unbounded derivative
+    at y = 0 that ngspice's truncation-error control chases below its minimum step at tight
+    RELTOL (measured: a relay with a snubber aborted at the first make at RELTOL 1e-6).
+    With the ramp G ~ y^2.4 near touchdown: twice differentiable.
+    """
+    if penetration <= 0.0:
+        return 0.0
+    if onset <= 0.0 or penetration >= onset:
+        return 1.0
+    x = penetration / onset
+    return x * x * (3.0 - 2.0 * x)
 
 
 def _contact_intervals(seg, touching_at_start) -> list[list[tuple[float, float]]]:
@@ -271,6 +310,42 @@ def _contact_intervals(seg, touching_at_start) -> list[list[tuple[float, float]]
             spans.append((start, seg.t_end))
         intervals.append(spans)
     return intervals
+
+
+# A step extrapolates the current over at most this fraction of its local time scale
+# |dI/dt|/|d2I/dt2|: an exponential overshoots by ~(1 - e^-x - x)... ~x^2/2 of its remaining
+# change over x time constants, ~12 % at 0.5.
+TIME_SCALE_FRACTION = 0.5
+CURRENT_FLOOR = 1e-3  # A: floor of |I| in the cautious time scale |I|/|dI/dt|
+TAIL_POINTS = 8  # circuit points kept across macro steps for the slope and its curvature
+
+
+def _end_rate(t: np.ndarray, i: np.ndarray, span: float) -> tuple[float, float]:
+    """(dI/dt in A/s, its time scale |dI/dt| / |d2I/dt2| in s) of the loop current at the last
+    of the circuit points (t, i) (several steps' worth: a short step may hold only one or
+    two), with differences over at least 1e-3 of ``span`` (s) so a sliver landing step does
+    not dominate; (0, inf) without enough points. For an exponential approach the time
+    scale is its time constant wherever the current is on it; for a ramp it is infinite."""
+    if len(t) < 2 or not np.all(np.isfinite(i[-3:])):
+        return 0.0, math.inf
+    k = len(t) - 2
+    while k > 0 and t[-1] - t[k] < 1e-3 * span:
+        k -= 1
+    dt = t[-1] - t[k]
+    if dt <= 0:
+        return 0.0, math.inf
+    rate = float((i[-1] - i[k]) / dt)
+    j = k - 1
+    while j > 0 and t[k] - t[j] < 1e-3 * span:
+        j -= 1
+    if j < 0 or t[k] <= t[j]:
+        # too few points for a curvature: the cautious scale |I|/|dI/dt|
+        return rate, (abs(float(i[-1])) + CURRENT_FLOOR) / abs(rate) if rate != 0.0 else math.inf
+    previous = (i[k] - i[j]) / (t[k] - t[j])
+    curvature = 2.0 * (rate - previous) / (t[-1] - t[j])
+    if curvature == 0.0:
+        return rate, math.inf
+    return rate, float(abs(rate / curvature))
 
 
 def _coupling_current(step) -> float:

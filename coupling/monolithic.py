@@ -26,6 +26,7 @@ from scipy.optimize import brentq
 
 from mech import CoupledStates, ImpactSolver
 
+from .master import conduction_onset
 from .results import CoupledResult
 from .scene import Scene
 
@@ -76,9 +77,10 @@ def series_loop(circuit) -> SeriesLoop:
 class LoopODE:
     """The circuit part of the monolithic system; state z = [I (if L > 0), v_c, v_C (if capacitive)]."""
 
-    def __init__(self, loop: SeriesLoop, resistance_law, mu, rtol: float):
+    def __init__(self, loop: SeriesLoop, resistance_law, mu, rtol: float, onset: float = 0.0):
         self.loop = loop
         self.law = resistance_law
+        self.onset = onset
         self.mu = mu
         self.i_I = 0 if loop.has_inductance else None
         self.i_vc = 1 if loop.has_inductance else 0
@@ -100,6 +102,11 @@ class LoopODE:
             z0[self.i_vC] = i0 * loop.bleed_resistance
         self.initial = z0
 
+    def conductance(self, contact) -> float:
+        """S: G_F of both tips with the conduction onset, as the co-simulation gives ngspice."""
+        return sum(self.law.scalar_force_conductance(contact[i, 2]) * conduction_onset(contact[i, 0], self.onset)
+                   for i in range(2))
+
     def loop_current(self, z) -> float:
         lp = self.loop
         if self.i_I is not None:
@@ -120,7 +127,7 @@ class LoopODE:
 
     def rhs(self, t, z, contact) -> np.ndarray:
         lp = self.loop
-        g_force = float(np.sum(self.law.force_conductance(contact[:, 2])))
+        g_force = self.conductance(contact)
         v = z[self.i_vc]
         i_c = self.contact_current(g_force, v)
         i_loop = self.loop_current(z)
@@ -147,7 +154,7 @@ def run_monolithic(scene: Scene, *, method: str = "Radau", rtol: float | None = 
     feedback = scene.tribology.feedback
     mu = (lambda i: float(laws.mu(i))) if feedback else (lambda i, m0=float(laws.mu(0.0)): m0)
     tol = rtol if rtol is not None else scene.mech.solver.rtol
-    ode = LoopODE(loop, laws.resistance_law, mu, tol)
+    ode = LoopODE(loop, laws.resistance_law, mu, tol, scene.coupling.onset_penetration)
     coupled = CoupledStates(initial=ode.initial, atol=ode.atol, rhs=ode.rhs,
                             friction_coefficient=ode.friction_coefficient)
     mech_scene = scene.mech
@@ -163,7 +170,8 @@ def run_monolithic(scene: Scene, *, method: str = "Radau", rtol: float | None = 
     aux = mech_result.aux
     times = mech_result.t
     forces = aux[:, :, 2]
-    g_force = np.array([float(np.sum(laws.resistance_law.force_conductance(f))) for f in forces])
+    g_force = np.array([ode.conductance(np.column_stack([aux[k, :, 0], aux[k, :, 1], forces[k]]))
+                        for k in range(len(times))])
     v = z[:, ode.i_vc]
     i_c = np.array([ode.contact_current(g, vv) for g, vv in zip(g_force, v)])
     i_loop = np.array([ode.loop_current(row) for row in z])

@@ -416,9 +416,10 @@ def dense_contact(times, t_valid, dense_t0, dense_h, dense_coef, regimes, fpar, 
 
 @njit(cache=True)
 def dense_tip_forces(t, t_valid, dense_t0, dense_h, dense_coef, fpar, ipar, psi, xc, out):
-    """Normal force (N) of each tip and the gap (m) of the nearer tip at time t from the
-    dense output, into out = (F_0, F_1, gap): only what a circuit needs, without the full
-    right-hand side (the ngspice callbacks ask for it thousands of times per run)."""
+    """Normal force (N) of each tip, the gap (m) of the nearer tip and each tip's
+    penetration (m) at time t from the dense output, into out = (F_0, F_1, gap, y_0, y_1):
+    only what a circuit needs, without the full right-hand side (the ngspice callbacks ask
+    for it thousands of times per run)."""
     n_steps = t_valid.shape[0]
     lo = 0
     hi = n_steps - 1
@@ -456,6 +457,7 @@ def dense_tip_forces(t, t_valid, dense_t0, dense_h, dense_coef, fpar, ipar, psi,
         vz = V[2] + R[2, 0] * vb0 + R[2, 1] * vb1 + R[2, 2] * vb2
         pen = rtip - zc
         out[i] = normal_force(pen, -vz, fpar[F_K], fpar[F_C], fpar[F_BETA])
+        out[3 + i] = pen
         if -pen < gap:
             gap = -pen
     out[2] = gap if gap > 0.0 else 0.0

@@ -97,9 +97,9 @@ class Segment:
     _regime: np.ndarray
     _eref: np.ndarray
     _work: tuple = field(repr=False, default=None)
-    _out: np.ndarray = field(repr=False, default_factory=lambda: np.empty(3))
+    _out: np.ndarray = field(repr=False, default_factory=lambda: np.empty(5))
     _last_t: float = field(repr=False, default=float("nan"))
-    _last_forces: tuple = field(repr=False, default=(0.0, 0.0, 0.0))
+    _last_forces: tuple = field(repr=False, default=(0.0, 0.0, 0.0, 0.0, 0.0))
 
     def state(self, t: float) -> np.ndarray:
         """State vector at time t (s) in [t_start, t_end] (4th-order dense output)."""
@@ -130,10 +130,11 @@ class Segment:
         """N: total normal force of both tips at t."""
         return float(self.contact(t)[:, 2].sum())
 
-    def tip_forces(self, t: float) -> tuple[float, float, float]:
-        """(F_0, F_1, gap) at t: each tip's normal force (N) and the nearer tip's height
-        above the block (m, 0 when touching), by a compiled evaluation of the dense output
-        (about 1/10 the cost of ``contact``). Repeated calls at the same t are cached."""
+    def tip_forces(self, t: float) -> tuple[float, float, float, float, float]:
+        """(F_0, F_1, gap, y_0, y_1) at t: each tip's normal force (N), the nearer tip's
+        height above the block (m, 0 when touching) and each tip's penetration (m), by a
+        compiled evaluation of the dense output (about 1/10 the cost of ``contact``).
+        Repeated calls at the same t are cached."""
         if t == self._last_t:
             return self._last_forces
         if not (self.t_start - 1e-15 <= t <= self.t_end + 1e-15):
@@ -141,11 +142,12 @@ class Segment:
         m = self._model
         if len(self._t_valid) == 0 or t <= self.t_start:
             c = self.contact(t)
-            forces = (float(c[0, 2]), float(c[1, 2]), float(max(0.0, -np.max(c[:, 0]))))
+            forces = (float(c[0, 2]), float(c[1, 2]), float(max(0.0, -np.max(c[:, 0]))),
+                      float(c[0, 0]), float(c[1, 0]))
         else:
             dense_tip_forces(t, self._t_valid, self._t0, self._h, self._coef, m.fpar, m.ipar,
                              m.basis.psi_tip, m.basis.x_centre, self._out)
-            forces = (float(self._out[0]), float(self._out[1]), float(self._out[2]))
+            forces = tuple(float(v) for v in self._out)
         self._last_t, self._last_forces = t, forces
         return forces
 

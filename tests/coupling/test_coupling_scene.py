@@ -107,3 +107,16 @@ def test_scene_pickles_as_its_document_for_other_processes():
 
 def _angle_of(scene):
     return scene.mech.initial.angle_deg
+
+
+def test_update_validates_once_and_unset_restores_defaults():
+    sc = default_scene()
+    # resting needs angle 0: one at a time the first change alone is invalid
+    with pytest.raises(ValueError, match="initial.resting"):
+        sc.set("initial.resting", True)
+    rest = sc.update({"initial.resting": True, "initial.angle_deg": 0.0})
+    assert rest.mech.initial.resting and rest.mech.initial.angle_deg == 0.0
+    damped = sc.unset("contact.restitution").set("contact.damping", 1e7)
+    assert damped.mech.contact.damping == 1e7 and damped.mech.contact.restitution is None
+    with pytest.raises(ValueError, match="expected 'section.key'"):
+        sc.unset("contact")

@@ -229,7 +229,10 @@ def test_inrush_current_lowers_r_c_and_raises_mu_as_the_fit_says(inrush):
     f, rc, i_c = w.normal_force.to_numpy(), w.contact_resistance.to_numpy(), w.contact_current.to_numpy()
     firm = (f >= 1.0) & np.isfinite(rc)
     ratio = rc[firm] / laws.contact_resistance(f[firm], 0.0)
-    assert np.max(np.abs(ratio / laws.resistance_law.current_factor(i_c[firm]) - 1.0)) < 1e-4
+    # ngspice evaluates g(I) at its last Newton iterate, converged to RELTOL (the scene's,
+    # the circuit package's 1e-4 unless set): the agreement to expect
+    reltol = float(_toml("capacitive_inrush")["circuit"].get("reltol", 1e-4))
+    assert np.max(np.abs(ratio / laws.resistance_law.current_factor(i_c[firm]) - 1.0)) < 2 * reltol
     g_floor = float(laws.resistance_law.current_factor(hi))
     assert np.all((ratio >= g_floor * (1 - 1e-6)) & (ratio <= 1.0 + 1e-9))
     assert numbers["current_factor_min"] < 1.0  # the inrush lowers R_c at the same force
