@@ -28,7 +28,6 @@ the first of the tip's contacts that leaves it separating.
 
 from __future__ import annotations
 
-import argparse
 import copy
 import json
 import math
@@ -42,6 +41,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from coupling import load_scene, run, scene_from_dict  # noqa: E402
+
+import example_cli  # noqa: E402  (examples/example_cli.py, next to this script)
 
 NAME = "incidence_angle_study"
 SCENE = Path(__file__).with_name(f"{NAME}.toml")
@@ -315,15 +316,7 @@ def _summary(n: dict) -> str:
 
 
 def cli(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--fast", action="store_true", help="3 angles, fewer variants, looser tolerance")
-    parser.add_argument("--out", default=None, help=f"output directory (default runs/examples/{NAME})")
-    args = parser.parse_args(argv)
-    out = Path(args.out) if args.out else Path("runs/examples") / NAME
-    numbers = main(fast=args.fast, out=out)
-    print(_summary(numbers))
-    print(f"written to {out}/")
-    return 0
+    return example_cli.run(__doc__, NAME, main, _summary, argv, fast_help='3 angles, fewer variants, looser tolerance')
 
 
 if __name__ == "__main__":

@@ -23,7 +23,6 @@ linearly over each macro step, so right after a make it overshoots for one step)
 
 from __future__ import annotations
 
-import argparse
 import json
 import sys
 from pathlib import Path
@@ -35,6 +34,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from coupling import load_scene, run  # noqa: E402
+
+import example_cli  # noqa: E402  (examples/example_cli.py, next to this script)
 
 NAME = "mu_feedback"
 HERE = Path(__file__).parent
@@ -255,15 +256,7 @@ def _summary(n: dict) -> str:
 
 
 def cli(argv=None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--fast", action="store_true", help="short runs (a few seconds), looser tolerance")
-    parser.add_argument("--out", default=None, help=f"output directory (default runs/examples/{NAME})")
-    args = parser.parse_args(argv)
-    out = Path(args.out) if args.out else Path("runs/examples") / NAME
-    numbers = main(fast=args.fast, out=out)
-    print(_summary(numbers))
-    print(f"written to {out}/")
-    return 0
+    return example_cli.run(__doc__, NAME, main, _summary, argv, fast_help='short runs (a few seconds), looser tolerance')
 
 
 if __name__ == "__main__":
