@@ -111,10 +111,10 @@ class CoSimulation:
                     if opts.scheme == "jacobi":
                         i_now, t = self._jacobi_step(mech, stepper, rl, t, t_next, i_now)
                     else:
-                        probe = opts.macro_step ** 2 / opts.free_step
+                        probe = opts.macro_step ** 2 / PROBE_TIME
                         if jump_since_prev:
                             # Right after a make/break the current has jumped and is known only
-                            # at the jump: a short step (H^2 / H_free) fetches it, so the
+                            # at the jump: a short step (H^2 / PROBE_TIME) fetches it, so the
                             # zero-order hold costs O(H^2), not O(H): still second order.
                             t_next = min(t + probe, t_end)
                             slope = 0.0
@@ -124,10 +124,10 @@ class CoSimulation:
                             # make is ~100 ns) no slope extrapolates over it: the step shrinks
                             # to half that time scale, at least the probe length.
                             slope = rate
-                            if touching:
+                            if touching and abs(rate) * (t_next - t) > CHANGE_FRACTION * (abs(i_now) + CURRENT_FLOOR):
                                 t_next = min(t_next, t + max(probe, TIME_SCALE_FRACTION * scale))
                         t_new, current, jumped, (rate, scale) = self._mechanics_first_step(
-                            mech, stepper, rl, t, t_next, i_now, slope)
+                            mech, stepper, rl, t, t_next, i_now, slope, scale)
                         i_now, t = current, t_new
                         jump_since_prev = jumped
                     self.stats["macro_steps"] += 1
@@ -146,9 +146,11 @@ class CoSimulation:
 
     # --- schemes -----------------------------------------------------------------------
 
-    def _mechanics_first_step(self, mech, stepper, rl, t, t_next, i_now, slope):
+    def _mechanics_first_step(self, mech, stepper, rl, t, t_next, i_now, slope, horizon=math.inf):
         def current_at(s):
-            return i_now + slope * (s - t)
+            # linear, but not beyond the current's time scale: an exponential approach
+            # extrapolated over its time constant lands on its asymptote
+            return i_now + slope * min(s - t, horizon)
 
         mu0 = self._mu(current_at(t))
         touching = mech.regime != FREE
@@ -158,7 +160,7 @@ class CoSimulation:
         switching = [e["time"] for e in seg.events if e["kind"] in CONTACT_EVENTS]
         opts = self.scene.coupling
         guard = 1e-9 * opts.macro_step
-        probe = opts.macro_step ** 2 / opts.free_step
+        probe = opts.macro_step ** 2 / PROBE_TIME
         aligned = False
         if cp is not None and switching:
             if t + guard < switching[0] < t_next - guard:
@@ -315,7 +317,9 @@ def _contact_intervals(seg, touching_at_start) -> list[list[tuple[float, float]]
 # A step extrapolates the current over at most this fraction of its local time scale
 # |dI/dt|/|d2I/dt2|: an exponential overshoots by ~(1 - e^-x - x)... ~x^2/2 of its remaining
 # change over x time constants, ~12 % at 0.5.
+PROBE_TIME = 1e-4  # s: the step right after a current jump is H^2 / PROBE_TIME (O(H^2): second order)
 TIME_SCALE_FRACTION = 0.5
+CHANGE_FRACTION = 1e-3  # the time-scale rule applies only where a step would change the current by more
 CURRENT_FLOOR = 1e-3  # A: floor of |I| in the cautious time scale |I|/|dI/dt|
 TAIL_POINTS = 8  # circuit points kept across macro steps for the slope and its curvature
 
