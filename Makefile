@@ -20,7 +20,7 @@ $(STAMP): pyproject.toml scripts/install-system-deps
 	sh scripts/install-system-deps
 	$(PY) -m venv $(VENV)
 	$(VENV)/bin/python -m pip install -q --upgrade pip
-	$(VENV)/bin/python -m pip install -q -e '.[test,sweep]'
+	$(VENV)/bin/python -m pip install -q -e '.[test]'
 	touch $(STAMP)
 
 bench: $(STAMP)
