@@ -111,7 +111,7 @@ class CoSimulation:
                     if opts.scheme == "jacobi":
                         i_now, t = self._jacobi_step(mech, stepper, rl, t, t_next, i_now)
                     else:
-                        probe = opts.macro_step ** 2 / PROBE_TIME
+                        probe = _probe_step(opts.macro_step)
                         if jump_since_prev:
                             # Right after a make/break the current has jumped and is known only
                             # at the jump: a short step (H^2 / PROBE_TIME) fetches it, so the
@@ -160,7 +160,7 @@ class CoSimulation:
         switching = [e["time"] for e in seg.events if e["kind"] in CONTACT_EVENTS]
         opts = self.scene.coupling
         guard = 1e-9 * opts.macro_step
-        probe = opts.macro_step ** 2 / PROBE_TIME
+        probe = _probe_step(opts.macro_step)
         aligned = False
         if cp is not None and switching:
             if t + guard < switching[0] < t_next - guard:
@@ -314,14 +314,20 @@ def _contact_intervals(seg, touching_at_start) -> list[list[tuple[float, float]]
     return intervals
 
 
+PROBE_TIME = 1e-4  # s: the step right after a current jump is H^2 / PROBE_TIME (O(H^2): second order)
 # A step extrapolates the current over at most this fraction of its local time scale
 # |dI/dt|/|d2I/dt2|: an exponential overshoots by ~(1 - e^-x - x)... ~x^2/2 of its remaining
 # change over x time constants, ~12 % at 0.5.
-PROBE_TIME = 1e-4  # s: the step right after a current jump is H^2 / PROBE_TIME (O(H^2): second order)
 TIME_SCALE_FRACTION = 0.5
 CHANGE_FRACTION = 1e-3  # the time-scale rule applies only where a step would change the current by more
 CURRENT_FLOOR = 1e-3  # A: floor of |I| in the cautious time scale |I|/|dI/dt|
 TAIL_POINTS = 8  # circuit points kept across macro steps for the slope and its curvature
+
+
+def _probe_step(macro_step: float) -> float:
+    """s, the short step that fetches the current right after a make/break (H^2 / PROBE_TIME).
+    The run loop takes it and the event alignment must recognise it: both call this."""
+    return macro_step ** 2 / PROBE_TIME
 
 
 def _end_rate(t: np.ndarray, i: np.ndarray, span: float) -> tuple[float, float]:
