@@ -147,13 +147,10 @@ def test_models_the_data_cannot_support_are_skipped_with_a_reason():
     assert "needs >= 3 current levels" in rs["holm_elastic_film+exponential_floor"]
 
 
-def test_shipped_fit_recovers_its_generator_and_is_fast():
-    import time
-
+def test_shipped_fit_recovers_its_generator_and_is_computed_once():
+    # its speed (target < 1 s) is measured in benchmarks/bench_tribology.py, not timed here
     default_fit.cache_clear()
-    t0 = time.perf_counter()
     fit = default_fit()
-    assert time.perf_counter() - t0 < 1.0
     assert default_fit() is fit
     assert fit.gamma_ci95[0] <= 0.7 <= fit.gamma_ci95[1]
     assert fit.friction.mu_selection.chosen.name == MU_TRUE.model
