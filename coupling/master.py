@@ -27,7 +27,6 @@ import time
 import numpy as np
 
 from mech import ImpactSolver
-from mech.kernel import FREE
 
 from .results import CoupledResult
 from .scene import Scene
@@ -103,7 +102,7 @@ class CoSimulation:
         try:
             with stepper:
                 while t < t_end * (1.0 - 1e-14):
-                    touching = jump_since_prev or bool(np.any(mech.regime != FREE)) or bool(
+                    touching = jump_since_prev or bool(np.any(mech.friction_engaged())) or bool(
                         np.any(mech.contact_now()[:, 0] > 0.0))
                     t_next = min(t + (opts.macro_step if touching else opts.free_step), t_end)
                     if t_end - t_next < 1e-3 * opts.macro_step:
@@ -153,7 +152,7 @@ class CoSimulation:
             return i_now + slope * min(s - t, horizon)
 
         mu0 = self._mu(current_at(t))
-        touching = mech.regime != FREE
+        touching = mech.friction_engaged()
         cp = mech.checkpoint() if self.scene.coupling.align_events else None
         tick = time.perf_counter()
         seg = mech.advance(t_next, mu=(mu0, self._mu(current_at(t_next))))

@@ -35,7 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from mech.parameters import Friction, MechScene, check_nonnegative, check_positive
-from mech.scene import SECTIONS as MECH_SECTIONS
+from mech.scene import SCENE_SECTIONS as MECH_SECTIONS
 from mech.scene import read_toml
 from mech.scene import scene_from_dict as mech_scene_from_dict
 
@@ -345,7 +345,7 @@ def scene_from_dict(doc: dict, *, base_dir: Path | str = ".", name: str = "scene
     where = name
     doc = _table(where, doc)
     base_dir = Path(base_dir)
-    known = set(MECH_SECTIONS) | {"environment"} | set(COUPLING_SECTIONS)
+    known = set(MECH_SECTIONS) | set(COUPLING_SECTIONS)
     for section in doc:
         if section not in known:
             close = difflib.get_close_matches(section, list(known), n=1)
@@ -353,7 +353,7 @@ def scene_from_dict(doc: dict, *, base_dir: Path | str = ".", name: str = "scene
             raise ValueError(f"{where}: unknown section [{section}]{hint}; allowed: {', '.join(sorted(known))}")
     circuit_table = doc.get("circuit")
     schedule_given = isinstance(circuit_table, dict) and "schedule" in circuit_table
-    mech_given = [s for s in ("bar", "block", "initial", "contact", "friction", "environment") if s in doc]
+    mech_given = [s for s in MECH_SECTIONS if s != "solver" and s in doc]
     solver_only_t_end = set(_table("[solver]", doc.get("solver", {}))) <= {"t_end"}
 
     if schedule_given and (mech_given or not solver_only_t_end):
@@ -374,7 +374,7 @@ def scene_from_dict(doc: dict, *, base_dir: Path | str = ".", name: str = "scene
 
     mech = None
     if not schedule_given:
-        mech_doc = {k: v for k, v in doc.items() if k in MECH_SECTIONS or k == "environment"}
+        mech_doc = {k: v for k, v in doc.items() if k in MECH_SECTIONS}
         if tribology is not None:
             fr = _table("[friction]", mech_doc.get("friction", {}))
             for key in ("mu", "gamma"):

@@ -18,7 +18,7 @@ from numba import njit
 
 from .kernel import (
     A_FN, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_COMPRESSION, EV_CONTACT, EV_SLIP, EV_STICK,
-    F_BETA, F_C, F_K, F_RTIP, F_VBOUND, FRICTION_EXACT, I_FRICTION, I_N, I_PLANAR, NEV_TIP, SLIP, STICK,
+    C_C, C_K, C_ON, C_R, F_BETA, F_BLOCK_Z, F_VBOUND, FRICTION_EXACT, I_FRICTION, I_N, I_PLANAR, NEV_TIP, SLIP, STICK,
     dynamics, tip_offset, unpack,
 )
 from .contact_laws import normal_force
@@ -59,12 +59,13 @@ def _dense_coefficients(y, ynew, h, k1, k3, k4, k5, k6, k7, coef):
 
 
 @njit(cache=True)
-def events_from_aux(aux, eref, fpar, g):
+def events_from_aux(aux, eref, mdl, g):
     """Event function values (see kernel.event_values) from a dynamics evaluation's aux."""
-    k_h = fpar[F_K]
-    c_h = fpar[F_C]
-    beta = fpar[F_BETA]
+    beta = mdl[0][F_BETA]
+    cpar = mdl[9]
     for i in range(2):
+        k_h = cpar[i, C_K]
+        c_h = cpar[i, C_C]
         pen = aux[i, A_Y]
         pp = pen if pen > 0.0 else 0.0
         g[NEV_TIP * i + EV_CONTACT] = pen
@@ -92,34 +93,34 @@ def _active(k, g_old, g_new, regime, fmodel):
 
 
 @njit(cache=True)
-def _rk_stages(t, y, h, k1, k2, k3, k4, k5, k6, k7, ytmp, ynew, fpar, ipar, J0, sp_ptr, sp_idx, sp_val,
-               psi, theta, xc, regime, eref, aux_stage, aux_new, work):
+def _rk_stages(t, y, h, k1, k2, k3, k4, k5, k6, k7, ytmp, ynew, mdl,
+               regime, eref, aux_stage, aux_new, work):
     """One Dormand-Prince step of size h from (t, y) with k1 = f(t, y): ynew and the stages;
     k7 = f(t + h, ynew) with its aux in aux_new (first-same-as-last)."""
     N = y.shape[0]
     for i in range(N):
         ytmp[i] = y[i] + h * A21 * k1[i]
-    dynamics(t + C2 * h, ytmp, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, k2, aux_stage, work)
+    dynamics(t + C2 * h, ytmp, mdl, regime, eref, k2, aux_stage, work)
     for i in range(N):
         ytmp[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i])
-    dynamics(t + C3 * h, ytmp, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, k3, aux_stage, work)
+    dynamics(t + C3 * h, ytmp, mdl, regime, eref, k3, aux_stage, work)
     for i in range(N):
         ytmp[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-    dynamics(t + C4 * h, ytmp, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, k4, aux_stage, work)
+    dynamics(t + C4 * h, ytmp, mdl, regime, eref, k4, aux_stage, work)
     for i in range(N):
         ytmp[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-    dynamics(t + C5 * h, ytmp, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, k5, aux_stage, work)
+    dynamics(t + C5 * h, ytmp, mdl, regime, eref, k5, aux_stage, work)
     for i in range(N):
         ytmp[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
-    dynamics(t + h, ytmp, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, k6, aux_stage, work)
+    dynamics(t + h, ytmp, mdl, regime, eref, k6, aux_stage, work)
     for i in range(N):
         ynew[i] = y[i] + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i])
-    dynamics(t + h, ynew, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, k7, aux_new, work)
+    dynamics(t + h, ynew, mdl, regime, eref, k7, aux_new, work)
 
 
 @njit(cache=True)
 def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
-              fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, ev_sign,
+              mdl, regime, eref, ev_sign,
               rec_t, rec_y, rec_aux, rec_fmax, dense_t0, dense_h, dense_coef, store_dense,
               max_steps, work, stats):
     """Advance y (in place) from t towards t_stop.
@@ -132,7 +133,8 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
     """
     N = y.shape[0]
     nev = 2 * NEV_TIP
-    fmodel = ipar[I_FRICTION]
+    fpar = mdl[0]
+    fmodel = mdl[1][I_FRICTION]
     k1 = np.empty(N)
     k2 = np.empty(N)
     k3 = np.empty(N)
@@ -154,9 +156,9 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
     n_rec = 0
     facold = 1e-4
 
-    dynamics(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, k1, aux_old, work)
+    dynamics(t, y, mdl, regime, eref, k1, aux_old, work)
     stats[2] += 1
-    events_from_aux(aux_old, eref, fpar, g_old)
+    events_from_aux(aux_old, eref, mdl, g_old)
     if h <= 0.0:  # initial step from the derivative scale (Hairer's heuristic, simplified)
         d0 = 0.0
         d1 = 0.0
@@ -191,8 +193,7 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
             last = True
         if not last and (h < 1e-15 * max(1.0, abs(t)) or h < 1e-18):
             return STEP_TOO_SMALL, t, h, n_rec, -1  # (a last step clipped to t_stop may be tiny)
-        _rk_stages(t, y, h, k1, k2, k3, k4, k5, k6, k7, ytmp, ynew, fpar, ipar, J0, sp_ptr, sp_idx, sp_val,
-                   psi, theta, xc, regime, eref, aux_stage, aux_new, work)
+        _rk_stages(t, y, h, k1, k2, k3, k4, k5, k6, k7, ytmp, ynew, mdl, regime, eref, aux_stage, aux_new, work)
         stats[2] += 6
         err = 0.0
         finite = True
@@ -224,7 +225,7 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
             continue
         # accepted: events
         facold = max(err, 1e-4)
-        events_from_aux(aux_new, eref, fpar, g_new)
+        events_from_aux(aux_new, eref, mdl, g_new)
         _dense_coefficients(y, ynew, h, k1, k3, k4, k5, k6, k7, coef)
         first_k = -1
         h_continue = h
@@ -250,9 +251,9 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
                 if not (a < tc < b):
                     tc = 0.5 * (a + b)
                 dense_eval(coef, tc, ymid)
-                dynamics(t + tc * h, ymid, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, ytmp, aux_stage, work)
+                dynamics(t + tc * h, ymid, mdl, regime, eref, ytmp, aux_stage, work)
                 stats[2] += 1
-                events_from_aux(aux_stage, eref, fpar, g_mid)
+                events_from_aux(aux_stage, eref, mdl, g_mid)
                 gc = g_mid[k]
                 if s * gc > 0.0:
                     a = tc
@@ -291,10 +292,10 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
                 side = 0
                 found = False
                 for _ in range(40):
-                    _rk_stages(t, y, trial * h, k1, k2, k3, k4, k5, k6, k7, ytmp, ymid, fpar, ipar,
-                               J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, aux_stage, aux_new, work)
+                    _rk_stages(t, y, trial * h, k1, k2, k3, k4, k5, k6, k7, ytmp, ymid, mdl,
+                               regime, eref, aux_stage, aux_new, work)
                     stats[2] += 6
-                    events_from_aux(aux_new, eref, fpar, g_mid)
+                    events_from_aux(aux_new, eref, mdl, g_mid)
                     gt = g_mid[first_k]
                     if s_ev * gt < 0.0:
                         hi = trial
@@ -318,8 +319,8 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
                     if not (lo < trial < hi):
                         trial = 0.5 * (lo + hi)
                 if not found:  # the last trial ended on the old side: retake at hi
-                    _rk_stages(t, y, hi * h, k1, k2, k3, k4, k5, k6, k7, ytmp, ymid, fpar, ipar,
-                               J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, aux_stage, aux_new, work)
+                    _rk_stages(t, y, hi * h, k1, k2, k3, k4, k5, k6, k7, ytmp, ymid, mdl,
+                               regime, eref, aux_stage, aux_new, work)
                     stats[2] += 6
                 hh = hi * h
                 h_continue = h
@@ -327,11 +328,11 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
                 _dense_coefficients(y, ymid, hh, k1, k3, k4, k5, k6, k7, coef)
                 h = hh
                 first_theta = 1.0
-            dynamics(tev, ymid, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, ytmp, aux_new, work)
+            dynamics(tev, ymid, mdl, regime, eref, ytmp, aux_new, work)
             stats[2] += 1
             _record(n_rec, t, h, tev, ymid, aux_new, aux_old, coef, rec_t, rec_y, rec_aux, rec_fmax,
                     dense_t0, dense_h, dense_coef, store_dense,
-                    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, work, ytmp, aux_stage, first_theta)
+                    mdl, regime, eref, work, ytmp, aux_stage, first_theta)
             n_rec += 1
             for i in range(N):
                 y[i] = ymid[i]
@@ -340,7 +341,7 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
             return EVENT, tev, h_continue, n_rec, first_k
         _record(n_rec, t, h, t + h, ynew, aux_new, aux_old, coef, rec_t, rec_y, rec_aux, rec_fmax,
                 dense_t0, dense_h, dense_coef, store_dense,
-                fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, work, ytmp, aux_stage, 1.0)
+                mdl, regime, eref, work, ytmp, aux_stage, 1.0)
         n_rec += 1
         stats[0] += 1
         for k in range(nev):
@@ -364,7 +365,7 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
 @njit(cache=True)
 def _record(n_rec, t_start, h, t_end, y_end, aux_end, aux_start, coef, rec_t, rec_y, rec_aux, rec_fmax,
             dense_t0, dense_h, dense_coef, store_dense,
-            fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, work, scratch, aux_scratch, theta_end):
+            mdl, regime, eref, work, scratch, aux_scratch, theta_end):
     """Store an accepted step (and its dense-output coefficients when kept); its peak normal
     force is sampled at both ends and 3 interior points."""
     if store_dense:
@@ -385,15 +386,15 @@ def _record(n_rec, t_start, h, t_end, y_end, aux_end, aux_start, coef, rec_t, re
         ymid = np.empty(N)
         for f in (0.25, 0.5, 0.75):
             dense_eval(coef, f * theta_end, ymid)
-            dynamics(0.0, ymid, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, scratch, aux_scratch, work)
+            dynamics(0.0, ymid, mdl, regime, eref, scratch, aux_scratch, work)
             for i in range(2):
                 if aux_scratch[i, A_FN] > rec_fmax[n_rec, i]:
                     rec_fmax[n_rec, i] = aux_scratch[i, A_FN]
 
 
 @njit(cache=True)
-def dense_contact(times, t_valid, dense_t0, dense_h, dense_coef, regimes, fpar, ipar, J0, sp_ptr, sp_idx,
-                  sp_val, psi, theta, xc, eref, work, out):
+def dense_contact(times, t_valid, dense_t0, dense_h, dense_coef, regimes, mdl,
+                  eref, work, out):
     """Per tip penetration (m), rate (m/s) and normal force (N) at sorted ``times`` from the
     stored dense output; out has shape (len(times), 2, 3)."""
     N = dense_coef.shape[2]
@@ -407,7 +408,7 @@ def dense_contact(times, t_valid, dense_t0, dense_h, dense_coef, regimes, fpar, 
         while k < n - 1 and t_valid[k] < t:
             k += 1
         dense_eval(dense_coef[k], (t - dense_t0[k]) / dense_h[k], y)
-        dynamics(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regimes[k], eref, dy, aux, work)
+        dynamics(t, y, mdl, regimes[k], eref, dy, aux, work)
         for i in range(2):
             out[m, i, 0] = aux[i, A_Y]
             out[m, i, 1] = aux[i, A_YDOT]
@@ -415,7 +416,7 @@ def dense_contact(times, t_valid, dense_t0, dense_h, dense_coef, regimes, fpar, 
 
 
 @njit(cache=True)
-def dense_tip_forces(t, t_valid, dense_t0, dense_h, dense_coef, fpar, ipar, psi, xc, out):
+def dense_tip_forces(t, t_valid, dense_t0, dense_h, dense_coef, mdl, out):
     """Normal force (N) of each tip, the gap (m) of the nearer tip and each tip's
     penetration (m) at time t from the dense output, into out = (F_0, F_1, gap, y_0, y_1):
     only what a circuit needs, without the full right-hand side (the ngspice callbacks ask
@@ -433,6 +434,7 @@ def dense_tip_forces(t, t_valid, dense_t0, dense_h, dense_coef, fpar, ipar, psi,
     N = dense_coef.shape[2]
     y = np.empty(N)
     dense_eval(dense_coef[k], (t - dense_t0[k]) / dense_h[k], y)
+    fpar, ipar, psi, xc, cpar = mdl[0], mdl[1], mdl[6], mdl[8], mdl[9]
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
     r = np.empty(3)
@@ -442,12 +444,15 @@ def dense_tip_forces(t, t_valid, dense_t0, dense_h, dense_coef, fpar, ipar, psi,
     w = np.empty(3)
     eta = np.empty(n)
     unpack(y, n, planar, r, R, q, V, w, eta)
-    rtip = fpar[F_RTIP]
     gap = 1e300
     s = np.empty(3)
     d = np.empty(3)
-    no_axis = np.zeros(2)
+    no_axis = np.zeros((2, 3))
     for i in range(2):
+        if cpar[i, C_ON] == 0.0:
+            out[i] = 0.0
+            out[3 + i] = -1e3
+            continue
         tip_offset(i, xc, psi, q, n, s)
         tip_offset(i, no_axis, psi, eta, n, d)
         zc = r[2] + R[2, 0] * s[0] + R[2, 1] * s[1] + R[2, 2] * s[2]
@@ -455,8 +460,8 @@ def dense_tip_forces(t, t_valid, dense_t0, dense_h, dense_coef, fpar, ipar, psi,
         vb1 = w[2] * s[0] - w[0] * s[2] + d[1]
         vb2 = w[0] * s[1] - w[1] * s[0] + d[2]
         vz = V[2] + R[2, 0] * vb0 + R[2, 1] * vb1 + R[2, 2] * vb2
-        pen = rtip - zc
-        out[i] = normal_force(pen, -vz, fpar[F_K], fpar[F_C], fpar[F_BETA])
+        pen = cpar[i, C_R] - (zc - fpar[F_BLOCK_Z])
+        out[i] = normal_force(pen, -vz, cpar[i, C_K], cpar[i, C_C], fpar[F_BETA])
         out[3 + i] = pen
         if -pen < gap:
             gap = -pen

@@ -29,18 +29,36 @@ from numba import njit
 from .contact_laws import normal_force
 from .friction import friction_limit, regularized_scale
 
-# fpar indices
-F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MU0, F_MU_SLOPE, F_T_MU, F_MAX_RATIO, F_RTIP, F_VREG, F_BAUM, F_VBOUND = range(14)
-N_FPAR = 14
+# fpar indices (F_K, F_C, F_RTIP: the first contact point's values, kept for the scales;
+# the kernel reads each contact point's own from cpar)
+(F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MU0, F_MU_SLOPE, F_T_MU, F_MAX_RATIO, F_RTIP, F_VREG, F_BAUM,
+ F_VBOUND, F_BLOCK_Z, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN) = range(20)
+N_FPAR = 20
 # ipar indices
-I_N, I_PLANAR, I_FRICTION = range(3)
+I_N, I_PLANAR, I_FRICTION, I_MOUNT, I_NLOAD = range(5)
+N_IPAR = 5
 FRICTION_NONE, FRICTION_EXACT, FRICTION_REGULARIZED = 0, 1, 2
+# how the bar is held: free (6 rigid degrees of freedom), clamped at a base that moves
+# with a piecewise-constant velocity (none), pivoted about body y (rotation only, planar)
+MOUNT_FREE, MOUNT_CLAMP, MOUNT_PIVOT = 0, 1, 2
+# per contact point (cpar rows 0, 1): Hertz stiffness N/m^1.5, damping c, cap radius m,
+# 1.0 when the point exists
+C_K, C_C, C_R, C_ON = range(4)
+# per load (rows of ``load``): actuator force (a time table of magnitude times a unit
+# direction, world or body frame) or linear spring-dashpot to a world anchor
+LOAD_FORCE, LOAD_SPRING = 0, 1
+(L_KIND, L_POINT, L_BODY, L_DX, L_DY, L_DZ, L_T0, L_TN, L_AX, L_AY, L_AZ, L_K, L_C, L_L0) = range(14)
+N_LOAD = 14
 # regimes of a tip
 FREE, SLIP, STICK = 0, 1, 2
 # quadratures: dissipations; per tip i, compression work at Q_WCOMP + 2i, restitution
-# work at Q_WCOMP + 2i + 1, normal impulse at Q_IMPULSE + i
-Q_DNORMAL, Q_DFRICTION, Q_DMODAL, Q_WCOMP, Q_IMPULSE = 0, 1, 2, 3, 7
-NQ = 9
+# work at Q_WCOMP + 2i + 1, normal impulse at Q_IMPULSE + i; work put in by actuators
+# and by a moving clamp (Q_WIN); dashpot dissipation of springs and pivot (Q_DLOAD)
+# (the last two exist only in models with loads or a mount: NQ_FREE quadratures otherwise,
+# so a plain free bar's state and error norm are what they were)
+Q_DNORMAL, Q_DFRICTION, Q_DMODAL, Q_WCOMP, Q_IMPULSE, Q_WIN, Q_DLOAD = 0, 1, 2, 3, 7, 9, 10
+NQ_FREE = 9
+NQ = 11
 # aux columns per tip
 A_Y, A_YDOT, A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_MARGIN = range(8)
 NAUX = 8
@@ -56,12 +74,6 @@ def layout(n, planar):
     if planar:
         return 3 + n, 3 + n
     return 7 + n, 6 + n
-
-
-@njit(cache=True)
-def state_size(n, planar):
-    npos, nvel = layout(n, planar)
-    return npos + nvel + NQ
 
 
 @njit(cache=True)
@@ -156,11 +168,12 @@ def make_work(n):
 
 @njit(cache=True)
 def tip_offset(i, xc, psi, modal, n, out):
-    """Body-frame offset of tip sphere i from the centroid, x_i b1 + sum_j Psi_ij modal_j
-    (with modal = q: the position; with modal = eta, and xc zero: its rate)."""
-    out[0] = xc[i]
-    out[1] = 0.0
-    out[2] = 0.0
+    """Body-frame offset of point i (a contact cap's centre or a load point) from the frame
+    origin, xc_i + sum_j Psi_ij modal_j (with modal = q: the position; with modal = eta and
+    xc zero: its rate)."""
+    out[0] = xc[i, 0]
+    out[1] = xc[i, 1]
+    out[2] = xc[i, 2]
     for j in range(n):
         out[0] += psi[i, j, 0] * modal[j]
         out[1] += psi[i, j, 1] * modal[j]
@@ -175,8 +188,8 @@ def mu_at(t, fpar):
 
 
 @njit(cache=True)
-def _add_point_force(i, Fw, Mw, R, s_tip, psi, theta, n, F, f_r, f_e):
-    """Generalized forces of world force Fw at tip-sphere centre i plus world moment Mw."""
+def _add_force_at(p, s0, s1, s2, Fw, Mw, R, psi, theta, n, F, f_r, f_e):
+    """Generalized forces of world force Fw at point p (body position s) plus world moment Mw."""
     for a in range(3):
         F[a] += Fw[a]
     # body components: Fb = R^T Fw, Mb = R^T Mw
@@ -186,15 +199,100 @@ def _add_point_force(i, Fw, Mw, R, s_tip, psi, theta, n, F, f_r, f_e):
     mb0 = R[0, 0] * Mw[0] + R[1, 0] * Mw[1] + R[2, 0] * Mw[2]
     mb1 = R[0, 1] * Mw[0] + R[1, 1] * Mw[1] + R[2, 1] * Mw[2]
     mb2 = R[0, 2] * Mw[0] + R[1, 2] * Mw[1] + R[2, 2] * Mw[2]
-    s0 = s_tip[i, 0]
-    s1 = s_tip[i, 1]
-    s2 = s_tip[i, 2]
     f_r[0] += s1 * fb2 - s2 * fb1 + mb0
     f_r[1] += s2 * fb0 - s0 * fb2 + mb1
     f_r[2] += s0 * fb1 - s1 * fb0 + mb2
     for j in range(n):
-        f_e[j] += (psi[i, j, 0] * fb0 + psi[i, j, 1] * fb1 + psi[i, j, 2] * fb2
-                   + theta[i, j, 0] * mb0 + theta[i, j, 1] * mb1 + theta[i, j, 2] * mb2)
+        f_e[j] += (psi[p, j, 0] * fb0 + psi[p, j, 1] * fb1 + psi[p, j, 2] * fb2
+                   + theta[p, j, 0] * mb0 + theta[p, j, 1] * mb1 + theta[p, j, 2] * mb2)
+
+
+@njit(cache=True)
+def _add_point_force(i, Fw, Mw, R, s_tip, psi, theta, n, F, f_r, f_e):
+    """Generalized forces of world force Fw at contact cap centre i plus world moment Mw."""
+    _add_force_at(i, s_tip[i, 0], s_tip[i, 1], s_tip[i, 2], Fw, Mw, R, psi, theta, n, F, f_r, f_e)
+
+
+@njit(cache=True)
+def load_point_motion(p, xc, psi, r, R, q, V, w, eta, n, x, v):
+    """World position x (m) and velocity v (m/s) of load point p; returns nothing."""
+    s0 = xc[p, 0]
+    s1 = xc[p, 1]
+    s2 = xc[p, 2]
+    d0 = 0.0
+    d1 = 0.0
+    d2 = 0.0
+    for j in range(n):
+        s0 += psi[p, j, 0] * q[j]
+        s1 += psi[p, j, 1] * q[j]
+        s2 += psi[p, j, 2] * q[j]
+        d0 += psi[p, j, 0] * eta[j]
+        d1 += psi[p, j, 1] * eta[j]
+        d2 += psi[p, j, 2] * eta[j]
+    vb0 = w[1] * s2 - w[2] * s1 + d0
+    vb1 = w[2] * s0 - w[0] * s2 + d1
+    vb2 = w[0] * s1 - w[1] * s0 + d2
+    for a in range(3):
+        x[a] = r[a] + R[a, 0] * s0 + R[a, 1] * s1 + R[a, 2] * s2
+        v[a] = V[a] + R[a, 0] * vb0 + R[a, 1] * vb1 + R[a, 2] * vb2
+    return s0, s1, s2
+
+
+@njit(cache=True)
+def spring_length(ld, load, x):
+    """Length (m) of spring ``ld`` with its bar end at world point x."""
+    d0 = x[0] - load[ld, L_AX]
+    d1 = x[1] - load[ld, L_AY]
+    d2 = x[2] - load[ld, L_AZ]
+    return math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+
+
+@njit(cache=True)
+def _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r, f_e, Fw, Mw):
+    """Add load ``ld`` (actuator force or spring-dashpot) to the generalized forces.
+
+    Returns (power the actuator puts in, W; power the dashpot dissipates, W).
+    """
+    p = int(load[ld, L_POINT])
+    x = np.empty(3)
+    v = np.empty(3)
+    s0, s1, s2 = load_point_motion(p, xc, psi, r, R, q, V, w, eta, n, x, v)
+    Mw[0] = 0.0
+    Mw[1] = 0.0
+    Mw[2] = 0.0
+    p_in = 0.0
+    p_diss = 0.0
+    if load[ld, L_KIND] == LOAD_FORCE:
+        mag = table_value(tabs, int(load[ld, L_T0]), int(load[ld, L_TN]), t)
+        d0 = load[ld, L_DX]
+        d1 = load[ld, L_DY]
+        d2 = load[ld, L_DZ]
+        if load[ld, L_BODY] != 0.0:
+            for a in range(3):
+                Fw[a] = mag * (R[a, 0] * d0 + R[a, 1] * d1 + R[a, 2] * d2)
+        else:
+            Fw[0] = mag * d0
+            Fw[1] = mag * d1
+            Fw[2] = mag * d2
+        p_in = Fw[0] * v[0] + Fw[1] * v[1] + Fw[2] * v[2]
+    else:
+        length = spring_length(ld, load, x)
+        if length > 0.0:
+            e0 = (x[0] - load[ld, L_AX]) / length
+            e1 = (x[1] - load[ld, L_AY]) / length
+            e2 = (x[2] - load[ld, L_AZ]) / length
+        else:
+            e0 = 0.0
+            e1 = 0.0
+            e2 = 0.0
+        ldot = v[0] * e0 + v[1] * e1 + v[2] * e2
+        f = -(load[ld, L_K] * (length - load[ld, L_L0]) + load[ld, L_C] * ldot)
+        Fw[0] = f * e0
+        Fw[1] = f * e1
+        Fw[2] = f * e2
+        p_diss = load[ld, L_C] * ldot * ldot
+    _add_force_at(p, s0, s1, s2, Fw, Mw, R, psi, theta, n, F, f_r, f_e)
+    return p_in, p_diss
 
 
 @njit(cache=True)
@@ -212,6 +310,50 @@ def _solve_accel(f_r, f_e, Ainv, B, m, n, wdot, etadot):
         wdot[a] = Ainv[a, 0] * r0 + Ainv[a, 1] * r1 + Ainv[a, 2] * r2
     for j in range(n):
         etadot[j] = (f_e[j] - B[0, j] * wdot[0] - B[1, j] * wdot[1] - B[2, j] * wdot[2]) / m
+
+
+@njit(cache=True)
+def _solve_mounted(mount, F, f_r, f_e, Ainv, B, m, n, Vdot, wdot, etadot):
+    """Accelerations from generalized forces for the bar as held by ``mount``.
+
+    free: m dV/dt = F and the rotation/modal block; pivot: the frame origin stays put, the
+    rotation/modal block as for the free bar (planar: only w_y moves); clamp: the frame
+    moves with the base (no acceleration between base breakpoints), only the modes move.
+    """
+    if mount == MOUNT_FREE:
+        for a in range(3):
+            Vdot[a] = F[a] / m
+    else:
+        for a in range(3):
+            Vdot[a] = 0.0
+    if mount == MOUNT_CLAMP:
+        for a in range(3):
+            wdot[a] = 0.0
+        for j in range(n):
+            etadot[j] = f_e[j] / m
+    else:
+        _solve_accel(f_r, f_e, Ainv, B, m, n, wdot, etadot)
+
+
+@njit(cache=True)
+def table_value(tabs, start, count, t):
+    """Linear interpolation in a time table stored as tabs[0, start:start+count] (times,
+    s) and tabs[1, ...] (values); constant beyond its ends."""
+    if count == 1 or t <= tabs[0, start]:
+        return tabs[1, start]
+    last = start + count - 1
+    if t >= tabs[0, last]:
+        return tabs[1, last]
+    lo = start
+    hi = last
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if tabs[0, mid] <= t:
+            lo = mid
+        else:
+            hi = mid
+    f = (t - tabs[0, lo]) / (tabs[0, hi] - tabs[0, lo])
+    return tabs[1, lo] + f * (tabs[1, hi] - tabs[1, lo])
 
 
 @njit(cache=True)
@@ -242,26 +384,27 @@ def _tip_accel(k, R, s_tip, psi, theta, n, Rtip, Vdot, wdot, etadot, out):
 
 
 @njit(cache=True)
-def dynamics(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, dy, aux, work):
-    """Time derivative of the state into ``dy``; per-tip contact quantities into ``aux`` (2, NAUX).
+def dynamics(t, y, mdl, regime, eref, dy, aux, work):
+    """Time derivative of the state into ``dy``; per-contact-point quantities into ``aux`` (2, NAUX).
 
-    regime: (2,) FREE/SLIP/STICK per tip (friction bookkeeping; the normal force always
-    follows the penetration). eref: (2, 2) reference slip direction per tip.
+    mdl: the model arrays (model.BarModel.arrays). regime: (2,) FREE/SLIP/STICK per
+    contact point (friction bookkeeping; the normal force always follows the
+    penetration). eref: (2, 2) reference slip direction per contact point.
     """
+    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs = mdl
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
     fmodel = ipar[I_FRICTION]
+    mount = ipar[I_MOUNT]
     (r, R, q, V, w, eta, Jm, B, Ainv, f_r, f_e, F, wdot, etadot, Vdot,
      s_tip, sd_tip, th_tip, vP, u_wdot, u_etadot, u_Vdot, sv, Amat) = work
     unpack(y, n, planar, r, R, q, V, w, eta)
     m = fpar[F_MASS]
-    k_h = fpar[F_K]
-    c_h = fpar[F_C]
     beta = fpar[F_BETA]
-    Rtip = fpar[F_RTIP]
+    zb = fpar[F_BLOCK_Z]
 
     # Modal invariants as sparse lists (modal_basis.sparse_invariants):
-    # J(q) = J0 + sum J1_j q_j + sum J2_jk q_j q_k ; B[:, j] = sum_k q_k S_kj
+    # J(q) = J0 + sum J1_j q_j + sum J2_jk q_j q_k ; B[:, j] = H_j + sum_k q_k S_kj
     inv_m = 1.0 / m
     for a in range(3):
         for b in range(3):
@@ -270,7 +413,7 @@ def dynamics(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regim
     for j in range(n):
         f_e[j] = 0.0
         for a in range(3):
-            B[a, j] = 0.0
+            B[a, j] = cL[a, n + 1 + j]  # H_j: zero about a free bar's centroid
     for e in range(sp_ptr[0], sp_ptr[1]):
         j = sp_idx[e, 0]
         a = sp_idx[e, 1]
@@ -319,6 +462,31 @@ def dynamics(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regim
     F[0] = 0.0
     F[1] = 0.0
     F[2] = -m * fpar[F_G]
+    # Gravity on the rotation and the modes through the first moments about the frame
+    # origin (c + L q: zero for a free bar about its centroid with free-free modes).
+    gb0 = -fpar[F_G] * R[2, 0]
+    gb1 = -fpar[F_G] * R[2, 1]
+    gb2 = -fpar[F_G] * R[2, 2]
+    c0 = cL[0, 0]
+    c1 = cL[1, 0]
+    c2 = cL[2, 0]
+    for j in range(n):
+        c0 += cL[0, j + 1] * q[j]
+        c1 += cL[1, j + 1] * q[j]
+        c2 += cL[2, j + 1] * q[j]
+        f_e[j] += cL[0, j + 1] * gb0 + cL[1, j + 1] * gb1 + cL[2, j + 1] * gb2
+    f_r[0] += c1 * gb2 - c2 * gb1
+    f_r[1] += c2 * gb0 - c0 * gb2
+    f_r[2] += c0 * gb1 - c1 * gb0
+    d_load = 0.0
+    if mount == MOUNT_PIVOT:
+        # torsion spring and damper about the hinge (body y): the preload turns the free
+        # end towards the block (F_PIV_SIGN: the sense of that turn in phi)
+        sg = fpar[F_PIV_SIGN]
+        th = sg * (y[2] - fpar[F_PIV_PHI0])
+        thd = sg * w[1]
+        f_r[1] += sg * (fpar[F_PIV_T0] - fpar[F_PIV_K] * th - fpar[F_PIV_C] * thd)
+        d_load += fpar[F_PIV_C] * thd * thd
     # Schur complement A = J - B B^T / m
     for a in range(3):
         for b in range(3):
@@ -337,10 +505,22 @@ def dynamics(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regim
     Fw = sv[0:3]
     Mw = sv[3:6]
     for i in range(2):
-        # tip-sphere centre: body position, velocity; section rotation rate
-        s_tip[i, 0] = xc[i]
-        s_tip[i, 1] = 0.0
-        s_tip[i, 2] = 0.0
+        if cpar[i, C_ON] == 0.0:
+            # no such contact point: a far gap that never closes
+            for c_ in range(NAUX):
+                aux[i, c_] = 0.0
+            aux[i, A_Y] = -1e3
+            for a in range(3):
+                s_tip[i, a] = 0.0
+                vP[i, a] = 0.0
+            continue
+        k_h = cpar[i, C_K]
+        c_h = cpar[i, C_C]
+        Rtip = cpar[i, C_R]
+        # cap centre: body position, velocity; section rotation rate
+        s_tip[i, 0] = xc[i, 0]
+        s_tip[i, 1] = xc[i, 1]
+        s_tip[i, 2] = xc[i, 2]
         for a in range(3):
             sd_tip[i, a] = 0.0
             th_tip[i, a] = 0.0
@@ -365,7 +545,7 @@ def dynamics(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regim
         vP[i, 0] = vc0 - ow1 * Rtip
         vP[i, 1] = vc1 + ow0 * Rtip
         vP[i, 2] = vc2
-        pen = Rtip - zc
+        pen = Rtip - (zc - zb)
         pdot = -vc2
         fn = normal_force(pen, pdot, k_h, c_h, beta)
         aux[i, A_Y] = pen
@@ -425,13 +605,27 @@ def dynamics(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regim
                 d_friction -= ftx * vP[i, 0] + fty * vP[i, 1]
                 aux[i, A_MARGIN] = lim - math.sqrt(ftx * ftx + fty * fty)
 
-    for a in range(3):
-        Vdot[a] = F[a] / m
-    _solve_accel(f_r, f_e, Ainv, B, m, n, wdot, etadot)
+    w_in = 0.0
+    nload = ipar[I_NLOAD]
+    for ld in range(nload):
+        w_in_l, d_l = _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r, f_e, Fw, Mw)
+        w_in += w_in_l
+        d_load += d_l
+
+    _solve_mounted(mount, F, f_r, f_e, Ainv, B, m, n, Vdot, wdot, etadot)
 
     if n_stick > 0:
-        _apply_stick(fpar, n, planar, R, w, eta, s_tip, sd_tip, th_tip, vP, regime, aux,
-                     psi, theta, Ainv, B, m, Rtip, Vdot, wdot, etadot, u_Vdot, u_wdot, u_etadot)
+        _apply_stick(fpar, n, planar, mount, R, w, eta, s_tip, sd_tip, th_tip, vP, regime, aux,
+                     psi, theta, Ainv, B, m, cpar, Vdot, wdot, etadot, u_Vdot, u_wdot, u_etadot)
+
+    if mount == MOUNT_CLAMP:
+        # power of the clamp's reaction on the bar: (dP/dt - F) . V_base with the
+        # momentum P = m V + R (L eta) (the clamp does not turn)
+        for a in range(3):
+            ra = -F[a]
+            for j in range(n):
+                ra += (R[a, 0] * cL[0, j + 1] + R[a, 1] * cL[1, j + 1] + R[a, 2] * cL[2, j + 1]) * etadot[j]
+            w_in += ra * V[a]
 
     # assemble dy
     npos, nvel = layout(n, planar)
@@ -468,6 +662,9 @@ def dynamics(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regim
     dy[base + Q_DNORMAL] = d_normal
     dy[base + Q_DFRICTION] = d_friction
     dy[base + Q_DMODAL] = d_modal
+    if dy.shape[0] >= base + NQ:
+        dy[base + Q_WIN] = w_in
+        dy[base + Q_DLOAD] = d_load
     for i in range(2):
         p = aux[i, A_FN] * aux[i, A_YDOT]
         dy[base + Q_WCOMP + 2 * i] = p if p > 0.0 else 0.0
@@ -499,7 +696,7 @@ def _min_norm_solve(W, rhs):
 
 
 @njit(cache=True)
-def _stick_matrix(n, planar, R, s_tip, psi, theta, Ainv, B, m, Rtip, tips, ns, u_Vdot, u_wdot, u_etadot):
+def _stick_matrix(n, planar, mount, R, s_tip, psi, theta, Ainv, B, m, cpar, tips, ns, u_Vdot, u_wdot, u_etadot):
     """W = G M^-1 G^T for the sticking contact points; columns of M^-1 G^T into u_*."""
     ndir = 1 if planar else 2
     nc = ns * ndir
@@ -519,31 +716,29 @@ def _stick_matrix(n, planar, R, s_tip, psi, theta, Ainv, B, m, Rtip, tips, ns, u
             Fz[:] = 0.0
             Fw[:] = 0.0
             Fw[d] = 1.0
-            Mw[0] = Rtip * Fw[1]
-            Mw[1] = -Rtip * Fw[0]
+            Mw[0] = cpar[i, C_R] * Fw[1]
+            Mw[1] = -cpar[i, C_R] * Fw[0]
             Mw[2] = 0.0
             _add_point_force(i, Fw, Mw, R, s_tip, psi, theta, n, Fz, f_r, f_e)
-            for a in range(3):
-                u_Vdot[col, a] = Fz[a] / m
-            _solve_accel(f_r, f_e, Ainv, B, m, n, u_wdot[col], u_etadot[col])
+            _solve_mounted(mount, Fz, f_r, f_e, Ainv, B, m, n, u_Vdot[col], u_wdot[col], u_etadot[col])
             for b_k in range(ns):
                 k = tips[b_k]
-                _tip_accel(k, R, s_tip, psi, theta, n, Rtip, u_Vdot[col], u_wdot[col], u_etadot[col], acc)
+                _tip_accel(k, R, s_tip, psi, theta, n, cpar[k, C_R], u_Vdot[col], u_wdot[col], u_etadot[col], acc)
                 for d2 in range(ndir):
                     W[b_k * ndir + d2, col] = acc[d2]
     return W
 
 
 @njit(cache=True)
-def _apply_stick(fpar, n, planar, R, w, eta, s_tip, sd_tip, th_tip, vP, regime, aux,
-                 psi, theta, Ainv, B, m, Rtip, Vdot, wdot, etadot, u_Vdot, u_wdot, u_etadot):
+def _apply_stick(fpar, n, planar, mount, R, w, eta, s_tip, sd_tip, th_tip, vP, regime, aux,
+                 psi, theta, Ainv, B, m, cpar, Vdot, wdot, etadot, u_Vdot, u_wdot, u_etadot):
     """Solve the stick constraint forces: tangential acceleration of each sticking contact
     point = -baumgarte * its slip velocity; add their accelerations and record them in aux."""
     tips, ns = _sticking_tips(regime, aux)
     if ns == 0:
         return
     ndir = 1 if planar else 2
-    W = _stick_matrix(n, planar, R, s_tip, psi, theta, Ainv, B, m, Rtip, tips, ns, u_Vdot, u_wdot, u_etadot)
+    W = _stick_matrix(n, planar, mount, R, s_tip, psi, theta, Ainv, B, m, cpar, tips, ns, u_Vdot, u_wdot, u_etadot)
     rhs = np.zeros(ns * ndir)
     acc = np.zeros(3)
     baum = fpar[F_BAUM]
@@ -551,6 +746,7 @@ def _apply_stick(fpar, n, planar, R, w, eta, s_tip, sd_tip, th_tip, vP, regime, 
     # R (2 w x sdot + w x (w x s)) + (R (w x theta_dot)) x (0, 0, -Rtip)
     for b_k in range(ns):
         k = tips[b_k]
+        Rtip = cpar[k, C_R]
         _tip_accel(k, R, s_tip, psi, theta, n, Rtip, Vdot, wdot, etadot, acc)
         s0, s1, s2 = s_tip[k, 0], s_tip[k, 1], s_tip[k, 2]
         ws0 = w[1] * s2 - w[2] * s1
@@ -587,21 +783,23 @@ def _apply_stick(fpar, n, planar, R, w, eta, s_tip, sd_tip, th_tip, vP, regime, 
 
 
 @njit(cache=True)
-def project_to_stick(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, aux, work):
+def project_to_stick(t, y, mdl, regime, eref, aux, work):
     """Remove the slip velocity of every sticking tip by the smallest change of the speeds
     in the kinetic-energy metric: du = -M^-1 G^T (G M^-1 G^T)^-1 v_t. Returns the kinetic
     energy change (J); used only when |v_t| is already below the stick tolerance."""
+    fpar, ipar, cpar = mdl[0], mdl[1], mdl[9]
+    psi, theta = mdl[6], mdl[7]
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
     dy = np.empty(y.shape[0])
-    dynamics(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regime, eref, dy, aux, work)
+    dynamics(t, y, mdl, regime, eref, dy, aux, work)
     (r, R, q, V, w, eta, Jm, B, Ainv, f_r, f_e, F, wdot, etadot, Vdot,
      s_tip, sd_tip, th_tip, vP, u_wdot, u_etadot, u_Vdot, sv, Amat) = work
     tips, ns = _sticking_tips(regime, aux)
     if ns == 0:
         return 0.0
     ndir = 1 if planar else 2
-    W = _stick_matrix(n, planar, R, s_tip, psi, theta, Ainv, B, fpar[F_MASS], fpar[F_RTIP],
+    W = _stick_matrix(n, planar, ipar[I_MOUNT], R, s_tip, psi, theta, Ainv, B, fpar[F_MASS], cpar,
                       tips, ns, u_Vdot, u_wdot, u_etadot)
     rhs = np.zeros(ns * ndir)
     for b_k in range(ns):
@@ -638,8 +836,14 @@ def project_to_stick(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, x
 
 
 @njit(cache=True)
-def energies(y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, xc, work, out):
-    """out = (kinetic, elastic strain, gravity potential m g z, stored Hertz energy), all J."""
+def energies(y, mdl, work, out):
+    """out = (kinetic, elastic strain, gravity potential, stored Hertz energy, stored
+    energy of springs and the pivot's torsion spring incl. its preload), all J.
+
+    Kinetic energy about a frame origin that is not the centroid (held bars):
+    1/2 m V.V + V . R (w x (c + L q) + L eta) + 1/2 w J w + w B eta + 1/2 m eta.eta.
+    """
+    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs = mdl
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
     r, R, q, V, w, eta, Jm, B = work[0], work[1], work[2], work[3], work[4], work[5], work[6], work[7]
@@ -650,7 +854,7 @@ def energies(y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, xc, work, out):
             Jm[a, b] = J0[a, b]
     for j in range(n):
         for a in range(3):
-            B[a, j] = 0.0
+            B[a, j] = cL[a, n + 1 + j]
     for e in range(sp_ptr[0], sp_ptr[1]):
         Jm[sp_idx[e, 1], sp_idx[e, 2]] += sp_val[e] * q[sp_idx[e, 0]]
     for e in range(sp_ptr[1], sp_ptr[2]):
@@ -663,17 +867,45 @@ def energies(y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, xc, work, out):
             kin += 0.5 * w[a] * Jm[a, b] * w[b]
     for j in range(n):
         kin += (w[0] * B[0, j] + w[1] * B[1, j] + w[2] * B[2, j]) * eta[j] + 0.5 * m * eta[j] ** 2
+    # first moment c + L q and its body rate L eta
+    cq = np.empty(3)
+    le = np.empty(3)
+    for a in range(3):
+        cq[a] = cL[a, 0]
+        le[a] = 0.0
+        for j in range(n):
+            cq[a] += cL[a, j + 1] * q[j]
+            le[a] += cL[a, j + 1] * eta[j]
+    ub0 = w[1] * cq[2] - w[2] * cq[1] + le[0]
+    ub1 = w[2] * cq[0] - w[0] * cq[2] + le[1]
+    ub2 = w[0] * cq[1] - w[1] * cq[0] + le[2]
+    for a in range(3):
+        kin += V[a] * (R[a, 0] * ub0 + R[a, 1] * ub1 + R[a, 2] * ub2)
     el = 0.0
     for e in range(sp_ptr[3], sp_ptr[4]):
         el += 0.5 * q[sp_idx[e, 0]] * sp_val[e] * q[sp_idx[e, 1]]
     hz = 0.0
     s = np.empty(3)
     for i in range(2):
+        if cpar[i, C_ON] == 0.0:
+            continue
         tip_offset(i, xc, psi, q, n, s)
-        pen = fpar[F_RTIP] - (r[2] + R[2, 0] * s[0] + R[2, 1] * s[1] + R[2, 2] * s[2])
+        pen = cpar[i, C_R] - (r[2] + R[2, 0] * s[0] + R[2, 1] * s[1] + R[2, 2] * s[2] - fpar[F_BLOCK_Z])
         if pen > 0.0:
-            hz += 0.4 * fpar[F_K] * pen * pen * math.sqrt(pen)
+            hz += 0.4 * cpar[i, C_K] * pen * pen * math.sqrt(pen)
+    sp = 0.0
+    x = np.empty(3)
+    v = np.empty(3)
+    for ld in range(ipar[I_NLOAD]):
+        if load[ld, L_KIND] == LOAD_SPRING:
+            load_point_motion(int(load[ld, L_POINT]), xc, psi, r, R, q, V, w, eta, n, x, v)
+            ext = spring_length(ld, load, x) - load[ld, L_L0]
+            sp += 0.5 * load[ld, L_K] * ext * ext
+    if ipar[I_MOUNT] == MOUNT_PIVOT:
+        th = fpar[F_PIV_SIGN] * (y[2] - fpar[F_PIV_PHI0])
+        sp += 0.5 * fpar[F_PIV_K] * th * th - fpar[F_PIV_T0] * th
     out[0] = kin
     out[1] = el
-    out[2] = m * fpar[F_G] * r[2]
+    out[2] = fpar[F_G] * (m * r[2] + R[2, 0] * cq[0] + R[2, 1] * cq[1] + R[2, 2] * cq[2])
     out[3] = hz
+    out[4] = sp

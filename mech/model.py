@@ -18,7 +18,12 @@ from .contact_laws import (
 from .kernel import (
     F_BAUM, F_BETA, F_C, F_G, F_GAMMA, F_VBOUND, F_K, F_MASS, F_MAX_RATIO, F_MU0, F_MU_SLOPE, F_RTIP,
     F_T_MU, F_VREG, FRICTION_EXACT, FRICTION_NONE, FRICTION_REGULARIZED, I_FRICTION, I_N,
-    I_PLANAR, N_FPAR, NQ, layout,
+    I_PLANAR, I_MOUNT, I_NLOAD, MOUNT_CLAMP, MOUNT_FREE, MOUNT_PIVOT, N_FPAR,
+    F_PIV_C, F_PIV_K, F_PIV_PHI0, F_PIV_SIGN, F_PIV_T0, L_L0, N_IPAR, N_LOAD, NQ, NQ_FREE, C_C, C_K, C_ON, C_R, layout,
+)
+from .mechanism import (
+    MechanismArrays, build_arrays, closing_work, contact_parameters, contact_points,
+    effective_contact_mass, frame_height, needs_mechanism,
 )
 from .modal_basis import ModalBasis, build_modal_basis, sparse_invariants
 from .parameters import MechScene
@@ -83,6 +88,7 @@ class ContactScales:
     shortest_contact: float  # s, Hertz contact time lower bound
     energy_scale: float  # J
     speed_bound: float  # m/s, no tip approaches the block faster (energy available, lightest mass)
+    dampings: tuple = ()  # c of each contact point (mechanism scenes)
 
 
 def _first_impact(scene: MechScene) -> tuple[float, float]:
@@ -138,6 +144,85 @@ def contact_scales(scene: MechScene, n_modes: int) -> ContactScales:
     )
 
 
+def mechanism_scales(scene: MechScene, arr: MechanismArrays, n_modes: int) -> ContactScales:
+    """Contact constants and scales of a mechanism scene (held bar, rivets, loads).
+
+    The reference impact is the first contact point's: its effective mass
+    (mechanism.effective_contact_mass) at the speed the closing work could give it (held
+    bars) or the free-flight speed (free bars); ``contact.reference_speed`` overrides.
+    """
+    con, blk = scene.contact, scene.block
+    cps = arr.contacts
+    ks = contact_parameters(cps, blk, con.stiffness, (0.0,))[: len(cps), C_K]
+    m_eff = effective_contact_mass(arr, scene)
+    work = closing_work(scene, arr)
+    if scene.mount.held:
+        # nothing may drive the contact closed (a free vibration): the scale of the motion
+        # the scene starts with then, and 1 mm/s at least, as for the free bar
+        r = float(np.hypot(arr.points[2][0, 0], arr.points[2][0, 2]))
+        spin = float(np.linalg.norm(scene.initial.angular_velocity)) * r
+        v_est = max(math.sqrt(2.0 * work / m_eff), spin, 1e-3)
+        e_avail = work + 0.5 * m_eff * spin * spin
+    else:
+        v_est, _ = _first_impact(scene)
+        ini = scene.initial
+        m = arr.basis.mass
+        e_avail = (0.5 * m * float(np.dot(ini.velocity, ini.velocity)) + work
+                   + m * scene.gravity * (ini.height + scene.bar.length))
+    v_ref = con.reference_speed or v_est
+    dampings = []
+    for k in ks:
+        if con.damping is not None:
+            dampings.append(con.damping)
+        elif con.calibration == "formula":
+            dampings.append(damping_formula(con.law, con.restitution, v_ref, k))
+        else:
+            dampings.append(calibrate_damping(con.law, con.restitution, v_ref, k, m_eff))
+    m_min = m_eff / (4.0 * (1.0 + n_modes))
+    v_max = math.sqrt(2.0 * e_avail / m_min) + v_ref
+    k0 = float(ks[0])
+    return ContactScales(
+        stiffness=k0, damping=dampings[0], beta=con.beta, reference_speed=v_ref, reference_mass=m_eff,
+        penetration_scale=hertz_impact(m_eff, k0, v_ref).max_penetration,
+        shortest_contact=hertz_impact(m_min, k0, v_max).contact_time,
+        energy_scale=max(e_avail, 1e-12), speed_bound=v_max, dampings=tuple(dampings),
+    )
+
+
+def _set_up_mount(model: "BarModel", scene: MechScene) -> None:
+    """Pivot spring parameters and the springs' rest lengths from their preloads."""
+    fpar = model.fpar
+    mnt = scene.mount
+    xc = model.points[2]
+    if mnt.kind == "pivot":
+        # the free end is the side of the first contact point; with kernel.unpack's
+        # rotation a point at body x moves by dz/dphi = -x cos(phi), so turning it down,
+        # towards the block, is -phi when it lies at body -x
+        fpar[F_PIV_SIGN] = -1.0 if xc[0, 0] < 0.0 else 1.0
+        fpar[F_PIV_K] = mnt.stiffness
+        fpar[F_PIV_C] = mnt.damping
+        fpar[F_PIV_T0] = mnt.preload_torque
+        fpar[F_PIV_PHI0] = -math.radians(scene.initial.angle_deg)
+    if model.mechanism.spring_points:
+        y0 = model.initial_state()
+        R0 = rotation_y(-math.radians(scene.initial.angle_deg))
+        r0 = np.array([y0[0], 0.0, y0[1]]) if model.planar else y0[0:3]
+        for row, sp in model.mechanism.spring_points:
+            p = int(model.load[row, 1])
+            x = r0 + R0 @ xc[p]
+            length = float(np.linalg.norm(x - np.array(sp.anchor)))
+            if sp.rest_length is not None:
+                rest = sp.rest_length
+            elif sp.preload is not None:
+                rest = length - sp.preload / sp.stiffness
+                if rest < 0.0:
+                    raise ValueError(f"{sp.name}.preload = {sp.preload!r}: more than the spring's stiffness times "
+                                     f"its length ({sp.stiffness * length!r} N) can give")
+            else:
+                rest = length
+            model.load[row, L_L0] = rest
+
+
 @dataclass
 class BarModel:
     """The compiled model's arrays plus what Python needs to interpret the state."""
@@ -159,17 +244,51 @@ class BarModel:
 
     sparse: tuple = ()
 
+    points: tuple = ()  # (psi, theta, xc): contact caps (rows 0, 1) then load points
+    cpar: np.ndarray | None = None  # (2, 4) per contact point: k, c, cap radius, on
+    first_moments: np.ndarray | None = None  # (3, 2n + 1): c (kg m), L_j (kg), H_j (kg m), body frame
+    load: np.ndarray | None = None  # (n_loads, N_LOAD) actuator forces and springs
+    tables: np.ndarray | None = None  # (2, n) concatenated time tables of the loads
+    mechanism: MechanismArrays | None = None  # set for mechanism scenes (mech.mechanism)
+
     @property
     def arrays(self) -> tuple:
-        """The compiled kernel's model arguments, in its order."""
+        """The compiled kernel's model argument (one tuple, see kernel.dynamics)."""
         b = self.basis
         ptr, idx, val = self.sparse
-        return (self.fpar, self.ipar, b.J0, ptr, idx, val, b.psi_tip, b.theta_tip, b.x_centre)
+        psi, theta, xc = self.points
+        return (self.fpar, self.ipar, b.J0, ptr, idx, val, psi, theta, xc, self.cpar,
+                self.first_moments, self.load, self.tables)
 
     @property
     def state_size(self) -> int:
         npos, nvel = layout(self.n, self.planar)
-        return npos + nvel + NQ
+        return npos + nvel + self.nq
+
+    @property
+    def cap_axes(self) -> list:
+        """Per contact row: (outward body axis of its cap, cap half-angle rad), or (None, 0)
+        where no cap limit applies (a rivet on the axis of the bar)."""
+        bar = self.scene.bar
+        ends = {"tip 0": np.array([-1.0, 0.0, 0.0]), "tip 1": np.array([1.0, 0.0, 0.0])}
+        if self.mechanism is None:
+            return [(ends["tip 0"], bar.cap_half_angle), (ends["tip 1"], bar.cap_half_angle)]
+        out = []
+        for cp in self.mechanism.contacts:
+            if cp.name in ends:
+                out.append((ends[cp.name], bar.cap_half_angle))
+            elif cp.offset != 0.0:
+                out.append((np.array([0.0, 0.0, math.copysign(1.0, cp.offset)]), 0.5 * math.pi))
+            else:
+                out.append((None, 0.0))
+        return out + [(None, 0.0)] * (2 - len(out))
+
+    @property
+    def nq(self) -> int:
+        """Number of quadratures: the input-work and load-dissipation ones only when the
+        scene has loads or a mount."""
+        held = self.ipar[I_MOUNT] != MOUNT_FREE or self.ipar[I_NLOAD] > 0
+        return NQ if held else NQ_FREE
 
     def slices(self) -> dict:
         """Named slices of the state vector."""
@@ -177,10 +296,10 @@ class BarModel:
         if self.planar:
             return {"pos": slice(0, 2), "angle": slice(2, 3), "q": slice(3, 3 + n),
                     "vel": slice(3 + n, 5 + n), "omega": slice(5 + n, 6 + n),
-                    "eta": slice(6 + n, 6 + 2 * n), "quad": slice(6 + 2 * n, 6 + 2 * n + NQ)}
+                    "eta": slice(6 + n, 6 + 2 * n), "quad": slice(6 + 2 * n, 6 + 2 * n + self.nq)}
         return {"pos": slice(0, 3), "quat": slice(3, 7), "q": slice(7, 7 + n),
                 "vel": slice(7 + n, 10 + n), "omega": slice(10 + n, 13 + n),
-                "eta": slice(13 + n, 13 + 2 * n), "quad": slice(13 + 2 * n, 13 + 2 * n + NQ)}
+                "eta": slice(13 + n, 13 + 2 * n), "quad": slice(13 + 2 * n, 13 + 2 * n + self.nq)}
 
     def _resting(self, R0: np.ndarray) -> tuple[float, np.ndarray]:
         """Centre height (m) and modal coordinates (m) of the bar resting on the block.
@@ -215,6 +334,9 @@ class BarModel:
         theta = math.radians(ini.angle_deg)
         a = 0.5 * bar.length - bar.tip_radius
         z0 = ini.height + bar.tip_radius + a * abs(math.sin(theta))
+        if self.mechanism is not None:
+            R0 = rotation_z(self.azimuth) @ rotation_y(-theta)
+            z0 = frame_height(self.scene, self.points[2], self.mechanism.contacts, R0)
         y = np.zeros(self.state_size)
         if ini.resting:
             z0, q_rest = self._resting(rotation_z(self.azimuth) @ rotation_y(-theta))
@@ -249,12 +371,15 @@ def build_model(scene: MechScene) -> BarModel:
             "vertical plane; use 'auto' or '3d'"
         )
     planar = planar_ok if mode == "auto" else mode == "planar"
-    basis = build_modal_basis(scene.bar, planar)
+    if scene.mount.held and not planar:
+        raise ValueError("mount: a held bar is solved in its plane (x-z); its initial motion must stay there")
+    arr = build_arrays(scene, planar) if needs_mechanism(scene) else None
+    basis = arr.basis if arr is not None else build_modal_basis(scene.bar, planar)
     n = basis.n
-    cs = contact_scales(scene, n)
+    cs = contact_scales(scene, n) if arr is None else mechanism_scales(scene, arr, n)
     fr = scene.friction
     fpar = np.zeros(N_FPAR)
-    fpar[F_MASS] = scene.bar.mass
+    fpar[F_MASS] = basis.mass
     fpar[F_G] = scene.gravity
     fpar[F_K] = cs.stiffness
     fpar[F_C] = cs.damping
@@ -275,10 +400,13 @@ def build_model(scene: MechScene) -> BarModel:
         fmodel = FRICTION_REGULARIZED
     else:
         fmodel = FRICTION_EXACT
-    ipar = np.zeros(3, dtype=np.int64)
+    ipar = np.zeros(N_IPAR, dtype=np.int64)
     ipar[I_N] = n
     ipar[I_PLANAR] = int(planar)
     ipar[I_FRICTION] = fmodel
+    if arr is not None:
+        ipar[I_MOUNT] = {"free": MOUNT_FREE, "clamp": MOUNT_CLAMP, "pivot": MOUNT_PIVOT}[scene.mount.kind]
+        ipar[I_NLOAD] = len(arr.load)
 
     # Error scales: positions and angles absolutely, against the Hertz penetration, so
     # the contact geometry is resolved at every height; speeds and energies relatively.
@@ -287,7 +415,8 @@ def build_model(scene: MechScene) -> BarModel:
     dstar = cs.penetration_scale
     vstar = cs.reference_speed
     npos, nvel = layout(n, planar)
-    atol = np.empty(npos + nvel + NQ)
+    nq = NQ if (ipar[I_MOUNT] != MOUNT_FREE or ipar[I_NLOAD] > 0) else NQ_FREE
+    atol = np.empty(npos + nvel + nq)
     rel = np.zeros_like(atol)
     sl_model = BarModel(scene, planar, basis, cs, fpar, ipar, math.radians(scene.initial.azimuth_deg),
                         atol, rel, 0.0)
@@ -312,4 +441,25 @@ def build_model(scene: MechScene) -> BarModel:
         max_step = min(max_step, scene.solver.max_step)
     sl_model.max_step = max_step
     sl_model.sparse = sparse_invariants(basis)
+    if arr is None:
+        xc = np.zeros((2, 3))
+        xc[:, 0] = basis.x_centre
+        sl_model.points = (basis.psi_tip, basis.theta_tip, xc)
+        cpar = np.zeros((2, 4))
+        cpar[:, C_K] = cs.stiffness
+        cpar[:, C_C] = cs.damping
+        cpar[:, C_R] = scene.bar.tip_radius
+        cpar[:, C_ON] = 1.0
+        sl_model.cpar = cpar
+        sl_model.first_moments = np.zeros((3, 2 * n + 1))
+        sl_model.load = np.zeros((0, N_LOAD))
+        sl_model.tables = np.zeros((2, 1))
+    else:
+        sl_model.mechanism = arr
+        sl_model.points = arr.points
+        sl_model.cpar = contact_parameters(arr.contacts, scene.block, scene.contact.stiffness, cs.dampings)
+        sl_model.first_moments = arr.first_moments
+        sl_model.load = arr.load.copy()
+        sl_model.tables = arr.tables
+        _set_up_mount(sl_model, scene)
     return sl_model

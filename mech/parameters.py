@@ -177,14 +177,33 @@ class Bar:
 
 @dataclass(frozen=True)
 class Block:
-    """The massive block (an elastic half-space). youngs_modulus: Pa; poisson_ratio: -."""
+    """The fixed contact: a massive elastic body. youngs_modulus: Pa; poisson_ratio: -.
+
+    shape: "plane" (a half-space, its surface the plane z = 0) or "sphere" (a fixed
+    spherical rivet of ``radius`` m whose top is at z = 0, right below the striking
+    contact at the start, shifted by ``offset`` m along the bar's horizontal direction).
+    The sphere is treated by its tangent plane at the top with the curvature in the Hertz
+    stiffness (effective radius R1 R2 / (R1 + R2)): exact while the contact stays within a
+    small fraction of the radius from the top, which the run checks and flags.
+    """
 
     youngs_modulus: float = 210e9
     poisson_ratio: float = 0.3
+    shape: str = "plane"
+    radius: float | None = None
+    offset: float = 0.0
 
     def __post_init__(self):
         check_positive("block.youngs_modulus", self.youngs_modulus)
         check_range("block.poisson_ratio", self.poisson_ratio, -1.0, 0.5)
+        check_choice("block.shape", self.shape, ("plane", "sphere"))
+        if self.shape == "sphere":
+            if self.radius is None:
+                raise ValueError("block.radius: needed for block.shape = 'sphere' (m)")
+            check_positive("block.radius", self.radius)
+        elif self.radius is not None:
+            raise ValueError("block.radius: only a spherical block has a radius; set block.shape = 'sphere'")
+        check_finite("block.offset", self.offset)
 
 
 CONTACT_LAWS = ("paper", "hunt_crossley", "lankarani_nikravesh", "flores")
@@ -358,6 +377,209 @@ class SolverOptions:
             raise ValueError(f"solver.max_steps = {self.max_steps!r}: must be a whole number >= 1")
 
 
+def check_table(name: str, times, values=None, *, width: int | None = None):
+    """A time table: times strictly increasing, finite, >= 0; values finite, one per time
+    (``width``: each value a list of that many numbers). Returns (times, values) as tuples."""
+    try:
+        ts = [float(v) for v in times]
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}.time = {times!r}: expected a list of numbers (s)") from None
+    if not ts:
+        raise ValueError(f"{name}.time: the table is empty; give at least one time")
+    for k, t in enumerate(ts):
+        if not math.isfinite(t) or t < 0.0:
+            raise ValueError(f"{name}.time[{k}] = {t!r}: times must be finite and >= 0 s")
+        if k and t <= ts[k - 1]:
+            raise ValueError(f"{name}.time[{k}] = {t!r}: times must increase strictly "
+                             f"(previous {ts[k - 1]!r})")
+    if values is None:
+        return tuple(ts), None
+    try:
+        vals = list(values)
+    except TypeError:
+        raise ValueError(f"{name}: expected a list of values, one per time") from None
+    if len(vals) != len(ts):
+        raise ValueError(f"{name}: {len(vals)} values for {len(ts)} times; give one value per time")
+    out = []
+    for k, v in enumerate(vals):
+        if width is None:
+            out.append(check_finite(f"{name}[{k}]", v))
+        else:
+            out.append(check_vector3(f"{name}[{k}]", v))
+    return tuple(ts), tuple(out)
+
+
+def check_position(name: str, value, length: float) -> float:
+    """A position along the bar (m from tip 0) inside [0, length]."""
+    x = check_finite(name, value)
+    if not 0.0 <= x <= length:
+        raise ValueError(f"{name} = {x!r}: must lie on the bar, in [0, {length!r}] m from tip 0")
+    return x
+
+
+MOUNT_KINDS = ("free", "clamp", "pivot")
+
+
+@dataclass(frozen=True)
+class Mount:
+    """Where the bar is held.
+
+    kind: "free" (no support), "clamp" (a cantilever blade clamped at ``position``) or
+    "pivot" (a hinge at ``position`` about the horizontal axis normal to the bar's plane).
+    position: m along the bar from tip 0 (``length`` holds it at the tip-1 end, so tip 0 or
+    a rivet strikes). base_motion (clamp only): prescribed travel of the clamp,
+    ``{time = [...] s, displacement = [[x, y, z], ...] m}`` in the world frame, linear
+    between points (constant before the first and after the last).
+    stiffness: N m/rad, torsion spring of the pivot; preload_torque: N m, its torque at
+    the initial position, turning the free end towards the block; damping: N m s/rad.
+    """
+
+    kind: str = "free"
+    position: float | None = None
+    base_motion: dict | None = None
+    stiffness: float = 0.0
+    preload_torque: float = 0.0
+    damping: float = 0.0
+
+    def __post_init__(self):
+        check_choice("mount.kind", self.kind, MOUNT_KINDS)
+        if self.kind == "free":
+            for key in ("position", "base_motion"):
+                if getattr(self, key) is not None:
+                    raise ValueError(f"mount.{key}: a free bar is not held; set mount.kind = "
+                                     "'clamp' or 'pivot', or remove the key")
+        elif self.position is None:
+            raise ValueError(f"mount.position: needed for mount.kind = {self.kind!r} "
+                             "(m along the bar from tip 0)")
+        else:
+            check_finite("mount.position", self.position)
+        if self.kind != "pivot":
+            for key in ("stiffness", "preload_torque", "damping"):
+                if getattr(self, key) != 0.0:
+                    raise ValueError(f"mount.{key}: a torsion spring belongs to a pivot; "
+                                     f"mount.kind = {self.kind!r}")
+        check_nonnegative("mount.stiffness", self.stiffness)
+        check_finite("mount.preload_torque", self.preload_torque)
+        check_nonnegative("mount.damping", self.damping)
+        if self.base_motion is not None:
+            if self.kind != "clamp":
+                raise ValueError("mount.base_motion: only a clamped bar has a moving base "
+                                 f"(mount.kind = {self.kind!r})")
+            bm = self.base_motion
+            if not isinstance(bm, dict) or set(bm) != {"time", "displacement"}:
+                raise ValueError(f"mount.base_motion = {bm!r}: expected "
+                                 "{time = [...], displacement = [[x, y, z], ...]}")
+            ts, ds = check_table("mount.base_motion", bm["time"], bm["displacement"], width=3)
+            object.__setattr__(self, "base_motion", {"time": ts, "displacement": ds})
+
+    @property
+    def held(self) -> bool:
+        return self.kind != "free"
+
+
+@dataclass(frozen=True)
+class PointForce:
+    """An actuator force on the bar (an armature, a finger).
+
+    position: m along the bar from tip 0. direction: a vector (normalized here) in the
+    ``frame`` "world" (fixed) or "body" (turning with the bar's frame). magnitude: N,
+    constant; or ``time`` (s) and ``value`` (N) tables, linear between points.
+    """
+
+    position: float = 0.0
+    direction: tuple[float, float, float] = (0.0, 0.0, -1.0)
+    frame: str = "world"
+    magnitude: float | None = None
+    time: tuple | None = None
+    value: tuple | None = None
+    name: str = "force"
+
+    def __post_init__(self):
+        n = self.name
+        check_finite(f"{n}.position", self.position)
+        d = check_vector3(f"{n}.direction", self.direction)
+        norm = math.sqrt(sum(v * v for v in d))
+        if norm == 0.0:
+            raise ValueError(f"{n}.direction = {list(d)!r}: must not be the zero vector")
+        object.__setattr__(self, "direction", tuple(v / norm for v in d))
+        check_choice(f"{n}.frame", self.frame, ("world", "body"))
+        if self.magnitude is not None:
+            if self.time is not None or self.value is not None:
+                raise ValueError(f"{n}: give magnitude (constant) or time and value (a table), not both")
+            check_finite(f"{n}.magnitude", self.magnitude)
+        else:
+            if self.time is None or self.value is None:
+                raise ValueError(f"{n}: give magnitude (N) or both time (s) and value (N) tables")
+            ts, vs = check_table(f"{n}", self.time, self.value)
+            object.__setattr__(self, "time", ts)
+            object.__setattr__(self, "value", vs)
+
+    def table(self) -> tuple[tuple, tuple]:
+        """(times s, values N) of the magnitude (one point for a constant)."""
+        if self.magnitude is not None:
+            return (0.0,), (float(self.magnitude),)
+        return self.time, self.value
+
+
+@dataclass(frozen=True)
+class Spring:
+    """A linear spring and dashpot from a fixed world ``anchor`` (m) to the bar at
+    ``position`` (m from tip 0). stiffness: N/m (> 0); damping: N s/m. Give ``preload``
+    (N, the spring's pull towards the anchor at the initial position; negative pushes)
+    or ``rest_length`` (m); neither: unstressed at the start."""
+
+    anchor: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    position: float = 0.0
+    stiffness: float = 0.0
+    preload: float | None = None
+    rest_length: float | None = None
+    damping: float = 0.0
+    name: str = "spring"
+
+    def __post_init__(self):
+        n = self.name
+        object.__setattr__(self, "anchor", check_vector3(f"{n}.anchor", self.anchor))
+        check_finite(f"{n}.position", self.position)
+        check_positive(f"{n}.stiffness", self.stiffness)
+        check_nonnegative(f"{n}.damping", self.damping)
+        if self.preload is not None and self.rest_length is not None:
+            raise ValueError(f"{n}: give preload or rest_length, not both")
+        if self.preload is not None:
+            check_finite(f"{n}.preload", self.preload)
+        if self.rest_length is not None:
+            check_nonnegative(f"{n}.rest_length", self.rest_length)
+
+
+@dataclass(frozen=True)
+class Rivet:
+    """A spherical contact cap on the bar (a contact rivet).
+
+    position: m along the bar from tip 0; offset: m from the bar's axis along body b3 (the
+    face normal of a blade; negative: the underside, towards the block when the blade
+    lies flat above it). radius: m, of the cap; mass: kg, carried by the bar at that point.
+    youngs_modulus (Pa) and poisson_ratio: the rivet's own material (None: the bar's).
+    """
+
+    position: float = 0.0
+    offset: float = 0.0
+    radius: float = 1e-3
+    mass: float = 0.0
+    youngs_modulus: float | None = None
+    poisson_ratio: float | None = None
+    name: str = "rivet"
+
+    def __post_init__(self):
+        n = self.name
+        check_finite(f"{n}.position", self.position)
+        check_finite(f"{n}.offset", self.offset)
+        check_positive(f"{n}.radius", self.radius)
+        check_nonnegative(f"{n}.mass", self.mass)
+        if self.youngs_modulus is not None:
+            check_positive(f"{n}.youngs_modulus", self.youngs_modulus)
+        if self.poisson_ratio is not None:
+            check_range(f"{n}.poisson_ratio", self.poisson_ratio, -1.0, 0.5)
+
+
 @dataclass(frozen=True)
 class MechScene:
     """Everything the impact solver needs. gravity: m/s^2 (>= 0), acting along -z."""
@@ -369,10 +591,75 @@ class MechScene:
     initial: Initial = field(default_factory=Initial)
     solver: SolverOptions = field(default_factory=SolverOptions)
     gravity: float = 9.80665
+    mount: Mount = field(default_factory=Mount)
+    forces: tuple = ()
+    springs: tuple = ()
+    rivets: tuple = ()
 
     def __post_init__(self):
         check_nonnegative("environment.gravity", self.gravity)
         for name, cls in (("bar", Bar), ("block", Block), ("contact", Contact),
-                          ("friction", Friction), ("initial", Initial), ("solver", SolverOptions)):
+                          ("friction", Friction), ("initial", Initial), ("solver", SolverOptions),
+                          ("mount", Mount)):
             if not isinstance(getattr(self, name), cls):
                 raise ValueError(f"{name}: expected a {cls.__name__}, got {type(getattr(self, name)).__name__}")
+        for name, cls in (("forces", PointForce), ("springs", Spring), ("rivets", Rivet)):
+            items = tuple(getattr(self, name))
+            object.__setattr__(self, name, items)
+            for item in items:
+                if not isinstance(item, cls):
+                    raise ValueError(f"{name}: expected {cls.__name__} entries, got {type(item).__name__}")
+        self._check_mechanism()
+
+    def _check_mechanism(self) -> None:
+        """Cross-section checks: points on the bar, held bars in one plane, rivets apart."""
+        L = self.bar.length
+        mnt = self.mount
+        if mnt.held:
+            check_position("mount.position", mnt.position, L)
+        for f in self.forces:
+            check_position(f"{f.name}.position", f.position, L)
+            if f.frame == "world" and abs(f.direction[1]) > 1e-12 and mnt.held:
+                raise ValueError(f"{f.name}.direction = {list(f.direction)!r}: a held bar moves in the "
+                                 "x-z plane; the force must have no y component")
+        for sp in self.springs:
+            check_position(f"{sp.name}.position", sp.position, L)
+            if mnt.held and sp.anchor[1] != 0.0:
+                raise ValueError(f"{sp.name}.anchor = {list(sp.anchor)!r}: a held bar moves in the "
+                                 "x-z plane; the anchor must have y = 0")
+        if len(self.rivets) > 2:
+            raise ValueError(f"rivet: {len(self.rivets)} rivets given; at most 2 contact points are "
+                             "supported (a single or a bridge contact)")
+        half_t = 0.5 * (self.bar.thickness if self.bar.thickness is not None else self.bar.diameter)
+        for rv in self.rivets:
+            check_position(f"{rv.name}.position", rv.position, L)
+            if abs(rv.offset) > half_t + rv.radius:
+                raise ValueError(f"{rv.name}.offset = {rv.offset!r}: the rivet's cap centre must lie within "
+                                 f"its radius of the bar's face (|offset| <= {half_t + rv.radius!r} m)")
+            if mnt.kind == "clamp" and abs(rv.position - mnt.position) < rv.radius:
+                raise ValueError(f"{rv.name}.position = {rv.position!r}: the rivet sits in the clamp "
+                                 f"(mount.position = {mnt.position!r}); it must be at least its radius away")
+        if len(self.rivets) == 2 and abs(self.rivets[0].position - self.rivets[1].position) < (
+                self.rivets[0].radius + self.rivets[1].radius) and self.rivets[0].offset == self.rivets[1].offset:
+            raise ValueError("rivet: the two rivets overlap; place them at least the sum of their radii apart")
+        if mnt.held:
+            if self.initial.azimuth_deg != 0.0:
+                raise ValueError(f"initial.azimuth_deg = {self.initial.azimuth_deg!r}: a held bar lies in "
+                                 "the x-z plane; use 0")
+            if any(v != 0.0 for v in self.initial.velocity):
+                raise ValueError(f"initial.velocity = {list(self.initial.velocity)!r}: a held bar starts at rest "
+                                 "with its mount; move a clamp with mount.base_motion")
+            w = self.initial.angular_velocity
+            if mnt.kind == "clamp" and any(v != 0.0 for v in w):
+                raise ValueError(f"initial.angular_velocity = {list(w)!r}: a clamped bar cannot turn")
+            if mnt.kind == "pivot" and (w[0] != 0.0 or w[2] != 0.0):
+                raise ValueError(f"initial.angular_velocity = {list(w)!r}: a pivoted bar turns about y only")
+            if self.solver.model == "3d":
+                raise ValueError("solver.model = '3d': held bars are solved in their plane (x-z); "
+                                 "use 'auto' or 'planar'")
+            if self.initial.resting:
+                raise ValueError("initial.resting: a held bar is placed by initial.height (gap of its "
+                                 "contact) and closed by its forces; remove initial.resting")
+        if self.initial.resting and (self.rivets or self.forces or self.springs):
+            raise ValueError("initial.resting: the resting start is for the free bar on its tips "
+                             "without rivets, forces or springs")

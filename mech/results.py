@@ -20,7 +20,7 @@ from numba import njit
 
 from .kernel import (
     A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_Y, A_YDOT, NQ, Q_DFRICTION, Q_DMODAL, Q_DNORMAL,
-    Q_IMPULSE, Q_WCOMP, energies, make_work,
+    Q_DLOAD, Q_IMPULSE, Q_WCOMP, Q_WIN, energies, make_work,
 )
 from .model import BarModel, matrix_to_quaternion, rotation_y, rotation_z
 
@@ -28,13 +28,13 @@ REGIME_NAMES = ("free", "slip", "stick")
 
 
 @njit(cache=True)
-def _energy_table(Y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, xc):
-    n = ipar[0]
+def _energy_table(Y, mdl):
+    n = mdl[1][0]
     work = make_work(n)
-    out = np.empty((Y.shape[0], 4))
-    e = np.empty(4)
+    out = np.empty((Y.shape[0], 5))
+    e = np.empty(5)
     for k in range(Y.shape[0]):
-        energies(Y[k], fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, xc, work, e)
+        energies(Y[k], mdl, work, e)
         out[k] = e
     return out
 
@@ -105,9 +105,7 @@ class ImpactResult:
         """Per record: kinetic, elastic, potential (change), contact_stored, dissipations, residual (J)."""
         if "energy" not in self._cache:
             m = self.model
-            b = m.basis
-            ptr, idx, val = m.sparse
-            E = _energy_table(self.states, m.fpar, m.ipar, b.J0, ptr, idx, val, b.psi_tip, b.x_centre)
+            E = _energy_table(self.states, m.arrays)
             qd = self.states[:, m.slices()["quad"]]
             df = pd.DataFrame({
                 "time": self.t,
@@ -118,10 +116,15 @@ class ImpactResult:
                 "normal_dissipation": qd[:, Q_DNORMAL],
                 "friction_dissipation": qd[:, Q_DFRICTION],
                 "modal_dissipation": qd[:, Q_DMODAL],
+                "spring_stored": E[:, 4],
             })
-            e0 = E[0, 0] + E[0, 1] + E[0, 3]
+            held = qd.shape[1] > Q_WIN  # quadratures of input work and load dissipation
+            df["load_dissipation"] = qd[:, Q_DLOAD] if held else 0.0
+            df["work_in"] = qd[:, Q_WIN] if held else 0.0
+            e0 = E[0, 0] + E[0, 1] + E[0, 3] + E[0, 4]
             total = (df.kinetic + df.elastic + df.potential + df.contact_stored + df.normal_dissipation
-                     + df.friction_dissipation + df.modal_dissipation)
+                     + df.friction_dissipation + df.modal_dissipation + df.spring_stored
+                     + df.load_dissipation - df.work_in)
             df["residual"] = e0 - total + self._projection_series()
             self._cache["energy"] = df
         return self._cache["energy"]

@@ -5,7 +5,12 @@ Sections and keys (all optional; defaults are the documented default scene):
     [bar]       length, diameter | (width, thickness), tip_radius, youngs_modulus,
                 poisson_ratio, density, modes (per family, or {axial = n, bending = n}),
                 bending ("euler_bernoulli" | "paper_shear"), modal_damping
-    [block]     youngs_modulus, poisson_ratio
+    [block]     youngs_modulus, poisson_ratio, shape ("plane" | "sphere"), radius, offset
+    [mount]     kind ("free" | "clamp" | "pivot"), position, base_motion {time, displacement},
+                stiffness, preload_torque, damping
+    [[force]]   position, direction [3], frame ("world" | "body"), magnitude | (time, value)
+    [[spring]]  anchor [3], position, stiffness, preload | rest_length, damping
+    [[rivet]]   position, offset, radius, mass, youngs_modulus, poisson_ratio
     [initial]   height, angle_deg, azimuth_deg, velocity [3], angular_velocity [3]
     [contact]   law, restitution | damping, reference_speed, calibration, stiffness
     [friction]  mu, gamma, model, max_ratio, regularization_speed
@@ -25,7 +30,9 @@ import math
 import tomllib
 from pathlib import Path
 
-from .parameters import Bar, Block, Contact, Friction, Initial, MechScene, SolverOptions
+from .parameters import (
+    Bar, Block, Contact, Friction, Initial, MechScene, Mount, PointForce, Rivet, SolverOptions, Spring,
+)
 
 SECTIONS = {
     "bar": Bar,
@@ -34,8 +41,17 @@ SECTIONS = {
     "contact": Contact,
     "friction": Friction,
     "solver": SolverOptions,
+    "mount": Mount,
+}
+# arrays of tables ([[force]] ...): TOML name -> (MechScene field, dataclass)
+LIST_SECTIONS = {
+    "force": ("forces", PointForce),
+    "spring": ("springs", Spring),
+    "rivet": ("rivets", Rivet),
 }
 ENVIRONMENT_KEYS = ("gravity",)
+# every top-level name a mechanics scene may hold (tables and arrays of tables)
+SCENE_SECTIONS = tuple(SECTIONS) + tuple(LIST_SECTIONS) + ("environment",)
 
 # The default mechanics scene: the paper's steel link (L = 0.3 m) with a 10 mm round
 # section and hemispherical 5 mm tips, released 1 mm above a steel block at 30 deg,
@@ -129,13 +145,26 @@ def scene_from_dict(doc: dict, *, where: str = "scene", extra_sections=()) -> Me
     """
     if not isinstance(doc, dict):
         raise ValueError(f"{where}: expected a table of sections")
-    known = set(SECTIONS) | {"environment"} | set(extra_sections)
+    known = set(SECTIONS) | set(LIST_SECTIONS) | {"environment"} | set(extra_sections)
     for name in doc:
         if name not in known:
             raise ValueError(f"{where}: unknown section [{name}]{_suggest(name, known)}; "
                              f"allowed sections: {', '.join(sorted(known))}")
+    doc = _held_defaults(doc)
     parts = {name: _section(name, cls, doc.get(name, {}), where) for name, cls in SECTIONS.items()
              if name in doc}
+    for name, (fld, cls) in LIST_SECTIONS.items():
+        if name not in doc:
+            continue
+        entries = doc[name]
+        if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
+            raise ValueError(f"{where}[[{name}]]: expected an array of tables ([[{name}]] blocks)")
+        items = []
+        for k, entry in enumerate(entries):
+            if "name" in entry:
+                raise ValueError(f"{where}[[{name}]] #{k}: unknown key 'name'")
+            items.append(_section(name, cls, dict(entry, name=f"{name}[{k}]"), where))
+        parts[fld] = tuple(items)
     env = doc.get("environment", {})
     if not isinstance(env, dict):
         raise ValueError(f"{where}[environment]: expected a table of keys")
@@ -146,6 +175,21 @@ def scene_from_dict(doc: dict, *, where: str = "scene", extra_sections=()) -> Me
     if "gravity" in env:
         kwargs["gravity"] = env["gravity"]
     return MechScene(**kwargs)
+
+
+def _held_defaults(doc: dict) -> dict:
+    """A held bar starts at rest and level unless the scene says otherwise (the free
+    drop's defaults, a moving, tilted bar, would contradict its mount)."""
+    mount = doc.get("mount")
+    if not isinstance(mount, dict) or mount.get("kind", "free") == "free":
+        return doc
+    initial = doc.get("initial", {})
+    if not isinstance(initial, dict):
+        return doc
+    initial = dict(initial)
+    initial.setdefault("velocity", [0.0, 0.0, 0.0])
+    initial.setdefault("angle_deg", 0.0)
+    return dict(doc, initial=initial)
 
 
 def read_toml(path) -> dict:
@@ -188,4 +232,16 @@ def scene_to_dict(scene: MechScene) -> dict:
             table[f.name] = value
         out[name] = table
     out["environment"] = {"gravity": scene.gravity}
+    if not scene.mount.held:
+        del out["mount"]
+    elif scene.mount.base_motion is not None:
+        bm = scene.mount.base_motion
+        out["mount"]["base_motion"] = {"time": list(bm["time"]), "displacement": [list(d) for d in bm["displacement"]]}
+    for name, (fld, cls) in LIST_SECTIONS.items():
+        items = getattr(scene, fld)
+        if items:
+            out[name] = [{f.name: (list(v) if isinstance(v, tuple) else v)
+                          for f in dataclasses.fields(cls)
+                          if f.name != "name" and (v := getattr(it, f.name)) is not None}
+                         for it in items]
     return out

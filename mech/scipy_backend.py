@@ -44,7 +44,7 @@ def scipy_segment(solver, t_target: float, method: str):
         dy = np.empty(N + n_ext)
         if coupled is not None:
             m.fpar[F_MU0] = coupled.friction_coefficient(t, y[N:])
-        dynamics(t, y[:N], *arrays, regime, eref, dy[:N], aux, work)
+        dynamics(t, y[:N], arrays, regime, eref, dy[:N], aux, work)
         if coupled is not None:
             dy[N:] = coupled.rhs(t, y[N:], aux[:, [A_Y, A_YDOT, A_FN]])
         counter["nfev"] += 1
@@ -61,9 +61,9 @@ def scipy_segment(solver, t_target: float, method: str):
             dy = np.empty(N)
             if coupled is not None:
                 m.fpar[F_MU0] = coupled.friction_coefficient(t, y[N:])
-            dynamics(t, y[:N], *arrays, regime, eref, dy, aux, work)
+            dynamics(t, y[:N], arrays, regime, eref, dy, aux, work)
             counter_events["nfev"] += 1
-            events_from_aux(aux, eref, m.fpar, g)
+            events_from_aux(aux, eref, m.arrays, g)
             if kind == EV_SLIP and not (fexact and regime[i] == SLIP):
                 return solver.ev_sign[k]
             if kind == EV_STICK and not (fexact and regime[i] == STICK):
@@ -128,7 +128,7 @@ def scipy_segment(solver, t_target: float, method: str):
         if coupled is not None:
             m.fpar[F_MU0] = coupled.friction_coefficient(sol.t[k], sol.y[N:, k])
             solver._rec_ext[n0 + k - 1] = sol.y[N:, k]
-        dynamics(sol.t[k], y, *arrays, regime, eref, dy, aux, work)
+        dynamics(sol.t[k], y, arrays, regime, eref, dy, aux, work)
         r = n0 + k - 1
         solver._rec_t[r] = sol.t[k]
         solver._rec_y[r] = y
@@ -138,7 +138,7 @@ def scipy_segment(solver, t_target: float, method: str):
             # the peak force lies inside a step: sample the dense output as the compiled loop does
             for f in (0.25, 0.5, 0.75):
                 tm = sol.t[k - 1] + f * (sol.t[k] - sol.t[k - 1])
-                dynamics(tm, sol.sol(tm)[:N], *arrays, regime, eref, dy, aux_mid, work)
+                dynamics(tm, sol.sol(tm)[:N], arrays, regime, eref, dy, aux_mid, work)
                 solver._rec_fmax[r] = np.maximum(solver._rec_fmax[r], aux_mid[:, A_FN])
     solver.stats[0] += n_new
     solver.y[:] = sol.y[:N, -1]

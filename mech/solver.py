@@ -33,9 +33,10 @@ from .integrator import (
 from .kernel import (
     A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_COMPRESSION, EV_CONTACT,
     EV_SLIP, EV_STICK, F_MU0, F_MU_SLOPE, F_T_MU, FREE, FRICTION_EXACT, I_FRICTION, NAUX, NEV_TIP, SLIP,
-    STICK, dynamics, make_work, project_to_stick,
+    STICK, F_MASS, Q_WIN, dynamics, energies, make_work, project_to_stick, quat_to_matrix,
 )
 from .contact_laws import hertz_impact
+from .mechanism import base_velocity_jumps
 from .model import BarModel, build_model
 from .parameters import MechScene
 from .scipy_backend import METHODS as SCIPY_METHODS, scipy_segment
@@ -123,7 +124,7 @@ class Segment:
         k = int(np.searchsorted(self._t_valid, t)) if len(self._t_valid) else 0
         k = min(k, max(len(self._regime) - 1, 0))
         regime = self._regime[k] if len(self._regime) else np.zeros(2, np.int64)
-        dynamics(t, y, *self._model.arrays, regime, self._eref, dy, aux, self._work)
+        dynamics(t, y, self._model.arrays, regime, self._eref, dy, aux, self._work)
         return aux[:, [A_Y, A_YDOT, A_FN]].copy()
 
     def normal_force(self, t: float) -> float:
@@ -145,8 +146,7 @@ class Segment:
             forces = (float(c[0, 2]), float(c[1, 2]), float(max(0.0, -np.max(c[:, 0]))),
                       float(c[0, 0]), float(c[1, 0]))
         else:
-            dense_tip_forces(t, self._t_valid, self._t0, self._h, self._coef, m.fpar, m.ipar,
-                             m.basis.psi_tip, m.basis.x_centre, self._out)
+            dense_tip_forces(t, self._t_valid, self._t0, self._h, self._coef, m.arrays, self._out)
             forces = tuple(float(v) for v in self._out)
         self._last_t, self._last_forces = t, forces
         return forces
@@ -204,6 +204,10 @@ class ImpactSolver:
         self._dense_t0 = np.empty(dcap)
         self._dense_h = np.empty(dcap)
         self._dense_coef = np.empty((dcap, 5, N))
+        self._jumps = base_velocity_jumps(scene)
+        self._jump_index = 0
+        if self._jumps and self._jumps[0][0] == 0.0:
+            self._apply_base_jump(resolve=False)
         self._initial_state = self.y.copy()
         hz = hertz_impact(m.contact.reference_mass, m.contact.stiffness, m.contact.reference_speed)
         self._onset_step = hz.contact_time * scene.solver.rtol ** (2.0 / 7.0)
@@ -248,8 +252,11 @@ class ImpactSolver:
             if self._n >= self._cap - 1:
                 self._grow()
             n0 = self._n
+            goal = t_target
+            if self._jump_index < len(self._jumps) and self._jumps[self._jump_index][0] <= t_target:
+                goal = max(self._jumps[self._jump_index][0], self.t)
             try:
-                status, t_new, h, n_rec, ev = self._segment(t_target, n0)
+                status, t_new, h, n_rec, ev = self._segment(goal, n0)
             except np.linalg.LinAlgError as err:
                 self.wall_time += time.perf_counter() - tick
                 raise MechSolverError(f"mechanics integration failed at t = {self.t!r} s: {err}",
@@ -259,7 +266,12 @@ class ImpactSolver:
             self.t = t_new
             self.h = h
             if status == DONE:
-                self.t = t_target
+                self.t = goal
+                if goal < t_target or (self._jump_index < len(self._jumps)
+                                       and self._jumps[self._jump_index][0] == goal):
+                    self._apply_base_jump()
+                    if goal < t_target:
+                        continue
                 break
             if status == BUFFER_FULL:
                 continue
@@ -292,7 +304,7 @@ class ImpactSolver:
         m = self.model
         return integrate(
             self.t, self.y, t_target, self.h, m.max_step, self.scene.solver.rtol, m.atol, m.relmask,
-            *m.arrays, self.regime, self.eref, self.ev_sign,
+            m.arrays, self.regime, self.eref, self.ev_sign,
             self._rec_t[n0:], self._rec_y[n0:], self._rec_aux[n0:], self._rec_fmax[n0:],
             self._dense_t0[n0:] if self.keep_dense else self._dense_t0,
             self._dense_h[n0:] if self.keep_dense else self._dense_h,
@@ -351,7 +363,7 @@ class ImpactSolver:
         return dict(t=self.t, y=self.y.copy(), z=self.z.copy(), h=self.h, regime=self.regime.copy(),
                     eref=self.eref.copy(), ev_sign=self.ev_sign.copy(), stats=self.stats.copy(),
                     n=self._n, n_events=len(self.events), projection_energy=self.projection_energy,
-                    fpar=self.model.fpar.copy())
+                    fpar=self.model.fpar.copy(), jump_index=self._jump_index)
 
     def restore(self, cp: dict) -> None:
         """Return to a ``checkpoint`` (e.g. to redo a coupling step so it ends at an event)."""
@@ -366,6 +378,7 @@ class ImpactSolver:
         del self.events[cp["n_events"]:]
         self.projection_energy = cp["projection_energy"]
         self.model.fpar[:] = cp["fpar"]
+        self._jump_index = cp["jump_index"]
 
     def contact_series(self, times) -> np.ndarray:
         """(len(times), 2, 3): per tip penetration (m), rate (m/s), normal force (N) at the
@@ -379,11 +392,15 @@ class ImpactSolver:
             raise ValueError(f"times must lie in [{self._rec_t[0]!r}, {self.t!r}] s")
         out = np.empty((len(times), 2, 3))
         dense_contact(times[order], self._rec_t[:n], self._dense_t0[:n], self._dense_h[:n],
-                      self._dense_coef[:n], self._rec_regime[:n], *self.model.arrays, self.eref,
+                      self._dense_coef[:n], self._rec_regime[:n], self.model.arrays, self.eref,
                       self._work, out)
         result = np.empty_like(out)
         result[order] = out
         return result
+
+    def friction_engaged(self) -> np.ndarray:
+        """(2,) bool: each contact point is sliding or sticking (in a friction regime) now."""
+        return self.regime != FREE
 
     def contact_now(self) -> np.ndarray:
         """(2, 3) per tip: penetration (m), rate (m/s), normal force (N) at the current time."""
@@ -398,8 +415,38 @@ class ImpactSolver:
     # --- internals ------------------------------------------------------------------
 
     def _evaluate(self) -> np.ndarray:
-        dynamics(self.t, self.y, *self.model.arrays, self.regime, self.eref, self._dy, self._aux, self._work)
+        dynamics(self.t, self.y, self.model.arrays, self.regime, self.eref, self._dy, self._aux, self._work)
         return self._aux
+
+    def _apply_base_jump(self, resolve: bool = True) -> None:
+        """A breakpoint of a clamp's piecewise-linear travel: the base velocity jumps by dv
+        (world). The clamp's impulse changes the frame velocity by dv and, the blade lagging
+        its clamp, the modal speeds by -(L^T R^T dv)/m; the kinetic energy it puts in is
+        credited to the input work, so the audit still closes."""
+        _, dv = self._jumps[self._jump_index]
+        self._jump_index += 1
+        m = self.model
+        sl = m.slices()
+        n = m.n
+        e = np.empty(5)
+        energies(self.y, m.arrays, self._work, e)
+        ke_before = e[0]
+        if m.planar:
+            self.y[sl["vel"]] += (dv[0], dv[2])
+            phi = float(self.y[sl["angle"]][0])
+            R = np.array([[math.cos(phi), 0.0, math.sin(phi)], [0.0, 1.0, 0.0],
+                          [-math.sin(phi), 0.0, math.cos(phi)]])
+        else:
+            self.y[sl["vel"]] += dv
+            quat = self.y[sl["quat"]]
+            R = np.empty((3, 3))
+            quat_to_matrix(quat[0], quat[1], quat[2], quat[3], R)
+        L = m.first_moments[:, 1:n + 1]
+        self.y[sl["eta"]] -= (L.T @ (R.T @ dv)) / m.fpar[F_MASS]
+        energies(self.y, m.arrays, self._work, e)
+        if resolve:  # (a jump at t = 0 comes before the first record: the audit starts after it)
+            self.y[sl["quad"].start + Q_WIN] += e[0] - ke_before
+            self._resolve(triggered=None)
 
     def _grow(self) -> None:
         cap = 2 * self._cap
@@ -492,23 +539,24 @@ class ImpactSolver:
 
     def _check_cap(self, tip: int) -> None:
         """Flag contacts whose normal leaves the spherical cap (the model then does not hold)."""
-        from .kernel import quat_to_matrix
-
+        axis, half_angle = self.model.cap_axes[tip]
+        if axis is None:
+            return
         R = np.empty((3, 3))
         if self.model.planar:
             phi = self.y[2]
-            b1z = -math.sin(phi)
+            R = np.array([[math.cos(phi), 0.0, math.sin(phi)], [0.0, 1.0, 0.0],
+                          [-math.sin(phi), 0.0, math.cos(phi)]])
         else:
             quat_to_matrix(*self.y[3:7], R)
-            b1z = R[2, 0]
-        outward_z = b1z if tip == 1 else -b1z  # z of the tip's outward axis
+        outward_z = float(R[2] @ axis)  # z of the cap's outward axis
         angle = math.acos(max(-1.0, min(1.0, -outward_z)))  # between outward axis and -z
-        if angle > self.scene.bar.cap_half_angle + 1e-9:
+        if angle > half_angle + 1e-9:
             self.events.append(dict(
                 time=self.t, tip=tip, kind="invalid_contact_geometry", regime_before="", regime_after="",
                 penetration=0.0, penetration_rate=0.0, normal_force=0.0, slip_speed=0.0,
-                note=f"contact normal {math.degrees(angle):.1f} deg from the tip axis, beyond the cap's "
-                     f"{math.degrees(self.scene.bar.cap_half_angle):.1f} deg: the bar's side would touch",
+                note=f"contact normal {math.degrees(angle):.1f} deg from the cap's axis, beyond the cap's "
+                     f"{math.degrees(half_angle):.1f} deg: the bar's side would touch",
             ))
 
     def _resolve(self, triggered: int | None) -> None:
@@ -573,10 +621,10 @@ class ImpactSolver:
         self.regime[:] = new
         if fexact and np.any(new == STICK):
             self.projection_energy += project_to_stick(
-                self.t, self.y, *self.model.arrays, self.regime, self.eref, self._aux, self._work)
+                self.t, self.y, self.model.arrays, self.regime, self.eref, self._aux, self._work)
         aux = self._evaluate()
         g = np.empty(2 * NEV_TIP)
-        events_from_aux(aux, self.eref, self.model.fpar, g)
+        events_from_aux(aux, self.eref, self.model.arrays, g)
         for i in range(2):
             b = NEV_TIP * i
             self.ev_sign[b + EV_CONTACT] = -1.0 if new[i] == FREE else 1.0

@@ -40,7 +40,7 @@ def model_for(planar: bool, friction: str, modes: int = 2):
 def evaluate(fn, model, t, y, regime, eref):
     dy = np.empty_like(y)
     aux = np.empty((2, NAUX))
-    fn(t, y, *model.arrays, regime, eref, dy, aux, make_work(model.n))
+    fn(t, y, model.arrays, regime, eref, dy, aux, make_work(model.n))
     return dy, aux
 
 
@@ -241,10 +241,8 @@ def test_inertia_invariants_reproduce_the_kinetic_energy_of_the_bar_volume():
         y[sl["vel"]] = u[0:3]
         y[sl["omega"]] = u[3:6]
         y[sl["eta"]] = u[6:]
-        out = np.empty(4)
-        b = model.basis
-        ptr, idx, val = model.sparse
-        energies(y, model.fpar, model.ipar, b.J0, ptr, idx, val, b.psi_tip, b.x_centre, make_work(n), out)
+        out = np.empty(5)
+        energies(y, model.arrays, make_work(n), out)
         assert out[0] == pytest.approx(T_brute, rel=1e-10)
 
 

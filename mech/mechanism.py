@@ -1,0 +1,246 @@
+"""Switch mechanisms: a held bar, its rivets, actuator forces and springs, as kernel arrays.
+
+A scene that is a plain free bar with its two end caps keeps the analytic free-free
+basis (mech.modal_basis). Anything else -- a clamp or a pivot, rivets (contact caps
+anywhere on the bar, with mass), forces or springs -- takes its modes from the
+finite-element beam (mech.beam_fe) of the bar as held, with the rivets' masses on it,
+and its invariants about the frame origin: the support for a held bar, the composite
+centroid for a free one.
+
+Geometry (body frame): b1 along the bar, origin at ``x0`` m from tip 0; a point at
+``position`` s m from tip 0 with ``offset`` h m along b3 sits at (s - x0, 0, h). Contact
+points are rows 0 and 1 of the point arrays (a missing second one is switched off);
+load points follow.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .beam_fe import FEBeam, PointMass, beam_basis, beam_invariants, point_shapes
+from .kernel import (
+    C_C, C_K, C_ON, C_R, L_AX, L_AY, L_AZ, L_BODY, L_C, L_DX, L_DY, L_DZ, L_K, L_KIND, L_L0, L_POINT,
+    L_T0, L_TN, LOAD_FORCE, LOAD_SPRING, N_LOAD,
+)
+from .modal_basis import ModalBasis
+from .parameters import MechScene
+
+
+@dataclass(frozen=True)
+class ContactPoint:
+    """One contact cap: ``position`` m from tip 0, ``offset`` m along b3, cap ``radius`` m,
+    its material (Pa, -), and a name for messages and results."""
+
+    name: str
+    position: float
+    offset: float
+    radius: float
+    youngs_modulus: float
+    poisson_ratio: float
+
+
+def needs_mechanism(scene: MechScene) -> bool:
+    """True when the scene is more than the free bar on its two end caps."""
+    return bool(scene.mount.held or scene.rivets or scene.forces or scene.springs
+                or scene.block.shape != "plane")
+
+
+def contact_points(scene: MechScene) -> list[ContactPoint]:
+    """The contact caps: the rivets, or else the end caps not inside a clamp or hinge."""
+    bar = scene.bar
+    if scene.rivets:
+        return [ContactPoint(rv.name, rv.position, rv.offset, rv.radius,
+                             rv.youngs_modulus or bar.youngs_modulus,
+                             rv.poisson_ratio if rv.poisson_ratio is not None else bar.poisson_ratio)
+                for rv in scene.rivets]
+    tips = [ContactPoint(f"tip {i}", s, 0.0, bar.tip_radius, bar.youngs_modulus, bar.poisson_ratio)
+            for i, s in enumerate((bar.tip_radius, bar.length - bar.tip_radius))]
+    if scene.mount.held:
+        # an end cap within its radius of the support is held, not a contact
+        tips = [tp for tp in tips if abs(tp.position - scene.mount.position) > bar.tip_radius]
+    return tips
+
+
+def fe_beam(scene: MechScene) -> FEBeam:
+    """The finite-element beam of the bar as held, with the rivets as point masses.
+
+    A rivet's rotary inertia about the section's bending axis: a sphere's 2/5 m r^2 plus
+    m h^2 for its offset h from the axis (it is carried on the axis point it sits above).
+    """
+    bar = scene.bar
+    i22, i33 = bar.second_moments
+    masses = tuple(PointMass(rv.position, rv.mass, rv.mass * (0.4 * rv.radius**2 + rv.offset**2))
+                   for rv in scene.rivets if rv.mass > 0.0)
+    mnt = scene.mount
+    return FEBeam(length=bar.length, youngs_modulus=bar.youngs_modulus, density=bar.density,
+                  area=bar.area, i22=i22, i33=i33, support=mnt.kind,
+                  support_position=mnt.position if mnt.held else 0.0, point_masses=masses)
+
+
+@dataclass
+class MechanismArrays:
+    """Everything the kernel needs beyond the free bar (SI units, body frame)."""
+
+    basis: ModalBasis
+    x0: float  # m from tip 0: the body frame's origin
+    points: tuple  # (psi (P, n, 3), theta (P, n, 3), xc (P, 3))
+    contacts: list  # ContactPoint per enabled contact row
+    first_moments: np.ndarray  # (3, 2n + 1): c, L_j, H_j
+    load: np.ndarray  # (n_loads, N_LOAD)
+    tables: np.ndarray  # (2, k)
+    spring_points: list  # (load row, spring) for the rest-length set-up
+
+
+def build_arrays(scene: MechScene, planar: bool) -> MechanismArrays:
+    """Modes, invariants and point arrays of a mechanism scene."""
+    bar = scene.bar
+    if bar.bending != "euler_bernoulli":
+        raise ValueError(f"bar.bending = {bar.bending!r}: switch mechanisms (mount, rivets, forces, springs) "
+                         "use Euler-Bernoulli finite-element modes; use 'euler_bernoulli'")
+    beam = fe_beam(scene)
+    modes = beam_basis(beam, bar.axial_modes, bar.bending_modes, planar=planar)
+    inv = beam_invariants(beam, modes, modal_damping=bar.modal_damping)
+    x0 = inv.x0
+    n = inv.n
+
+    cps = contact_points(scene)
+    s_pts = [cp.position for cp in cps]
+    h_pts = [cp.offset for cp in cps]
+    loads = list(scene.forces) + list(scene.springs)
+    s_pts += [ld.position for ld in loads]
+    h_pts += [0.0 for _ in loads]
+    # two contact rows always; a missing second contact is a switched-off dummy row
+    if len(cps) < 2:
+        s_pts.insert(len(cps), s_pts[0] if s_pts else 0.0)
+        h_pts.insert(len(cps), 0.0)
+    if len(cps) == 0:
+        raise ValueError("no contact point: every end cap is held by the mount; add a [[rivet]]")
+    s_arr = np.array(s_pts, dtype=float)
+    h_arr = np.array(h_pts, dtype=float)
+    if n:
+        psi, theta = point_shapes(modes, s_arr, h_arr)
+    else:
+        psi = np.zeros((len(s_arr), 0, 3))
+        theta = np.zeros((len(s_arr), 0, 3))
+    xc = np.zeros((len(s_arr), 3))
+    xc[:, 0] = s_arr - x0
+    xc[:, 2] = h_arr
+
+    first = np.zeros((3, 2 * n + 1))
+    first[:, 0] = inv.first_moment
+    first[:, 1:n + 1] = inv.translational_coupling
+    first[:, n + 1:] = inv.rotational_coupling
+
+    load = np.zeros((len(loads), N_LOAD))
+    times, values = [], []
+    for k, ld in enumerate(loads):
+        row = load[k]
+        row[L_POINT] = 2 + k
+        if k < len(scene.forces):
+            row[L_KIND] = LOAD_FORCE
+            row[L_BODY] = 1.0 if ld.frame == "body" else 0.0
+            row[L_DX], row[L_DY], row[L_DZ] = ld.direction
+            ts, vs = ld.table()
+            row[L_T0] = len(times)
+            row[L_TN] = len(ts)
+            times += list(ts)
+            values += list(vs)
+        else:
+            row[L_KIND] = LOAD_SPRING
+            row[L_AX], row[L_AY], row[L_AZ] = ld.anchor
+            row[L_K] = ld.stiffness
+            row[L_C] = ld.damping
+    tables = np.array([times, values], dtype=float) if times else np.zeros((2, 1))
+
+    basis = ModalBasis(
+        families=inv.families, orders=inv.orders, frequencies=inv.frequencies, mass=inv.mass,
+        J0=inv.J0, J1=inv.J1, J2=inv.J2, S=inv.S, stiffness=inv.stiffness, damping=inv.damping,
+        psi_tip=psi[:2], theta_tip=theta[:2], x_centre=xc[:2, 0].copy(),
+    )
+    springs = [(len(scene.forces) + k, sp) for k, sp in enumerate(scene.springs)]
+    return MechanismArrays(basis, x0, (psi, theta, xc), cps, first, load, tables, springs)
+
+
+def contact_parameters(cps, block, stiffness_override, dampings) -> np.ndarray:
+    """cpar rows (k N/m^1.5, c, cap radius m, on) of the contact points.
+
+    The Hertz stiffness uses the effective radius R1 R2/(R1 + R2) against a spherical block.
+    """
+    from .contact_laws import hertz_stiffness
+
+    cpar = np.zeros((2, 4))
+    for i, cp in enumerate(cps):
+        r_eff = cp.radius
+        if block.shape == "sphere":
+            r_eff = cp.radius * block.radius / (cp.radius + block.radius)
+        k = stiffness_override or hertz_stiffness(r_eff, cp.youngs_modulus, cp.poisson_ratio,
+                                                  block.youngs_modulus, block.poisson_ratio)
+        cpar[i] = (k, dampings[i] if i < len(dampings) else dampings[0], cp.radius, 1.0)
+    return cpar
+
+
+def frame_height(scene: MechScene, xc: np.ndarray, cps, R0: np.ndarray) -> float:
+    """z of the frame origin that puts the lowest contact cap ``initial.height`` above z = 0."""
+    lowest = min(float((R0 @ xc[i])[2]) - cp.radius for i, cp in enumerate(cps))
+    return scene.initial.height - lowest
+
+
+def effective_contact_mass(arr: MechanismArrays, scene: MechScene) -> float:
+    """kg: the mass the first contact point presents to a normal impact.
+
+    Pivot: the rigid rotation about the hinge, I / r^2; clamp: the fundamental bending
+    mode's mass at the point, m / phi_1(x)^2; free: the rigid bar with its inertia.
+    """
+    b = arr.basis
+    xc = arr.points[2]
+    m = b.mass
+    if scene.mount.kind == "pivot":
+        r = float(np.hypot(xc[0, 0], xc[0, 2]))
+        return b.J0[1, 1] / max(r * r, 1e-30)
+    if scene.mount.kind == "clamp":
+        bend = [j for j, f in enumerate(b.families) if f == "bend3"]
+        if not bend:
+            raise ValueError("bar.modes: a clamped blade needs at least one bending mode to move")
+        phi = abs(float(b.psi_tip[0, bend[0], 2]))
+        return m / max(phi * phi, 1e-30)
+    # free bar: the rigid bar's normal mass at its lowest contact, the lever arm being
+    # the horizontal distance from the centroid (tilt angle_deg)
+    lowest = min(range(len(arr.contacts)), key=lambda i: math.sin(math.radians(scene.initial.angle_deg)) * xc[i, 0])
+    r = float(xc[lowest, 0]) * math.cos(math.radians(scene.initial.angle_deg))
+    return m / (1.0 + m * r * r / b.J0[1, 1])
+
+
+def closing_work(scene: MechScene, arr: MechanismArrays) -> float:
+    """J: an upper estimate of the work available to close the gap (forces, preloads,
+    gravity over the initial gap); a scale for the error control, not a prediction."""
+    gap = scene.initial.height
+    force = sum(max(abs(v) for v in f.table()[1]) for f in scene.forces)
+    force += sum(abs(sp.preload or 0.0) + sp.stiffness * gap for sp in scene.springs)
+    xc = arr.points[2]
+    if scene.mount.kind == "pivot":
+        r = max(float(np.hypot(xc[0, 0], xc[0, 2])), 1e-9)
+        force += abs(scene.mount.preload_torque) / r + scene.mount.stiffness * gap / (r * r)
+    force += arr.basis.mass * scene.gravity
+    return force * max(gap, 1e-6)
+
+
+def base_velocity_jumps(scene: MechScene) -> list[tuple[float, np.ndarray]]:
+    """(time s, world velocity jump m/s) at each breakpoint of a piecewise-linear base
+    travel; the velocity is zero before the first and after the last point."""
+    bm = scene.mount.base_motion
+    if bm is None:
+        return []
+    ts = np.array(bm["time"], dtype=float)
+    ds = np.array(bm["displacement"], dtype=float)
+    vel = np.zeros((len(ts) + 1, 3))
+    if len(ts) > 1:
+        vel[1:-1] = np.diff(ds, axis=0) / np.diff(ts)[:, None]
+    jumps = []
+    for k, t in enumerate(ts):
+        dv = vel[k + 1] - vel[k]
+        if np.any(dv != 0.0):
+            jumps.append((float(t), dv))
+    return jumps
