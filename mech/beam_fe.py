@@ -174,9 +174,8 @@ class BeamModes:
     family: "axial" | "bend2" | "bend3". condition: "free" | "clamp" | "pin" applied.
     frequencies: Hz, (n,). modal_mass: kg, generalized mass of every mode (m_total).
     nodes: m from tip 0, the element end nodes (E + 1,).
-    coefficients: axial (n, 3E + 1) nodal u (element end node i at 3 i, two inner nodes
-    between, equally spaced); bending (n, E + 1, 2)
-    nodal (w, w') - dimensionless and 1/m.
+    coefficients: axial (n, 3E + 1) nodal u (element end node i at 3 i, two equally spaced
+    inner nodes between); bending (n, E + 1, 2) nodal (w, w'), dimensionless and 1/m.
     """
 
     family: str
@@ -233,7 +232,8 @@ class FESystem:
 
     nodes: m (E + 1,). stiffness: N/m-type (dof, dof), with the family's E A or E I.
     mass: kg-type (dof, dof). constrained: dof indices fixed by the support (sorted).
-    Bending dofs are (w_i, w'_i) per node; axial dofs u at end and mid nodes, node i at 2 i.
+    Bending dofs are (w_i, w'_i) per node; axial dofs are u at the element end nodes (node
+    i at dof 3 i) and at two equally spaced inner nodes per element.
     """
 
     family: str
@@ -367,8 +367,10 @@ def mesh(beam: FEBeam, elements: int) -> np.ndarray:
 
 
 def _support_node(beam: FEBeam, nodes: np.ndarray) -> int:
+    """Index of the node at the support (``mesh`` always puts one there)."""
     i = int(np.argmin(np.abs(nodes - beam.support_position)))
-    assert abs(nodes[i] - beam.support_position) <= _COINCIDENT * beam.length * 1.01
+    if abs(nodes[i] - beam.support_position) > 1.01 * _COINCIDENT * beam.length:
+        raise RuntimeError(f"no mesh node at support_position = {beam.support_position!r}")
     return i
 
 
@@ -472,8 +474,9 @@ def _strain_integral(family: str, nodes: np.ndarray, full: np.ndarray) -> np.nda
     """(n,): int (phi'')^2 dx (bending) or int (phi')^2 dx (axial), 3-point Gauss (exact).
 
     Computed from the curvature, not as v' K v: the matrix product loses eps * lambda_max
-    in absolute terms (1e-5 relative on the first mode at 256 elements, measured), the
-    curvature only about eps / (beta h)^2.
+    in absolute terms, the curvature only about eps / (beta h)^2 relative (first
+    clamped-free mode at 256 elements, error against the FE theory (beta h)^4 / 720:
+    6e-8 from v' K v, 4e-12 from the curvature; measured in this module's development).
     """
     h = np.diff(nodes)
     derivative = 1 if family == "axial" else 2
