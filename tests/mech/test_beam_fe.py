@@ -142,6 +142,9 @@ def test_free_free_bending_matches_the_roots_and_the_analytic_shapes():
     np.testing.assert_allclose(modes.value(x), exact, atol=4e-6)
     exact_slope = np.array([bending_shape(b, x / L, 1) / L for b in free_free_roots(4)])
     np.testing.assert_allclose(modes.slope(x), exact_slope, atol=2e-4 * np.max(np.abs(exact_slope)))
+    # Curvature is piecewise linear: error O(h^2), about 0.1 (beta h)^2 (3e-3 on mode 4).
+    exact_curv = np.array([bending_shape(b, x / L, 2) / L**2 for b in free_free_roots(4)])
+    np.testing.assert_allclose(modes.curvature(x), exact_curv, atol=5e-3 * np.max(np.abs(exact_curv)))
 
 
 def test_axial_fixed_free_and_free_free_rod():
@@ -248,8 +251,12 @@ def gauss_rule(pieces=400, points=6):
 
 @pytest.mark.parametrize("support, position", [("free", 0.0), ("clamp", L), ("pivot", 0.15), ("clamp", 0.07)])
 def test_modes_have_the_total_mass_as_generalized_mass_with_rivets(support, position):
-    rivets = [PointMass(0.0, 0.004, 2e-8), PointMass(0.11, 0.01, 5e-7)]
+    # With the support at 0.07 the third rivet is within a quarter element (h = 4 mm) of its
+    # node: it gets no node of its own and enters through the shape functions.
+    rivets = [PointMass(0.0, 0.004, 2e-8), PointMass(0.11, 0.01, 5e-7), PointMass(0.0705, 0.003, 1e-8)]
     beam = strip(support=support, support_position=position, point_masses=rivets)
+    nodes = mesh(beam, 50)
+    assert 0.11 in nodes and (0.0705 in nodes) == (position != 0.07)
     for modes in beam_basis(beam, 3, 4, elements=50):
         n = modes.n
         x, w = gauss_rule()
