@@ -129,6 +129,14 @@ class FEBeam:
             masses.append(p)
         object.__setattr__(self, "point_masses", tuple(masses))
 
+    @classmethod
+    def from_bar(cls, bar, support: str = "free", support_position: float = 0.0,
+                 point_masses=()) -> "FEBeam":
+        """The beam of a ``mech.Bar`` (length, E, rho, section) held as given."""
+        i22, i33 = bar.second_moments
+        return cls(bar.length, bar.youngs_modulus, bar.density, bar.area, i22, i33,
+                   support=support, support_position=support_position, point_masses=tuple(point_masses))
+
     @property
     def bar_mass(self) -> float:
         """kg: rho A L."""

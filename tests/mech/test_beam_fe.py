@@ -279,8 +279,8 @@ def test_free_free_invariants_agree_with_the_analytic_modal_basis():
     bar = Bar(length=0.3, diameter=None, width=0.012, thickness=0.004, tip_radius=0.007,
               axial_modes=3, bending_modes=3)
     ref = build_modal_basis(bar, planar=False)
-    i22, i33 = bar.second_moments
-    beam = FEBeam(bar.length, bar.youngs_modulus, bar.density, bar.area, i22, i33)
+    beam = FEBeam.from_bar(bar)
+    assert (beam.i22, beam.i33) == bar.second_moments and beam.bar_mass == pytest.approx(bar.mass)
     modes = beam_basis(beam, 3, 3, elements=80)
     inv = beam_invariants(beam, modes)
     assert inv.families == ref.families and inv.orders == ref.orders
@@ -320,6 +320,23 @@ def test_free_bar_with_rivets_is_a_mean_axis_frame_about_the_composite_centroid(
     held = beam_invariants(strip(support="clamp", support_position=L),
                            beam_basis(strip(support="clamp", support_position=L), 0, 1, planar=True))
     assert abs(held.translational_coupling[2, 0]) > 0.5 * RHO_A * L
+
+
+def test_cantilever_couplings_give_the_closed_form_effective_masses():
+    """Clamped-free modes phi = cosh - cos - sigma (sinh - sin) (mean square 1): from
+    EI phi'''' = rho A w^2 phi, int phi ds = 2 sigma / beta and int s phi ds = 2 / beta^2 (s from
+    the clamp), so the effective masses are L_j^2 / m = m 4 sigma^2 / (beta L)^2 (61.3 %,
+    18.8 %, ...) and H_j^2 / m = m L^2 4 / (beta L)^4 (their sum over all modes is m L^2 / 3)."""
+    beam = strip(support="clamp", support_position=L)
+    inv = beam_invariants(beam, beam_basis(beam, 0, 4, planar=True, elements=80))
+    b = clamped_free_roots(4)
+    sigma = (np.sinh(b) - np.sin(b)) / (np.cosh(b) + np.cos(b))
+    m = RHO_A * L
+    assert inv.mass == pytest.approx(m)
+    np.testing.assert_allclose(inv.translational_coupling[2] ** 2 / m, m * 4 * sigma**2 / b**2, rtol=1e-6)
+    np.testing.assert_allclose(inv.rotational_coupling[1] ** 2 / m, m * L**2 * 4 / b**4, rtol=1e-6)
+    np.testing.assert_allclose((inv.translational_coupling[2] ** 2 / m**2)[:2], [0.6131, 0.1883], atol=1e-4)
+    assert np.all(inv.translational_coupling[[0, 1]] == 0.0) and np.all(inv.rotational_coupling[[0, 2]] == 0.0)
 
 
 def test_pinned_modes_carry_no_angular_momentum_about_the_pin():
