@@ -577,7 +577,7 @@ def _fix_signs(beam: FEBeam, family: str, full: np.ndarray, nodes: np.ndarray) -
 
 def _package(beam, family, cond, system, lam, full) -> BeamModes:
     full = _fix_signs(beam, family, full, system.nodes)
-    coeff = full if family == "axial" else full.reshape(len(full), -1, 2)
+    coeff = full if family == "axial" else full.reshape(len(full), len(system.nodes), 2)
     freq = np.sqrt(lam) / (2.0 * math.pi)
     coeff.setflags(write=False)
     freq.setflags(write=False)

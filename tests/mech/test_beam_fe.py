@@ -401,3 +401,13 @@ def test_asking_for_more_modes_than_the_mesh_holds_is_an_error():
         beam_modes(strip(), "bend3", 40, elements=10)
     with pytest.raises(ValueError, match="outside|on the bar"):
         beam_modes(strip(), "bend3", 2).value([L * 1.1])
+
+
+def test_no_modes_leaves_the_rigid_bar_about_the_support():
+    beam = strip(support="pivot", support_position=L)
+    assert beam_modes(beam, "bend3", 0).n == 0 and beam_basis(beam, 0, 0) == ()
+    inv = beam_invariants(beam, ())
+    assert inv.n == 0 and inv.stiffness.shape == (0, 0)
+    # A bar hinged at its end: I = m L^2 / 3 (plus the section's rotary inertia), c = -m L / 2.
+    assert inv.J0[1, 1] == pytest.approx(RHO_A * L**3 / 3 + RHO * L * I22, rel=1e-14)
+    assert inv.first_moment[0] == pytest.approx(-RHO_A * L * L / 2, rel=1e-14)
