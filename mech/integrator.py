@@ -180,8 +180,12 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
             return MAX_STEPS, t, h, n_rec, -1
         # The contact-time bound on the step matters only where a tip could reach the
         # block within the step: far above it, a tip needs gap / v_bound to arrive
-        # (v_bound bounds every tip's approach speed from the energy available).
-        gap = -aux_old[0, A_Y] if aux_old[0, A_Y] < aux_old[1, A_Y] else -aux_old[1, A_Y]
+        # (v_bound bounds every tip's approach speed from the energy available). A
+        # switched-off contact row (a held bar with one contact) does not count.
+        if mdl[9][1, C_ON] == 0.0:
+            gap = -aux_old[0, A_Y]
+        else:
+            gap = -aux_old[0, A_Y] if aux_old[0, A_Y] < aux_old[1, A_Y] else -aux_old[1, A_Y]
         hcap = hmax
         if gap > 0.0 and 0.5 * gap / fpar[F_VBOUND] > hmax:
             hcap = 0.5 * gap / fpar[F_VBOUND]

@@ -213,12 +213,47 @@ def effective_contact_mass(arr: MechanismArrays, scene: MechScene) -> float:
     return m / (1.0 + m * r * r / b.J0[1, 1])
 
 
+def impulse_mass(arr: MechanismArrays, scene: MechScene) -> float:
+    """kg: the mass a held bar's first contact point presents to an impulse along the
+    normal, 1/m = sum_j (Psi_j . n)^2 / m (+ r^2 / I for a pivot's rotation): the lightest
+    mass any impact can meet there, with every mode of the basis taking part."""
+    b = arr.basis
+    th = math.radians(scene.initial.angle_deg)
+    normal_body = np.array([-math.sin(th), 0.0, math.cos(th)])  # world z in the body frame
+    mobility = float(np.sum((b.psi_tip[0] @ normal_body) ** 2)) / b.mass
+    if scene.mount.kind == "pivot":
+        xc = arr.points[2][0]
+        arm = xc[0] * math.cos(th) - xc[2] * math.sin(th)  # horizontal lever of the point
+        mobility += arm * arm / b.J0[1, 1]
+    return 1.0 / max(mobility, 1e-300)
+
+
+def _lever(arr: MechanismArrays, scene: MechScene, row: int) -> float:
+    """How far load point ``row`` moves per unit motion of the first contact point in the
+    bar's slowest way of moving (the rigid rotation of a pivot, the fundamental mode of
+    a clamp; 1 for a free bar)."""
+    xc = arr.points[2]
+    if scene.mount.kind == "pivot":
+        return abs(xc[row, 0]) / max(abs(xc[0, 0]), 1e-12)
+    if scene.mount.kind == "clamp":
+        b = arr.basis
+        bend = [j for j, f in enumerate(b.families) if f == "bend3"]
+        if bend:
+            psi = arr.points[0]
+            return abs(psi[row, bend[0], 2]) / max(abs(psi[0, bend[0], 2]), 1e-12)
+    return 1.0
+
+
 def closing_work(scene: MechScene, arr: MechanismArrays) -> float:
     """J: an upper estimate of the work available to close the gap (forces, preloads,
     gravity over the initial gap); a scale for the error control, not a prediction."""
     gap = scene.initial.height
-    force = sum(max(abs(v) for v in f.table()[1]) for f in scene.forces)
-    force += sum(abs(sp.preload or 0.0) + sp.stiffness * gap for sp in scene.springs)
+    # each load's largest force times how far its point travels while the contact closes
+    force = sum(max(abs(v) for v in f.table()[1]) * _lever(arr, scene, 2 + k)
+                for k, f in enumerate(scene.forces))
+    nf = len(scene.forces)
+    force += sum((abs(sp.preload or 0.0) + sp.stiffness * gap) * _lever(arr, scene, 2 + nf + k)
+                 for k, sp in enumerate(scene.springs))
     xc = arr.points[2]
     if scene.mount.kind == "pivot":
         r = max(float(np.hypot(xc[0, 0], xc[0, 2])), 1e-9)

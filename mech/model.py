@@ -23,7 +23,7 @@ from .kernel import (
 )
 from .mechanism import (
     MechanismArrays, build_arrays, closing_work, contact_parameters, contact_points,
-    effective_contact_mass, frame_height, needs_mechanism,
+    effective_contact_mass, frame_height, impulse_mass, needs_mechanism,
 )
 from .modal_basis import ModalBasis, build_modal_basis, sparse_invariants
 from .parameters import MechScene
@@ -178,7 +178,9 @@ def mechanism_scales(scene: MechScene, arr: MechanismArrays, n_modes: int) -> Co
             dampings.append(damping_formula(con.law, con.restitution, v_ref, k))
         else:
             dampings.append(calibrate_damping(con.law, con.restitution, v_ref, k, m_eff))
-    m_min = m_eff / (4.0 * (1.0 + n_modes))
+    # lightest mass an impact can meet: a held bar's impulse mass from its modes; a free
+    # bar's bound as in contact_scales (|phi_j| <= 2 at a point)
+    m_min = impulse_mass(arr, scene) if scene.mount.held else m_eff / (4.0 * (1.0 + n_modes))
     v_max = math.sqrt(2.0 * e_avail / m_min) + v_ref
     k0 = float(ks[0])
     return ContactScales(
@@ -282,6 +284,31 @@ class BarModel:
             else:
                 out.append((None, 0.0))
         return out + [(None, 0.0)] * (2 - len(out))
+
+    @property
+    def rest_window(self) -> float:
+        """s: how long a contact must stay quiet before the solver holds it at rest: two
+        periods of the slowest oscillation it could still hide (the lowest elastic mode,
+        the contact's own rebound on its reference mass, a pivot's torsion spring)."""
+        cs = self.contact
+        k_lin = 1.5 * cs.stiffness * math.sqrt(cs.penetration_scale)
+        periods = [2.0 * math.pi * math.sqrt(cs.reference_mass / k_lin)]
+        f = self.basis.frequencies
+        if len(f) and np.min(f) > 0.0:
+            periods.append(1.0 / float(np.min(f)))
+        mnt = self.scene.mount
+        if mnt.kind == "pivot" and mnt.stiffness > 0.0:
+            periods.append(2.0 * math.pi * math.sqrt(self.basis.J0[1, 1] / mnt.stiffness))
+        return 2.0 * max(periods)
+
+    @property
+    def load_change_times(self) -> list:
+        """s: the breakpoints of the actuator force tables (a held state must end there)."""
+        out = []
+        for f in self.scene.forces:
+            if f.time is not None:
+                out += list(f.time)
+        return sorted(out)
 
     @property
     def nq(self) -> int:

@@ -206,6 +206,12 @@ class ImpactSolver:
         self._dense_coef = np.empty((dcap, 5, N))
         self._jumps = base_velocity_jumps(scene)
         self._jump_index = 0
+        self._hold_until = -math.inf
+        self._hold_regime = self.regime.copy()
+        self._rest_t0 = 0.0
+        self._rest_ke = 0.0
+        self._rest_e = np.empty(5)
+        self.holds: list[list[float]] = []  # [start, end] of each hold at rest (s)
         if self._jumps and self._jumps[0][0] == 0.0:
             self._apply_base_jump(resolve=False)
         self._initial_state = self.y.copy()
@@ -248,13 +254,34 @@ class ImpactSolver:
         t_start = self.t
         tick = time.perf_counter()
         m = self.model
+        if self._hold_until > self.t and np.any(self.regime != self._hold_regime):
+            self._release_hold()  # the new mu no longer holds a contact at rest
         while self.t < t_target:
             if self._n >= self._cap - 1:
                 self._grow()
             n0 = self._n
             goal = t_target
-            if self._jump_index < len(self._jumps) and self._jumps[self._jump_index][0] <= t_target:
+            jump_due = self._jump_index < len(self._jumps) and self._jumps[self._jump_index][0] <= t_target
+            if jump_due:
                 goal = max(self._jumps[self._jump_index][0], self.t)
+            if self._hold_until > self.t:
+                # at rest: nothing changes until a load or the base does
+                self.t = min(goal, self._hold_until)
+                self._record_point()
+                if self.t >= self._hold_until:
+                    self._release_hold()
+                if jump_due and self.t == goal:
+                    self._apply_base_jump()
+                continue
+            # watched for rest in windows only while a contact is closed (a bar in flight
+            # is never at rest, and its steps stay as they were)
+            window_end = self._rest_t0 + self.model.rest_window
+            closed = bool(np.any(self._rec_aux[self._n - 1, :, A_Y] > 0.0))
+            if not closed:
+                self._restart_rest_window()
+            elif window_end < goal:
+                goal = window_end
+                jump_due = False
             try:
                 status, t_new, h, n_rec, ev = self._segment(goal, n0)
             except np.linalg.LinAlgError as err:
@@ -267,16 +294,18 @@ class ImpactSolver:
             self.h = h
             if status == DONE:
                 self.t = goal
-                if goal < t_target or (self._jump_index < len(self._jumps)
-                                       and self._jumps[self._jump_index][0] == goal):
+            if status in (DONE, BUFFER_FULL, EVENT):
+                self._watch_rest(n0, n_rec)
+            if status == DONE:
+                if jump_due and self._jumps[self._jump_index][0] == goal:
                     self._apply_base_jump()
-                    if goal < t_target:
-                        continue
-                break
+                continue
             if status == BUFFER_FULL:
                 continue
             if status == EVENT:
                 self._handle_event(ev)
+                if ev % NEV_TIP == EV_CONTACT:  # a contact made or broken: not at rest
+                    self._restart_rest_window()
                 continue
             self.wall_time += time.perf_counter() - tick
             raise MechSolverError(
@@ -363,7 +392,9 @@ class ImpactSolver:
         return dict(t=self.t, y=self.y.copy(), z=self.z.copy(), h=self.h, regime=self.regime.copy(),
                     eref=self.eref.copy(), ev_sign=self.ev_sign.copy(), stats=self.stats.copy(),
                     n=self._n, n_events=len(self.events), projection_energy=self.projection_energy,
-                    fpar=self.model.fpar.copy(), jump_index=self._jump_index)
+                    fpar=self.model.fpar.copy(), jump_index=self._jump_index,
+                    rest=(self._hold_until, self._hold_regime.copy(), self._rest_t0, self._rest_ke,
+                          [list(h) for h in self.holds]))
 
     def restore(self, cp: dict) -> None:
         """Return to a ``checkpoint`` (e.g. to redo a coupling step so it ends at an event)."""
@@ -379,6 +410,9 @@ class ImpactSolver:
         self.projection_energy = cp["projection_energy"]
         self.model.fpar[:] = cp["fpar"]
         self._jump_index = cp["jump_index"]
+        self._hold_until, hold_regime, self._rest_t0, self._rest_ke, holds = cp["rest"]
+        self._hold_regime = hold_regime.copy()
+        self.holds = [list(h) for h in holds]
 
     def contact_series(self, times) -> np.ndarray:
         """(len(times), 2, 3): per tip penetration (m), rate (m/s), normal force (N) at the
@@ -417,6 +451,56 @@ class ImpactSolver:
     def _evaluate(self) -> np.ndarray:
         dynamics(self.t, self.y, self.model.arrays, self.regime, self.eref, self._dy, self._aux, self._work)
         return self._aux
+
+    # --- contacts at rest ------------------------------------------------------------
+
+    def _restart_rest_window(self) -> None:
+        self._rest_t0 = self.t
+        self._rest_ke = 0.0
+
+    def _release_hold(self) -> None:
+        self._hold_until = -math.inf
+        self._restart_rest_window()
+
+    def _watch_rest(self, n0: int, n_rec: int) -> None:
+        """Hold a bar that has come to rest until its loads change.
+
+        At rest means: for a whole window (model.rest_window, two periods of the slowest
+        oscillation the contacts and modes allow) the kinetic energy stayed below rtol times
+        the energy stored in the closed contacts, no contact slips and no regime changed. The state is then an equilibrium of constant loads to the run's
+        tolerance, and integrating it further would only follow the decay of motion
+        already below that tolerance; so the solver holds it until the next change of a
+        load (a force table's breakpoint, a base breakpoint) or of mu that unsticks a contact.
+        """
+        if self.model.rest_window <= 0.0:
+            return
+        e = self._rest_e
+        for k in range(n0, n0 + n_rec):
+            energies(self._rec_y[k], self.model.arrays, self._work, e)
+            if e[0] > self._rest_ke:
+                self._rest_ke = e[0]
+        if self.t - self._rest_t0 < self.model.rest_window * (1.0 - 1e-12):
+            return
+        energies(self.y, self.model.arrays, self._work, e)
+        # Against the energy stored in the contacts (elastic and spring energy when none
+        # is closed): a Hertz contact oscillation of kinetic energy K moves the contact
+        # force by dF/F = sqrt(1.2 K / U_contact), so K <= rtol U_contact holds every
+        # contact force within sqrt(rtol) (0.1 % at the default rtol) of its equilibrium.
+        stored = e[3] if e[3] > 0.0 else e[1] + e[4]
+        quiet = self._rest_ke <= self.scene.solver.rtol * stored and stored > 0.0
+        # micro-slip at a contact held near its friction limit may go on at slip speeds far
+        # below the stick tolerance; it does not keep a quiet bar from being at rest
+        aux = self._evaluate()
+        slipping = any(self.regime[i] == SLIP and math.hypot(aux[i, A_VTX], aux[i, A_VTY])
+                       > self.scene.solver.stick_velocity_tol for i in range(2))
+        if quiet and not slipping:
+            later = [t for t in self.model.load_change_times if t > self.t]
+            later += [t for t, _ in self._jumps[self._jump_index:] if t > self.t]
+            self._hold_until = min(later) if later else math.inf
+            self._hold_regime = self.regime.copy()
+            self.holds.append([self.t, self._hold_until])
+        else:
+            self._restart_rest_window()
 
     def _apply_base_jump(self, resolve: bool = True) -> None:
         """A breakpoint of a clamp's piecewise-linear travel: the base velocity jumps by dv
@@ -492,12 +576,16 @@ class ImpactSolver:
                 f"regime switching does not settle at t = {self.t!r} s: {self._chatter} events at one "
                 f"instant (last: tip {tip} {EVENT_KINDS[kind]}, regimes "
                 f"{[REGIME_NAMES[r] for r in self.regime]})", self.t, self.named_state(), partial=self.result())
+        if kind == EV_COMPRESSION:
+            # a restart for the work split only (the time of maximum compression is in the
+            # history): no regime changes, the watched sign turns; a contact chattering at
+            # rest makes many of these, so they skip the full regime resolution
+            self.ev_sign[ev] = -self.ev_sign[ev]
+            return
         old = self.regime.copy()
         old_sign = self.ev_sign[ev]
         self._resolve(triggered=ev)
         aux = self._aux
-        if kind == EV_COMPRESSION:
-            return  # a restart for the work split only; the time of maximum compression is in the history
         if kind == EV_CONTACT:
             name = "contact_start" if old_sign < 0 else "contact_end"
             if name == "contact_start":

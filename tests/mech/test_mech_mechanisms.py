@@ -88,7 +88,7 @@ def test_rigid_pivoted_bar_on_a_torsion_spring_oscillates_at_sqrt_k_over_i():
         "bar": dict(length=L, diameter=d, tip_radius=0.005, **STEEL, modes=0),
         "mount": dict(kind="pivot", position=L, stiffness=kt),
         "initial": dict(height=0.05, angular_velocity=[0.0, 1.0, 0.0]),
-        "solver": dict(t_end=0.2),
+        "solver": dict(t_end=0.2, rtol=1e-8),
         "environment": dict(gravity=0.0),
     }
     res = ImpactSolver(scene_from_dict(doc)).run()
