@@ -250,6 +250,26 @@ def main(fast: bool = False, out: str | Path | None = None) -> dict:
     return numbers
 
 
+def mode_study(modes=(3, 5, 7, 10), current: float = 1.0) -> dict:
+    """The full scene at ``current`` with ``modes`` per family: contact starts (s), restitutions,
+    friction dissipation (J). The paper found three modes enough; this is the check for the bounce
+    sequence (docs/coupling.md section 8)."""
+    out = {}
+    for n_modes in modes:
+        n = mechanics_numbers(run(scene().set("circuit.current", current).set("bar.modes", n_modes)))
+        out[n_modes] = dict(bounces=n["bounces"], contact_starts=[c["t_start"] for c in n["contacts"]],
+                            restitutions=[c["kinematic_restitution"] for c in n["contacts"]],
+                            friction_dissipation=n["friction_dissipation"])
+    return out
+
+
+def print_mode_study() -> None:
+    for n_modes, r in mode_study().items():
+        print(f"{n_modes:2d} modes: {r['bounces']} bounces, contacts at "
+              + " ".join(f"{t * 1e3:.3f}" for t in r["contact_starts"]) + " ms, restitutions "
+              + " ".join(f"{e:.3f}" for e in r["restitutions"]) + f", friction {r['friction_dissipation'] * 1e6:.1f} uJ")
+
+
 def _summary(n: dict) -> str:
     lines = [table(n)]
     for label, r in n["runs"].items():
