@@ -49,6 +49,7 @@ COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output")
 TEMPLATES = ("resistive", "inductive", "capacitive", "current_source", "netlist")
 SCHEMES = ("mechanics_first", "jacobi")
 
+
 def _unknown(where: str, key: str, allowed) -> ValueError:
     return ValueError(f"{where}: unknown key {key!r}{suggest(key, allowed)}; allowed keys: {', '.join(sorted(allowed))}")
 
@@ -283,7 +284,7 @@ def _template_keys(template: str) -> set:
 CIRCUIT_KEYS = frozenset({"template", "schedule", *_OPTION_KEYS}.union(*(_template_keys(t) for t in TEMPLATES)))
 
 
-def _circuit_names(ck) -> dict:
+def circuit_key_names(ck) -> dict:
     """'Class.field' of every dataclass behind [circuit] -> the scene key that sets it."""
     names = {}
     for cls, keys in ((ck.DCSource, _VOLTAGE_SOURCE), (ck.CurrentSource, _CURRENT_SOURCE), (ck.Wiring, _WIRING),
@@ -358,7 +359,7 @@ def _circuit(table: dict, base_dir: Path, where: str, current_factor: str | None
             hint = " (a current source needs template = \"current_source\")"
         raise ValueError(f"{where}: circuit.{', circuit.'.join(stray)} do(es) not apply to template {template!r}"
                          f"{hint}; its keys: {', '.join(sorted(_template_keys(template)))}")
-    names = _circuit_names(ck)
+    names = circuit_key_names(ck)
     try:
         options = ck.SimulationOptions(**{k: table[k] for k in _OPTION_KEYS if k in table})
         arc = _part(table, "arc", ck.ArcModel, where)

@@ -84,9 +84,9 @@ def test_unknown_keys_list_the_allowed_ones_with_a_did_you_mean(circuit, expecte
 
 
 def test_every_circuit_key_is_listed_once_and_maps_to_a_dataclass_field():
-    from coupling.scene import _circuit_names  # the map the errors are translated with
+    from coupling.scene import circuit_key_names  # the map the errors are translated with (public)
 
-    targets = set(_circuit_names(ck).values())
+    targets = set(circuit_key_names(ck).values())
     top = {t.split(".")[1] for t in targets if t.count(".") == 1}
     assert CIRCUIT_KEYS - {"template", "schedule", "netlist"} <= top | {"snubber", "flyback", "arc"}
     option_fields = {f.name for f in dataclasses.fields(ck.SimulationOptions)}
