@@ -31,6 +31,7 @@ from .schedule import ContactSchedule
 from .stepping import StepResult, Stepper
 from .templates import (
     CapacitiveLoad,
+    CurrentSource,
     DCSource,
     FlybackDiode,
     InductiveLoad,
@@ -45,6 +46,7 @@ __all__ = [
     "ArcModel",
     "COLUMNS",
     "CapacitiveLoad",
+    "CurrentSource",
     "ConductanceError",
     "ContactSchedule",
     "ConvergenceError",

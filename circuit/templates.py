@@ -12,10 +12,18 @@ Loads: ``ResistiveLoad`` (R), ``InductiveLoad`` (R + L in series: relay coil, mo
 ``CapacitiveLoad`` (series R, then C with a bleed resistor across it: lamp or
 supply-input inrush). ``Vload`` is a 0 V probe: its current is the load current, which
 keeps flowing through it when the flyback diode freewheels.
+
+Sources: ``DCSource`` (a voltage source E behind its internal resistance) or
+``CurrentSource`` (a supply in constant-current mode: I_set with its output resistance
+and capacitance and a compliance clamp; see its docstring for the netlist)::
+
+    Isource 0 src I_set ; Rsource_out src 0 ; Csource_out src 0
+    Dclamp src clamp (switchsim_clamp) ; Vclamp clamp 0 V_comp - (diode drop at I_set)
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Union
 
@@ -27,6 +35,11 @@ from .contact import (
 )
 from .probes import Probes
 from .validation import check_range
+
+BOLTZMANN_OVER_CHARGE = 8.617333262e-5  # V/K
+CLAMP_TEMPERATURE = 27.0  # degC: the clamp diode's instance temperature (fixed, whatever TEMP)
+CLAMP_SATURATION_CURRENT = 1e-12  # A
+CLAMP_MODEL = "switchsim_clamp"
 
 NODE_A = "contact_a"
 NODE_B = "contact_b"
@@ -43,6 +56,78 @@ class DCSource:
     def __post_init__(self) -> None:
         check_range("DCSource", "voltage", self.voltage, "V", 0.0, 1e5, low_open=True)
         check_range("DCSource", "internal_resistance", self.internal_resistance, "ohm", 0.0, 1e6)
+
+
+@dataclass(frozen=True)
+class CurrentSource:
+    """DC supply in constant-current mode (SI units).
+
+    current: the set current I_set, A (> 0).
+    compliance_voltage: V_comp, the most the supply puts out, V: with the load open it
+        leaves constant-current mode and holds V_comp (constant-voltage mode).
+    output_capacitance: C_out across the output terminals, F (> 0: output filter
+        capacitor, lead capacitance). It sets how fast the voltage rises when the load
+        opens (I_set / C_out at first) and discharges into the contact at each make.
+    output_resistance: R_out across the output, ohm: the finite output impedance of the
+        current regulator; a closed loop of resistance R gets I_set R_out / (R_out + R).
+
+    The netlist (``SwitchCircuit.build``)::
+
+        Isource     0 src I_set                 (the regulated current, into src)
+        Rsource_out src 0 R_out
+        Csource_out src 0 C_out
+        Dclamp      src clamp switchsim_clamp temp=27   (IS = 1e-12 A, N = 1, RS = 0)
+        Vclamp      clamp 0 V_comp - V_T ln(1 + I_set/IS)
+
+    The compliance limit is a diode clamp onto a voltage source, not a behavioural
+    min(I_set, ...) law: ngspice limits a junction's voltage between Newton iterations
+    (pnjlim), so the clamp's exponential knee converges from any operating point, while
+    a piecewise-linear clamp has a kink that Newton and the truncation-error control must
+    find by step rejection at every break. Vclamp is offset by the diode's drop at I_set,
+    so with the load open the output sits at V_comp when the clamp takes the whole set
+    current, and at V_comp + V_T ln(I_clamp / I_set) when it takes less (V_T = k T / q =
+    25.9 mV at the clamp's fixed 27 degC: -60 mV per decade). Below V_comp - 0.3 V the
+    clamp carries less than 1e-5 I_set: constant-current mode.
+    """
+
+    current: float = 1.0
+    compliance_voltage: float = 20.0
+    output_capacitance: float = 1e-6
+    output_resistance: float = 1e4
+
+    def __post_init__(self) -> None:
+        check_range("CurrentSource", "current", self.current, "A", 0.0, 1e3, low_open=True)
+        check_range("CurrentSource", "compliance_voltage", self.compliance_voltage, "V", 0.0, 1e5, low_open=True)
+        check_range("CurrentSource", "output_capacitance", self.output_capacitance, "F", 0.0, 1.0, low_open=True)
+        check_range("CurrentSource", "output_resistance", self.output_resistance, "ohm", 1e-3, 1e12)
+
+    @property
+    def thermal_voltage(self) -> float:
+        """V: k T / q of the clamp diode at its fixed temperature."""
+        return BOLTZMANN_OVER_CHARGE * (CLAMP_TEMPERATURE + 273.15)
+
+    @property
+    def clamp_source_voltage(self) -> float:
+        """V: the clamp's voltage source, V_comp less the diode's drop at I_set."""
+        return self.compliance_voltage - self.thermal_voltage * math.log1p(self.current / CLAMP_SATURATION_CURRENT)
+
+    def open_voltage(self, load_conductance: float = 0.0) -> float:
+        """V: the steady output voltage with the contact open (CV mode if the clamp conducts).
+
+        load_conductance: S, whatever else draws current from the output (leakage).
+        Solves I_set = V (1/R_out + G) + IS (exp((V - V_clamp)/V_T) - 1) by bisection.
+        """
+        g = 1.0 / self.output_resistance + load_conductance
+        vt, vc, i_s = self.thermal_voltage, self.clamp_source_voltage, CLAMP_SATURATION_CURRENT
+        lo, hi = 0.0, min(self.current / g, self.compliance_voltage + 1.0)
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            excess = mid * g + i_s * math.expm1(min((mid - vc) / vt, 700.0)) - self.current
+            lo, hi = (mid, hi) if excess < 0 else (lo, mid)
+        return 0.5 * (lo + hi)
+
+
+Source = Union[DCSource, CurrentSource]
 
 
 @dataclass(frozen=True)
@@ -143,7 +228,7 @@ class SwitchCircuit:
         print(circuit.build())        # the netlist
     """
 
-    source: DCSource = field(default_factory=DCSource)
+    source: Source = field(default_factory=DCSource)
     load: Load = field(default_factory=ResistiveLoad)
     wiring: Wiring = field(default_factory=Wiring)
     contact_capacitance: float = 100e-12
@@ -156,9 +241,10 @@ class SwitchCircuit:
 
     def __post_init__(self) -> None:
         name = "SwitchCircuit"
-        for attr, kind in (("source", DCSource), ("wiring", Wiring)):
-            if not isinstance(getattr(self, attr), kind):
-                raise ValueError(f"{name}.{attr} = {getattr(self, attr)!r}: must be a {kind.__name__}")
+        if not isinstance(self.source, (DCSource, CurrentSource)):
+            raise ValueError(f"{name}.source = {self.source!r}: must be a DCSource or CurrentSource")
+        if not isinstance(self.wiring, Wiring):
+            raise ValueError(f"{name}.wiring = {self.wiring!r}: must be a Wiring")
         if not isinstance(self.load, (ResistiveLoad, InductiveLoad, CapacitiveLoad)):
             raise ValueError(
                 f"{name}.load = {self.load!r}: must be a ResistiveLoad, InductiveLoad or CapacitiveLoad"
@@ -172,6 +258,18 @@ class SwitchCircuit:
                 f"{name}.flyback is set but load is {type(self.load).__name__}: "
                 "a flyback diode belongs across an InductiveLoad"
             )
+        if isinstance(self.source, CurrentSource):
+            if not isinstance(self.load, ResistiveLoad):
+                raise ValueError(f"{name}.load is {type(self.load).__name__}: a CurrentSource drives a "
+                                 "ResistiveLoad (the rest of the loop: leads, specimen)")
+            closed = self.wiring.resistance + self.load.resistance
+            if self.source.compliance_voltage < self.source.current * closed:
+                raise ValueError(
+                    f"CurrentSource.compliance_voltage = {self.source.compliance_voltage:g} V is below "
+                    f"CurrentSource.current x (Wiring.resistance + ResistiveLoad.resistance) = "
+                    f"{self.source.current:g} A x {closed:g} ohm = {self.source.current * closed:g} V: the "
+                    "supply could not drive the set current even through the closed contact"
+                )
         check_range(name, "contact_capacitance", self.contact_capacitance, "F", 0.0, 1e-6)
         check_range(name, "leakage_conductance", self.leakage_conductance, "S", 0.0, 1e-3)
         check_current_factor(name, self.contact_current_factor)
@@ -193,11 +291,22 @@ class SwitchCircuit:
         """The PySpice circuit (``print`` it for the netlist)."""
         c = Circuit(self.title)
         gnd = c.gnd
-        c.V("source", "src", gnd, float(self.source.voltage))
+        source = self.source
+        if isinstance(source, CurrentSource):
+            c.I("source", gnd, "src", float(source.current))
+            c.R("source_out", "src", gnd, float(source.output_resistance))
+            c.C("source_out", "src", gnd, float(source.output_capacitance))
+            c.D("clamp", "src", "clamp", model=CLAMP_MODEL, temperature=CLAMP_TEMPERATURE)
+            c.model(CLAMP_MODEL, "D", IS=CLAMP_SATURATION_CURRENT, N=1.0, RS=0.0)
+            c.V("clamp", "clamp", gnd, float(source.clamp_source_voltage))
+            internal = 0.0
+        else:
+            c.V("source", "src", gnd, float(source.voltage))
+            internal = source.internal_resistance
         series = [
             (kind, name, value)
             for kind, name, value in (
-                ("R", "source", self.source.internal_resistance),
+                ("R", "source", internal),
                 ("R", "wire", self.wiring.resistance),
                 ("L", "wire", self.wiring.inductance),
             )

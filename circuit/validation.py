@@ -22,15 +22,14 @@ def check_range(
     Ranges are wide on purpose: they catch unit slips (100 instead of 100e-12 F) and
     non-physical signs, not unusual designs.
     """
+    u = f" {unit}" if unit else ""  # a dimensionless value has no unit to print
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ValueError(f"{owner}.{field} = {value!r}: must be a real number in {unit}")
+        raise ValueError(f"{owner}.{field} = {value!r}: must be a real number" + (f" in {unit}" if unit else ""))
     number = float(value)
     if math.isnan(number) or (math.isinf(number) and not allow_inf):
-        raise ValueError(f"{owner}.{field} = {value!r} {unit}: must be finite")
+        raise ValueError(f"{owner}.{field} = {value!r}{u}: must be finite")
     too_low = number <= low if low_open else number < low
     if too_low or number > high:
         lower = f"{low:g} < value" if low_open else f"{low:g} <= value"
-        raise ValueError(
-            f"{owner}.{field} = {number:g} {unit} is out of range: allowed {lower} <= {high:g} {unit}"
-        )
+        raise ValueError(f"{owner}.{field} = {number:g}{u} is out of range: allowed {lower} <= {high:g}{u}")
     return number

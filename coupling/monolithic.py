@@ -62,6 +62,9 @@ def series_loop(circuit) -> SeriesLoop:
         if getattr(circuit, part) is not None:
             raise ValueError(f"monolithic reference: circuit.{part} is set; the reference covers series "
                              "R/L/C loops only (no arc, snubber or flyback diode)")
+    if not isinstance(circuit.source, ck.DCSource):
+        raise ValueError("monolithic reference: the source is a CurrentSource; the reference covers a "
+                         "voltage source only")
     if circuit.contact_capacitance <= 0.0:
         raise ValueError("monolithic reference: contact_capacitance must be > 0 (it carries the loop "
                          "current while the contact is open)")

@@ -8,12 +8,15 @@ A scene names only what it needs, and only that is built:
     [tribology]   source = "illustrative" | fit = "fit.json" | data = "data.csv"
                   | inline [tribology.mu] and [tribology.resistance] tables (docs/tribology.md)
                   feedback = true (mu follows the contact current; false: mu = mu(0))
-    [circuit]     template = "resistive" | "inductive" | "capacitive" | "netlist"
-                  voltage, source_resistance, wiring_resistance, wiring_inductance,
-                  load_resistance, load_inductance, load_capacitance, bleed_resistance,
-                  contact_capacitance, leakage_conductance, snubber = {resistance, capacitance},
-                  flyback = true | {...}, arc = true | false | {min_voltage, min_current, ...},
-                  netlist = "file.cir", load_probe, max_step, reltol, method, wall_timeout
+    [circuit]     template = "resistive" | "inductive" | "capacitive" | "current_source" | "netlist"
+                  voltage, source_resistance (voltage templates) | current, compliance_voltage,
+                  output_capacitance, output_resistance (current_source), wiring_resistance,
+                  wiring_inductance, load_resistance, load_inductance, load_capacitance,
+                  bleed_resistance, contact_capacitance, leakage_conductance,
+                  snubber = {resistance, capacitance} (both), flyback = true | {...},
+                  arc = true | false | {min_voltage, min_current, ...}, netlist = "file.cir",
+                  load_probe, max_step, reltol, abstol, vntol, chgtol, method, temperature,
+                  wall_timeout (each key one dataclass field; omitted: that field's default)
     [circuit.schedule]  make = [...], break = [...], closed_resistance, opening_speed
                         (s, s, ohm, m/s: the gap for an arc whose voltage grows with it)
     [coupling]    scheme = "mechanics_first" | "jacobi", macro_step, max_macro_step (s),
@@ -27,7 +30,9 @@ section and key and says what is allowed, before any solver starts.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import difflib
+import re
 import tomllib
 from dataclasses import dataclass, field
 from importlib import resources
@@ -38,30 +43,15 @@ from mech.parameters import Friction, MechScene, check_nonnegative, check_positi
 from mech.scene import SCENE_SECTIONS as MECH_SECTIONS
 from mech.scene import read_toml
 from mech.scene import scene_from_dict as mech_scene_from_dict
+from mech.scene import suggest
 
 COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output")
-TEMPLATES = ("resistive", "inductive", "capacitive", "netlist")
+TEMPLATES = ("resistive", "inductive", "capacitive", "current_source", "netlist")
 SCHEMES = ("mechanics_first", "jacobi")
-
-_CIRCUIT_KEYS = {
-    "template", "voltage", "source_resistance", "wiring_resistance", "wiring_inductance",
-    "load_resistance", "load_inductance", "load_capacitance", "bleed_resistance",
-    "contact_capacitance", "leakage_conductance", "snubber", "flyback", "arc", "netlist",
-    "load_probe", "max_step", "reltol", "method", "wall_timeout", "schedule",
-}
-_LOAD_KEYS = {
-    "resistive": {"load_resistance"},
-    "inductive": {"load_resistance", "load_inductance"},
-    "capacitive": {"load_resistance", "load_capacitance", "bleed_resistance"},
-    "netlist": set(),
-}
-_ALL_LOAD_KEYS = {"load_resistance", "load_inductance", "load_capacitance", "bleed_resistance"}
 
 
 def _unknown(where: str, key: str, allowed) -> ValueError:
-    close = difflib.get_close_matches(key, list(allowed), n=1)
-    hint = f" (did you mean {close[0]!r}?)" if close else ""
-    return ValueError(f"{where}: unknown key {key!r}{hint}; allowed keys: {', '.join(sorted(allowed))}")
+    return ValueError(f"{where}: unknown key {key!r}{suggest(key, allowed)}; allowed keys: {', '.join(sorted(allowed))}")
 
 
 def _table(where: str, value) -> dict:
@@ -258,85 +248,156 @@ def _tribology(table: dict, base_dir: Path, where: str) -> TribologySpec:
     return TribologySpec(laws, "inline laws", feedback)
 
 
+# --- [circuit]: scene keys mapped 1:1 onto the circuit dataclasses ------------------------
+# Each flat [circuit] key is one field of one dataclass; an omitted key takes that field's
+# default (the dataclasses are the only source of defaults). Sub-tables snubber, flyback,
+# arc and schedule map their keys onto the fields of the same name. Errors raised by a
+# dataclass ("DCSource.voltage = ...") are reported in the scene's words ("circuit.voltage").
+
+_VOLTAGE_SOURCE = {"voltage": "voltage", "source_resistance": "internal_resistance"}
+_CURRENT_SOURCE = {"current": "current", "compliance_voltage": "compliance_voltage",
+                   "output_capacitance": "output_capacitance", "output_resistance": "output_resistance"}
+_WIRING = {"wiring_resistance": "resistance", "wiring_inductance": "inductance"}
+_LOADS = {
+    "resistive": {"load_resistance": "resistance"},
+    "inductive": {"load_resistance": "resistance", "load_inductance": "inductance"},
+    "capacitive": {"load_resistance": "resistance", "load_capacitance": "capacitance",
+                   "bleed_resistance": "bleed_resistance"},
+    "current_source": {"load_resistance": "resistance"},
+}
+_TEMPLATE_CIRCUIT = {"contact_capacitance": "contact_capacitance", "leakage_conductance": "leakage_conductance"}
+_NETLIST = {"netlist": None, "load_probe": "load_probe", "leakage_conductance": "leakage_conductance"}
+_PARTS = ("snubber", "flyback", "arc")
+_OPTION_KEYS = ("max_step", "reltol", "abstol", "vntol", "chgtol", "method", "temperature", "wall_timeout")
+_SCHEDULE = {"make": "intervals", "break": "intervals", "closed_resistance": "closed_resistance",
+             "edge_time": "edge_time", "opening_speed": "opening_speed"}
+
+
+def _template_keys(template: str) -> set:
+    """The [circuit] keys a template uses (besides template, schedule and the ngspice options)."""
+    if template == "netlist":
+        return set(_NETLIST) | {"arc"}
+    source = _CURRENT_SOURCE if template == "current_source" else _VOLTAGE_SOURCE
+    return set(source) | set(_WIRING) | set(_LOADS[template]) | set(_TEMPLATE_CIRCUIT) | set(_PARTS)
+
+
+CIRCUIT_KEYS = frozenset({"template", "schedule", *_OPTION_KEYS}.union(*(_template_keys(t) for t in TEMPLATES)))
+
+
+def circuit_key_names(ck) -> dict:
+    """'Class.field' of every dataclass behind [circuit] -> the scene key that sets it."""
+    names = {}
+    for cls, keys in ((ck.DCSource, _VOLTAGE_SOURCE), (ck.CurrentSource, _CURRENT_SOURCE), (ck.Wiring, _WIRING),
+                      (ck.ResistiveLoad, _LOADS["resistive"]), (ck.InductiveLoad, _LOADS["inductive"]),
+                      (ck.CapacitiveLoad, _LOADS["capacitive"]), (ck.SwitchCircuit, _TEMPLATE_CIRCUIT),
+                      (ck.NetlistCircuit, _NETLIST)):
+        names.update({f"{cls.__name__}.{name}": f"circuit.{key}" for key, name in keys.items() if name})
+    for part, cls in zip(_PARTS, (ck.Snubber, ck.FlybackDiode, ck.ArcModel)):
+        names[f"SwitchCircuit.{part}"] = names[f"NetlistCircuit.{part}"] = f"circuit.{part}"
+        names.update({f"{cls.__name__}.{f.name}": f"circuit.{part}.{f.name}" for f in dataclasses.fields(cls)})
+    names.update({f"SimulationOptions.{k}": f"circuit.{k}" for k in _OPTION_KEYS})
+    names.update({f"ContactSchedule.{name}": f"circuit.schedule.{'make/break' if name == 'intervals' else key}"
+                  for key, name in _SCHEDULE.items()})
+    names["SwitchCircuit.load"] = "circuit.template"
+    return names
+
+
+def _in_scene_words(err: Exception, names: dict) -> str:
+    """The message of a dataclass's error with every 'Class.field' it names replaced by its scene key."""
+    return re.sub(r"\b[A-Z]\w*\.\w+", lambda m: names.get(m.group(0), m.group(0)), str(err))
+
+
+def _fields(table: dict, keys: dict) -> dict:
+    """The dataclass keyword arguments of the scene keys present in ``table`` (scene key -> field)."""
+    return {name: table[key] for key, name in keys.items() if key in table and name}
+
+
+def _part(table: dict, name: str, cls, where: str):
+    """A sub-table (snubber, flyback, arc): false/absent -> None, true -> defaults, a table -> its fields."""
+    value = table.get(name)
+    if value is None or value is False:
+        return None
+    if value is True:
+        if name == "snubber":
+            raise ValueError(f"{where}: circuit.snubber = true: give its resistance (ohm) and capacitance (F), "
+                             "e.g. snubber = {resistance = 100.0, capacitance = 100e-9}")
+        return cls()
+    if not isinstance(value, dict):
+        raise ValueError(f"{where}: circuit.{name} = {value!r}: expected true, false or a table of keys")
+    allowed = [f.name for f in dataclasses.fields(cls)]
+    for key in value:
+        if key not in allowed:
+            raise _unknown(f"{where}: circuit.{name}", key, allowed)
+    if name == "snubber" and len(value) != 2:
+        missing = sorted(set(allowed) - set(value))
+        raise ValueError(f"{where}: circuit.snubber needs both resistance (ohm) and capacitance (F); "
+                         f"missing: {', '.join(missing)}")
+    return cls(**value)
+
+
 def _circuit(table: dict, base_dir: Path, where: str, current_factor: str | None):
     import circuit as ck
 
-    table = _table(where, table)
+    table = _table(f"{where}: [circuit]", table)
     for key in table:
-        if key not in _CIRCUIT_KEYS:
-            raise _unknown(where, key, _CIRCUIT_KEYS)
+        if key not in CIRCUIT_KEYS:
+            raise _unknown(f"{where}: [circuit]", key, CIRCUIT_KEYS)
     template = table.get("template", "resistive")
     if template not in TEMPLATES:
-        raise ValueError(f"{where} template = {template!r}: allowed values are {', '.join(map(repr, TEMPLATES))}")
-    stray = (set(table) & _ALL_LOAD_KEYS) - _LOAD_KEYS[template]
+        raise ValueError(f"{where}: circuit.template = {template!r}: allowed values are "
+                         f"{', '.join(map(repr, TEMPLATES))}")
+    if "voltage" in table and "current" in table:
+        raise ValueError(f"{where}: circuit.voltage and circuit.current both name a source: give one, current "
+                         "(A) with template = \"current_source\", or voltage (V) with a voltage-source template")
+    usable = _template_keys(template) | {"template", "schedule", *_OPTION_KEYS}
+    stray = sorted(set(table) - usable)
     if stray:
-        raise ValueError(f"{where}: {', '.join(sorted(stray))} do(es) not apply to template {template!r} "
-                         f"(its load keys: {', '.join(sorted(_LOAD_KEYS[template])) or 'none: the netlist has the load'})")
-
-    def sub(name, cls):
-        value = table.get(name)
-        if value is None or value is False:
-            return None
-        if value is True:
-            return cls()
-        try:
-            return cls(**_table(f"{where} {name}", value))
-        except TypeError as err:
-            raise ValueError(f"{where} {name}: {err}") from None
-
-    arc = sub("arc", ck.ArcModel)
-    option_keys = {k: table[k] for k in ("max_step", "reltol", "method", "wall_timeout") if k in table}
-    options = ck.SimulationOptions(**option_keys)
-    if template == "netlist":
-        if "netlist" not in table:
-            raise ValueError(f"{where}: template \"netlist\" needs netlist = \"file.cir\" (with one 'XCONTACT a b' line)")
-        for key in ("voltage", "source_resistance", "wiring_resistance", "wiring_inductance",
-                    "contact_capacitance", "snubber", "flyback"):
-            if key in table:
-                raise ValueError(f"{where}: {key} does not apply to template \"netlist\" (put it in the netlist)")
-        path = base_dir / str(table["netlist"])
-        if not path.is_file():
-            raise FileNotFoundError(f"{where} netlist = {str(table['netlist'])!r}: file {str(path)!r} not found")
-        kwargs = dict(arc=arc, contact_current_factor=current_factor)
-        if "load_probe" in table:
-            kwargs["load_probe"] = table["load_probe"]
-        if "leakage_conductance" in table:
-            kwargs["leakage_conductance"] = table["leakage_conductance"]
-        circ = ck.NetlistCircuit.from_file(path, **kwargs)
-    else:
-        if "netlist" in table or "load_probe" in table:
-            raise ValueError(f"{where}: netlist/load_probe apply to template \"netlist\" only")
-        source = ck.DCSource(**{k: v for k, v in (("voltage", table.get("voltage")),
-                                                 ("internal_resistance", table.get("source_resistance")))
-                                if v is not None})
-        wiring = ck.Wiring(**{k: v for k, v in (("resistance", table.get("wiring_resistance")),
-                                               ("inductance", table.get("wiring_inductance"))) if v is not None})
-        if template == "resistive":
-            load = ck.ResistiveLoad(**({"resistance": table["load_resistance"]} if "load_resistance" in table else {}))
-        elif template == "inductive":
-            load = ck.InductiveLoad(**{k: table[f"load_{k}"] for k in ("resistance", "inductance") if f"load_{k}" in table})
+        hint = {"netlist": " (put it in the netlist)",
+                "current_source": " (a current source: current, compliance_voltage, output_capacitance, "
+                                  "output_resistance)"}.get(template, "")
+        if template not in ("netlist", "current_source") and set(stray) & set(_CURRENT_SOURCE):
+            hint = " (a current source needs template = \"current_source\")"
+        raise ValueError(f"{where}: circuit.{', circuit.'.join(stray)} do(es) not apply to template {template!r}"
+                         f"{hint}; its keys: {', '.join(sorted(_template_keys(template)))}")
+    names = circuit_key_names(ck)
+    try:
+        options = ck.SimulationOptions(**{k: table[k] for k in _OPTION_KEYS if k in table})
+        arc = _part(table, "arc", ck.ArcModel, where)
+        if template == "netlist":
+            if "netlist" not in table:
+                raise ValueError(f"{where}: template \"netlist\" needs netlist = \"file.cir\" "
+                                 "(with one 'XCONTACT a b' line)")
+            path = base_dir / str(table["netlist"])
+            if not path.is_file():
+                raise FileNotFoundError(f"{where}: circuit.netlist = {str(table['netlist'])!r}: file "
+                                        f"{str(path)!r} not found")
+            circ = ck.NetlistCircuit.from_file(path, arc=arc, contact_current_factor=current_factor,
+                                               **_fields(table, _NETLIST))
         else:
-            kw = {k: table[f"load_{k}"] for k in ("resistance", "capacitance") if f"load_{k}" in table}
-            if "bleed_resistance" in table:
-                kw["bleed_resistance"] = table["bleed_resistance"]
-            load = ck.CapacitiveLoad(**kw)
-        kwargs = dict(source=source, load=load, wiring=wiring, snubber=sub("snubber", ck.Snubber),
-                      flyback=sub("flyback", ck.FlybackDiode), arc=arc, contact_current_factor=current_factor)
-        for key in ("contact_capacitance", "leakage_conductance"):
-            if key in table:
-                kwargs[key] = table[key]
-        circ = ck.SwitchCircuit(**kwargs)
-    schedule = None
-    if "schedule" in table:
-        st = _table(f"{where}.schedule", table["schedule"])
-        allowed = {"make", "break", "closed_resistance", "edge_time", "opening_speed"}
-        for key in st:
-            if key not in allowed:
-                raise _unknown(f"{where}.schedule", key, allowed)
-        if "make" not in st or "break" not in st:
-            raise ValueError(f"{where}.schedule: needs make = [...] and break = [...] (s)")
-        kw = {k: st[k] for k in ("closed_resistance", "edge_time", "opening_speed") if k in st}
-        schedule = ck.ContactSchedule.from_events(st["make"], st["break"], **kw)
+            if template == "current_source":
+                source = ck.CurrentSource(**_fields(table, _CURRENT_SOURCE))
+                load = ck.ResistiveLoad(**_fields(table, _LOADS[template]))
+            else:
+                source = ck.DCSource(**_fields(table, _VOLTAGE_SOURCE))
+                load = {"resistive": ck.ResistiveLoad, "inductive": ck.InductiveLoad,
+                        "capacitive": ck.CapacitiveLoad}[template](**_fields(table, _LOADS[template]))
+            circ = ck.SwitchCircuit(source=source, load=load, wiring=ck.Wiring(**_fields(table, _WIRING)),
+                                    snubber=_part(table, "snubber", ck.Snubber, where),
+                                    flyback=_part(table, "flyback", ck.FlybackDiode, where), arc=arc,
+                                    contact_current_factor=current_factor, **_fields(table, _TEMPLATE_CIRCUIT))
+        schedule = None
+        if "schedule" in table:
+            st = _table(f"{where}: circuit.schedule", table["schedule"])
+            for key in st:
+                if key not in _SCHEDULE:
+                    raise _unknown(f"{where}: circuit.schedule", key, _SCHEDULE)
+            if "make" not in st or "break" not in st:
+                raise ValueError(f"{where}: circuit.schedule needs make = [...] and break = [...] (s)")
+            schedule = ck.ContactSchedule.from_events(st["make"], st["break"], **_fields(st, {
+                k: k for k in ("closed_resistance", "edge_time", "opening_speed")}))
+    except ValueError as err:
+        message = _in_scene_words(err, names)
+        raise ValueError(message if message.startswith(where) else f"{where}: {message}") from None
     return CircuitSpec(circ, options, schedule, template)
 
 
@@ -397,7 +458,7 @@ def scene_from_dict(doc: dict, *, base_dir: Path | str = ".", name: str = "scene
     if circuit_table is not None:
         # R_c(F, I) = g(|I|)/G_F(F): the current factor goes into ngspice (solved without lag)
         factor = tribology.laws.resistance_law.current_factor_expression("I") if tribology is not None else None
-        circuit = _circuit(circuit_table, base_dir, f"{where} [circuit]", factor)
+        circuit = _circuit(circuit_table, base_dir, where, factor)
 
     coupling = CouplingOptions(**_known(doc.get("coupling", {}), CouplingOptions, f"{where} [coupling]"))
     output = OutputOptions(**_known(doc.get("output", {}), OutputOptions, f"{where} [output]"))

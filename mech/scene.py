@@ -95,6 +95,9 @@ def _suggest(key: str, allowed) -> str:
     return f" (did you mean {close[0]!r}?)" if close else ""
 
 
+suggest = _suggest  # public: the one did-you-mean of every scene section (coupling reuses it)
+
+
 def _field_names(cls) -> list[str]:
     return [f.name for f in dataclasses.fields(cls)]
 
