@@ -19,6 +19,7 @@ A scene names only what it needs, and only that is built:
     [coupling]    scheme = "mechanics_first" | "jacobi", macro_step, max_macro_step (s),
                   align_events = true, onset_penetration (m)
     [output]      csv, parquet, plots, history = true | false
+    [metrics]     settle_window (s), make_guard (s), arc_toggle_limit (coupling.metrics)
 
 SI units everywhere. File paths are relative to the scene file. Every error names the
 section and key and says what is allowed, before any solver starts.
@@ -39,7 +40,7 @@ from mech.scene import SECTIONS as MECH_SECTIONS
 from mech.scene import read_toml
 from mech.scene import scene_from_dict as mech_scene_from_dict
 
-COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output")
+COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output", "metrics")
 TEMPLATES = ("resistive", "inductive", "capacitive", "netlist")
 SCHEMES = ("mechanics_first", "jacobi")
 
@@ -160,6 +161,7 @@ class Scene:
     coupling: CouplingOptions = field(default_factory=CouplingOptions)
     output: OutputOptions = field(default_factory=OutputOptions)
     name: str = "scene"
+    metrics: Any = None  # coupling.metrics.MetricSettings
 
     @property
     def kind(self) -> str:
@@ -406,8 +408,11 @@ def scene_from_dict(doc: dict, *, base_dir: Path | str = ".", name: str = "scene
     t_end = _table("[solver]", doc.get("solver", {})).get("t_end")
     if t_end is not None:
         check_positive("solver.t_end", t_end)
+    from .metrics import MetricSettings
+
+    metrics = MetricSettings(**_known(doc.get("metrics", {}), MetricSettings, f"{where} [metrics]"))
     return Scene(raw=copy.deepcopy(doc), base_dir=base_dir, mech=mech, tribology=tribology, circuit=circuit,
-                 coupling=coupling, output=output, name=name)
+                 coupling=coupling, output=output, name=name, metrics=metrics)
 
 
 def _known(table, cls, where: str) -> dict:
