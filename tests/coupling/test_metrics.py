@@ -198,6 +198,7 @@ def test_coupled_run_reports_openings_and_the_fit_range(tmp_path):
     ops = pd.read_csv(tmp_path / "openings.csv")
     assert ops.reclosed.tolist() == [True, True] and b["final_state"] == "closed" and b["settled"] is False
     assert np.allclose(ops.start, [o["start"] for o in b["openings"]])
-    # the loop current (~2 A = 24 V / 12 ohm) is what each break interrupts
-    assert np.allclose(ops.current_at_break, 24.0 / 12.05, rtol=0.05)
+    # at separation the falling force has already pushed the contact voltage up to the arc's
+    # U_min = 12 V: the loop carries (E - U_min) / (R_load + R_source + R_arc), not E / R
+    assert np.allclose(ops.current_at_break, (24.0 - 12.0) / (12.0 + 0.05 + 0.05), rtol=2e-3)
     assert any("above the 3-8 N" in w for w in summary["warnings"]) and summary["warnings"] == res.warnings
