@@ -222,9 +222,46 @@ class Scene:
 
 
 def _tribology(table: dict, base_dir: Path, where: str) -> TribologySpec:
+    """[tribology]; ``resistance = { law = "holm" | "constant", ... }`` takes R_c from
+    contact materials (coupling.materials) instead of a fit, with mu from the fit or
+    ``mu = number`` (Coulomb, gamma = 0)."""
+    table = _table(where, table)
+    resistance = table.get("resistance")
+    if not (isinstance(resistance, dict) and "law" in resistance):
+        return _tribology_fitted(table, base_dir, where)
+    from coupling.materials import resistance_law_from_table
+    from coupling.tribology import ContactLaws, MuLaw
+
+    law = resistance_law_from_table(resistance, f"{where} resistance")
+    rest = {k: v for k, v in table.items() if k != "resistance"}
+    mu = rest.get("mu")
+    if isinstance(mu, (int, float)) and not isinstance(mu, bool):
+        for key in ("source", "fit", "data"):
+            if key in rest:
+                raise ValueError(f"{where}: mu = {mu!r} and {key} = both give mu; remove one")
+        if not (mu > 0 and mu < float("inf")):
+            raise ValueError(f"{where} mu = {mu!r}: expected a finite number > 0 (Coulomb friction coefficient)")
+        feedback = _bool(f"{where} feedback", rest.get("feedback", True))
+        for key in rest:
+            if key not in ("mu", "feedback"):
+                raise _unknown(where, key, {"mu", "feedback", "resistance", "source", "fit", "data"})
+        mu_law = MuLaw(0.0, "constant", (("mu0", float(mu)),), (0.0, 1e6))
+        return TribologySpec(ContactLaws(mu_law, law), f"materials ({law.name}), mu = {mu:g}", feedback)
+    if "mu" in rest and not any(k in rest for k in ("source", "fit", "data")):
+        mu_law = MuLaw.from_dict(_table(f"{where} mu", rest["mu"]))
+        return TribologySpec(ContactLaws(mu_law, law), f"materials ({law.name}), inline mu",
+                             _bool(f"{where} feedback", rest.get("feedback", True)))
+    if not any(k in rest for k in ("source", "fit", "data")):
+        raise ValueError(f"{where}: resistance = {{ law = {resistance['law']!r} }} gives R_c only; give mu too: "
+                         "mu = 0.3 (Coulomb), or source/fit/data for the fitted mu(I)")
+    spec = _tribology_fitted(rest, base_dir, where)
+    return TribologySpec(ContactLaws(spec.laws.mu_law, law), f"{spec.source} (mu); materials ({law.name}) (R_c)",
+                         spec.feedback, spec.fit)
+
+
+def _tribology_fitted(table: dict, base_dir: Path, where: str) -> TribologySpec:
     from coupling.tribology import ContactLaws, TribometerFit, default_fit, fit_tribometer, read_tribometer_csv
 
-    table = _table(where, table)
     allowed = {"source", "fit", "data", "mu", "resistance", "feedback"}
     for key in table:
         if key not in allowed:
