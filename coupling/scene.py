@@ -13,7 +13,8 @@ A scene names only what it needs, and only that is built:
                   load_resistance, load_inductance, load_capacitance, bleed_resistance,
                   contact_capacitance, leakage_conductance, snubber = {resistance, capacitance},
                   flyback = true | {...}, arc = true | false | {min_voltage, min_current, ...},
-                  netlist = "file.cir", load_probe, max_step, reltol, method, wall_timeout
+                  netlist = "file.cir", load_probe, max_step, reltol, method, wall_timeout,
+                  probes = ["v(node)", "v(n1,n2)", "i(element)"] (recorded as waveform columns)
     [circuit.schedule]  make = [...], break = [...], closed_resistance, opening_speed
                         (s, s, ohm, m/s: the gap for an arc whose voltage grows with it)
     [coupling]    scheme = "mechanics_first" | "jacobi", macro_step, max_macro_step (s),
@@ -48,7 +49,7 @@ _CIRCUIT_KEYS = {
     "template", "voltage", "source_resistance", "wiring_resistance", "wiring_inductance",
     "load_resistance", "load_inductance", "load_capacitance", "bleed_resistance",
     "contact_capacitance", "leakage_conductance", "snubber", "flyback", "arc", "netlist",
-    "load_probe", "max_step", "reltol", "method", "wall_timeout", "schedule",
+    "load_probe", "max_step", "reltol", "method", "wall_timeout", "schedule", "probes",
 }
 _LOAD_KEYS = {
     "resistive": {"load_resistance"},
@@ -147,6 +148,7 @@ class CircuitSpec:
     options: Any  # circuit.SimulationOptions
     schedule: Any = None  # circuit.ContactSchedule | None
     template: str = "resistive"
+    probes: tuple = ()  # circuit.probes.UserProbe: [circuit] probes = ["v(node)", "i(element)"]
 
 
 @dataclass(frozen=True)
@@ -376,7 +378,13 @@ def _circuit(table: dict, base_dir: Path, where: str, current_factor: str | None
             raise ValueError(f"{where}.schedule: needs make = [...] and break = [...] (s)")
         kw = {k: st[k] for k in ("closed_resistance", "edge_time", "opening_speed") if k in st}
         schedule = ck.ContactSchedule.from_events(st["make"], st["break"], **kw)
-    return CircuitSpec(circ, options, schedule, template)
+    probes = ()
+    if "probes" in table:  # validated against the deck's nodes and elements
+        from circuit.deck import build_deck
+        from circuit.probes import check_probes
+
+        probes = check_probes(table["probes"], build_deck(circ, 1.0, options)[0], f"{where} probes")
+    return CircuitSpec(circ, options, schedule, template, probes)
 
 
 def scene_from_dict(doc: dict, *, base_dir: Path | str = ".", name: str = "scene") -> Scene:
