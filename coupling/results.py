@@ -114,12 +114,19 @@ class CoupledResult:
         return out
 
     def save(self, out_dir) -> Path:
-        """Write summary.json, the waveforms (CSV, parquet), the mechanics tables and PNG plots,
-        as the scene's [output] asks."""
+        """Write summary.json, the waveforms (CSV, parquet, the interactive waveforms.html),
+        openings.csv, the mechanics tables and PNG plots, as the scene's [output] asks."""
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         opts = self.scene.output
-        (out / "summary.json").write_text(json.dumps(self.summary, indent=2))
+        summary = self.summary
+        html = None
+        if self.waveforms is not None and getattr(opts, "html", True):
+            from .waveview import write_waveform_html
+
+            html = write_waveform_html(self, out / "waveforms.html")
+            summary["waveforms_html"] = "waveforms.html" if html == "written" else html
+        (out / "summary.json").write_text(json.dumps(summary, indent=2))
         if self.waveforms is not None:
             if opts.csv:
                 self.waveforms.to_csv(out / "waveforms.csv", index=False)

@@ -19,7 +19,7 @@ A scene names only what it needs, and only that is built:
                         (s, s, ohm, m/s: the gap for an arc whose voltage grows with it)
     [coupling]    scheme = "mechanics_first" | "jacobi", macro_step, max_macro_step (s),
                   align_events = true, onset_penetration (m)
-    [output]      csv, parquet, plots, history = true | false
+    [output]      csv, parquet, plots, history, html = true | false
     [metrics]     settle_window (s), make_guard (s), arc_toggle_limit (coupling.metrics)
 
 SI units everywhere. File paths are relative to the scene file. Every error names the
@@ -122,12 +122,14 @@ class CouplingOptions:
 
 @dataclass(frozen=True)
 class OutputOptions:
-    """What a run writes besides summary.json: csv, parquet, plots (PNG), history (mechanics CSV)."""
+    """What a run writes besides summary.json: csv, parquet, plots (PNG), history (mechanics CSV),
+    html (waveforms.html, the interactive waveform page)."""
 
     csv: bool = True
     parquet: bool = True
     plots: bool = True
     history: bool = True
+    html: bool = True
 
 
 @dataclass(frozen=True)
