@@ -193,11 +193,17 @@ class Scene:
 
     def update(self, changes: dict) -> "Scene":
         """A new scene with several "section.key" values set at once, validated once (for
-        keys that only make sense together, e.g. initial.resting with initial.angle_deg = 0)."""
+        keys that only make sense together, e.g. initial.resting with initial.angle_deg = 0).
+
+        Setting one of several exclusive alternatives drops the others the scene had (unless
+        they are set in the same call): ``update({"bar.width": 0.02, "bar.thickness": 3e-4})``
+        turns a round bar (bar.diameter) into a rectangular one in one call; likewise
+        bar.diameter back, and tribology.source / fit / data (ALTERNATIVES)."""
         raw = copy.deepcopy(self.raw)
         for key, value in changes.items():
             node, last = _walk(raw, key)
             node[last] = list(value) if isinstance(value, tuple) else value
+        _drop_replaced_alternatives(raw, changes)
         return scene_from_dict(raw, base_dir=self.base_dir, name=self.name)
 
     def unset(self, *keys: str) -> "Scene":
@@ -471,6 +477,30 @@ def _known(table, cls, where: str) -> dict:
         if key not in allowed:
             raise _unknown(where, key, allowed)
     return dict(table)
+
+
+#: Exclusive key groups: (section, alternatives); setting keys of one drops the others.
+ALTERNATIVES = (
+    ("bar", (("diameter",), ("width", "thickness"))),
+    ("tribology", (("source",), ("fit",), ("data",))),
+)
+
+
+def _drop_replaced_alternatives(raw: dict, changes: dict) -> None:
+    """Remove the alternatives replaced by ``changes`` ("section.key" -> value) from raw."""
+    for section, groups in ALTERNATIVES:
+        set_now = {k.split(".", 1)[1] for k in changes if k.startswith(section + ".") and k.count(".") == 1}
+        table = raw.get(section)
+        if not set_now or not isinstance(table, dict):
+            continue
+        chosen = [g for g in groups if set_now & set(g)]
+        if len(chosen) != 1:
+            continue  # none touched, or several at once: validation says what is wrong
+        for group in groups:
+            if group is not chosen[0]:
+                for key in group:
+                    if key not in set_now:
+                        table.pop(key, None)
 
 
 def _walk(raw: dict, key: str) -> tuple[dict, str]:

@@ -202,3 +202,16 @@ def test_coupled_run_reports_openings_and_the_fit_range(tmp_path):
     # U_min = 12 V: the loop carries (E - U_min) / (R_load + R_source + R_arc), not E / R
     assert np.allclose(ops.current_at_break, (24.0 - 12.0) / (12.0 + 0.05 + 0.05), rtol=2e-3)
     assert any("above the 3-8 N" in w for w in summary["warnings"]) and summary["warnings"] == res.warnings
+
+
+def test_switching_a_bar_section_is_one_call():
+    """Scene.update with width and thickness used to fail until bar.diameter was unset."""
+    from coupling import default_scene
+
+    base = default_scene()
+    blade = base.update({"bar.width": 0.008, "bar.thickness": 0.002})
+    assert "diameter" not in blade.raw["bar"] and blade.mech.bar.width == 0.008
+    round_again = blade.set("bar.diameter", 0.01)
+    assert "width" not in round_again.raw["bar"] and round_again.mech.bar.diameter == 0.01
+    with pytest.raises(ValueError, match="either diameter"):
+        base.update({"bar.width": 0.008, "bar.thickness": 0.002, "bar.diameter": 0.01})
