@@ -1,0 +1,50 @@
+"""docs/scene_keys.md lists every section and key the scene validators accept (and no other)."""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+from pathlib import Path
+
+from coupling import scene as cs
+from coupling.metrics import MetricSettings
+from mech.scene import ENVIRONMENT_KEYS, SECTIONS
+
+DOC = Path(__file__).resolve().parents[2] / "docs" / "scene_keys.md"
+
+
+def _documented() -> dict[str, set[str]]:
+    out: dict[str, set[str]] = {}
+    section = None
+    for line in DOC.read_text().splitlines():
+        m = re.match(r"^## \[([a-z_.]+)\]", line)
+        if m:
+            section = m.group(1)
+            out[section] = set()
+            continue
+        m = re.match(r"^\| `([a-z_]+)` \|", line)
+        if m and section:
+            out[section].add(m.group(1))
+    return out
+
+
+def _fields(cls) -> set[str]:
+    return {f.name for f in dataclasses.fields(cls)}
+
+
+def test_every_accepted_key_is_documented_and_nothing_else():
+    doc = _documented()
+    expected = {name: _fields(cls) for name, cls in SECTIONS.items()}
+    # [bar] modes stands for axial_modes/bending_modes
+    expected["bar"] = (expected["bar"] - {"axial_modes", "bending_modes"}) | {"modes"}
+    expected["initial"] = expected["initial"]
+    expected["environment"] = set(ENVIRONMENT_KEYS)
+    expected["tribology"] = {"source", "fit", "data", "mu", "resistance", "feedback"}
+    expected["circuit"] = set(cs._CIRCUIT_KEYS)
+    expected["circuit.schedule"] = {"make", "break", "closed_resistance", "edge_time", "opening_speed"}
+    expected["coupling"] = _fields(cs.CouplingOptions)
+    expected["output"] = _fields(cs.OutputOptions)
+    expected["metrics"] = _fields(MetricSettings)
+    assert set(doc) == set(expected), "sections of docs/scene_keys.md differ from the scene's"
+    for section, keys in expected.items():
+        assert doc[section] == keys, f"[{section}]: missing {keys - doc[section]}, extra {doc[section] - keys}"
