@@ -13,8 +13,9 @@ Definitions (SI: s, V, A, J), documented for users in docs/coupling.md ("Bounce 
   by the end of the run. ``settle_time`` = start of the final closure - first make
   (None when not settled: the run ends open, or the final closure is shorter than the
   settle window; ``settle_note`` then says which).
-- bounce window: first make to the start of the final closure (run ends closed) or to
-  the last break (run ends open: the final opening is reported on its own).
+- bounce window: first make to the start of the last closure (the last make). When the
+  run ends open, that last closure's break and the final opening are reported on their
+  own (``final_opening``): a single make that opens for good has no bounce window.
 - make-instant samples: at a make ngspice keeps the left limit (the open contact) and may
   put one or more samples within femtoseconds after it that still show the open-circuit
   voltage. Samples with make <= t <= make + guard (``make_guard``, default
@@ -220,9 +221,8 @@ def bounce_metrics(intervals, t_end: float, closed_at_end: bool, t=None, v=None,
     first_event = min([x for x in (makes[:1] + breaks[:1])], default=None)
     if first_event is not None:
         out["peak_contact_voltage"] = _peak(v, (t >= first_event) & ~excluded)
-    if makes:
-        window_end = iv[-1][0] if closed_at_end else (breaks[-1] if breaks else t_end)
-        out["peak_bounce_voltage"] = _peak(v, (t >= makes[0]) & (t <= window_end) & ~excluded)
+    if makes:  # the bounce window: first make to the last make (the start of the final closure)
+        out["peak_bounce_voltage"] = _peak(v, (t >= makes[0]) & (t <= makes[-1]) & ~excluded)
     rows = opening_table(t, v, i_loop, i_arc, openings, makes, guard)
     out["openings"] = rows
     if rows and not rows[-1]["reclosed"]:

@@ -135,8 +135,9 @@ def plot_waveforms(result, whole_run: bool = False):
     final = b.get("peak_final_opening_voltage")
     settle = ("settled, settle time " + f"{b['settle_time'] * 1e3:.4g} ms") if b.get("settled") else (
         "not settled" + (" (ends open)" if b.get("final_state") == "open" else ""))
-    ax_v.set_title(f"{title}: {b.get('bounces', 0)} bounce(s), {settle}; peak in bounces "
-                   f"{peak or 0:.3g} V" + (f", final opening {final:.3g} V" if final else "")
+    ax_v.set_title(f"{title}: {b.get('bounces', 0)} bounce(s), {settle}; "
+                   + (f"peak in bounces {peak:.3g} V" if peak is not None else "no bounce peak")
+                   + (f", final opening {final:.3g} V" if final else "")
                    + f"; arc energy {b.get('arc_energy') or 0:.3g} J", fontsize=9)
     fig.tight_layout()
     return fig

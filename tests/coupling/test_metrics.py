@@ -215,3 +215,14 @@ def test_switching_a_bar_section_is_one_call():
     assert "width" not in round_again.raw["bar"] and round_again.mech.bar.diameter == 0.01
     with pytest.raises(ValueError, match="either diameter"):
         base.update({"bar.width": 0.008, "bar.thickness": 0.002, "bar.diameter": 0.01})
+
+
+def test_a_single_make_that_opens_for_good_has_no_bounce_peak():
+    """One closure then the final opening (the contact's voltage rises to the arc's 12 V at the
+    break): no bounce, so no bounce peak; the break is the final opening's."""
+    t_end = 3e-3
+    iv = [(1.0e-3, 1.3e-3)]
+    t, v, i_c, i_a = waveform(t_end, iv)
+    b = bounce_metrics(iv, t_end, False, t, v, i_c, i_a)
+    assert b["bounces"] == 0 and b["peak_bounce_voltage"] is None
+    assert b["peak_final_opening_voltage"] == pytest.approx(U_ARC) and b["final_opening"]["break_time"] == 1.3e-3
