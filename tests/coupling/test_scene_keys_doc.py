@@ -48,3 +48,16 @@ def test_every_accepted_key_is_documented_and_nothing_else():
     assert set(doc) == set(expected), "sections of docs/scene_keys.md differ from the scene's"
     for section, keys in expected.items():
         assert doc[section] == keys, f"[{section}]: missing {keys - doc[section]}, extra {doc[section] - keys}"
+
+
+def test_readme_relay_quick_start_scene_is_valid():
+    """The README's "model my relay" scene validates as written (and uses the material law)."""
+    import tomllib
+
+    from coupling.scene import scene_from_dict
+
+    text = (DOC.parents[1] / "README.md").read_text()
+    block = re.search(r"```toml\n(# relay\.toml.*?)```", text, re.S).group(1)
+    scene = scene_from_dict(tomllib.loads(block), name="relay")
+    assert scene.kind == "coupled" and scene.tribology.laws.resistance_law.materials == ("AgNi10", "Ag")
+    assert scene.mech.initial.height == 0.4e-3 and scene.circuit.circuit.load.resistance == 5.0
