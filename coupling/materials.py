@@ -285,7 +285,7 @@ class HolmResistance(_ForceLaw):
     def to_dict(self) -> dict[str, Any]:
         return {"law": "holm", "materials": list(self.materials), "regime": self.regime, "spots": self.spots,
                 "radius": self.radius, "film_resistivity": self.film_resistivity,
-                "validity_force_N": list(self.validity["force_N"])}
+                "validity_force_N": [f if math.isfinite(f) else None for f in self.validity["force_N"]]}
 
 
 HOLM_KEYS = {"law", "materials", "regime", "spots", "radius", "film_resistivity"}

@@ -135,6 +135,11 @@ def test_scene_selects_material_laws():
     fitted = _scene({"resistance": {"law": "constant", "value": 2e-3}, "source": "illustrative"})
     assert float(fitted.tribology.laws.resistance_law.resistance(10.0)) == 2e-3
     assert fitted.tribology.fit is not None  # mu(I) still from the fit
+    import json
+
+    # summary.json stays strict JSON (no Infinity) for a law without an upper force bound
+    text = json.dumps(sc.tribology.laws.to_dict(), allow_nan=False)
+    assert '"validity_force_N": [' in text
     with pytest.raises(ValueError, match="gives R_c only; give mu too"):
         _scene({"resistance": {"law": "holm", "materials": "Ag"}})
 
