@@ -17,7 +17,7 @@ def _documented() -> dict[str, set[str]]:
     out: dict[str, set[str]] = {}
     section = None
     for line in DOC.read_text().splitlines():
-        m = re.match(r"^## \[([a-z_.]+)\]", line)
+        m = re.match(r"^## \[\[?([a-z_.]+)\]\]?", line)  # [section] or [[array of tables]]
         if m:
             section = m.group(1)
             out[section] = set()
