@@ -241,3 +241,35 @@ def test_a_bounce_without_the_arc_model_warns_of_breakdown():
     assert b["peak_final_opening_voltage"] > 1000.0  # L di/dt of 50 uH interrupted without an arc
     lines = [w for w in res.warnings if "exceeds air breakdown" in w]
     assert len(lines) == 1 and "add the arc model" in lines[0]
+
+
+def test_opening_operation_against_the_closed_form_of_a_lengthening_arc():
+    """A contact closed from t = 0 opens at 0.1 ms at 2 m/s (24 V, 0.05 + 12 ohm, arc 12 V +
+    2 V/mm): the arc current falls linearly, i = (V - U_min - E_col v t')/R_total, and goes
+    out at I_min after t* = d*/v; its energy is R_total/(E_col v) [V (i0^2 - I_min^2)/2 -
+    (R_s + R_L)(i0^3 - I_min^3)/3] (the closed form of tests/circuit/test_circuit_arc_gap.py)."""
+    from coupling import run
+    from coupling.scene import scene_from_dict
+
+    v_s, r_s, r_l, e_col, speed, t_break = 24.0, 0.05, 12.0, 2e3, 2.0, 1e-4
+    u_min, i_min, r_arc = 12.0, 0.4, 0.05
+    doc = {"circuit": {"voltage": v_s, "source_resistance": r_s, "wiring_resistance": 0.0, "wiring_inductance": 0.0,
+                       "load_resistance": r_l, "contact_capacitance": 100e-12, "max_step": 1e-6,
+                       "arc": {"min_voltage": u_min, "min_current": i_min, "resistance": r_arc, "column_gradient": e_col},
+                       "schedule": {"make": [0.0], "break": [t_break], "closed_resistance": 0.01,
+                                    "opening_speed": speed}},
+           "solver": {"t_end": 2.5e-3}}
+    b = run(scene_from_dict(doc)).bounce
+    r_total = r_s + r_l + r_arc
+    i0 = (v_s - u_min) / r_total
+    t_star = (v_s - u_min - i_min * r_total) / e_col / speed
+    w = r_total / (e_col * speed) * (v_s * (i0**2 - i_min**2) / 2 - (r_s + r_l) * (i0**3 - i_min**3) / 3)
+    assert b["initial_state"] == "closed" and b["final_state"] == "open" and b["first_make"] is None
+    fo = b["final_opening"]
+    assert fo["break_time"] == pytest.approx(t_break)
+    # at separation the 10 ns conductance ramp before the break has already moved part of the
+    # closed current (24 V / 12.06 ohm) into the contact capacitance; the arc has not taken over yet
+    assert i0 < fo["current_at_break"] < v_s / (r_s + r_l + 0.01)
+    assert fo["arc_duration"] == pytest.approx(t_star, rel=2e-3)  # sampled at 1 us
+    assert fo["arc_energy"] == pytest.approx(w, rel=2e-3)
+    assert b["settled"] is False and b["settle_time"] is None
