@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from typing import Callable
 
@@ -107,3 +108,143 @@ class Probes:
         if node.lower() in _GROUND:
             return np.zeros_like(time)
         return vec(node)
+
+
+# --- user probes: any node voltage or branch current of the deck ------------------------------
+
+_PROBE = re.compile(r"^\s*([vViI])\s*\(\s*([^(),\s]+)\s*(?:,\s*([^(),\s]+)\s*)?\)\s*$")
+_SUFFIX = {"t": 1e12, "g": 1e9, "meg": 1e6, "k": 1e3, "m": 1e-3, "u": 1e-6, "n": 1e-9, "p": 1e-12, "f": 1e-15}
+_TWO_NODES = set("rclvidbsw")  # element letters whose first two tokens after the name are nodes
+
+
+@dataclass(frozen=True)
+class UserProbe:
+    """A recorded quantity named as in SPICE: ``v(node)``, ``v(node1,node2)`` (V) or
+    ``i(element)`` (A, positive into the element's first node): the column name is ``text``.
+
+    Currents: a voltage source's or inductor's branch vector; a resistor's (V(n1) - V(n2)) / R;
+    a capacitor's C d(V(n1) - V(n2))/dt by finite differences over the accepted points.
+    """
+
+    text: str
+    kind: str  # "v" | "i"
+    names: tuple[str, ...]  # nodes (v) or the element (i), lower case
+
+
+def parse_probe(text, where: str = "probes") -> UserProbe:
+    """One probe from its text; ValueError (one line) for anything else."""
+    m = _PROBE.match(text) if isinstance(text, str) else None
+    if m is None or (m.group(1).lower() == "i" and m.group(3)):
+        raise ValueError(f"{where}: probe {text!r}: expected 'v(node)', 'v(node1,node2)' or 'i(element)'")
+    names = tuple(n.lower() for n in m.groups()[1:] if n)
+    return UserProbe(text.strip(), m.group(1).lower(), names)
+
+
+def spice_number(token: str) -> float:
+    """A SPICE number with an optional scale suffix (1k, 100n, 2.2meg, 1e-6, 5uF)."""
+    m = re.match(r"^([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)([a-zA-Z]*)", token)
+    if m is None:
+        raise ValueError(f"not a number: {token!r}")
+    value, suffix = float(m.group(1)), m.group(2).lower()
+    for key in ("meg", "t", "g", "k", "m", "u", "n", "p", "f"):
+        if suffix.startswith(key):
+            return value * _SUFFIX[key]
+    return value
+
+
+def deck_topology(lines) -> tuple[set[str], dict[str, tuple[tuple[str, ...], str]]]:
+    """(node names, element name -> (its two nodes, its value token)) of a deck, lower case."""
+    nodes: set[str] = {"0"}
+    elements: dict[str, tuple[tuple[str, ...], str]] = {}
+    for line in list(lines)[1:]:
+        tokens = line.split()
+        if not tokens or tokens[0][0] in ".*+":
+            continue
+        name = tokens[0].lower()
+        letter = name[0]
+        if letter in _TWO_NODES and len(tokens) >= 3:
+            pair = (tokens[1].lower(), tokens[2].lower())
+            nodes.update(pair)
+            elements[name] = (pair, tokens[3] if len(tokens) > 3 else "")
+            if letter in "sw" and len(tokens) > 4:
+                nodes.update(t.lower() for t in tokens[3:5])
+        elif letter in "eg" and len(tokens) >= 5:
+            nodes.update(t.lower() for t in tokens[1:5])
+            elements[name] = ((tokens[1].lower(), tokens[2].lower()), "")
+        elif letter == "x":
+            nodes.update(t.lower() for t in tokens[1:-1] if "=" not in t)
+        elif letter in "qmj":
+            nodes.update(t.lower() for t in tokens[1:4])
+    return nodes, elements
+
+
+def check_probes(texts, lines, where: str = "probes") -> tuple[UserProbe, ...]:
+    """Parse and validate probes against a deck's nodes and elements (one-line errors)."""
+    if isinstance(texts, str) or not isinstance(texts, (list, tuple)):
+        raise ValueError(f"{where} = {texts!r}: expected a list such as [\"v(snubber)\", \"i(Lload)\"]")
+    nodes, elements = deck_topology(lines)
+    out = []
+    for text in texts:
+        probe = parse_probe(text, where)
+        if probe.kind == "v":
+            for n in probe.names:
+                if n not in nodes and n != "gnd":
+                    raise ValueError(f"{where}: probe {text!r}: no node {n!r} in the circuit; nodes: "
+                                     f"{', '.join(sorted(nodes))}")
+        else:
+            (name,) = probe.names
+            if name not in elements or name[0] not in "vlrc":
+                known = sorted(e for e in elements if e[0] in "vlrc")
+                raise ValueError(f"{where}: probe {text!r}: no element {name!r} whose current can be recorded "
+                                 f"(V, L, R or C elements: {', '.join(known)})")
+            if name[0] in "rc":
+                try:
+                    spice_number(elements[name][1])
+                except ValueError:
+                    raise ValueError(f"{where}: probe {text!r}: the value {elements[name][1]!r} of {name} is "
+                                     "not a number (a behavioural element): probe its nodes' voltages") from None
+        if probe.text in COLUMNS or probe.text in (p.text for p in out):
+            raise ValueError(f"{where}: probe {text!r} is given twice or names a built-in column")
+        out.append(probe)
+    return tuple(out)
+
+
+def probe_columns(probes, read: Callable[[str], np.ndarray], lines) -> dict[str, np.ndarray]:
+    """The probes' columns, each read through ``read(vector_name) -> array`` (SI: V, A)."""
+    if not probes:
+        return {}
+    _, elements = deck_topology(lines)
+    time = read("time")
+
+    def node(n: str) -> np.ndarray:
+        return np.zeros_like(time) if n in _GROUND else read(n)
+
+    out: dict[str, np.ndarray] = {}
+    for p in probes:
+        if p.kind == "v":
+            out[p.text] = node(p.names[0]) - (node(p.names[1]) if len(p.names) > 1 else 0.0)
+            continue
+        name = p.names[0]
+        (a, b), value = elements[name]
+        if name[0] in "vl":
+            out[p.text] = read(f"{name}#branch")
+        elif name[0] == "r":
+            out[p.text] = (node(a) - node(b)) / spice_number(value)
+        else:
+            dv = node(a) - node(b)
+            out[p.text] = spice_number(value) * _derivative(dv, time)
+    return out
+
+
+def _derivative(y: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """dy/dt at the samples: the mean of the adjacent secant slopes (one-sided at the ends);
+    repeated time points (a breakpoint's two sides) count as one."""
+    if len(t) < 2:
+        return np.zeros_like(t)
+    dt = np.diff(t)
+    slope = np.where(dt > 0, np.diff(y) / np.where(dt > 0, dt, 1.0), np.nan)
+    left = np.concatenate([[np.nan], slope])
+    right = np.concatenate([slope, [np.nan]])
+    out = np.nanmean(np.vstack([left, right]), axis=0) if np.isfinite(slope).any() else np.zeros_like(t)
+    return np.nan_to_num(out)
+    return out

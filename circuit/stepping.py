@@ -39,7 +39,7 @@ from .deck import CircuitLike, arc_state, build_deck, circuit_arc
 from .errors import SessionBusyError
 from .ngspice import NgspiceSession, get_session
 from .options import SimulationOptions
-from .probes import COLUMNS
+from .probes import COLUMNS, probe_columns
 
 #: The gap distance d(t) >= 0 (m) as a function of time (s).
 Gap = Callable[[float], float]
@@ -291,14 +291,23 @@ class Stepper:
         return {"steps": self._steps, "points": points, "conductance_calls": calls, "gap_calls": gap_calls,
                 "ngspice_seconds": self._ngspice_seconds, "arc_switches": self._arc.switches if self._arc else 0}
 
-    def results(self, extra: tuple[str, ...] = ()) -> pd.DataFrame:
-        """The whole run so far: columns ``COLUMNS`` (SI) plus raw ngspice vectors named in ``extra``."""
+    def results(self, extra: tuple[str, ...] = (), probes=()) -> pd.DataFrame:
+        """The whole run so far: columns ``COLUMNS`` (SI) plus raw ngspice vectors named in ``extra``
+        and the user probes (``circuit.probes.check_probes``: v(node), i(element)) as columns
+        named by their text; after ``close()`` the probes' columns are NaN (ngspice's vectors
+        are gone: ask for them before)."""
         if self._final is not None and not extra:
-            return self._final.copy()
+            frame = self._final.copy()
+            for p in probes:
+                frame[p.text] = np.nan
+            return frame
         session = self._active()
         if not self._started:
-            return pd.DataFrame({name: np.empty(0) for name in COLUMNS + tuple(extra)})
-        return self.probes.frame(session.vector, tuple(extra))
+            return pd.DataFrame({name: np.empty(0) for name in COLUMNS + tuple(extra) + tuple(p.text for p in probes)})
+        frame = self.probes.frame(session.vector, tuple(extra))
+        for name, values in probe_columns(probes, lambda n: session.vector(n.lower()), self.deck).items():
+            frame[name] = values
+        return frame
 
     def vector(self, name: str) -> np.ndarray:
         """Any raw ngspice vector of the run (node name, 'element#branch'), while open."""

@@ -25,6 +25,7 @@ def run_transient(
     breakpoints: Iterable[float] = (),
     extra: tuple[str, ...] = (),
     gap: Gap | float | None = None,
+    probes=(),
 ) -> pd.DataFrame:
     """Run 0..t_end (s) with the contact conductance from Python; returns the waveform (SI columns).
 
@@ -35,6 +36,7 @@ def run_transient(
         model that depends on it (``ArcModel.column_gradient``/``breakdown_gradient``);
         None: a schedule's own ``gap`` if it has an ``opening_speed``. Missing while
         needed: ValueError before anything runs.
+    probes: user probes (``circuit.probes.check_probes``) recorded as extra columns.
     """
     points = set(float(b) for b in breakpoints)
     if isinstance(contact, ContactSchedule):
@@ -45,7 +47,7 @@ def run_transient(
     _require_gap(circuit, gap, "run_transient(..., gap=function_of_time_or_number)")
     with Stepper(circuit, t_end, options) as stepper:
         stepper.advance(t_end, contact, sorted(p for p in points if 0.0 < p <= t_end), gap=gap)
-        return stepper.results(extra)
+        return stepper.results(extra, probes)
 
 
 def _require_gap(circuit: CircuitLike, gap: object, how: str) -> None:

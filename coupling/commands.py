@@ -36,6 +36,8 @@ def run_command(scene_path: str | None, out_dir: str, *, quiet: bool = False) ->
                   f"{summary['restitution']}, energy residual {summary['energy']['relative_residual']:.2g}")
         for flag in summary.get("flags", []):
             print(f"switchsim: flag: {flag}")
+        for line in summary.get("warnings", []):  # coupling.diagnostics
+            print(f"switchsim: warning: {line}")
         print(f"switchsim: wrote {out}", file=sys.stderr)
     return 0
 

@@ -250,7 +250,7 @@ class CoSimulation:
     # --- results -------------------------------------------------------------------------
 
     def _result(self, mech, stepper, status: str) -> CoupledResult:
-        waves = stepper.results()
+        waves = stepper.results(probes=self.scene.circuit.probes)
         waves = waves[waves.time <= mech.t + 1e-15].reset_index(drop=True)
         contact = mech.contact_series(waves.time.to_numpy())
         for i in range(2):
@@ -387,7 +387,7 @@ def run(scene: Scene, *, progress: bool = False) -> CoupledResult:
 
     tick = time.perf_counter()
     spec = scene.circuit
-    waves = run_transient(spec.circuit, spec.schedule, scene.t_end, options=spec.options)
+    waves = run_transient(spec.circuit, spec.schedule, scene.t_end, options=spec.options, probes=spec.probes)
     return CoupledResult(scene=scene, mechanics=None, waveforms=waves,
                          stats=dict(wall_time=time.perf_counter() - tick), status="ok")
 

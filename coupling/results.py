@@ -1,14 +1,10 @@
-"""The outcome of a run: mechanics result, circuit waveforms, bounce metrics, files and plots.
+"""The outcome of a run: mechanics result, circuit waveforms, bounce metrics, warnings, files and plots.
 
-Bounce metrics (``bounce`` in summary.json), from the closed intervals of the contact
-(mechanics: the union of both tips' contact intervals; prescribed schedule: its
-intervals), SI units:
-    first_make, last_make      s, first and last closing instant
-    bounces                    re-closures after the first make (makes - 1)
-    total_bounce_time          s, last_make - first_make
-    final_state                "closed" or "open" at the end of the run
-    peak_contact_voltage       V, largest |contact voltage| after the first make
-    arc_energy                 J, integral of |contact voltage x arc current| dt
+Bounce metrics (``bounce`` in summary.json) are computed by coupling.metrics from the
+closed intervals of the contact (mechanics: the union of the tips' contact intervals;
+prescribed schedule: its intervals) and the waveform; every key is defined in
+docs/coupling.md ("Bounce metrics"). Warnings (``warnings``) come from
+coupling.diagnostics.
 """
 
 from __future__ import annotations
@@ -21,6 +17,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .metrics import MetricSettings, merge_intervals
+from .metrics import bounce_metrics as _bounce_metrics
+
 
 def _num(v):
     if v is None:
@@ -29,36 +28,17 @@ def _num(v):
     return v if math.isfinite(v) else None
 
 
-def merge_intervals(intervals) -> list[tuple[float, float]]:
-    """Union of closed intervals (s), sorted."""
-    out: list[list[float]] = []
-    for a, b in sorted(intervals):
-        if out and a <= out[-1][1]:
-            out[-1][1] = max(out[-1][1], b)
-        else:
-            out.append([a, b])
-    return [(a, b) for a, b in out]
-
-
-def bounce_metrics(intervals, t_end: float, waveforms: pd.DataFrame | None, closed_at_end: bool) -> dict:
-    """The bounce summary (see the module docstring) from closed intervals and the waveform."""
-    iv = merge_intervals(intervals)
-    out = dict(first_make=None, last_make=None, bounces=0, total_bounce_time=0.0,
-               final_state="closed" if closed_at_end else "open", peak_contact_voltage=None, arc_energy=0.0)
-    if iv:
-        out.update(first_make=iv[0][0], last_make=iv[-1][0], bounces=len(iv) - 1,
-                   total_bounce_time=iv[-1][0] - iv[0][0])
-    if waveforms is not None and len(waveforms):
-        t = waveforms.time.to_numpy()
-        v = waveforms.contact_voltage.to_numpy()
-        # strictly after the first make: at the make instant itself ngspice still has the
-        # open contact (left limit at the breakpoint), i.e. the full supply voltage
-        mask = t > iv[0][0] if iv else np.ones(len(t), bool)
-        out["peak_contact_voltage"] = float(np.max(np.abs(v[mask]))) if mask.any() else None
-        if "arc_current" in waveforms:
-            p = np.abs(v * waveforms.arc_current.to_numpy())
-            out["arc_energy"] = float(np.sum(0.5 * (p[1:] + p[:-1]) * np.diff(t)))
-    return out
+def bounce_metrics(intervals, t_end: float, waveforms: pd.DataFrame | None, closed_at_end: bool,
+                   settings: MetricSettings | None = None) -> dict:
+    """The bounce summary (coupling.metrics.bounce_metrics) from closed intervals and a waveform frame."""
+    if waveforms is None or not len(waveforms):
+        return _bounce_metrics(intervals, t_end, closed_at_end, settings=settings)
+    arc = waveforms.arc_current.to_numpy() if "arc_current" in waveforms else None
+    loop = waveforms.load_current.to_numpy() if "load_current" in waveforms else None
+    if loop is None or not np.all(np.isfinite(loop)):  # no load probe: metallic + arc current
+        loop = waveforms.contact_current.to_numpy() + (arc if arc is not None else 0.0)
+    return _bounce_metrics(intervals, t_end, closed_at_end, waveforms.time.to_numpy(),
+                           waveforms.contact_voltage.to_numpy(), loop, arc, settings=settings)
 
 
 @dataclass
@@ -92,7 +72,28 @@ class CoupledResult:
             closed_at_end = bool((~c.complete).any()) if len(c) else False
         else:
             closed_at_end = self.scene.circuit.schedule.is_closed(self.scene.t_end)
-        return bounce_metrics(self.closed_intervals, self.scene.t_end, self.waveforms, closed_at_end)
+        key = "bounce"
+        if key not in self._cache:
+            self._cache[key] = bounce_metrics(self.closed_intervals, self.scene.t_end, self.waveforms,
+                                              closed_at_end, getattr(self.scene, "metrics", None))
+        return self._cache[key]
+
+    @property
+    def openings(self) -> pd.DataFrame:
+        """The per-opening table of ``bounce`` (openings.csv): start, end, open_duration, reclosed,
+        kind, current_at_break, peak_voltage, arc_duration, arc_energy (SI)."""
+        columns = ["start", "end", "open_duration", "reclosed", "kind", "current_at_break", "peak_voltage",
+                   "arc_duration", "arc_energy"]
+        return pd.DataFrame(self.bounce.get("openings", []), columns=columns)
+
+    @property
+    def warnings(self) -> list[str]:
+        """One-line warnings about physically doubtful states of the run (coupling.diagnostics)."""
+        if "warnings" not in self._cache:
+            from .diagnostics import run_warnings
+
+            self._cache["warnings"] = run_warnings(self)
+        return self._cache["warnings"]
 
     @property
     def summary(self) -> dict:
@@ -103,26 +104,36 @@ class CoupledResult:
         if self.mechanics is not None:
             out.update(self.mechanics.to_summary())
         if self.scene.circuit is not None:
-            out["bounce"] = {k: (_num(v) if isinstance(v, float) else v) for k, v in self.bounce.items()}
+            out["bounce"] = _jsonable(self.bounce)
         if self.scene.tribology is not None:
             out["tribology"] = {"source": self.scene.tribology.source,
                                 "feedback": self.scene.tribology.feedback,
                                 "laws": self.scene.tribology.laws.to_dict()}
+        out["warnings"] = list(self.warnings)
         out["run"] = _jsonable(self.stats)
         return out
 
     def save(self, out_dir) -> Path:
-        """Write summary.json, the waveforms (CSV, parquet), the mechanics tables and PNG plots,
-        as the scene's [output] asks."""
+        """Write summary.json, the waveforms (CSV, parquet, the interactive waveforms.html),
+        openings.csv, the mechanics tables and PNG plots, as the scene's [output] asks."""
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         opts = self.scene.output
-        (out / "summary.json").write_text(json.dumps(self.summary, indent=2))
+        summary = self.summary
+        html = None
+        if self.waveforms is not None and getattr(opts, "html", True):
+            from .waveview import write_waveform_html
+
+            html = write_waveform_html(self, out / "waveforms.html")
+            summary["waveforms_html"] = "waveforms.html" if html == "written" else html
+        (out / "summary.json").write_text(json.dumps(summary, indent=2))
         if self.waveforms is not None:
             if opts.csv:
                 self.waveforms.to_csv(out / "waveforms.csv", index=False)
             if opts.parquet:
                 self.waveforms.to_parquet(out / "waveforms.parquet", index=False)
+            if self.scene.circuit is not None:
+                self.openings.to_csv(out / "openings.csv", index=False)
         if self.mechanics is not None:
             if opts.history:
                 self.mechanics.history.to_csv(out / "history.csv", index=False)

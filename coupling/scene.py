@@ -16,12 +16,14 @@ A scene names only what it needs, and only that is built:
                   snubber = {resistance, capacitance} (both), flyback = true | {...},
                   arc = true | false | {min_voltage, min_current, ...}, netlist = "file.cir",
                   load_probe, max_step, reltol, abstol, vntol, chgtol, method, temperature,
-                  wall_timeout (each key one dataclass field; omitted: that field's default)
+                  wall_timeout (each key one dataclass field; omitted: that field's default),
+                  probes = ["v(node)", "v(n1,n2)", "i(element)"] (recorded as waveform columns)
     [circuit.schedule]  make = [...], break = [...], closed_resistance, opening_speed
                         (s, s, ohm, m/s: the gap for an arc whose voltage grows with it)
     [coupling]    scheme = "mechanics_first" | "jacobi", macro_step, max_macro_step (s),
                   align_events = true, onset_penetration (m)
-    [output]      csv, parquet, plots, history = true | false
+    [output]      csv, parquet, plots, history, html = true | false
+    [metrics]     settle_window (s), make_guard (s), arc_toggle_limit (coupling.metrics)
 
 SI units everywhere. File paths are relative to the scene file. Every error names the
 section and key and says what is allowed, before any solver starts.
@@ -45,7 +47,7 @@ from mech.scene import read_toml
 from mech.scene import scene_from_dict as mech_scene_from_dict
 from mech.scene import suggest
 
-COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output")
+COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output", "metrics")
 TEMPLATES = ("resistive", "inductive", "capacitive", "current_source", "netlist")
 SCHEMES = ("mechanics_first", "jacobi")
 
@@ -110,12 +112,14 @@ class CouplingOptions:
 
 @dataclass(frozen=True)
 class OutputOptions:
-    """What a run writes besides summary.json: csv, parquet, plots (PNG), history (mechanics CSV)."""
+    """What a run writes besides summary.json: csv, parquet, plots (PNG), history (mechanics CSV),
+    html (waveforms.html, the interactive waveform page)."""
 
     csv: bool = True
     parquet: bool = True
     plots: bool = True
     history: bool = True
+    html: bool = True
 
 
 @dataclass(frozen=True)
@@ -136,6 +140,7 @@ class CircuitSpec:
     options: Any  # circuit.SimulationOptions
     schedule: Any = None  # circuit.ContactSchedule | None
     template: str = "resistive"
+    probes: tuple = ()  # circuit.probes.UserProbe: [circuit] probes = ["v(node)", "i(element)"]
 
 
 @dataclass(frozen=True)
@@ -150,6 +155,7 @@ class Scene:
     coupling: CouplingOptions = field(default_factory=CouplingOptions)
     output: OutputOptions = field(default_factory=OutputOptions)
     name: str = "scene"
+    metrics: Any = None  # coupling.metrics.MetricSettings
 
     @property
     def kind(self) -> str:
@@ -177,11 +183,17 @@ class Scene:
 
     def update(self, changes: dict) -> "Scene":
         """A new scene with several "section.key" values set at once, validated once (for
-        keys that only make sense together, e.g. initial.resting with initial.angle_deg = 0)."""
+        keys that only make sense together, e.g. initial.resting with initial.angle_deg = 0).
+
+        Setting one of several exclusive alternatives drops the others the scene had (unless
+        they are set in the same call): ``update({"bar.width": 0.02, "bar.thickness": 3e-4})``
+        turns a round bar (bar.diameter) into a rectangular one in one call; likewise
+        bar.diameter back, and tribology.source / fit / data (ALTERNATIVES)."""
         raw = copy.deepcopy(self.raw)
         for key, value in changes.items():
             node, last = _walk(raw, key)
             node[last] = list(value) if isinstance(value, tuple) else value
+        _drop_replaced_alternatives(raw, changes)
         return scene_from_dict(raw, base_dir=self.base_dir, name=self.name)
 
     def unset(self, *keys: str) -> "Scene":
@@ -210,9 +222,46 @@ class Scene:
 
 
 def _tribology(table: dict, base_dir: Path, where: str) -> TribologySpec:
+    """[tribology]; ``resistance = { law = "holm" | "constant", ... }`` takes R_c from
+    contact materials (coupling.materials) instead of a fit, with mu from the fit or
+    ``mu = number`` (Coulomb, gamma = 0)."""
+    table = _table(where, table)
+    resistance = table.get("resistance")
+    if not (isinstance(resistance, dict) and "law" in resistance):
+        return _tribology_fitted(table, base_dir, where)
+    from coupling.materials import resistance_law_from_table
+    from coupling.tribology import ContactLaws, MuLaw
+
+    law = resistance_law_from_table(resistance, f"{where} resistance")
+    rest = {k: v for k, v in table.items() if k != "resistance"}
+    mu = rest.get("mu")
+    if isinstance(mu, (int, float)) and not isinstance(mu, bool):
+        for key in ("source", "fit", "data"):
+            if key in rest:
+                raise ValueError(f"{where}: mu = {mu!r} and {key} = both give mu; remove one")
+        if not (mu > 0 and mu < float("inf")):
+            raise ValueError(f"{where} mu = {mu!r}: expected a finite number > 0 (Coulomb friction coefficient)")
+        feedback = _bool(f"{where} feedback", rest.get("feedback", True))
+        for key in rest:
+            if key not in ("mu", "feedback"):
+                raise _unknown(where, key, {"mu", "feedback", "resistance", "source", "fit", "data"})
+        mu_law = MuLaw(0.0, "constant", (("mu0", float(mu)),), (0.0, 1e6))
+        return TribologySpec(ContactLaws(mu_law, law), f"materials ({law.name}), mu = {mu:g}", feedback)
+    if "mu" in rest and not any(k in rest for k in ("source", "fit", "data")):
+        mu_law = MuLaw.from_dict(_table(f"{where} mu", rest["mu"]))
+        return TribologySpec(ContactLaws(mu_law, law), f"materials ({law.name}), inline mu",
+                             _bool(f"{where} feedback", rest.get("feedback", True)))
+    if not any(k in rest for k in ("source", "fit", "data")):
+        raise ValueError(f"{where}: resistance = {{ law = {resistance['law']!r} }} gives R_c only; give mu too: "
+                         "mu = 0.3 (Coulomb), or source/fit/data for the fitted mu(I)")
+    spec = _tribology_fitted(rest, base_dir, where)
+    return TribologySpec(ContactLaws(spec.laws.mu_law, law), f"{spec.source} (mu); materials ({law.name}) (R_c)",
+                         spec.feedback, spec.fit)
+
+
+def _tribology_fitted(table: dict, base_dir: Path, where: str) -> TribologySpec:
     from coupling.tribology import ContactLaws, TribometerFit, default_fit, fit_tribometer, read_tribometer_csv
 
-    table = _table(where, table)
     allowed = {"source", "fit", "data", "mu", "resistance", "feedback"}
     for key in table:
         if key not in allowed:
@@ -281,7 +330,7 @@ def _template_keys(template: str) -> set:
     return set(source) | set(_WIRING) | set(_LOADS[template]) | set(_TEMPLATE_CIRCUIT) | set(_PARTS)
 
 
-CIRCUIT_KEYS = frozenset({"template", "schedule", *_OPTION_KEYS}.union(*(_template_keys(t) for t in TEMPLATES)))
+CIRCUIT_KEYS = frozenset({"template", "schedule", "probes", *_OPTION_KEYS}.union(*(_template_keys(t) for t in TEMPLATES)))
 
 
 def circuit_key_names(ck) -> dict:
@@ -299,6 +348,7 @@ def circuit_key_names(ck) -> dict:
     names.update({f"ContactSchedule.{name}": f"circuit.schedule.{'make/break' if name == 'intervals' else key}"
                   for key, name in _SCHEDULE.items()})
     names["SwitchCircuit.load"] = "circuit.template"
+    names["CircuitSpec.probes"] = "circuit.probes"  # what to record, beside the circuit itself
     return names
 
 
@@ -349,7 +399,7 @@ def _circuit(table: dict, base_dir: Path, where: str, current_factor: str | None
     if "voltage" in table and "current" in table:
         raise ValueError(f"{where}: circuit.voltage and circuit.current both name a source: give one, current "
                          "(A) with template = \"current_source\", or voltage (V) with a voltage-source template")
-    usable = _template_keys(template) | {"template", "schedule", *_OPTION_KEYS}
+    usable = _template_keys(template) | {"template", "schedule", "probes", *_OPTION_KEYS}
     stray = sorted(set(table) - usable)
     if stray:
         hint = {"netlist": " (put it in the netlist)",
@@ -398,7 +448,13 @@ def _circuit(table: dict, base_dir: Path, where: str, current_factor: str | None
     except ValueError as err:
         message = _in_scene_words(err, names)
         raise ValueError(message if message.startswith(where) else f"{where}: {message}") from None
-    return CircuitSpec(circ, options, schedule, template)
+    probes = ()
+    if "probes" in table:  # validated against the deck's nodes and elements
+        from circuit.deck import build_deck
+        from circuit.probes import check_probes
+
+        probes = check_probes(table["probes"], build_deck(circ, 1.0, options)[0], f"{where}: [circuit] probes")
+    return CircuitSpec(circ, options, schedule, template, probes)
 
 
 def scene_from_dict(doc: dict, *, base_dir: Path | str = ".", name: str = "scene") -> Scene:
@@ -467,8 +523,11 @@ def scene_from_dict(doc: dict, *, base_dir: Path | str = ".", name: str = "scene
     t_end = _table("[solver]", doc.get("solver", {})).get("t_end")
     if t_end is not None:
         check_positive("solver.t_end", t_end)
+    from .metrics import MetricSettings
+
+    metrics = MetricSettings(**_known(doc.get("metrics", {}), MetricSettings, f"{where} [metrics]"))
     return Scene(raw=copy.deepcopy(doc), base_dir=base_dir, mech=mech, tribology=tribology, circuit=circuit,
-                 coupling=coupling, output=output, name=name)
+                 coupling=coupling, output=output, name=name, metrics=metrics)
 
 
 def _known(table, cls, where: str) -> dict:
@@ -480,6 +539,30 @@ def _known(table, cls, where: str) -> dict:
         if key not in allowed:
             raise _unknown(where, key, allowed)
     return dict(table)
+
+
+#: Exclusive key groups: (section, alternatives); setting keys of one drops the others.
+ALTERNATIVES = (
+    ("bar", (("diameter",), ("width", "thickness"))),
+    ("tribology", (("source",), ("fit",), ("data",))),
+)
+
+
+def _drop_replaced_alternatives(raw: dict, changes: dict) -> None:
+    """Remove the alternatives replaced by ``changes`` ("section.key" -> value) from raw."""
+    for section, groups in ALTERNATIVES:
+        set_now = {k.split(".", 1)[1] for k in changes if k.startswith(section + ".") and k.count(".") == 1}
+        table = raw.get(section)
+        if not set_now or not isinstance(table, dict):
+            continue
+        chosen = [g for g in groups if set_now & set(g)]
+        if len(chosen) != 1:
+            continue  # none touched, or several at once: validation says what is wrong
+        for group in groups:
+            if group is not chosen[0]:
+                for key in group:
+                    if key not in set_now:
+                        table.pop(key, None)
 
 
 def _walk(raw: dict, key: str) -> tuple[dict, str]:

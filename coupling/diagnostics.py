@@ -1,0 +1,202 @@
+"""Warnings about physically doubtful states of a run (``warnings`` in summary.json).
+
+Each is one line that says what was seen, when, and what to add to the scene. Checks
+(documented in docs/coupling.md, "Warnings"):
+
+1. Field across the open gap beyond air breakdown: |V| > V_bd(d) at an open-contact
+   sample with no arc burning, where V_bd is Paschen's law for air at 1 atm,
+   V = B p d / (ln(A p d) - ln(ln(1 + 1/gamma_se))) with A = 15 /(cm Torr),
+   B = 365 V/(cm Torr), gamma_se = 0.01 (textbook constants for air), on the branch
+   above its minimum, and the measured minimum of air, 327 V, for smaller gaps (the
+   micrometre gaps of a bounce). Large gaps tend to ~3 MV/m (35 kV at 1 cm).
+2. Currents beyond what the circuit's own source and impedances allow: a template
+   circuit's source E behind R_source + R_wiring can drive at most E / (R_source +
+   R_wiring) (its short-circuit current); a contact or arc current above it comes from a
+   parasitic capacitance discharging through the contact or the arc's small incremental
+   resistance.
+3. More arc ignitions and extinctions than ``[metrics] arc_toggle_limit`` (a showering arc).
+4. A contact law used outside the data it was fitted on (normal force or current range),
+   or outside a material law's stated validity range.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .metrics import ARC_BURNING_CURRENT, arc_toggles
+
+PASCHEN_A = 15.0  # 1/(cm Torr), air
+PASCHEN_B = 365.0  # V/(cm Torr), air
+PASCHEN_GAMMA = 0.01  # secondary emission coefficient
+PASCHEN_MINIMUM_V = 327.0  # V: measured minimum breakdown voltage of air
+ATMOSPHERE_TORR = 760.0
+
+
+def air_breakdown_voltage(gap_m, pressure_torr: float = ATMOSPHERE_TORR):
+    """V: breakdown voltage of an air gap of d metres (Paschen, right branch; 327 V floor).
+
+    Vectorized; d <= 0 gives the floor (a closing/closed contact is checked elsewhere)."""
+    d_cm = np.asarray(gap_m, dtype=float) * 100.0
+    pd_ = np.maximum(pressure_torr * d_cm, 1e-30)
+    denom = np.log(PASCHEN_A * pd_) - math.log(math.log(1.0 + 1.0 / PASCHEN_GAMMA))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        paschen = np.where(denom > 1.0, PASCHEN_B * pd_ / np.where(denom > 1.0, denom, 1.0), 0.0)
+    return np.maximum(paschen, PASCHEN_MINIMUM_V)
+
+
+def breakdown_warning(t, v, gap, open_mask) -> str | None:
+    """The worst open-gap sample whose |V| exceeds air breakdown, as a warning line."""
+    t, v, gap = (np.asarray(x, float) for x in (t, v, gap))
+    sel = open_mask & np.isfinite(gap) & (gap > 0.0)
+    if not sel.any():
+        return None
+    ratio = np.where(sel, np.abs(v) / air_breakdown_voltage(gap), 0.0)
+    k = int(np.argmax(ratio))
+    if ratio[k] <= 1.0:
+        return None
+    n = int(np.count_nonzero(ratio > 1.0))
+    return (f"contact voltage {abs(v[k]):.4g} V across a {gap[k] * 1e6:.4g} um gap at t = {t[k] * 1e3:.6g} ms "
+            f"exceeds air breakdown (~{float(air_breakdown_voltage(gap[k])):.4g} V; {n} sample(s)): the gap would "
+            "break down; add the arc model ([circuit] arc = true, with breakdown_voltage), a snubber or the "
+            "contact capacitance")
+
+
+def overcurrent_warning(t, currents: dict, limit: float, source: str) -> str | None:
+    """The largest |current| among ``currents`` (name -> array, A) if above ``limit`` (A)."""
+    worst = None
+    for name, i in currents.items():
+        if i is None:
+            continue
+        i = np.abs(np.asarray(i, float))
+        if not len(i) or not np.isfinite(i).any():
+            continue
+        k = int(np.nanargmax(i))
+        if i[k] > limit and (worst is None or i[k] > worst[1]):
+            worst = (name, float(i[k]), float(t[k]))
+    if worst is None:
+        return None
+    name, peak, when = worst
+    return (f"{name} peaks at {peak:.4g} A at t = {when * 1e3:.6g} ms, above the {limit:.4g} A {source}: "
+            "a capacitance discharging through the contact or the arc; add a snubber resistor, "
+            "the real contact capacitance, or wiring resistance/inductance")
+
+
+def toggle_warning(toggles: int, limit: int) -> str | None:
+    if toggles <= limit:
+        return None
+    return (f"the arc switched on/off {toggles} times (more than [metrics] arc_toggle_limit = {limit}): "
+            "a re-igniting (showering) arc; add a snubber (RC across the contact), a flyback diode, "
+            "or the contact capacitance")
+
+
+def range_warnings(what: str, used: tuple[float, float] | None, valid: tuple[float, float] | None,
+                   unit: str, note: str = "") -> list[str]:
+    """A line when a quantity used over ``used`` = (min, max) exceeds the ``valid`` range's top.
+
+    Only the top: every make and break passes through F_n = 0 and I = 0, below any range."""
+    if used is None or valid is None:
+        return []
+    lo, hi = valid
+    umin, umax = used
+    out = []
+    if umax > hi * (1.0 + 1e-9):
+        out.append(f"{what} used up to {umax:.4g} {unit}, above the {lo:.4g}-{hi:.4g} {unit} it is valid for "
+                   f"(extrapolated{note})")
+    return out
+
+
+def _law_ranges(scene):
+    """(name, force range N, current range A, note) of the contact-resistance law, or None."""
+    trib = scene.tribology
+    if trib is None:
+        return None
+    law = trib.laws.resistance_law
+    validity = getattr(law, "validity", None)
+    if validity is not None:  # a material law (coupling.materials)
+        return (f"contact-resistance law {law.name}", validity.get("force_N"), validity.get("current_A"),
+                validity.get("note", ""))
+    if trib.fit is not None:
+        dr = trib.fit.data_range
+        return (f"contact-resistance law ({trib.source})", tuple(dr.load_range_N), tuple(dr.current_range_A),
+                f" with exponent m = {law.load_exponent:.3g}")
+    return None
+
+
+def run_warnings(result) -> list[str]:
+    """All warnings for a CoupledResult."""
+    out: list[str] = []
+    scene = result.scene
+    w = result.waveforms
+    if w is not None and len(w):
+        t = w.time.to_numpy()
+        v = w.contact_voltage.to_numpy()
+        i_arc = w.arc_current.to_numpy() if "arc_current" in w else np.zeros_like(t)
+        burning = np.abs(i_arc) > ARC_BURNING_CURRENT
+        gap = _gap_series(result, t)
+        if gap is not None:
+            open_mask = (w.contact_conductance.to_numpy() <= 0.0) & ~burning
+            line = breakdown_warning(t, v, gap, open_mask)
+            if line:
+                out.append(line)
+        limit = _current_limit(scene)
+        if limit is not None:
+            line = overcurrent_warning(t, {"contact current": w.contact_current.to_numpy(),
+                                           "arc current": i_arc}, *limit)
+            if line:
+                out.append(line)
+        stats = result.stats.get("circuit", {}) if isinstance(result.stats, dict) else {}
+        toggles = int(stats.get("arc_switches", arc_toggles(i_arc)))
+        settings = scene.metrics
+        line = toggle_warning(toggles, settings.arc_toggle_limit if settings is not None else 50)
+        if line:
+            out.append(line)
+        ranges = _law_ranges(scene)
+        if ranges is not None and "normal_force" in w:
+            name, force_range, current_range, note = ranges
+            f = w.normal_force.to_numpy()
+            closed = f > 0.0
+            if closed.any():
+                out += range_warnings(name + ": normal force", (float(f[closed].min()), float(f[closed].max())),
+                                      force_range, "N", note)
+                current = np.abs(w.load_current.to_numpy() if np.isfinite(w.load_current).all()
+                                 else w.contact_current.to_numpy())[closed]
+                out += [line + "; the current factor is held at its edge value" for line in range_warnings(
+                    name + ": current", (float(current.min()), float(current.max())), current_range, "A")]
+    return out
+
+
+def _gap_series(result, t):
+    """m: the gap at the waveform's times (coupled: the mechanics' gap column; prescribed
+    schedule: its gap when it has an opening speed), or None when unknown."""
+    w = result.waveforms
+    if "gap" in w:
+        return w.gap.to_numpy()
+    spec = result.scene.circuit
+    schedule = getattr(spec, "schedule", None) if spec is not None else None
+    if schedule is not None and getattr(schedule, "opening_speed", None) is not None:
+        return np.array([schedule.gap(s) for s in t])
+    return None
+
+
+def _current_limit(scene):
+    """(A, description) the template circuit's source can drive, or None (netlist, zero resistance)."""
+    spec = scene.circuit
+    circ = getattr(spec, "circuit", None)
+    source, wiring = getattr(circ, "source", None), getattr(circ, "wiring", None)
+    if source is None or wiring is None:
+        return None
+    if hasattr(source, "compliance_voltage"):  # a constant-current supply: I_set, plus at a make
+        rw = float(wiring.resistance)            # its output capacitor discharging into the wiring
+        if rw <= 0.0:
+            return None
+        v = float(source.compliance_voltage)
+        return (float(source.current) + v / rw,
+                f"the {float(source.current):.4g} A supply plus its output capacitor at {v:.4g} V through "
+                f"the {rw:.4g} ohm wiring")
+    r = float(source.internal_resistance) + float(wiring.resistance)
+    if r <= 0.0:
+        return None
+    e = abs(float(source.voltage))
+    return e / r, f"the {e:.4g} V source can drive through its own {r:.4g} ohm (source + wiring)"

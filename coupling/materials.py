@@ -1,0 +1,320 @@
+"""Contact resistance from contact materials: Holm's constriction laws, Greenwood's multi-spot
+form, a film term and a constant R_c, with a small library of contact materials.
+
+Laws (SI: N, m, Pa, ohm, ohm m^2), as small pure functions:
+
+- one circular a-spot between metals of resistivities rho1, rho2 (Holm, "Electric
+  Contacts", 4th ed., sec. 4): R_s = (rho1 + rho2) / (4 a);
+- contact radius, plastic: the softer metal's hardness H carries the load, F = H pi a^2,
+  a = sqrt(F / (pi H)); elastic: Hertz's radius of a sphere of radius R on a flat,
+  a = (3 F R / (4 E*))^(1/3), 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2;
+- n equal spots of radius a_i spread over a cluster of radius alpha (Greenwood, "Constriction
+  resistance and the real area of contact", Brit. J. Appl. Phys. 17 (1966) 1621):
+  R = rho_e / (2 sum a_i) + rho_e / (pi n^2) sum_{i != j} 1 / s_ij, rho_e = (rho1 + rho2)/2;
+  for spots spread uniformly over the cluster the mean 1/s is 16 / (3 pi alpha), so
+  R = (rho1 + rho2) / (4 n a_i) + (16 / (3 pi^2)) (1 - 1/n) (rho1 + rho2) / (2 alpha);
+  n = 1 gives the single spot back;
+- a film of tunnel resistivity sigma_f (ohm m^2) over the real contact area A:
+  R_f = sigma_f / A, A = pi a^2 (elastic) or F / H (plastic);
+- a constant R_c.
+
+Every law states its validity range (``validity``): the constriction formula needs contact
+spots much larger than the electrons' mean free path (~0.04-0.05 um in Ag, Cu, Au at room
+temperature; below it the ballistic Sharvin resistance takes over), so a_i >= 0.1 um; the
+plastic real area F/H must stay inside the apparent (Hertz) area of the rivet when its
+radius is given; Hertz's elastic law holds up to first yield, peak pressure
+p0 = 0.57 H (p0 = 1.6 Y, H ~ 2.8 Y; Johnson, "Contact Mechanics", sec. 6).
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from importlib import resources
+from typing import Any
+
+import numpy as np
+
+MIN_SPOT_RADIUS = 0.1e-6  # m: a >> the electron mean free path (Holm's diffusive constriction)
+YIELD_PRESSURE_OVER_HARDNESS = 0.57  # Hertz peak pressure at first yield / hardness
+GREENWOOD_COEFFICIENT = 16.0 / (3.0 * math.pi ** 2)  # interaction term of spots in a cluster
+
+
+# --- pure laws -------------------------------------------------------------------------------
+
+
+def holm_spot_resistance(rho1, rho2, radius):
+    """R = (rho1 + rho2) / (4 a): one circular a-spot of radius a (m) between two metals (ohm m)."""
+    return (rho1 + rho2) / (4.0 * np.asarray(radius, dtype=float))
+
+
+def plastic_radius(force, hardness):
+    """a = sqrt(F / (pi H)), m: F in N, H in Pa."""
+    return np.sqrt(np.maximum(np.asarray(force, dtype=float), 0.0) / (math.pi * hardness))
+
+
+def hertz_radius(force, sphere_radius, effective_modulus):
+    """a = (3 F R / (4 E*))^(1/3), m: sphere of radius R (m) on a flat, E* in Pa."""
+    return (3.0 * np.maximum(np.asarray(force, dtype=float), 0.0) * sphere_radius
+            / (4.0 * effective_modulus)) ** (1.0 / 3.0)
+
+
+def effective_modulus(e1, nu1, e2, nu2):
+    """E*, Pa: 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2."""
+    return 1.0 / ((1.0 - nu1 ** 2) / e1 + (1.0 - nu2 ** 2) / e2)
+
+
+def greenwood_resistance(rho1, rho2, spots, spot_radius, cluster_radius):
+    """R, ohm, of n equal spots of radius a_i (m) spread uniformly over a cluster of radius
+    alpha (m): (rho1 + rho2)/(4 n a_i) + 16/(3 pi^2) (1 - 1/n) (rho1 + rho2)/(2 alpha)."""
+    n = float(spots)
+    return ((rho1 + rho2) / (4.0 * n * np.asarray(spot_radius, dtype=float))
+            + GREENWOOD_COEFFICIENT * (1.0 - 1.0 / n) * (rho1 + rho2) / (2.0 * np.asarray(cluster_radius, dtype=float)))
+
+
+def film_resistance(film_resistivity, area):
+    """R_f = sigma_f / A, ohm: sigma_f in ohm m^2, A (real contact area) in m^2."""
+    return film_resistivity / np.asarray(area, dtype=float)
+
+
+# --- the material library --------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Material:
+    """A contact material: resistivity (ohm m), hardness (Pa), Young's modulus (Pa), Poisson
+    ratio, and for each the typical range and source written in the data file."""
+
+    name: str
+    description: str
+    resistivity: float
+    hardness: float
+    youngs_modulus: float
+    poisson_ratio: float
+    ranges: dict = field(default_factory=dict, compare=False)
+    sources: dict = field(default_factory=dict, compare=False)
+
+
+PROPERTIES = ("resistivity", "hardness", "youngs_modulus", "poisson_ratio")
+
+
+def load_materials(text: str | None = None) -> dict[str, Material]:
+    """The contact-material library (coupling/data/contact_materials.toml, or TOML ``text``)."""
+    if text is None:
+        text = resources.files("coupling").joinpath("data/contact_materials.toml").read_text()
+    doc = tomllib.loads(text)
+    out = {}
+    for name, entry in doc.items():
+        values, ranges, sources = {}, {}, {}
+        for prop in PROPERTIES:
+            item = entry[prop]
+            values[prop] = float(item["value"])
+            ranges[prop] = tuple(float(x) for x in item["range"])
+            sources[prop] = str(item["source"])
+            lo, hi = ranges[prop]
+            if not (lo <= values[prop] <= hi):
+                raise ValueError(f"contact materials: {name}.{prop} = {values[prop]!r} outside its range {[lo, hi]}")
+        out[name] = Material(name, entry.get("description", ""), ranges=ranges, sources=sources, **values)
+    return out
+
+
+MATERIALS = load_materials()
+
+
+def material(name: str, where: str = "material") -> Material:
+    """The library entry ``name``; ValueError naming the known ones."""
+    if name not in MATERIALS:
+        raise ValueError(f"{where}: unknown contact material {name!r}; known: {', '.join(MATERIALS)}")
+    return MATERIALS[name]
+
+
+# --- laws the coupling calls (same interface as coupling.tribology.ResistanceLaw) -------------
+
+
+class _ForceLaw:
+    """R_c(F) without a current dependence: the coupling's interface (conductance(F, I),
+    force_conductance(F), scalar_force_conductance(F), current_factor(I) = 1)."""
+
+    def resistance_of_force(self, force):  # pragma: no cover - overridden
+        raise NotImplementedError
+
+    def force_conductance(self, normal_force_N):
+        """1/R_c(F), S: exactly 0 for F <= 0."""
+        f = np.asarray(normal_force_N, dtype=float)
+        closed = f > 0.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = self.resistance_of_force(np.where(closed, f, 1.0))
+        return np.where(closed, 1.0 / r, 0.0)
+
+    def scalar_force_conductance(self, normal_force_N: float) -> float:
+        if normal_force_N <= 0.0:
+            return 0.0
+        return float(1.0 / self.resistance_of_force(float(normal_force_N)))
+
+    def conductance(self, normal_force_N, current_A=0.0):
+        return self.force_conductance(normal_force_N)
+
+    def resistance(self, normal_force_N, current_A=0.0):
+        g = self.force_conductance(normal_force_N)
+        with np.errstate(divide="ignore"):
+            return 1.0 / g
+
+    def current_factor(self, current_A):
+        """No current dependence: 1."""
+        return 1.0 + 0.0 * np.asarray(current_A, dtype=float)
+
+    def current_factor_expression(self, current: str = "I") -> str:
+        return "1"
+
+
+@dataclass(frozen=True)
+class ConstantResistance(_ForceLaw):
+    """R_c = value (ohm) whenever the contact is closed (F > 0)."""
+
+    value: float
+
+    def __post_init__(self):
+        v = self.value
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not (math.isfinite(v) and v > 0.0):
+            raise ValueError(f"resistance value = {v!r}: expected a finite number > 0 (ohm)")
+
+    name = "constant"
+    load_exponent = 0.0
+
+    def resistance_of_force(self, force):
+        return self.value + 0.0 * np.asarray(force, dtype=float)
+
+    @property
+    def validity(self) -> dict:
+        return {"force_N": (0.0, math.inf), "current_A": None, "note": ""}
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"law": "constant", "value": self.value}
+
+
+@dataclass(frozen=True)
+class HolmResistance(_ForceLaw):
+    """Holm / Greenwood constriction plus film resistance between two materials (SI).
+
+    materials: the two library names (rivet, counter-contact); regime: "plastic" (the
+    softer hardness carries the load) or "elastic" (Hertz, needs ``radius``); spots: n equal
+    a-spots (plastic; n > 1 needs ``radius``: the cluster is the rivet's Hertz circle);
+    radius: m, the rivet's spherical radius (or None); film_resistivity: ohm m^2 (>= 0).
+    """
+
+    materials: tuple[str, str]
+    regime: str = "plastic"
+    spots: int = 1
+    radius: float | None = None
+    film_resistivity: float = 0.0
+
+    name = "holm"
+
+    def __post_init__(self):
+        where = "[tribology] resistance"
+        m1, m2 = (material(m, f"{where} materials") for m in self.materials)
+        if self.regime not in ("plastic", "elastic"):
+            raise ValueError(f"{where} regime = {self.regime!r}: allowed values are 'plastic', 'elastic'")
+        if isinstance(self.spots, bool) or not isinstance(self.spots, int) or self.spots < 1:
+            raise ValueError(f"{where} spots = {self.spots!r}: expected a whole number >= 1")
+        if self.radius is not None and (isinstance(self.radius, bool) or not isinstance(self.radius, (int, float))
+                                        or not (math.isfinite(self.radius) and self.radius > 0.0)):
+            raise ValueError(f"{where} radius = {self.radius!r}: expected a finite number > 0 (m)")
+        f = self.film_resistivity
+        if isinstance(f, bool) or not isinstance(f, (int, float)) or not (math.isfinite(f) and f >= 0.0):
+            raise ValueError(f"{where} film_resistivity = {f!r}: expected a finite number >= 0 (ohm m^2)")
+        if self.radius is None and (self.regime == "elastic" or self.spots > 1):
+            need = "the elastic (Hertz) regime" if self.regime == "elastic" else f"spots = {self.spots}"
+            raise ValueError(f"{where}: {need} needs radius = the rivet's spherical radius (m)")
+        if self.regime == "elastic" and self.spots > 1:
+            raise ValueError(f"{where}: spots = {self.spots} applies to the plastic regime only")
+        object.__setattr__(self, "_m", (m1, m2))
+
+    @property
+    def rho(self) -> tuple[float, float]:
+        return self._m[0].resistivity, self._m[1].resistivity
+
+    @property
+    def hardness(self) -> float:
+        """Pa: the softer material's hardness."""
+        return min(m.hardness for m in self._m)
+
+    @property
+    def modulus(self) -> float:
+        """E*, Pa."""
+        m1, m2 = self._m
+        return float(effective_modulus(m1.youngs_modulus, m1.poisson_ratio, m2.youngs_modulus, m2.poisson_ratio))
+
+    @property
+    def load_exponent(self) -> float:
+        """m of the constriction term R ~ F^-m (1/2 plastic, 1/3 elastic)."""
+        return 0.5 if self.regime == "plastic" else 1.0 / 3.0
+
+    def resistance_of_force(self, force):
+        """R_c(F), ohm, for F > 0 (N)."""
+        rho1, rho2 = self.rho
+        f = np.asarray(force, dtype=float)
+        if self.regime == "elastic":
+            a = hertz_radius(f, self.radius, self.modulus)
+            return holm_spot_resistance(rho1, rho2, a) + film_resistance(self.film_resistivity, math.pi * a * a)
+        h = self.hardness
+        if self.spots == 1:
+            r = holm_spot_resistance(rho1, rho2, plastic_radius(f, h))
+        else:
+            spot = plastic_radius(f / self.spots, h)
+            r = greenwood_resistance(rho1, rho2, self.spots, spot, hertz_radius(f, self.radius, self.modulus))
+        return r + film_resistance(self.film_resistivity, f / h)
+
+    @property
+    def validity(self) -> dict:
+        """force_N: (F_min, F_max) in N where the law holds (module docstring); current_A: None
+        (no current dependence); note: for the warnings."""
+        h, n = self.hardness, self.spots
+        if self.regime == "elastic":
+            lo = 4.0 * self.modulus * MIN_SPOT_RADIUS ** 3 / (3.0 * self.radius)
+            p = YIELD_PRESSURE_OVER_HARDNESS * h
+            hi = math.pi ** 3 * self.radius ** 2 * p ** 3 / (6.0 * self.modulus ** 2)
+            note = "; Hertz holds up to first yield, p0 = 0.57 H: use regime = 'plastic' above it"
+        else:
+            lo = n * math.pi * h * MIN_SPOT_RADIUS ** 2
+            hi = math.pi * h * self.radius ** 2 if self.radius is not None else math.inf
+            note = "; the real area F/H outgrows the rivet's face"
+        return {"force_N": (lo, hi), "current_A": None, "note": note}
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"law": "holm", "materials": list(self.materials), "regime": self.regime, "spots": self.spots,
+                "radius": self.radius, "film_resistivity": self.film_resistivity,
+                "validity_force_N": [f if math.isfinite(f) else None for f in self.validity["force_N"]]}
+
+
+HOLM_KEYS = {"law", "materials", "regime", "spots", "radius", "film_resistivity"}
+CONSTANT_KEYS = {"law", "value"}
+
+
+def resistance_law_from_table(table: dict, where: str = "[tribology] resistance"):
+    """A material or constant R_c law from a scene table (``law = "holm"`` or ``"constant"``)."""
+    if not isinstance(table, dict):
+        raise ValueError(f"{where}: expected a table, got {table!r}")
+    law = table.get("law")
+    if law == "constant":
+        allowed = CONSTANT_KEYS
+    elif law == "holm":
+        allowed = HOLM_KEYS
+    else:
+        raise ValueError(f"{where} law = {law!r}: allowed values are 'holm', 'constant'")
+    for key in table:
+        if key not in allowed:
+            raise ValueError(f"{where}: unknown key {key!r} for law = {law!r}; allowed: {', '.join(sorted(allowed))}")
+    if law == "constant":
+        if "value" not in table:
+            raise ValueError(f"{where}: law = 'constant' needs value = R_c (ohm)")
+        return ConstantResistance(table["value"])
+    mats = table.get("materials")
+    if isinstance(mats, str):
+        mats = [mats, mats]
+    if not (isinstance(mats, list) and len(mats) == 2 and all(isinstance(m, str) for m in mats)):
+        raise ValueError(f"{where} materials = {table.get('materials')!r}: expected two names "
+                         f"[\"rivet\", \"counter-contact\"] (or one for both) from: {', '.join(MATERIALS)}")
+    kw = {k: table[k] for k in ("regime", "spots", "radius", "film_resistivity") if k in table}
+    return HolmResistance(tuple(mats), **kw)

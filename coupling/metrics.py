@@ -1,0 +1,243 @@
+"""Bounce and break metrics as pure functions of the contact's closed intervals and waveforms.
+
+Definitions (SI: s, V, A, J), documented for users in docs/coupling.md ("Bounce metrics"):
+
+- closed intervals: when the contact conducts metallically (merged, sorted). A run
+  *starts closed* when the first interval begins at the run's start.
+- make: the start of a closed interval after the run's start; break: the end of a closed
+  interval before the run's end.
+- opening: the open interval from a break to the next make (a *bounce* opening), or to
+  the end of the run (the *final* opening, the contact ends open).
+- final closure: the last closed interval when the contact is closed at the end of the run.
+  The contact is *settled* when the final closure has lasted at least ``settle_window``
+  by the end of the run. ``settle_time`` = start of the final closure - first make
+  (None when not settled: the run ends open, or the final closure is shorter than the
+  settle window; ``settle_note`` then says which).
+- bounce window: first make to the start of the last closure (the last make). When the
+  run ends open, that last closure's break and the final opening are reported on their
+  own (``final_opening``): a single make that opens for good has no bounce window.
+- make-instant samples: at a make ngspice keeps the left limit (the open contact) and may
+  put one or more samples within femtoseconds after it that still show the open-circuit
+  voltage. Samples with make <= t <= make + guard (``make_guard``, default
+  max(1e-12 s, 1e-9 t_end)) produce no voltage metric.
+- the arc burns where |arc current| > ARC_BURNING_CURRENT (1 mA: an extinguished gap's
+  1 nS leakage stays below it up to 1 MV).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+ARC_BURNING_CURRENT = 1e-3  # A
+DEFAULT_SETTLE_WINDOW = 1e-3  # s
+DEFAULT_ARC_TOGGLE_LIMIT = 50  # arc on/off changes in one run above which a warning is given
+
+
+@dataclass(frozen=True)
+class MetricSettings:
+    """The scene's [metrics] section (SI).
+
+    settle_window: s, how long the contact must stay closed at the end of the run to count
+        as settled (default 1 ms).
+    make_guard: s or None, samples this close after a make produce no voltage metric
+        (None: max(1e-12 s, 1e-9 t_end)).
+    arc_toggle_limit: more arc on/off changes than this in one run give a warning.
+    """
+
+    settle_window: float = DEFAULT_SETTLE_WINDOW
+    make_guard: float | None = None
+    arc_toggle_limit: int = DEFAULT_ARC_TOGGLE_LIMIT
+
+    def __post_init__(self):
+        for name in ("settle_window",) + (("make_guard",) if self.make_guard is not None else ()):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+                raise ValueError(f"metrics.{name} = {value!r}: expected a finite number >= 0 (s)")
+        limit = self.arc_toggle_limit
+        if isinstance(limit, bool) or not isinstance(limit, int) or limit < 0:
+            raise ValueError(f"metrics.arc_toggle_limit = {limit!r}: expected a whole number >= 0")
+
+    def guard(self, t_end: float) -> float:
+        """s: the make guard for a run of length t_end."""
+        return self.make_guard if self.make_guard is not None else max(1e-12, 1e-9 * t_end)
+
+
+def merge_intervals(intervals) -> list[tuple[float, float]]:
+    """Union of closed intervals (s), sorted."""
+    out: list[list[float]] = []
+    for a, b in sorted((float(a), float(b)) for a, b in intervals):
+        if out and a <= out[-1][1]:
+            out[-1][1] = max(out[-1][1], b)
+        else:
+            out.append([a, b])
+    return [(a, b) for a, b in out]
+
+
+def switching_instants(intervals, t_start: float, t_end: float, tol: float):
+    """(makes, breaks), s: interval starts after t_start and ends before t_end (tolerance tol)."""
+    iv = merge_intervals(intervals)
+    makes = [a for a, _ in iv if a > t_start + tol]
+    breaks = [b for _, b in iv if b < t_end - tol]
+    return makes, breaks
+
+
+def openings_of(intervals, t_start: float, t_end: float, tol: float) -> list[tuple[float, float, bool]]:
+    """Open intervals after the contact was first closed: (break, end, reclosed) with end the
+    next make, or t_end and reclosed False for the final opening."""
+    iv = merge_intervals(intervals)
+    out = []
+    for k, (_, b) in enumerate(iv):
+        if b >= t_end - tol:
+            break
+        if k + 1 < len(iv):
+            out.append((b, iv[k + 1][0], True))
+        else:
+            out.append((b, t_end, False))
+    return out
+
+
+def make_instant_mask(t: np.ndarray, makes, guard: float) -> np.ndarray:
+    """True for samples with make <= t <= make + guard for some make (they show the open
+    contact the make has just ended)."""
+    t = np.asarray(t, float)
+    mask = np.zeros(len(t), bool)
+    for m in makes:
+        mask |= (t >= m) & (t <= m + guard)
+    return mask
+
+
+def trapezoid(t: np.ndarray, y: np.ndarray) -> float:
+    """Integral of y over t, trapezoidal rule (0 for fewer than two samples)."""
+    if len(t) < 2:
+        return 0.0
+    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(t)))
+
+
+def _peak(v: np.ndarray, mask: np.ndarray) -> float | None:
+    return float(np.max(np.abs(v[mask]))) if mask.any() else None
+
+
+def _left_value(t: np.ndarray, y: np.ndarray, at: float, guard: float) -> float | None:
+    """y just before ``at``: the first sample within guard of it (ngspice keeps the left limit
+    at a breakpoint), else the last sample before it."""
+    k = int(np.searchsorted(t, at - guard, side="left"))
+    if k < len(t) and t[k] <= at + guard:
+        return float(y[k])
+    return float(y[k - 1]) if k >= 1 else None
+
+
+def arc_duration(t: np.ndarray, i_arc: np.ndarray, start: float, end: float) -> float:
+    """s: time the arc burns (|i| > ARC_BURNING_CURRENT) within [start, end], summed over the
+    sample intervals whose left sample burns."""
+    sel = (t >= start) & (t <= end)
+    ts, burning = t[sel], np.abs(i_arc[sel]) > ARC_BURNING_CURRENT
+    if len(ts) < 2:
+        return 0.0
+    return float(np.sum(np.diff(ts)[burning[:-1]]))
+
+
+def arc_toggles(i_arc: np.ndarray) -> int:
+    """Number of arc ignitions and extinctions seen in the samples."""
+    burning = np.abs(np.asarray(i_arc)) > ARC_BURNING_CURRENT
+    return int(np.count_nonzero(burning[1:] != burning[:-1]))
+
+
+def opening_table(t, v, i_loop, i_arc, openings, makes, guard) -> list[dict]:
+    """One row per opening: start, end (s; the next make, or the end of the run), open_duration
+    (s), reclosed, kind ("bounce" or "final"), current_at_break (A, the loop current i_loop at
+    the break: what the opening contact interrupts), peak_voltage (V, largest |v| in [start, end] outside
+    make-instant samples), arc_duration (s), arc_energy (J)."""
+    excluded = make_instant_mask(t, makes, guard)
+    power = np.abs(v * i_arc) if i_arc is not None else None
+    rows = []
+    for start, end, reclosed in openings:
+        sel = (t >= start) & (t <= end)
+        ts = t[sel]
+        rows.append(dict(
+            start=start, end=end, open_duration=end - start, reclosed=reclosed,
+            kind="bounce" if reclosed else "final",
+            current_at_break=_left_value(t, i_loop, start, guard),
+            peak_voltage=_peak(v, sel & ~excluded),
+            arc_duration=arc_duration(t, i_arc, start, end) if i_arc is not None else 0.0,
+            arc_energy=trapezoid(ts, power[sel]) if power is not None else 0.0,
+        ))
+    return rows
+
+
+def bounce_metrics(intervals, t_end: float, closed_at_end: bool, t=None, v=None, i_loop=None, i_arc=None,
+                   settings: MetricSettings | None = None, t_start: float = 0.0) -> dict:
+    """The ``bounce`` section of summary.json (module docstring; every key in docs/coupling.md).
+
+    intervals: closed intervals (s); closed_at_end: the contact's state at t_end; t, v,
+    i_loop, i_arc: the waveform (s, V, A, A; None: no circuit metrics); i_loop is the
+    loop current through the contact branch (the load current; or the metallic plus the arc
+    current when there is no load probe): the current at a break is read from it.
+    """
+    settings = settings or MetricSettings()
+    guard = settings.guard(t_end)
+    iv = merge_intervals(intervals)
+    tol = guard
+    starts_closed = bool(iv) and iv[0][0] <= t_start + tol
+    makes, breaks = switching_instants(iv, t_start, t_end, tol)
+    openings = openings_of(iv, t_start, t_end, tol)
+    if not closed_at_end and iv and iv[-1][1] >= t_end - tol:
+        closed_at_end = True  # the intervals say it (a schedule closed up to t_end)
+    out: dict = dict(
+        initial_state="closed" if starts_closed else "open",
+        final_state="closed" if closed_at_end else "open",
+        first_make=makes[0] if makes else None,
+        last_make=makes[-1] if makes else None,
+        bounces=sum(1 for o in openings if o[2]),
+        total_bounce_time=(makes[-1] - makes[0]) if makes else 0.0,
+        settle_window=settings.settle_window,
+        settled=False, settle_time=None, settle_note=None,
+        peak_contact_voltage=None, peak_bounce_voltage=None, peak_final_opening_voltage=None,
+        arc_energy=0.0, arc_toggles=0, openings=[], final_opening=None,
+    )
+    if closed_at_end and iv:
+        final_start = iv[-1][0]
+        held = t_end - final_start
+        if held >= settles(settings.settle_window):
+            out["settled"] = True
+            out["settle_time"] = final_start - makes[0] if makes else 0.0
+        else:
+            out["settle_note"] = (f"not settled: the final closure has lasted {held * 1e3:.4g} ms of the "
+                                  f"{settings.settle_window * 1e3:.4g} ms settle window at the end of the run "
+                                  "(run longer: [solver] t_end)")
+    elif iv:
+        out["settle_note"] = "not settled: the run ends open (no settle time)"
+    else:
+        out["settle_note"] = "the contact never closed"
+    if t is None or v is None or len(t) == 0:
+        return out
+    t = np.asarray(t, float)
+    v = np.asarray(v, float)
+    i_loop = np.asarray(i_loop, float) if i_loop is not None else np.zeros_like(t)
+    i_arc = np.asarray(i_arc, float) if i_arc is not None else None
+    excluded = make_instant_mask(t, makes, guard)
+    first_event = min([x for x in (makes[:1] + breaks[:1])], default=None)
+    if first_event is not None:
+        out["peak_contact_voltage"] = _peak(v, (t >= first_event) & ~excluded)
+    if makes:  # the bounce window: first make to the last make (the start of the final closure)
+        out["peak_bounce_voltage"] = _peak(v, (t >= makes[0]) & (t <= makes[-1]) & ~excluded)
+    rows = opening_table(t, v, i_loop, i_arc, openings, makes, guard)
+    out["openings"] = rows
+    if rows and not rows[-1]["reclosed"]:
+        last = rows[-1]
+        out["peak_final_opening_voltage"] = last["peak_voltage"]
+        out["final_opening"] = dict(break_time=last["start"], current_at_break=last["current_at_break"],
+                                    arc_duration=last["arc_duration"], arc_energy=last["arc_energy"],
+                                    peak_voltage=last["peak_voltage"])
+    if i_arc is not None:
+        out["arc_energy"] = trapezoid(t, np.abs(v * i_arc))
+        out["arc_toggles"] = arc_toggles(i_arc)
+    return out
+
+
+def settles(window: float) -> float:
+    """The settle criterion with a relative round-off allowance (a final closure of exactly
+    the window counts)."""
+    return window * (1.0 - 1e-12)
