@@ -18,7 +18,7 @@ A scene names only what it needs, and only that is built:
                         (s, s, ohm, m/s: the gap for an arc whose voltage grows with it)
     [coupling]    scheme = "mechanics_first" | "jacobi", macro_step, max_macro_step (s),
                   align_events = true, onset_penetration (m)
-    [output]      csv, parquet, plots, history = true | false
+    [output]      csv, parquet, plots, history = true | false, history_resolution (s)
 
 SI units everywhere. File paths are relative to the scene file. Every error names the
 section and key and says what is allowed, before any solver starts.
@@ -120,12 +120,23 @@ class CouplingOptions:
 
 @dataclass(frozen=True)
 class OutputOptions:
-    """What a run writes besides summary.json: csv, parquet, plots (PNG), history (mechanics CSV)."""
+    """What a run writes besides summary.json: csv, parquet, plots (PNG), history (mechanics CSV).
+
+    history_resolution: s, history.csv keeps the records on either side of every event and
+    regime change and, of the rest, one per interval this long (0: every solver step);
+    docs/coupling.md, "Outputs".
+    """
 
     csv: bool = True
     parquet: bool = True
     plots: bool = True
     history: bool = True
+    history_resolution: float = 1e-5
+
+    def __post_init__(self):
+        for name in ("csv", "parquet", "plots", "history"):
+            _bool(f"output.{name}", getattr(self, name))
+        check_nonnegative("output.history_resolution", self.history_resolution)
 
 
 @dataclass(frozen=True)
@@ -401,8 +412,6 @@ def scene_from_dict(doc: dict, *, base_dir: Path | str = ".", name: str = "scene
 
     coupling = CouplingOptions(**_known(doc.get("coupling", {}), CouplingOptions, f"{where} [coupling]"))
     output = OutputOptions(**_known(doc.get("output", {}), OutputOptions, f"{where} [output]"))
-    for key, value in doc.get("output", {}).items():
-        _bool(f"{where} [output] {key}", value)
     t_end = _table("[solver]", doc.get("solver", {})).get("t_end")
     if t_end is not None:
         check_positive("solver.t_end", t_end)
