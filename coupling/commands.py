@@ -51,6 +51,9 @@ def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = Fa
     except KeyboardInterrupt:
         _say(f"interrupted while writing the result; {out} was left as it was")
         return EXIT_INTERRUPTED
+    except OSError as err:
+        _say(f"could not write the result into {out}: {err.strerror or err}; {out} was left as it was")
+        return EXIT_FAILED
     _result_lines(result.summary)
     for problem in soundness["problems"]:
         _say(f"unsound: {problem}")
@@ -68,6 +71,9 @@ def _write_partial(folder, partial, extra: dict, message: str, code: int) -> int
     except KeyboardInterrupt:
         _say(f"{message}; interrupted again while writing: nothing written")
         return EXIT_INTERRUPTED
+    except OSError as err:
+        _say(f"{message}; the partial result could not be written: {err.strerror or err}")
+        return code
     _say(f"{message}; what was computed is in {folder.path} (status {partial.status.split(':')[0]!r})")
     return code
 
