@@ -50,8 +50,10 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _one_line(err: BaseException) -> str:
-    """The error's text on one line (a message quoting several lines stays one line)."""
-    return " ".join(str(err).split("\n")).strip() or type(err).__name__
+    """The error's text on one line: a message quoting several lines is joined, and any
+    other unprintable character (a control character in a key the user wrote) is escaped."""
+    text = " ".join(str(err).replace("\r\n", "\n").split("\n")).strip() or type(err).__name__
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
 
 
 if __name__ == "__main__":
