@@ -39,7 +39,8 @@ def report(label, rtol, result, wall):
         extra += f", bounces {result.bounce['bounces']}"
     print(f"{label:10s} rtol {rtol:7.0e}: residual/E {s['relative_residual']:.2e} (E = {s['energy_scale']:.4g} J), "
           f"max penetration {s['max_penetration']:.3g} m (bound {s['penetration_bound']:.3g}), "
-          f"max speed {s['max_speed']:.3g} m/s (bound {s['speed_bound']:.3g}){extra}, "
+          f"max speed {s['max_speed']:.3g} m/s (bound {s['speed_bound']:.3g}), "
+          f"max kinetic {s['max_kinetic']:.3g} J{extra}, "
           f"{'SOUND' if not s['problems'] else 'UNSOUND'}, {wall:.1f} s", flush=True)
 
 
