@@ -62,10 +62,19 @@ class ResultFolder:
     @classmethod
     def check(cls, out: str, identity: dict, *, overwrite: bool = False) -> "ResultFolder":
         """Validate ``out`` (as the user wrote it) before the run; DestinationError if unusable."""
+        try:
+            return cls._check(out, identity, overwrite)
+        except OSError as err:  # e.g. a folder on the way that cannot be read
+            raise DestinationError(f"--out {out!r}: {err.strerror or err}") from None
+
+    @classmethod
+    def _check(cls, out: str, identity: dict, overwrite: bool) -> "ResultFolder":
         if not isinstance(out, str) or not out.strip():
             raise DestinationError("--out '': give the name of a result folder, e.g. --out runs/my_scene")
         path = Path(out).expanduser()
         where = f"--out {out!r}"
+        if path.is_symlink() and path.is_dir():
+            path = path.resolve()  # a link to a folder: the folder it names is the destination
         if path.exists() or path.is_symlink():
             if not path.is_dir():
                 kind = "a file" if path.is_file() else "not a folder (a device or special file)"

@@ -140,6 +140,17 @@ def test_the_current_folder_is_never_a_destination(tmp_path, capsys, monkeypatch
 
 # --- written whole, replaced whole ----------------------------------------------------
 
+def test_a_link_to_a_folder_gets_the_result_in_the_folder_it_names(tmp_path):
+    scene = write(tmp_path, "drop.toml", DROP)
+    target = tmp_path / "results_disk"
+    target.mkdir()
+    link = tmp_path / "out"
+    link.symlink_to(target)
+    assert main(["run", str(scene), "--out", str(link), "--quiet"]) == 0
+    assert link.is_symlink() and (target / "summary.json").exists()
+    assert staging_left(tmp_path) == []
+
+
 def test_a_coupled_then_a_mechanics_run_of_the_same_scene_leaves_no_stale_waveforms(tmp_path):
     """The audit's case: the second run's summary beside the first run's waveforms."""
     scene = write(tmp_path, "relay.toml", COUPLED)
