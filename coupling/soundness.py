@@ -14,8 +14,9 @@ it out):
 - energy audit: max |residual| <= energy_tolerance * E ([solver] energy_tolerance);
 - speeds: the kinetic energy (translation, rotation, vibration) never exceeds E, and so
   the centre of mass moves at most sqrt(2 E / m) (m/s);
-- penetration: the Hertz spring stores (2/5) k y^(5/2), at most E, so no tip goes deeper
-  than (5 E / (2 k))^(2/5) (m);
+- penetration: the Hertz spring stores (2/5) k y^(5/2), at most E plus the work of the
+  weight W = m g over the penetration itself, so no tip goes deeper than the root of
+  (2/5) k y^(5/2) = E + W y (m; (5 E / (2 k))^(2/5) without gravity);
 - circuit (template circuits): the loop current through the load is at most
   2 V / (R_source + R_wiring + R_load) (A): the supply across the series loop, plus one
   full overshoot of the loop's ringing. A netlist circuit's topology is not known: no
@@ -44,9 +45,18 @@ def speed_bound(energy_scale: float, mass: float) -> float:
     return math.sqrt(2.0 * max(energy_scale, 0.0) / mass)
 
 
-def penetration_bound(energy_scale: float, stiffness: float) -> float:
-    """m: the deepest Hertz penetration energy E (J) can make against k y^1.5 (N/m^1.5)."""
-    return (2.5 * max(energy_scale, 0.0) / stiffness) ** 0.4
+def penetration_bound(energy_scale: float, stiffness: float, weight: float = 0.0) -> float:
+    """m: the deepest Hertz penetration energy E (J) can make against k y^1.5 (N/m^1.5),
+    with the weight W (N) doing work W y on the way down: the root of (2/5) k y^2.5 = E + W y
+    (fixed-point iteration; the right side grows more slowly than the left)."""
+    e = max(energy_scale, 0.0)
+    y = (2.5 * e / stiffness) ** 0.4
+    for _ in range(200):
+        y_new = (2.5 * (e + weight * y) / stiffness) ** 0.4
+        if abs(y_new - y) <= 1e-14 * y_new:
+            return y_new
+        y = y_new
+    return y
 
 
 def loop_current_bound(voltage: float, series_resistance: float) -> float:
@@ -110,7 +120,7 @@ def assess(result) -> dict:
         speed = float(np.max(np.linalg.norm(mres.states[:, mres.model.slices()["vel"]], axis=1)))
         pen = float(max(np.max(mres.aux[:, :, A_Y]), 0.0))
         v_max = speed_bound(scale, scene.bar.mass)
-        y_max = penetration_bound(scale, float(mres.solver["stiffness"]))
+        y_max = penetration_bound(scale, float(mres.solver["stiffness"]), scene.bar.mass * scene.gravity)
         kinetic = float(mres.energy_table.kinetic.max())
         out.update(energy_scale=scale, relative_residual=residual / scale if scale > 0 else None,
                    max_kinetic=kinetic, max_speed=speed, speed_bound=v_max, max_penetration=pen,

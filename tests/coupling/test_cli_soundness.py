@@ -27,6 +27,14 @@ def test_penetration_bound_is_where_the_hertz_spring_stores_the_whole_energy():
     assert 0.4 * k * y**2.5 == pytest.approx(e, rel=1e-12)
 
 
+def test_penetration_bound_with_the_weight_pressing_the_tip_in():
+    k, e, w = 1.088e10, 1e-9, 1.8
+    y = soundness.penetration_bound(e, k, w)
+    assert 0.4 * k * y**2.5 == pytest.approx(e + w * y, rel=1e-12)
+    # a bar resting on a tip (E ~ 0) can still be pressed to its static depth (W/k)^(2/3) and beyond
+    assert y > (w / k) ** (2 / 3)
+
+
 def test_loop_current_bound_is_twice_the_loop_current():
     assert soundness.loop_current_bound(24.0, 12.05) == pytest.approx(2 * 24.0 / 12.05)
 
