@@ -9,8 +9,9 @@
   by rename. A previous result there is replaced whole (its old files never mix with the
   new ones); an interruption or error while writing removes the unfinished folder and
   leaves the previous result as it was.
-- The mechanics history is thinned to ``[output] history_resolution`` (``thin_history``):
-  its size follows the simulated time, not the number of solver steps.
+- The mechanics history is thinned (``thin_history``) to ``[output] history_resolution``,
+  coarser where ``history_max_rows`` needs it: its size is bounded by that row budget
+  plus the events, however many steps the solver took.
 """
 
 from __future__ import annotations
@@ -143,10 +144,12 @@ def write_files(result, folder: Path, summary_extra: dict | None = None) -> None
     view.save(folder)
     summary = result.summary
     if result.mechanics is not None and opts.history:
-        kept = thin_history(result.mechanics, opts.history_resolution)
+        t = result.mechanics.t
+        interval = opts.history_interval(float(t[-1] - t[0]) if len(t) else 0.0)
+        kept = thin_history(result.mechanics, interval)
         thin_result(result.mechanics, kept).history.to_csv(folder / "history.csv", index=False)
-        summary["history"] = {"file": "history.csv", "resolution": opts.history_resolution,
-                              "rows": int(len(kept)), "solver_records": int(len(result.mechanics.t))}
+        summary["history"] = {"file": "history.csv", "resolution": interval,
+                              "rows": int(len(kept)), "solver_records": int(len(t))}
     summary.update(summary_extra or {})
     _write_text(folder / "summary.json", json.dumps(_jsonable(summary), indent=2))
 

@@ -97,6 +97,14 @@ def test_a_byte_order_mark_is_accepted(tmp_path):
     assert load_scene(scene).mech.bar.axial_modes == 1
 
 
+@pytest.mark.parametrize("value", ["-1", "2.5", "true", "\"many\""])
+def test_history_max_rows_is_validated(tmp_path, value):
+    scene = tmp_path / "rows.toml"
+    scene.write_text(f"[bar]\nmodes = 0\n[output]\nhistory_max_rows = {value}\n")
+    line = assert_one_line_error(*run_cli(["run", str(scene), "--out", str(tmp_path / "o")]))
+    assert "output.history_max_rows" in line and "whole number >= 0" in line
+
+
 def test_history_resolution_is_validated(tmp_path):
     scene = tmp_path / "res.toml"
     scene.write_text("[bar]\nmodes = 0\n[output]\nhistory_resolution = -1e-5\n")
@@ -153,7 +161,7 @@ OUT_OF_RANGE = {
     ("solver", "rtol"): [0.0, 1e-4, 0.1, 1.0], ("solver", "t_end"): [0.0, -1.0],
     ("solver", "max_step"): [0.0, -1e-6], ("solver", "stick_velocity_tol"): [0.0],
     ("solver", "energy_tolerance"): [0.0, -1e-3], ("environment", "gravity"): [-9.81],
-    ("output", "history_resolution"): [-1e-5],
+    ("output", "history_resolution"): [-1e-5], ("output", "history_max_rows"): [-1],
 }
 NUMERIC_KEYS = sorted(OUT_OF_RANGE) + [("initial", "azimuth_deg")]
 CHOICE_KEYS = [("bar", "bending"), ("contact", "law"), ("contact", "calibration"), ("friction", "model"),
