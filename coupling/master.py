@@ -417,7 +417,7 @@ def run(scene: Scene, *, progress: bool = False) -> CoupledResult:
             partial = None
             if err.partial_result is not None:
                 partial = CoupledResult(scene=scene, mechanics=err.partial_result, waveforms=None,
-                                        stats={}, status=f"failed: {err}")
+                                        stats={}, status=f"failed at t = {float(err.t)!r} s: {err}")
             raise CoupledRunError(str(err), partial) from err
         except KeyboardInterrupt as err:
             status = f"interrupted at t = {float(solver.t)!r} s"

@@ -230,6 +230,15 @@ def test_a_mechanics_failure_inside_a_coupled_run_writes_the_partial_result_at_i
     assert f"t = {t_fail!r} s" in err
 
 
+def test_a_mechanics_only_failure_states_its_time_the_same_way(tmp_path):
+    scene = write(tmp_path, "few.toml", DROP.replace("t_end = 0.001", "t_end = 0.001\nmax_steps = 10"))
+    out = tmp_path / "out"
+    assert main(["run", str(scene), "--out", str(out), "--quiet"]) == 1
+    summary = json.loads((out / "summary.json").read_text())
+    t_fail = float(summary["status"].split("failed at t = ")[1].split(" s")[0])
+    assert t_fail > 0.0 and t_fail == pytest.approx(pd.read_csv(out / "history.csv").time.iloc[-1], rel=1e-12)
+
+
 def test_a_netlist_line_ngspice_cannot_parse_writes_a_failed_result(tmp_path, capsys):
     (tmp_path / "relay.cir").write_text("* relay\nV1 supply 0 24\nR1 supply a 12\nXCONTACT a 0\n"
                                         "garbage line here %%%\n")
