@@ -315,7 +315,7 @@ def test_ctrl_c_in_a_mechanics_run_keeps_the_partial_result(tmp_path):
     assert main(["run", str(warm), "--out", str(tmp_path / "warm"), "--quiet"]) == 0  # compiled, loaded
     scene = write(tmp_path, "long.toml", LONG)
     out = tmp_path / "out"
-    timer = threading.Timer(1.0, _thread.interrupt_main)
+    timer = threading.Timer(2.0, _thread.interrupt_main)  # the run takes > 20 s: well inside it
     timer.start()
     try:
         rc = main(["run", str(scene), "--out", str(out), "--quiet"])
