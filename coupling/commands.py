@@ -54,6 +54,10 @@ def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = Fa
     except OSError as err:
         _say(f"could not write the result into {out}: {err.strerror or err}; {out} was left as it was")
         return EXIT_FAILED
+    except Exception as err:  # noqa: BLE001 - a fault while writing is not bad input (exit 2)
+        _say(f"could not write the result into {out}: {type(err).__name__}: {' '.join(str(err).split())}; "
+             f"{out} was left as it was")
+        return EXIT_FAILED
     _result_lines(result.summary)
     for problem in soundness["problems"]:
         _say(f"unsound: {problem}")
@@ -71,8 +75,9 @@ def _write_partial(folder, partial, extra: dict, message: str, code: int) -> int
     except KeyboardInterrupt:
         _say(f"{message}; interrupted again while writing: nothing written")
         return EXIT_INTERRUPTED
-    except OSError as err:
-        _say(f"{message}; the partial result could not be written: {err.strerror or err}")
+    except Exception as err:  # noqa: BLE001 - OSError (disk full) or a fault in a table or plot
+        _say(f"{message}; the partial result could not be written: {type(err).__name__}: "
+             f"{' '.join(str(getattr(err, 'strerror', None) or err).split())}")
         return code
     _say(f"{message}; what was computed is in {folder.path} (status {partial.status.split(':')[0]!r})")
     return code
