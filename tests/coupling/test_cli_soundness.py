@@ -108,3 +108,28 @@ def test_an_unsound_run_ends_unsound_with_exit_3_and_names_cause_and_fix(tmp_pat
     # the other bounds hold, with room: a sound impact is far inside them
     assert s["max_speed"] < s["speed_bound"] and s["max_penetration"] < s["penetration_bound"]
     assert math.isfinite(s["energy_scale"]) and s["energy_scale"] > 0
+
+
+def test_a_loose_integration_is_caught_and_the_fix_the_message_names_works():
+    """The mechanics default over its first impacts (5 ms): at rtol 1e-4 (outside the allowed
+    range, set here on purpose past the validation) the audit misses by ~4x its tolerance;
+    10 times tighter, the loosest allowed rtol, the same run is sound."""
+    import dataclasses
+
+    import mech
+    from coupling.results import CoupledResult
+
+    base = mech.default_scene()
+    wrapper = scene_from_dict({"bar": {"modes": 0}})  # a mechanics-only scene to hold the result
+
+    def judged(rtol):
+        solver = dataclasses.replace(base.solver, t_end=5e-3)
+        object.__setattr__(solver, "rtol", rtol)  # past the validated range on purpose
+        res = mech.simulate(dataclasses.replace(base, solver=solver))
+        return soundness.assess(CoupledResult(scene=wrapper, mechanics=res, waveforms=None, stats={}))
+
+    loose = judged(1e-4)
+    assert len(loose["problems"]) >= 1 and "rtol" in loose["problems"][0]
+    assert loose["relative_residual"] > 1e-3
+    tight = judged(1e-5)
+    assert tight["problems"] == [] and tight["relative_residual"] < 1e-4
