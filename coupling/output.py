@@ -82,7 +82,11 @@ class ResultFolder:
                 raise DestinationError(f"{where} is {kind}; give a folder name")
             resolved = path.resolve()
             cwd = Path.cwd().resolve()
-            if resolved == cwd or resolved in cwd.parents or resolved == Path.home().resolve():
+            try:
+                home = Path.home().resolve()
+            except RuntimeError:  # no home folder known
+                home = None
+            if resolved == cwd or resolved in cwd.parents or resolved == home:
                 raise DestinationError(f"{where} is the current folder, one of its parents or the home "
                                        "folder, which a result would replace; give a sub-folder")
             if any(path.iterdir()):
