@@ -1,4 +1,5 @@
-"""The `switchsim` command line: `switchsim run [SCENE.toml] --out DIR`, `switchsim fit DATA.csv --out DIR`."""
+"""The `switchsim` command line: `switchsim run [SCENE.toml] [--out DIR] [--overwrite] [--quiet]`,
+`switchsim fit DATA.csv --out DIR`. Exit codes: coupling/commands.py."""
 
 from __future__ import annotations
 
@@ -15,8 +16,11 @@ def _build_parser() -> argparse.ArgumentParser:
 
     run = sub.add_parser("run", help="run a scene (no scene: the built-in default)")
     run.add_argument("scene", nargs="?", default=None, help="scene TOML file (SI units)")
-    run.add_argument("--out", required=True, help="output directory (created if missing)")
-    run.add_argument("--quiet", action="store_true", help="no progress output")
+    run.add_argument("--out", default=None,
+                     help="result folder (default: runs/<scene name>/; written whole, summary.json last)")
+    run.add_argument("--overwrite", action="store_true",
+                     help="replace a non-empty --out folder that is not a previous result of this scene")
+    run.add_argument("--quiet", action="store_true", help="no progress output (the result lines stay)")
 
     fit = sub.add_parser("fit", help="fit gamma, mu(I) and R_c(F_n, I) to tribometer data")
     fit.add_argument("data", help="tribometer CSV (see docs/tribology.md for its form)")
@@ -30,16 +34,26 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "run":
             from coupling.commands import run_command
 
-            return run_command(args.scene, args.out, quiet=args.quiet)
+            return run_command(args.scene, args.out, quiet=args.quiet, overwrite=args.overwrite)
         if args.command == "fit":
             from coupling.tribology.command import fit_command
 
             return fit_command(args.data, args.out)
     except (ValueError, FileNotFoundError) as err:
         # Input errors: one clear line, no traceback.
-        print(f"switchsim: error: {err}", file=sys.stderr)
+        print(f"switchsim: error: {_one_line(err)}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:  # before the run started (loading, checking): nothing written
+        print("switchsim: interrupted", file=sys.stderr)
+        return 130
     return 1
+
+
+def _one_line(err: BaseException) -> str:
+    """The error's text on one line: a message quoting several lines is joined, and any
+    other unprintable character (a control character in a key the user wrote) is escaped."""
+    text = " ".join(str(err).replace("\r\n", "\n").split("\n")).strip() or type(err).__name__
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
 
 
 if __name__ == "__main__":

@@ -1,45 +1,116 @@
-"""What `switchsim run` does: load a scene (or the default), run it, write the results."""
+"""What `switchsim run` does: load a scene (or the default), check the destination, run,
+judge the result's soundness, write the result folder, report.
+
+Exit codes (docs/coupling.md, "Outputs"): 0 ok; 1 the run failed (what was computed is
+written, status "failed ..."); 2 bad input or destination (nothing runs, nothing is
+written); 3 the run finished but is physically unsound (written, status "unsound");
+130 interrupted by Ctrl-C (what was computed is written, status "interrupted ...").
+"""
 
 from __future__ import annotations
 
 import sys
 from pathlib import Path
 
+EXIT_OK, EXIT_FAILED, EXIT_INPUT, EXIT_UNSOUND, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+RUNS_DIR = "runs"  # where results go without --out: runs/<scene name>/
 
-def run_command(scene_path: str | None, out_dir: str, *, quiet: bool = False) -> int:
-    from .master import CoupledRunError, run
+
+def default_out(scene_path: str | None) -> str:
+    """The result folder without --out: runs/<scene file's name without .toml>/, or
+    runs/default/ for the built-in default scene (relative to the current folder)."""
+    return str(Path(RUNS_DIR) / ("default" if scene_path is None else Path(scene_path).stem or "scene"))
+
+
+def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = False,
+                overwrite: bool = False) -> int:
+    from .master import CoupledRunError, RunInterrupted, run
+    from .output import ResultFolder, scene_identity
     from .scene import default_scene, load_scene
+    from .soundness import assess
 
     scene = default_scene() if scene_path is None else load_scene(scene_path)  # validates before running
-    out = Path(out_dir)
-    if not quiet:
-        print(f"switchsim: running {scene.name} ({scene.kind}, t_end = {scene.t_end * 1e3:g} ms)", file=sys.stderr)
+    if out_dir is None:
+        out_dir = default_out(scene_path)
+    folder = ResultFolder.check(out_dir, scene_identity(scene, scene_path), overwrite=overwrite)
+    extra = {"scene_file": folder.identity["scene_file"]}
+    out = folder.path
+    _chatter(quiet, f"running {scene.name} ({scene.kind}, t_end = {scene.t_end * 1e3:g} ms)")
     try:
         result = run(scene, progress=not quiet)
+    except RunInterrupted as err:
+        return _write_partial(folder, err.partial, extra, f"{err}", EXIT_INTERRUPTED)
     except CoupledRunError as err:
-        if err.partial is not None:
-            err.partial.save(out)
-            print(f"switchsim: {err}; what was computed is in {out}", file=sys.stderr)
-        else:
-            print(f"switchsim: {err}", file=sys.stderr)
-        return 1
-    result.save(out)
+        return _write_partial(folder, err.partial, extra, f"{err}", EXIT_FAILED)
+    try:
+        soundness = assess(result)
+        extra["soundness"] = soundness
+        if soundness["problems"] and result.status == "ok":
+            result.status = "unsound"
+        folder.write(result, extra)
+    except KeyboardInterrupt:
+        _say(f"interrupted while writing the result; {out} was left as it was")
+        return EXIT_INTERRUPTED
+    except OSError as err:
+        _say(f"could not write the result into {out}: {err.strerror or err}; {out} was left as it was")
+        return EXIT_FAILED
+    except Exception as err:  # noqa: BLE001 - a fault while writing is not bad input (exit 2)
+        _say(f"could not write the result into {out}: {type(err).__name__}: {' '.join(str(err).split())}; "
+             f"{out} was left as it was")
+        return EXIT_FAILED
+    _result_lines(result.summary)
+    for problem in soundness["problems"]:
+        _say(f"unsound: {problem}")
+    _say(f"status {result.status}; wrote {out}")
+    return EXIT_UNSOUND if soundness["problems"] else EXIT_OK
+
+
+def _write_partial(folder, partial, extra: dict, message: str, code: int) -> int:
+    message = " ".join(message.split())  # one line, whatever the cause quotes
+    if partial is None:
+        _say(f"{message}; nothing could be kept, nothing written")
+        return code
+    try:
+        folder.write(partial, extra)
+    except KeyboardInterrupt:
+        _say(f"{message}; interrupted again while writing: nothing written")
+        return EXIT_INTERRUPTED
+    except Exception as err:  # noqa: BLE001 - OSError (disk full) or a fault in a table or plot
+        _say(f"{message}; the partial result could not be written: {type(err).__name__}: "
+             f"{' '.join(str(getattr(err, 'strerror', None) or err).split())}")
+        return code
+    _say(f"{message}; what was computed is in {folder.path} (status {partial.status.split(':')[0]!r})")
+    return code
+
+
+def _result_lines(summary: dict) -> None:
+    """The results (kept with --quiet): stdout, one line each."""
+    if "bounce" in summary:
+        b = summary["bounce"]
+        peak = b.get("peak_contact_voltage")
+        print(f"switchsim: first make {_ms(b.get('first_make'))}, last make {_ms(b.get('last_make'))}, "
+              f"{b.get('bounces')} bounce(s), final state {b.get('final_state')}, "
+              f"peak contact voltage {peak or 0:.3g} V, arc energy {b.get('arc_energy') or 0:.3g} J")
+    if "contacts" in summary:
+        residual = summary.get("energy", {}).get("relative_residual")
+        print(f"switchsim: {len(summary['contacts'])} tip contact(s), first restitution "
+              f"{summary.get('restitution')}, energy residual {residual if residual is None else f'{residual:.2g}'}")
+    for flag in summary.get("flags", []):
+        print(f"switchsim: flag: {flag}")
+    for line in summary.get("warnings", []):  # coupling.diagnostics
+        print(f"switchsim: warning: {line}")
+    sys.stdout.flush()
+
+
+def _chatter(quiet: bool, text: str) -> None:
+    """Progress and bookkeeping lines: stderr, dropped by --quiet."""
     if not quiet:
-        summary = result.summary
-        if "bounce" in summary:
-            b = summary["bounce"]
-            print(f"switchsim: first make {_ms(b['first_make'])}, last make {_ms(b['last_make'])}, "
-                  f"{b['bounces']} bounce(s), final state {b['final_state']}, "
-                  f"peak contact voltage {b['peak_contact_voltage'] or 0:.3g} V, arc energy {b['arc_energy']:.3g} J")
-        if "contacts" in summary:
-            print(f"switchsim: {len(summary['contacts'])} tip contact(s), first restitution "
-                  f"{summary['restitution']}, energy residual {summary['energy']['relative_residual']:.2g}")
-        for flag in summary.get("flags", []):
-            print(f"switchsim: flag: {flag}")
-        for line in summary.get("warnings", []):  # coupling.diagnostics
-            print(f"switchsim: warning: {line}")
-        print(f"switchsim: wrote {out}", file=sys.stderr)
-    return 0
+        print(f"switchsim: {text}", file=sys.stderr, flush=True)
+
+
+def _say(text: str) -> None:
+    """Outcome lines (failures, unsoundness, where the result is): stderr, always."""
+    print(f"switchsim: {text}", file=sys.stderr, flush=True)
 
 
 def _ms(value) -> str:

@@ -42,6 +42,23 @@ class CoupledRunError(RuntimeError):
         self.partial = partial
 
 
+class RunInterrupted(KeyboardInterrupt):
+    """Ctrl-C (SIGINT) stopped a run; ``partial`` holds the CoupledResult up to then (status
+    "interrupted at t = ... s") or None. A KeyboardInterrupt, so scripts stop as before."""
+
+    def __init__(self, message: str, partial: CoupledResult | None):
+        super().__init__(message)
+        self.partial = partial
+
+
+def _failure_time(err: BaseException, t_step: float) -> float:
+    """s: where a run failed: the mechanics' own failure time if it failed (inside a macro
+    step, later than the step's start), else the start of the macro step."""
+    from mech.solver import MechSolverError
+
+    return float(err.t) if isinstance(err, MechSolverError) else t_step
+
+
 class Progress:
     """Prints the simulated time now and then, for runs longer than a few seconds."""
 
@@ -91,7 +108,16 @@ class CoSimulation:
         rl = self.laws.resistance_law
         tick = time.perf_counter()
         mech = ImpactSolver(sc.mech, keep_dense=True)
-        stepper = Stepper(sc.circuit.circuit, t_end, sc.circuit.options)
+        try:
+            stepper = Stepper(sc.circuit.circuit, t_end, sc.circuit.options)
+        except Exception as err:  # e.g. a netlist line ngspice cannot parse: a failed run at t = 0
+            partial = None
+            try:
+                partial = CoupledResult(scene=sc, mechanics=mech.result(), waveforms=None,
+                                        stats=dict(self.stats), status=f"failed at t = 0.0 s: {err}")
+            except Exception:  # noqa: BLE001 - best effort
+                pass
+            raise CoupledRunError(f"coupled run failed at t = 0.0 s: {type(err).__name__}: {err}", partial) from err
         self.mech, self.stepper = mech, stepper
         t = 0.0
         i_now = 0.0
@@ -134,14 +160,24 @@ class CoSimulation:
                     self.progress(t)
                 self.stats["wall_time"] = time.perf_counter() - tick
                 return self._result(mech, stepper, status="ok")
+        except KeyboardInterrupt as err:  # Ctrl-C: keep what was computed
+            self.stats["wall_time"] = time.perf_counter() - tick
+            t_stop = min(float(mech.t), t_end)
+            partial = self._partial(mech, stepper, f"interrupted at t = {t_stop!r} s")
+            raise RunInterrupted(f"interrupted at t = {t_stop!r} s", partial) from err
         except Exception as err:  # a failure keeps what was computed and says why
             self.stats["wall_time"] = time.perf_counter() - tick
-            partial = None
-            try:
-                partial = self._result(mech, stepper, status=f"failed at t = {t!r} s: {err}")
-            except Exception:  # noqa: BLE001 - the partial result is best effort
-                partial = None
-            raise CoupledRunError(f"coupled run failed at t = {t!r} s: {type(err).__name__}: {err}", partial) from err
+            t_fail = _failure_time(err, t)
+            partial = self._partial(mech, stepper, f"failed at t = {t_fail!r} s: {err}")
+            raise CoupledRunError(f"coupled run failed at t = {t_fail!r} s: {type(err).__name__}: {err}",
+                                  partial) from err
+
+    def _partial(self, mech, stepper, status: str) -> CoupledResult | None:
+        """The result up to a failure or interruption (best effort: None if even that fails)."""
+        try:
+            return self._result(mech, stepper, status=status)
+        except Exception:  # noqa: BLE001
+            return None
 
     # --- schemes -----------------------------------------------------------------------
 
@@ -373,21 +409,39 @@ def run(scene: Scene, *, progress: bool = False) -> CoupledResult:
         from mech.solver import MechSolverError
 
         tick = time.perf_counter()
+        solver = ImpactSolver(scene.mech)
         try:
-            result = ImpactSolver(scene.mech).run()
+            result = solver.run()
         except MechSolverError as err:
             partial = None
             if err.partial_result is not None:
                 partial = CoupledResult(scene=scene, mechanics=err.partial_result, waveforms=None,
-                                        stats={}, status=f"failed: {err}")
+                                        stats={}, status=f"failed at t = {float(err.t)!r} s: {err}")
             raise CoupledRunError(str(err), partial) from err
+        except KeyboardInterrupt as err:
+            status = f"interrupted at t = {float(solver.t)!r} s"
+            try:
+                partial = CoupledResult(scene=scene, mechanics=solver.result(), waveforms=None,
+                                        stats=dict(wall_time=time.perf_counter() - tick), status=status)
+            except Exception:  # noqa: BLE001 - best effort
+                partial = None
+            raise RunInterrupted(status, partial) from err
         return CoupledResult(scene=scene, mechanics=result, waveforms=None,
                              stats=dict(wall_time=time.perf_counter() - tick), status="ok")
     from circuit import run_transient
 
     tick = time.perf_counter()
     spec = scene.circuit
-    waves = run_transient(spec.circuit, spec.schedule, scene.t_end, options=spec.options, probes=spec.probes)
+    try:
+        waves = run_transient(spec.circuit, spec.schedule, scene.t_end, options=spec.options,
+                              probes=spec.probes)
+    except KeyboardInterrupt as err:  # the one-shot transient has no partial waveforms
+        raise RunInterrupted("interrupted", CoupledResult(scene=scene, mechanics=None, waveforms=None,
+                                                          stats={}, status="interrupted")) from err
+    except Exception as err:  # noqa: BLE001 - a failed circuit run still leaves its summary
+        raise CoupledRunError(f"circuit run failed: {type(err).__name__}: {err}",
+                              CoupledResult(scene=scene, mechanics=None, waveforms=None, stats={},
+                                            status=f"failed: {err}")) from err
     return CoupledResult(scene=scene, mechanics=None, waveforms=waves,
                          stats=dict(wall_time=time.perf_counter() - tick), status="ok")
 

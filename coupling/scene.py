@@ -22,7 +22,8 @@ A scene names only what it needs, and only that is built:
                         (s, s, ohm, m/s: the gap for an arc whose voltage grows with it)
     [coupling]    scheme = "mechanics_first" | "jacobi", macro_step, max_macro_step (s),
                   align_events = true, onset_penetration (m)
-    [output]      csv, parquet, plots, history, html = true | false
+    [output]      csv, parquet, plots, history, html = true | false, history_resolution (s),
+                  history_max_rows
     [metrics]     settle_window (s), make_guard (s), arc_toggle_limit (coupling.metrics)
 
 SI units everywhere. File paths are relative to the scene file. Every error names the
@@ -113,13 +114,34 @@ class CouplingOptions:
 @dataclass(frozen=True)
 class OutputOptions:
     """What a run writes besides summary.json: csv, parquet, plots (PNG), history (mechanics CSV),
-    html (waveforms.html, the interactive waveform page)."""
+    html (waveforms.html, the interactive waveform page).
+
+    history_resolution, history_max_rows: history.csv keeps the records on either side of
+    every event and regime change and, of the rest, one per interval of
+    max(history_resolution, run length / history_max_rows) (s; both 0: every solver step);
+    docs/coupling.md, "Outputs".
+    """
 
     csv: bool = True
     parquet: bool = True
     plots: bool = True
     history: bool = True
     html: bool = True
+    history_resolution: float = 1e-6
+    history_max_rows: int = 50_000
+
+    def __post_init__(self):
+        for name in ("csv", "parquet", "plots", "history", "html"):
+            _bool(f"output.{name}", getattr(self, name))
+        check_nonnegative("output.history_resolution", self.history_resolution)
+        rows = self.history_max_rows
+        if isinstance(rows, bool) or not isinstance(rows, int) or rows < 0:
+            raise ValueError(f"output.history_max_rows = {rows!r}: expected a whole number >= 0 (0: no limit)")
+
+    def history_interval(self, duration: float) -> float:
+        """s: the history's resolution for a run of ``duration`` s (0: every record)."""
+        budget = duration / self.history_max_rows if self.history_max_rows else 0.0
+        return max(self.history_resolution, budget)
 
 
 @dataclass(frozen=True)
@@ -518,8 +540,6 @@ def scene_from_dict(doc: dict, *, base_dir: Path | str = ".", name: str = "scene
 
     coupling = CouplingOptions(**_known(doc.get("coupling", {}), CouplingOptions, f"{where} [coupling]"))
     output = OutputOptions(**_known(doc.get("output", {}), OutputOptions, f"{where} [output]"))
-    for key, value in doc.get("output", {}).items():
-        _bool(f"{where} [output] {key}", value)
     t_end = _table("[solver]", doc.get("solver", {})).get("t_end")
     if t_end is not None:
         check_positive("solver.t_end", t_end)

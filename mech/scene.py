@@ -32,6 +32,7 @@ from pathlib import Path
 
 from .parameters import (
     Bar, Block, Contact, Friction, Initial, MechScene, Mount, PointForce, Rivet, SolverOptions, Spring,
+    _check_count,
 )
 
 SECTIONS = {
@@ -131,13 +132,16 @@ def _section(name: str, cls, table: dict, where: str):
 
 
 def _modes(value, where: str) -> dict:
-    """`modes = 3` (every family) or `modes = {axial = 3, bending = 2}`."""
+    """`modes = 3` (every family) or `modes = {axial = 3, bending = 2}`; errors name the key
+    the user wrote (bar.modes, bar.modes.axial), not the field it maps to."""
     if isinstance(value, dict):
         unknown = set(value) - {"axial", "bending"}
         if unknown:
             raise ValueError(f"{where}[bar]: modes: unknown key(s) {sorted(unknown)}; allowed: axial, bending")
-        return {"axial_modes": value.get("axial", 3), "bending_modes": value.get("bending", 3)}
-    return {"axial_modes": value, "bending_modes": value}
+        return {"axial_modes": _check_count("bar.modes.axial", value.get("axial", 3)),
+                "bending_modes": _check_count("bar.modes.bending", value.get("bending", 3))}
+    count = _check_count("bar.modes", value)
+    return {"axial_modes": count, "bending_modes": count}
 
 
 def scene_from_dict(doc: dict, *, where: str = "scene", extra_sections=()) -> MechScene:
@@ -196,14 +200,39 @@ def _held_defaults(doc: dict) -> dict:
 
 
 def read_toml(path) -> dict:
-    """The parsed TOML document of a scene file, or a clear error (missing file, bad TOML)."""
+    """The parsed TOML document of a scene file, or a one-line error: missing file, a folder
+    or device instead of a file, text that is not UTF-8 (with line and column), bad TOML,
+    an empty document (an empty scene would silently run every default: refused).
+    A UTF-8 byte-order mark, as some Windows editors write, is accepted."""
     path = Path(path)
+    name = str(path)
+    if path.is_dir():
+        raise ValueError(f"scene {name!r} is a folder, not a scene file")
+    if not path.exists():
+        raise FileNotFoundError(f"scene file {name!r} not found")
     if not path.is_file():
-        raise FileNotFoundError(f"scene file {str(path)!r} not found")
+        raise ValueError(f"scene {name!r} is not a regular file (a device, pipe or socket); give a .toml file")
     try:
-        return tomllib.loads(path.read_text())
+        data = path.read_bytes()
+    except OSError as err:
+        raise ValueError(f"scene file {name!r} cannot be read: {err.strerror or err}") from None
+    if data.startswith(b"\xef\xbb\xbf"):
+        data = data[3:]
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        line = data.count(b"\n", 0, err.start) + 1
+        column = err.start - (data.rfind(b"\n", 0, err.start) + 1) + 1
+        raise ValueError(f"{name}: line {line}, column {column}: byte 0x{data[err.start]:02x} is not UTF-8 text; "
+                         "save the scene as UTF-8") from None
+    try:
+        doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
-        raise ValueError(f"{path}: not valid TOML: {err}") from None
+        raise ValueError(f"{name}: not valid TOML: {err}") from None
+    if not doc:
+        raise ValueError(f"{name}: the scene is empty (no sections); an empty scene would silently run "
+                         "every default: name the sections you mean (see docs/mechanics.md)")
+    return doc
 
 
 def load_scene(path) -> MechScene:

@@ -71,7 +71,7 @@ def test_mechanics_only_scene_starts_no_ngspice(tmp_path):
         """)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
-    rc, no_ngspice = out.stdout.split()
+    rc, no_ngspice = out.stdout.splitlines()[-1].split()  # after the result lines (--quiet keeps them)
     assert rc == "0" and no_ngspice == "True"
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["kind"] == "mechanics" and "bounce" not in summary

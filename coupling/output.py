@@ -1,0 +1,222 @@
+"""Writing a run's result folder: complete or not there at all.
+
+- The destination is checked before anything runs (``ResultFolder``): an empty name, an
+  existing file or device, a folder that cannot be written, the current folder itself,
+  or a non-empty folder that is not a previous result of the same scene (without
+  ``overwrite``) are refused with one line.
+- Everything is written into a fresh hidden folder beside the destination (same parent,
+  same file system), ``summary.json`` last; that folder then takes the destination's place
+  by rename. A previous result there is replaced whole (its old files never mix with the
+  new ones); an interruption or error while writing removes the unfinished folder and
+  leaves the previous result as it was.
+- The mechanics history is thinned (``thin_history``) to ``[output] history_resolution``,
+  coarser where ``history_max_rows`` needs it: its size is bounded by that row budget
+  plus the events, however many steps the solver took.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+STAGING_PREFIX = ".switchsim-"  # hidden working folders beside the destination
+
+
+class DestinationError(ValueError):
+    """The result folder cannot be used; raised before the run starts."""
+
+
+def scene_identity(scene, scene_path: str | None) -> dict:
+    """What marks a result folder as this scene's: the scene's name and its file (absolute)."""
+    return {"scene": getattr(scene, "name", "scene"),
+            "scene_file": None if scene_path is None else str(Path(scene_path).resolve())}
+
+
+def previous_result_of(folder: Path, identity: dict) -> bool:
+    """True if ``folder`` holds a switchsim result (summary.json with a status) of the same
+    scene (same scene file; for the built-in default scene, the same name)."""
+    try:
+        summary = json.loads((folder / "summary.json").read_text())
+    except (OSError, ValueError):
+        return False
+    if not isinstance(summary, dict) or "status" not in summary:
+        return False
+    if identity["scene_file"] is not None or summary.get("scene_file") is not None:
+        return summary.get("scene_file") == identity["scene_file"]
+    return summary.get("scene") == identity["scene"]
+
+
+@dataclasses.dataclass
+class ResultFolder:
+    """A checked destination for one run's files (see the module docstring)."""
+
+    path: Path
+    identity: dict
+    overwrite: bool = False
+
+    @classmethod
+    def check(cls, out: str, identity: dict, *, overwrite: bool = False) -> "ResultFolder":
+        """Validate ``out`` (as the user wrote it) before the run; DestinationError if unusable."""
+        try:
+            return cls._check(out, identity, overwrite)
+        except OSError as err:  # e.g. a folder on the way that cannot be read
+            raise DestinationError(f"--out {out!r}: {err.strerror or err}") from None
+
+    @classmethod
+    def _check(cls, out: str, identity: dict, overwrite: bool) -> "ResultFolder":
+        if not isinstance(out, str) or not out.strip():
+            raise DestinationError("--out '': give the name of a result folder, e.g. --out runs/my_scene")
+        path = Path(out).expanduser()
+        where = f"--out {out!r}"
+        if path.is_symlink() and path.is_dir():
+            path = path.resolve()  # a link to a folder: the folder it names is the destination
+        if path.exists() or path.is_symlink():
+            if not path.is_dir():
+                kind = "a file" if path.is_file() else "not a folder (a device or special file)"
+                raise DestinationError(f"{where} is {kind}; give a folder name")
+            resolved = path.resolve()
+            cwd = Path.cwd().resolve()
+            try:
+                home = Path.home().resolve()
+            except RuntimeError:  # no home folder known
+                home = None
+            if resolved == cwd or resolved in cwd.parents or resolved == home:
+                raise DestinationError(f"{where} is the current folder, one of its parents or the home "
+                                       "folder, which a result would replace; give a sub-folder")
+            if any(path.iterdir()):
+                if not previous_result_of(path, identity):
+                    if not overwrite:
+                        raise DestinationError(
+                            f"{where} holds files that are not a switchsim result of this scene; "
+                            "give another --out, or --overwrite to replace the folder whole")
+                    if any(p.is_dir() and not p.is_symlink() for p in path.iterdir()):
+                        raise DestinationError(
+                            f"{where} holds sub-folders (switchsim never writes any): it is not a result "
+                            "folder, and --overwrite will not delete it; give another --out")
+            if not os.access(path, os.W_OK | os.X_OK):
+                raise DestinationError(f"{where} is read-only; give a folder you can write")
+        parent = path.absolute().parent
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+            probe = tempfile.mkdtemp(prefix=STAGING_PREFIX + "probe-", dir=parent)
+            os.rmdir(probe)
+        except OSError as err:
+            raise DestinationError(f"{where}: cannot create a folder in {str(parent)!r}: "
+                                   f"{err.strerror or err}") from None
+        return cls(path=path.absolute(), identity=identity, overwrite=overwrite)
+
+    def write(self, result, summary_extra: dict | None = None) -> Path:
+        """Write ``result`` (a CoupledResult) and put it in place; returns the folder."""
+        staging = Path(tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{self.path.name}-", dir=self.path.parent))
+        try:
+            _make_public(staging)
+            write_files(result, staging, summary_extra)
+            self._swap(staging)
+        except BaseException:
+            shutil.rmtree(staging, ignore_errors=True)
+            raise
+        return self.path
+
+    def _swap(self, staging: Path) -> None:
+        if not (self.path.exists() or self.path.is_symlink()):
+            os.rename(staging, self.path)
+            return
+        old = Path(tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}old-{self.path.name}-", dir=self.path.parent))
+        os.rmdir(old)
+        os.rename(self.path, old)
+        try:
+            os.rename(staging, self.path)
+        except BaseException:
+            os.rename(old, self.path)  # put the previous result back
+            raise
+        shutil.rmtree(old, ignore_errors=True)
+
+
+def write_files(result, folder: Path, summary_extra: dict | None = None) -> None:
+    """Write all of a result's files into ``folder``, summary.json last."""
+    scene = result.scene
+    opts = scene.output
+    # the result writes its own tables and plots; the history is written thinned, here
+    view = dataclasses.replace(result, scene=dataclasses.replace(
+        scene, output=dataclasses.replace(opts, history=False)))
+    view.save(folder)
+    summary = result.summary
+    if result.mechanics is not None and opts.history:
+        t = result.mechanics.t
+        interval = opts.history_interval(float(t[-1] - t[0]) if len(t) else 0.0)
+        kept = thin_history(result.mechanics, interval)
+        thin_result(result.mechanics, kept).history.to_csv(folder / "history.csv", index=False)
+        summary["history"] = {"file": "history.csv", "resolution": interval,
+                              "rows": int(len(kept)), "solver_records": int(len(t))}
+    summary.update(summary_extra or {})
+    _write_text(folder / "summary.json", json.dumps(_jsonable(summary), indent=2))
+
+
+def thin_history(mres, resolution: float) -> np.ndarray:
+    """Indices of the records history.csv keeps: the first and last, those on either side
+    of every event and regime change, and of the rest the first in each interval of
+    ``resolution`` seconds (0: every record). At most t_end / resolution + 4 x (events +
+    regime changes) + 2 rows, however many steps the solver took."""
+    t = np.asarray(mres.t)
+    n = len(t)
+    if n <= 2 or resolution <= 0.0:
+        return np.arange(n)
+    keep = np.zeros(n, bool)
+    keep[[0, -1]] = True
+    bins = np.floor((t - t[0]) / resolution)
+    keep[np.flatnonzero(np.diff(bins) > 0) + 1] = True
+    reg = np.asarray(mres.regimes)
+    change = np.flatnonzero(np.any(reg[1:] != reg[:-1], axis=tuple(range(1, reg.ndim)))) if n > 1 else []
+    for k in change:
+        keep[k:k + 2] = True
+    times = np.array([e["time"] for e in mres.events], dtype=float)
+    if len(times):
+        k = np.clip(np.searchsorted(t, times), 0, n - 1)
+        keep[k] = True
+        keep[np.maximum(k - 1, 0)] = True
+    return np.flatnonzero(keep)
+
+
+def thin_result(mres, kept: np.ndarray):
+    """The mechanics result restricted to the records ``kept`` (for its history table)."""
+    if len(kept) == len(mres.t):
+        return mres
+    cls = type(mres)
+    extra = None if mres.extra_states is None else mres.extra_states[kept]
+    return cls(model=mres.model, t=mres.t[kept], states=mres.states[kept], aux=mres.aux[kept],
+               peak_force=mres.peak_force[kept], regimes=mres.regimes[kept], events=mres.events,
+               stats=mres.stats, projection_energy=mres.projection_energy, extra_states=extra)
+
+
+def _write_text(path: Path, text: str) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def _make_public(folder: Path) -> None:
+    """mkdtemp makes a private (0700) folder; a result folder gets the usual permissions."""
+    mask = os.umask(0)
+    os.umask(mask)
+    os.chmod(folder, 0o777 & ~mask)
+
+
+def _jsonable(value):
+    if isinstance(value, dict):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        value = float(value)
+        return value if np.isfinite(value) else None
+    return value

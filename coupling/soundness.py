@@ -1,0 +1,151 @@
+"""Is a finished run physically sound? Bounds every run must respect, as small pure laws.
+
+A run whose integration is too coarse can still finish: the explicit integrator may pump
+energy into the bar (speeds of km/s, a tip "penetrating" millimetres into the block) and
+the circuit then carries currents its source cannot drive. Such a result gets the status
+"unsound" (``switchsim`` exits 3), with each violated bound named, its cause and the fix.
+
+The bounds, all from the scene's own energy scale E (J, ``mech.ImpactResult.energy_scale``:
+initial kinetic + elastic + contact-stored energy + m g (z_c0 - R_tip), the potential
+energy of the centre above the lowest resting height; nothing in the scene adds
+mechanical energy after the start: contact damping, friction and modal damping only take
+it out):
+
+- energy audit: max |residual| <= energy_tolerance * E ([solver] energy_tolerance);
+- speeds: the kinetic energy (translation, rotation, vibration) never exceeds E, and so
+  the centre of mass moves at most sqrt(2 E / m) (m/s);
+- penetration: the Hertz spring stores (2/5) k y^(5/2), at most E plus the work of the
+  weight W = m g over the penetration itself, so no tip goes deeper than the root of
+  (2/5) k y^(5/2) = E + W y (m; (5 E / (2 k))^(2/5) without gravity);
+- circuit (template circuits): the loop current through the load is at most
+  2 V / (R_source + R_wiring + R_load) (A): the supply across the series loop, plus one
+  full overshoot of the loop's ringing. A netlist circuit's topology is not known: no
+  current bound.
+
+Bounds are compared with a relative margin (BOUND_MARGIN) for round-off and the
+integration error the energy check already limits.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from mech.kernel import A_Y
+
+BOUND_MARGIN = 0.01  # relative slack on the energy-derived bounds
+RINGING_FACTOR = 2.0  # a passive loop's step response reaches at most twice its final value
+
+FIX = "the integration is not accurate enough: set a tighter [solver] rtol (e.g. 10 times smaller)"
+
+
+def speed_bound(energy_scale: float, mass: float) -> float:
+    """m/s: the fastest the centre of mass can move with energy E (J) and mass m (kg)."""
+    return math.sqrt(2.0 * max(energy_scale, 0.0) / mass)
+
+
+def penetration_bound(energy_scale: float, stiffness: float, weight: float = 0.0) -> float:
+    """m: the deepest Hertz penetration energy E (J) can make against k y^1.5 (N/m^1.5),
+    with the weight W (N) doing work W y on the way down: the root of (2/5) k y^2.5 = E + W y
+    (fixed-point iteration; the right side grows more slowly than the left)."""
+    e = max(energy_scale, 0.0)
+    y = (2.5 * e / stiffness) ** 0.4
+    for _ in range(200):
+        y_new = (2.5 * (e + weight * y) / stiffness) ** 0.4
+        if abs(y_new - y) <= 1e-14 * y_new:
+            return y_new
+        y = y_new
+    return y
+
+
+def loop_current_bound(voltage: float, series_resistance: float) -> float:
+    """A: the largest loop current a DC source V (V) can drive through series R (ohm)."""
+    return RINGING_FACTOR * abs(voltage) / series_resistance
+
+
+def energy_problem(max_residual: float, energy_scale: float, tolerance: float) -> str | None:
+    """The energy audit's verdict: None if |residual| (J) <= tolerance x scale (J)."""
+    rel = max_residual / energy_scale if energy_scale > 0 else math.inf
+    if rel <= tolerance:
+        return None
+    return (f"energy audit: residual {max_residual:.3g} J is {rel:.3g} of the scene's energy {energy_scale:.3g} J "
+            f"(allowed: solver.energy_tolerance = {tolerance:g}); {FIX}")
+
+
+def speed_problem(max_speed: float, bound: float) -> str | None:
+    """None if the largest centre-of-mass speed (m/s) respects the energy bound (m/s)."""
+    if max_speed <= bound * (1.0 + BOUND_MARGIN):
+        return None
+    return (f"speed: the bar's centre moved at {max_speed:.3g} m/s, more than the {bound:.3g} m/s "
+            f"its energy allows; {FIX}")
+
+
+def kinetic_problem(max_kinetic: float, energy_scale: float) -> str | None:
+    """None if the largest kinetic energy (J; translation, rotation and vibration: every
+    speed of the bar) stays within the scene's energy (J)."""
+    if max_kinetic <= energy_scale * (1.0 + BOUND_MARGIN):
+        return None
+    return (f"speed: the bar's kinetic energy (translation, rotation and vibration) reached {max_kinetic:.3g} J, "
+            f"more than the scene's energy {energy_scale:.3g} J; {FIX}")
+
+
+def penetration_problem(max_penetration: float, bound: float, tip_radius: float) -> str | None:
+    """None if the deepest tip penetration (m) respects the energy bound and the tip radius (m)."""
+    if max_penetration <= min(bound * (1.0 + BOUND_MARGIN), tip_radius):
+        return None
+    return (f"penetration: a tip went {max_penetration:.3g} m into the block (tip radius {tip_radius:.3g} m), "
+            f"deeper than the {bound:.3g} m the scene's energy allows; {FIX}")
+
+
+def current_problem(max_current: float, bound: float) -> str | None:
+    """None if the largest |loop current| (A) respects the circuit's bound (A)."""
+    if max_current <= bound * (1.0 + BOUND_MARGIN):
+        return None
+    return (f"circuit: {max_current:.3g} A through the load, more than the {bound:.3g} A the source and the "
+            f"loop's resistances allow; {FIX}")
+
+
+def assess(result) -> dict:
+    """The soundness block of summary.json for a finished ``CoupledResult``: the measured
+    extremes, their bounds and ``problems`` (one line each; empty when sound)."""
+    out: dict = {}
+    problems: list[str] = []
+    mres = result.mechanics
+    if mres is not None and len(mres.t):
+        scene = mres.model.scene
+        scale = float(mres.energy_scale)
+        residual = float(np.max(np.abs(mres.energy_table.residual.to_numpy())))
+        # from the records themselves, not the history table (a long run's table is large)
+        speed = float(np.max(np.linalg.norm(mres.states[:, mres.model.slices()["vel"]], axis=1)))
+        pen = float(max(np.max(mres.aux[:, :, A_Y]), 0.0))
+        v_max = speed_bound(scale, scene.bar.mass)
+        y_max = penetration_bound(scale, float(mres.solver["stiffness"]), scene.bar.mass * scene.gravity)
+        kinetic = float(mres.energy_table.kinetic.max())
+        out.update(energy_scale=scale, relative_residual=residual / scale if scale > 0 else None,
+                   max_kinetic=kinetic, max_speed=speed, speed_bound=v_max, max_penetration=pen,
+                   penetration_bound=y_max)
+        problems += [p for p in (energy_problem(residual, scale, scene.solver.energy_tolerance),
+                                 kinetic_problem(kinetic, scale), speed_problem(speed, v_max),
+                                 penetration_problem(pen, y_max, scene.bar.tip_radius)) if p]
+    bound = _circuit_current_bound(result.scene)
+    waves = result.waveforms
+    if bound is not None and waves is not None and len(waves) and "load_current" in waves:
+        current = float(np.nanmax(np.abs(waves.load_current.to_numpy())))
+        out.update(max_load_current=current, load_current_bound=bound)
+        problem = current_problem(current, bound)
+        if problem:
+            problems.append(problem)
+    out["problems"] = problems
+    return out
+
+
+def _circuit_current_bound(scene) -> float | None:
+    spec = getattr(scene, "circuit", None)
+    circ = getattr(spec, "circuit", None)
+    try:
+        voltage = circ.source.voltage
+        series = circ.source.internal_resistance + circ.wiring.resistance + circ.load.resistance
+    except AttributeError:  # a netlist circuit: its topology is the user's
+        return None
+    return loop_current_bound(voltage, series) if series > 0 else None
