@@ -296,10 +296,17 @@ class Stepper:
         and the user probes (``circuit.probes.check_probes``: v(node), i(element)) as columns
         named by their text; after ``close()`` the probes' columns are NaN (ngspice's vectors
         are gone: ask for them before)."""
-        if self._final is not None and not extra:
-            frame = self._final.copy()
-            for p in probes:
-                frame[p.text] = np.nan
+        if self._session is None or (self._final is not None and not extra):
+            # closed (e.g. a run that failed and is being written as it stood): the columns
+            # kept at close, none if it never started; raw vectors and probes asked for
+            # afterwards are gone (NaN)
+            if self._final is not None:
+                frame = self._final.copy()
+            else:
+                frame = pd.DataFrame({name: np.empty(0) for name in COLUMNS})
+            for name in tuple(extra) + tuple(p.text for p in probes):
+                if name not in frame:
+                    frame[name] = np.nan
             return frame
         session = self._active()
         if not self._started:

@@ -12,7 +12,7 @@ Scenario scripts::
 
 from .master import CoSimulation, CoupledRunError, run
 from .results import CoupledResult
-from .scene import Scene, default_scene, load_scene, scene_from_dict
+from .scene import Scene, builtin_scene, default_scene, load_scene, scene_from_dict
 
-__all__ = ["CoSimulation", "CoupledResult", "CoupledRunError", "Scene", "default_scene", "load_scene",
+__all__ = ["CoSimulation", "CoupledResult", "CoupledRunError", "Scene", "builtin_scene", "default_scene", "load_scene",
            "run", "scene_from_dict"]

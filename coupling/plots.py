@@ -258,7 +258,7 @@ def save_plots(result, out_dir) -> list[Path]:
     """Write the plots that apply to this run's kind into out_dir; returns their paths."""
     out = Path(out_dir)
     figures = []
-    if result.waveforms is not None:
+    if result.waveforms is not None and len(result.waveforms) > 1:  # (a run that failed before the circuit started has none)
         figures.append(("waveforms.png", plot_waveforms))
         figures.append(("waveforms_whole_run.png", lambda r: plot_waveforms(r, whole_run=True)))
         figures.append(("contact_voltage_log.png", plot_log_voltage))

@@ -529,8 +529,7 @@ def scene_from_dict(doc: dict, *, base_dir: Path | str = ".", name: str = "scene
             friction = Friction(mu=lambda current, f=mu_fn: float(f(current)), gamma=float(laws.gamma),
                                 model=fr.model, max_ratio=fr.max_ratio,
                                 regularization_speed=fr.regularization_speed)
-            mech = MechScene(bar=mech.bar, block=mech.block, contact=mech.contact, friction=friction,
-                             initial=mech.initial, solver=mech.solver, gravity=mech.gravity)
+            mech = dataclasses.replace(mech, friction=friction)  # every other section as the scene says
 
     circuit = None
     if circuit_table is not None:
@@ -608,13 +607,29 @@ def load_scene(path) -> Scene:
     return scene_from_dict(read_toml(path), base_dir=path.parent, name=str(path))
 
 
+BUILTIN_SCENES = ("default", "relay_cycle", "free_drop")
+
+
+def builtin_scene_text(name: str = "default") -> str:
+    """A built-in scene as TOML text: "default" (a relay contact closing), "relay_cycle"
+    (closing, held, opening) or "free_drop" (the source paper's bar dropped on a block)."""
+    if name not in BUILTIN_SCENES:
+        raise ValueError(f"built-in scene {name!r}: allowed: {', '.join(BUILTIN_SCENES)}")
+    return resources.files("coupling").joinpath(f"scenes/{name}.toml").read_text()
+
+
+def builtin_scene(name: str = "default") -> Scene:
+    """A built-in coupled scene (coupling/scenes/<name>.toml), see builtin_scene_text."""
+    doc = tomllib.loads(builtin_scene_text(name))
+    return scene_from_dict(doc, base_dir=Path("."), name="default scene" if name == "default" else f"{name} scene")
+
+
 def default_scene_text() -> str:
-    """The built-in default coupled scene, as TOML text."""
-    return resources.files("coupling").joinpath("scenes/default.toml").read_text()
+    """The built-in default coupled scene (a relay contact closing), as TOML text."""
+    return builtin_scene_text("default")
 
 
 def default_scene() -> Scene:
     """The built-in default coupled scene (coupling/scenes/default.toml)."""
-    doc = tomllib.loads(default_scene_text())
-    return scene_from_dict(doc, base_dir=Path("."), name="default scene")
+    return builtin_scene("default")
 

@@ -280,17 +280,23 @@ class ImpactResult:
     @property
     def energy_scale(self) -> float:
         """J: the energy the audit is judged against: what the scene brings in, its initial
-        kinetic, elastic and contact-stored energy plus the potential energy of the centre
-        above its lowest resting height (lying flat on the block: the centre at the tip
-        radius), m g (z_c0 - R_tip). A bar at rest still has a scale (a standing bar can fall
+        kinetic, elastic, contact- and spring-stored energy, the most work its actuators and
+        a moving clamp put in, plus (a free bar) the potential energy of the centre above
+        its lowest resting height (lying flat on the block: the centre at the tip radius),
+        m g (z_c0 - R_tip). A bar at rest still has a scale (a standing bar can fall
         over), and a run that gains energy by error does not enlarge its own yardstick."""
         en = self.energy_table
         m = self.model
         z0 = float(self.states[0, m.slices()["pos"]][-1])  # centre height, z up (planar: x, z)
         scene = m.scene
-        drop = max(z0 - scene.bar.tip_radius, 0.0)
-        e_in = float(en.kinetic.iloc[0] + en.elastic.iloc[0] + en.contact_stored.iloc[0])
-        return max(e_in + scene.bar.mass * scene.gravity * drop, 1e-300)
+        # a held bar cannot fall; a free one can drop its centre to the tip radius
+        drop = 0.0 if scene.mount.held else max(z0 - scene.bar.tip_radius, 0.0)
+        e_in = float(en.kinetic.iloc[0] + en.elastic.iloc[0] + en.contact_stored.iloc[0]
+                     + en.spring_stored.iloc[0])
+        # actuators and a moving clamp bring energy in while the run goes on: the most they
+        # had put in at any time belongs to the yardstick too
+        work = max(float(en.work_in.max()), 0.0)
+        return max(e_in + work + m.basis.mass * scene.gravity * drop, 1e-300)
 
     @property
     def flags(self) -> list[str]:

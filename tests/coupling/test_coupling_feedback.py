@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from coupling import default_scene, run
+from coupling import builtin_scene, run
 from coupling.master import CoSimulation
 
 
@@ -16,13 +16,13 @@ def short(scene, t_end=2.3e-3):
 
 @pytest.fixture(scope="module")
 def default_run():
-    sim = CoSimulation(short(default_scene()))
+    sim = CoSimulation(short(builtin_scene("free_drop")))
     return sim, sim.run()
 
 
 def test_without_current_mu_stays_at_mu0():
     # a 1 Mohm load: the contact closes but carries ~24 uA
-    scene = short(default_scene().set("circuit.load_resistance", 1e6))
+    scene = short(builtin_scene("free_drop").set("circuit.load_resistance", 1e6))
     res = run(scene)
     laws = scene.tribology.laws
     mu0 = float(laws.mu(0.0))
@@ -52,7 +52,7 @@ def test_with_current_mu_is_the_law_at_the_extrapolated_current(default_run):
 
 
 def test_feedback_off_keeps_mu0_even_with_current():
-    scene = short(default_scene().set("tribology.feedback", False))
+    scene = short(builtin_scene("free_drop").set("tribology.feedback", False))
     res = run(scene)
     assert res.waveforms.load_current.max() > 1.5
     np.testing.assert_allclose(res.waveforms.mu, float(scene.tribology.laws.mu(0.0)), rtol=1e-12)

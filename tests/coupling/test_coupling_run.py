@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from coupling import default_scene, run
+from coupling import builtin_scene, default_scene, run
 from coupling.cli import main
 from coupling.scene import scene_from_dict
 
@@ -24,7 +24,7 @@ def test_default_scene_runs_end_to_end_through_the_command(tmp_path, capsys):
     scene = tmp_path / "short_default.toml"
     from coupling.scene import default_scene_text
 
-    scene.write_text(default_scene_text().replace("t_end = 0.01", "t_end = 0.003"))
+    scene.write_text(default_scene_text().replace("t_end = 0.005", "t_end = 0.003"))
     assert main(["run", str(scene), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     out = tmp_path / "out"
     summary = json.loads((out / "summary.json").read_text())
@@ -105,7 +105,7 @@ def test_circuit_only_scene_reproduces_the_one_shot_pwl_reference():
 
 
 def test_planar_scene_uses_the_planar_model_and_zero_modes_the_rigid_bar():
-    base = default_scene().set("solver.t_end", 1.2e-3)
+    base = builtin_scene("free_drop").set("solver.t_end", 1.2e-3)
     planar = base.set("initial.velocity", [0.2, 0.0, -1.0]).set("bar.modes", 0)
     res = run(planar)
     assert res.mechanics.solver["model"] == "planar" and res.mechanics.solver["modes"] == 0
@@ -117,7 +117,7 @@ def test_a_failed_run_writes_what_it_has_and_says_why(tmp_path, capsys):
     from coupling.scene import default_scene_text
 
     scene = tmp_path / "fails.toml"
-    scene.write_text(default_scene_text().replace("t_end = 0.01", "t_end = 0.003\nmax_steps = 300"))
+    scene.write_text(default_scene_text().replace("t_end = 0.005", "t_end = 0.003\nmax_steps = 300"))
     rc = main(["run", str(scene), "--out", str(tmp_path / "out"), "--quiet"])
     assert rc == 1
     err = capsys.readouterr().err

@@ -6,7 +6,7 @@ import textwrap
 
 import pytest
 
-from coupling import default_scene, load_scene
+from coupling import builtin_scene, load_scene
 from coupling.scene import scene_from_dict
 
 MECH = {"bar": {"modes": 0}, "initial": {"height": 1e-3, "angle_deg": 90.0, "velocity": [0, 0, -0.5]}}
@@ -14,8 +14,8 @@ TRIB = {"tribology": {"source": "illustrative"}}
 CIRCUIT = {"circuit": {"template": "resistive", "load_resistance": 12.0}}
 
 
-def test_default_scene_is_coupled_and_3d():
-    sc = default_scene()
+def test_free_drop_scene_is_coupled_and_3d():
+    sc = builtin_scene("free_drop")
     assert sc.kind == "coupled"
     assert sc.mech.friction.gamma == pytest.approx(sc.tribology.laws.gamma)
     assert sc.circuit.circuit.contact_current_factor is not None
@@ -33,7 +33,7 @@ def test_kinds_follow_the_sections():
 
 
 def test_set_revalidates_and_keeps_the_original():
-    sc = default_scene()
+    sc = builtin_scene("free_drop")
     changed = sc.set("initial.angle_deg", 45).set("circuit.load_resistance", 6.0)
     assert changed.mech.initial.angle_deg == 45 and changed.circuit.circuit.load.resistance == 6.0
     assert sc.mech.initial.angle_deg == 30.0
@@ -96,7 +96,7 @@ def test_scene_pickles_as_its_document_for_other_processes():
     import pickle
     from concurrent.futures import ProcessPoolExecutor
 
-    sc = default_scene().set("initial.angle_deg", 40.0)
+    sc = builtin_scene("free_drop").set("initial.angle_deg", 40.0)
     back = pickle.loads(pickle.dumps(sc))
     assert back.raw == sc.raw and back.name == sc.name and back.mech.initial.angle_deg == 40.0
     assert back.mech.friction.mu_at(2.0) == sc.mech.friction.mu_at(2.0)
@@ -110,7 +110,7 @@ def _angle_of(scene):
 
 
 def test_update_validates_once_and_unset_restores_defaults():
-    sc = default_scene()
+    sc = builtin_scene("free_drop")
     # resting needs angle 0: one at a time the first change alone is invalid
     with pytest.raises(ValueError, match="initial.resting"):
         sc.set("initial.resting", True)

@@ -118,9 +118,9 @@ def test_bad_resistance_tables_give_one_line_errors(table, match):
 
 
 def _scene(tribology):
-    from coupling.scene import default_scene
+    from coupling.scene import builtin_scene
 
-    base = default_scene()
+    base = builtin_scene("free_drop")
     raw = dict(base.raw, tribology=tribology)
     from coupling.scene import scene_from_dict
 

@@ -188,9 +188,9 @@ def test_coupled_run_reports_openings_and_the_fit_range(tmp_path):
 
     import pandas as pd
 
-    from coupling import default_scene, run
+    from coupling import builtin_scene, run
 
-    res = run(default_scene().set("solver.t_end", 1.5e-3))
+    res = run(builtin_scene("free_drop").set("solver.t_end", 1.5e-3))
     res.save(tmp_path)
     summary = json.loads((tmp_path / "summary.json").read_text())
     b = summary["bounce"]
@@ -206,9 +206,9 @@ def test_coupled_run_reports_openings_and_the_fit_range(tmp_path):
 
 def test_switching_a_bar_section_is_one_call():
     """Scene.update with width and thickness used to fail until bar.diameter was unset."""
-    from coupling import default_scene
+    from coupling import builtin_scene
 
-    base = default_scene()
+    base = builtin_scene("free_drop")
     blade = base.update({"bar.width": 0.008, "bar.thickness": 0.002})
     assert "diameter" not in blade.raw["bar"] and blade.mech.bar.width == 0.008
     round_again = blade.set("bar.diameter", 0.01)
@@ -231,9 +231,9 @@ def test_a_single_make_that_opens_for_good_has_no_bounce_peak():
 def test_a_bounce_without_the_arc_model_warns_of_breakdown():
     """The issue's case: 5 ohm, 50 uH, no arc model: the first bounce opening puts kV across a
     sub-micrometre gap (reproduced: 3.35 kV); the run says so and what to add."""
-    from coupling import default_scene, run
+    from coupling import builtin_scene, run
 
-    sc = default_scene().unset("circuit.arc").update(
+    sc = builtin_scene("free_drop").unset("circuit.arc").update(
         {"circuit.load_resistance": 5.0, "circuit.wiring_inductance": 50e-6, "solver.t_end": 1.15e-3})
     res = run(sc)
     b = res.bounce
