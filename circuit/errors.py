@@ -52,3 +52,9 @@ class ConductanceError(ValueError):
 
 class GapError(ValueError):
     """The gap-distance callable returned a value that is not finite and >= 0 (m)."""
+
+
+class NetlistInputError(ValueError):
+    """A netlist (or a file it includes) was refused before ngspice saw it: a construct
+    that could run a command or read a file, or a line that is not valid input. The
+    message names the file and line, never the line's text."""
