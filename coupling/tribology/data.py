@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import csv
 import difflib
-import io
 import re
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Sequence
 
@@ -31,7 +31,6 @@ def minimum_rows(n_current_levels: int) -> int:
     return n_current_levels + EXTRA_POINTS_NEEDED
 
 
-_COMMENT = re.compile(r"^[ \t]*#[^\n]*(?:\n|$)", re.M)
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,40}")
 
 
@@ -103,27 +102,24 @@ def read_tribometer_csv(path) -> pd.DataFrame:
     try:
         if path.is_dir():
             raise ValueError(f"{path}: is a folder, not a tribometer CSV file")
-        data = path.read_bytes()
+        scan = _scan(path)
     except FileNotFoundError:
         raise FileNotFoundError(f"{path}: no such tribometer CSV file") from None
     except OSError as err:
         raise ValueError(f"{path}: cannot read ({err.strerror or type(err).__name__})") from None
-    text = _decode(data, path)
-    del data
-    comments = [m.group(0) for m in _COMMENT.finditer(text)]
-    header = [c.strip().lstrip("#").strip() for c in comments]
-    body = _COMMENT.sub("", text) if comments else text
-    del text
-    first = next((ln for ln in body.splitlines() if ln.strip()), None) if len(body) < 4096 else _first_line(body)
+    if not scan.ascii or scan.nul:
+        _decode(path.read_bytes(), path)  # raises with line and column if the file is not UTF-8 text
+    header = [c.decode("utf-8", "replace").strip().lstrip("#").strip() for c in scan.comments]
+    comment_only = scan.hashes == sum(c.count(b"#") for c in scan.comments)
+    first, header_line, quoted = scan.first, scan.first_line, scan.quoted
     if first is None:
         raise ValueError(f"{path}: no header line and no data (expected columns {', '.join(NUMERIC_COLUMNS)})")
     names = [cell.strip() for cell in next(csv.reader([first]))]
-    header_line = _line_of_data_row(path, 0)
     _check_header(names, path, header_line)
-    df = _fast_frame(body, names) if '"' not in body else None
+    df = _fast_frame(path, names) if comment_only and not quoted else None
     if df is None:
-        # the exact reading: quoted cells, or a malformed file (the error says where)
-        _, rows, line_numbers = _data_lines(path.read_bytes().decode("utf-8-sig"))
+        # the exact reading: quoted cells, '#' inside data lines, or a malformed file (the error says where)
+        _, rows, line_numbers = _data_lines(_decode(path.read_bytes(), path))
         for cells, number in zip(rows[1:], line_numbers[1:]):
             if len(cells) != len(names):
                 raise ValueError(f"{path}: line {number} has {len(cells)} fields, the header line "
@@ -132,51 +128,122 @@ def read_tribometer_csv(path) -> pd.DataFrame:
         labels: Sequence[str] | Callable[[int], str] = [f"line {n}" for n in line_numbers[1:]]
     else:
         raw = df
-        labels = lambda k: f"line {_line_of_data_row(path, k + 1)}"  # noqa: E731
+        labels = lambda k: f"line {lines_of_rows(path, [k])[0]}"  # noqa: E731
     out = validate_tribometer_frame(raw, source=str(path), row_labels=labels)
     out.attrs["header"] = tuple(header)
     out.attrs["source"] = str(path)
+    out.attrs["csv"] = True  # rows are the file's data lines in order (outliers are reported by line)
     return out
 
 
-def _first_line(body: str) -> str | None:
-    start = 0
-    while start < len(body):
-        end = body.find("\n", start)
-        end = len(body) if end < 0 else end
-        if body[start:end].strip():
-            return body[start:end]
-        start = end + 1
-    return None
+_COMMENT_BYTES = re.compile(rb"^[ \t]*#[^\n]*", re.M)
 
 
-def _line_of_data_row(path: Path, k: int) -> int:
-    """File line number of data row k (0: the header line), counting comments and blank lines."""
+@dataclass
+class _Scan:
+    """What one streaming pass over the file's bytes tells: text or not, the comment lines,
+    how many '#' it holds, whether any cell is quoted, the header line and its number."""
+
+    ascii: bool = True
+    nul: bool = False
+    comments: list = field(default_factory=list)
+    hashes: int = 0
+    quoted: bool = False
+    first: str | None = None
+    first_line: int = 0
+    lines: int = 0
+
+
+def _scan(path: Path, block_size: int = 1 << 20) -> _Scan:
+    scan = _Scan()
+    carry = b""
+    with open(path, "rb") as handle:
+        start = True
+        while True:
+            block = handle.read(block_size)
+            if start:
+                block = block[3:] if block.startswith(b"\xef\xbb\xbf") else block
+                start = False
+            if not block:
+                if carry:
+                    _scan_lines(scan, carry)
+                break
+            scan.ascii = scan.ascii and block.isascii()
+            scan.nul = scan.nul or b"\x00" in block
+            buf = carry + block
+            cut = buf.rfind(b"\n")
+            if cut < 0:
+                carry = buf
+                continue
+            _scan_lines(scan, buf[: cut + 1])
+            carry = buf[cut + 1 :]
+    return scan
+
+
+def _scan_lines(scan: _Scan, chunk: bytes) -> None:
+    hashes = chunk.count(b"#")
+    scan.hashes += hashes
+    scan.quoted = scan.quoted or b'"' in chunk
+    if hashes:
+        scan.comments += [m.group(0) for m in _COMMENT_BYTES.finditer(chunk)]
+    if scan.first is None:
+        for number, line in enumerate(chunk.split(b"\n"), start=scan.lines + 1):
+            text = line.strip()
+            if text and not text.startswith(b"#"):
+                scan.first = line.decode("utf-8", "replace").rstrip("\r")
+                scan.first_line = number
+                break
+    scan.lines += chunk.count(b"\n")
+
+
+def lines_of_rows(path, rows: Sequence[int]) -> list[int]:
+    """File line numbers of data rows (0-based, in the order given), counting comment and
+    blank lines; one pass over the file."""
+    wanted = sorted(set(int(k) + 1 for k in rows))
+    found: dict[int, int] = {}
     count = -1
+    i = 0
     with open(path, encoding="utf-8-sig", errors="replace") as handle:
         for number, line in enumerate(handle, start=1):
+            if i >= len(wanted):
+                break
             stripped = line.strip()
             if not stripped or stripped.startswith("#"):
                 continue
             count += 1
-            if count == k:
-                return number
-    return -1
+            if count == wanted[i]:
+                found[count] = number
+                i += 1
+    return [found.get(int(k) + 1, -1) for k in rows]
 
 
-def _fast_frame(body: str, names: list[str]) -> pd.DataFrame | None:
-    """The table through pandas' C reader (large files), or None when a row does not
-    parse cleanly: wrong field count or a non-numeric cell (the exact reading then says where)."""
+def _fast_frame(path: Path, names: list[str]) -> pd.DataFrame | None:
+    """The table through pandas' C reader (large files, read in chunks), or None when a
+    row does not parse cleanly: wrong field count or a non-numeric or empty cell (the
+    exact reading then says where)."""
     dtypes = {c: np.float64 for c in NUMERIC_COLUMNS if c in names}
+    options = dict(skipinitialspace=True, skip_blank_lines=True, comment="#", encoding="utf-8-sig", engine="c")
+    df = None
     if "run" in names:
-        dtypes["run"] = "category"
-    try:
-        df = pd.read_csv(io.StringIO(body), dtype=dtypes, skipinitialspace=True, skip_blank_lines=True,
-                         na_filter=True, engine="c")
-    except (ValueError, pd.errors.ParserError):
+        # numeric run ids (the usual case) as numbers: a third of the memory of labels
+        try:
+            df = pd.read_csv(path, dtype={**dtypes, "run": np.float64}, **options)
+        except (ValueError, pd.errors.ParserError, UnicodeDecodeError):
+            df = None
+        if df is not None:
+            run = df["run"].to_numpy()
+            if np.all(np.isfinite(run)) and np.all(run == np.round(run)) and np.all(np.abs(run) < 2**53):
+                df["run"] = run.astype(np.int64)
+        else:
+            dtypes["run"] = "category"
+    if df is None:
+        try:
+            df = pd.read_csv(path, dtype=dtypes, **options)
+        except (ValueError, pd.errors.ParserError, UnicodeDecodeError):
+            return None
+    if [str(c).strip() for c in df.columns] != names:
         return None
-    if list(df.columns) != names:
-        return None
+    df.columns = names
     numeric = [c for c in NUMERIC_COLUMNS if c in names]
     if df[numeric].isna().to_numpy().any():
         return None  # an empty cell, NaN or a short row: located by the exact reading
@@ -212,13 +279,12 @@ def validate_tribometer_frame(df: pd.DataFrame, source: str = "DataFrame",
             f"required: {', '.join(NUMERIC_COLUMNS)} (units in the names), optional: run"
         )
     if row_labels is None:
-        index = list(df.index)
-        label = lambda k: f"row {index[k]}"  # noqa: E731
+        label = lambda k: f"row {df.index[k]}"  # noqa: E731
     elif callable(row_labels):
         label = row_labels
     else:
         label = row_labels.__getitem__
-    out = pd.DataFrame(index=pd.RangeIndex(len(df)))
+    columns_out: dict[str, object] = {}
     for column in NUMERIC_COLUMNS:
         series = df[column]
         if pd.api.types.is_float_dtype(series.dtype) or pd.api.types.is_integer_dtype(series.dtype):
@@ -236,7 +302,11 @@ def validate_tribometer_frame(df: pd.DataFrame, source: str = "DataFrame",
                     raise ValueError(f"{source}: column {column}, {label(k)}: missing value (NaN: {shown})")
                 raise ValueError(f"{source}: column {column}, {label(k)}: non-numeric value {shown}")
             raise ValueError(f"{source}: column {column}, {label(k)}: value {x} is not finite")
-        out[column] = numbers
+        columns_out[column] = numbers
+    if "run" in columns:
+        columns_out["run"] = df["run"].array
+    # no copy of the columns (a 1,000,000-row table is 32 MB per copy); pandas copies on write
+    out = pd.DataFrame(columns_out, index=pd.RangeIndex(len(df)), copy=False)
     for column, rule, bad in (
         ("load_N", "must be > 0 N (a point at zero load has no contact to measure)", out["load_N"] <= 0.0),
         ("friction_N", "must be > 0 N (the fits are in log space; a negative force is a sign error)", out["friction_N"] <= 0.0),
@@ -245,23 +315,27 @@ def validate_tribometer_frame(df: pd.DataFrame, source: str = "DataFrame",
         if bad.any():
             k = int(np.flatnonzero(bad.to_numpy())[0])
             raise ValueError(f"{source}: column {column}, {label(k)}: value {float(out[column].iloc[k])!r} {rule}")
-    if "run" in columns:
-        out["run"] = df["run"].array
-    levels = np.unique(np.abs(out["current_A"].to_numpy()))
+    # hashing, not sorting, the rows: linear time and little memory for large tables
+    level_of_row, levels = pd.factorize(np.abs(out["current_A"].to_numpy()))
+    levels = np.asarray(levels, float)
     needed = minimum_rows(len(levels))
     if len(out) < needed:
         raise ValueError(
             f"{source}: {len(out)} data row(s) are too few for a fit: at least {needed} are needed "
             f"({len(levels)} current level(s) -> one mu each, plus gamma, plus one to estimate the scatter)"
         )
-    loads = np.unique(out["load_N"].to_numpy())
+    loads = np.sort(pd.unique(out["load_N"].to_numpy()))
     if len(loads) < 2:
         raise ValueError(
             f"{source}: all points are at load {loads[0]} N; at least 2 different loads are needed "
             "to fit gamma and the load dependence of the resistance"
         )
-    per_level = out.groupby(np.abs(out["current_A"]))["load_N"].nunique()
-    if per_level.max() < 2:
+    load = out["load_N"].to_numpy()
+    lowest = np.full(len(levels), np.inf)
+    highest = np.full(len(levels), -np.inf)
+    np.minimum.at(lowest, level_of_row, load)
+    np.maximum.at(highest, level_of_row, load)
+    if not np.any(highest > lowest):
         raise ValueError(
             f"{source}: every current level has a single load, so gamma cannot be told apart from mu(I): "
             "at least one current level needs points at 2 or more different loads"

@@ -184,3 +184,36 @@ def test_spiceinit_in_the_working_directory_or_home_runs_nothing(tmp_path):
     assert Path(cwd) == work  # the working directory is restored after ngspice started
     assert not (work / "PWNED").exists() and not (home / "PWNED").exists()
     assert "PWNED-ECHO" not in done.stdout + done.stderr
+
+
+@pytest.mark.parametrize("extra, needle", [
+    ("Rl c", "line 6: resistor line with 2 field(s)"),
+    ("R1 c 0", "line 6: resistor line with 3 field(s)"),
+    ("D1 c 0 nodiode", "line 6: the diode names a model that no '.model' line"),
+    ("X1 c 0 nosub", "line 6: the subcircuit instance names a subcircuit that no '.subckt'"),
+    (".tran 1u 1m", "analysis lines are not allowed"),
+    (".options reltol=1e-3", "option reltol is set by switchsim"),
+])
+def test_dubious_netlist_lines_are_named_errors(tmp_path, extra, needle):
+    main = write(tmp_path, "main.cir", MAIN.format(extra=extra))
+    refused(main, needle)
+
+
+def test_defined_models_and_subcircuits_are_accepted():
+    # a reverse-biased diode (no current) and the 11 ohm load inside a subcircuit: 12 V / 12 ohm
+    text = MAIN.format(extra=".model dm D(is=1e-14)\nD1 0 c dm\n.subckt load p n\nR1 p n 11\n.ends\nX1 c 0 load")
+    circuit = NetlistCircuit(text)
+    df = run_transient(circuit, 1000.0, 5e-6, options=OPTIONS)
+    assert df.load_current.iloc[-1] == pytest.approx(1.0, rel=1e-3)
+
+
+def test_zero_contact_capacitance_with_series_inductance_is_refused():
+    from circuit import InductiveLoad, ResistiveLoad, Snubber, SwitchCircuit, Wiring
+
+    with pytest.raises(ValueError, match="contact_capacitance = 0 F with 1e-06 H"):
+        SwitchCircuit(contact_capacitance=0.0)
+    with pytest.raises(ValueError, match="contact_capacitance = 0 F"):
+        SwitchCircuit(load=InductiveLoad(), wiring=Wiring(0.0, 0.0), contact_capacitance=0.0)
+    # no inductance in series, or a snubber across the contact: allowed
+    SwitchCircuit(load=ResistiveLoad(), wiring=Wiring(0.0, 0.0), contact_capacitance=0.0)
+    SwitchCircuit(contact_capacitance=0.0, snubber=Snubber())
