@@ -311,6 +311,41 @@ def _is_param(token: str) -> bool:
     return "=" in token
 
 
+_EXPRESSION = re.compile(r"\{([^{}]*)\}|'([^']*)'")
+_IDENTIFIER = re.compile(r"(?<![\w.])([A-Za-z_]\w*)\s*(\()?")
+_ASSIGNED = re.compile(r"([A-Za-z_]\w*)\s*=(?!=)")
+#: Names an ngspice expression may use without a .param: constants and circuit variables.
+EXPRESSION_CONSTANTS = frozenset({"pi", "e", "temper", "hertz", "time", "boltz", "echarge", "kelvin", "planck",
+                                  "amu", "true", "false", "yes", "no", "gmin"})
+_PROBE_CALL = re.compile(r"(?<![\w.])[vi]\s*\([^()]*\)")  # v(node), i(source): names, not parameters
+
+
+def _check_expressions(lines: list[NetlistLine]) -> None:
+    """Every name used in a {...} or '...' expression must be defined by the netlist (.param,
+    .subckt params, .func and its arguments, instance parameters) or be a constant: ngspice
+    ends its session ('cannot recover') on an undefined parameter."""
+    defined: set[str] = set(EXPRESSION_CONSTANTS)
+    for line in lines[1:]:
+        low = line.text.lower()
+        head = low.split(None, 1)[0]
+        if head in (".param", ".subckt") or head.startswith("x"):
+            defined.update(m.group(1) for m in _ASSIGNED.finditer(low))
+        if head == ".func":
+            defined.update(m.group(1) for m in _IDENTIFIER.finditer(low.split(None, 1)[1] if " " in low else ""))
+    for line in lines[1:]:
+        low = line.text.lower()
+        head = low.split(None, 1)[0]
+        if head == ".func":
+            continue
+        for match in _EXPRESSION.finditer(low):
+            body = match.group(1) if match.group(1) is not None else match.group(2)
+            body = _PROBE_CALL.sub("0", body)
+            for ident in _IDENTIFIER.finditer(body):
+                if ident.group(2) is None and ident.group(1) not in defined:
+                    raise NetlistInputError(f"{_where(line.file, line.line)}: an expression uses a parameter that "
+                                            "no '.param' line defines")
+
+
 def check_lines(lines: list[NetlistLine]) -> None:
     """Check logical lines (title first) against the allow-list; raises NetlistInputError.
 
@@ -320,12 +355,18 @@ def check_lines(lines: list[NetlistLine]) -> None:
     models: set[str] = set()
     subckts: set[str] = set()
     uses: list[tuple[NetlistLine, str, tuple[int, ...] | None]] = []
+    scope = ""  # the subcircuit being defined: element names are local to it
+    seen: set[tuple[str, str]] = set()
     for line in lines[1:]:
         tokens = line.text.split()
         head = tokens[0].lower()
         where = _where(line.file, line.line)
         if head.startswith("."):
             _check_card(head, tokens, where)
+            if head == ".subckt":
+                scope = tokens[1].lower() if len(tokens) > 1 else "?"
+            elif head == ".ends":
+                scope = ""
             if head == ".model" and len(tokens) >= 2:
                 models.add(tokens[1].lower())
             elif head == ".subckt" and len(tokens) >= 2:
@@ -342,6 +383,9 @@ def check_lines(lines: list[NetlistLine]) -> None:
             raise NetlistInputError(f"{where}: the element name is an ngspice command; rename the element")
         if not re.fullmatch(r"[a-z0-9_.+\-#]+", head):
             raise NetlistInputError(f"{where}: an element name may hold letters, digits and _ . + - # only")
+        if (scope, head) in seen:
+            raise NetlistInputError(f"{where}: an element of this name is already defined (names must be unique)")
+        seen.add((scope, head))
         if head.lower() == "xcontact":
             continue
         needed = ELEMENT_FIELDS[letter]
@@ -355,6 +399,7 @@ def check_lines(lines: list[NetlistLine]) -> None:
             uses.append((line, "model", tuple(range(5, len(tokens)))))
         elif letter == "x":
             uses.append((line, "subckt", None))
+    _check_expressions(lines)
     for line, kind, positions in uses:
         tokens = line.text.split()
         where = _where(line.file, line.line)
