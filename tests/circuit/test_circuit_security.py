@@ -188,7 +188,8 @@ def test_spiceinit_in_the_working_directory_or_home_runs_nothing(tmp_path):
 
 @pytest.mark.parametrize("extra, needle", [
     ("Rl c", "line 6: resistor line with 2 field(s)"),
-    ("R1 c 0", "line 6: resistor line with 3 field(s)"),
+    ("R2 c 0", "line 6: resistor line with 3 field(s)"),
+    ("R1 c 0 5", "line 6: an element of this name is already defined"),
     ("D1 c 0 nodiode", "line 6: the diode names a model that no '.model' line"),
     ("X1 c 0 nosub", "line 6: the subcircuit instance names a subcircuit that no '.subckt'"),
     (".tran 1u 1m", "analysis lines are not allowed"),
