@@ -18,8 +18,11 @@ class NgspiceError(RuntimeError):
         super().__init__(text)
 
 
-class NetlistError(NgspiceError):
-    """ngspice could not parse the netlist (unknown element or model, bad value...)."""
+class NetlistError(NgspiceError, ValueError):
+    """ngspice could not parse the netlist (unknown element or model, bad value...).
+
+    Also a ValueError: the netlist is bad input, reported as such (exit status 2 from
+    the command line), not as a failure of the simulation."""
 
 
 class TimestepTooSmallError(NgspiceError):

@@ -383,11 +383,11 @@ def check_lines(lines: list[NetlistLine]) -> None:
             raise NetlistInputError(f"{where}: the element name is an ngspice command; rename the element")
         if not re.fullmatch(r"[a-z0-9_.+\-#]+", head):
             raise NetlistInputError(f"{where}: an element name may hold letters, digits and _ . + - # only")
+        if head == "xcontact":
+            continue  # NetlistCircuit checks there is exactly one
         if (scope, head) in seen:
             raise NetlistInputError(f"{where}: an element of this name is already defined (names must be unique)")
         seen.add((scope, head))
-        if head.lower() == "xcontact":
-            continue
         needed = ELEMENT_FIELDS[letter]
         if len(tokens) < needed:
             raise NetlistInputError(

@@ -58,3 +58,11 @@ def test_tribology_data_naming_a_system_file_echoes_none_of_it(tmp_path, capsys)
 def test_fit_of_a_system_file_echoes_none_of_it(tmp_path, capsys):
     code, text = run_cli(capsys, "fit", "/etc/passwd", "--out", str(tmp_path / "out"))
     assert code == 2 and "root:" not in text and "header line 1" in text
+
+
+def test_netlist_that_ngspice_rejects_is_an_input_error_not_a_traceback(tmp_path, capsys):
+    (tmp_path / "relay.cir").write_text("relay\nV1 s 0 24\nXCONTACT s b\nVLOAD b c 0\nR1 c 0 12\nR2 c 0 abc\n")
+    path = scene(tmp_path, '[tribology]\nsource = "illustrative"\n[circuit]\ntemplate = "netlist"\n'
+                           'netlist = "relay.cir"\n')
+    code, text = run_cli(capsys, "run", str(path), "--out", str(tmp_path / "out"), "--quiet")
+    assert code == 2 and "ngspice could not parse the netlist" in text and "Traceback" not in text
