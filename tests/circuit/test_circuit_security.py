@@ -218,3 +218,18 @@ def test_zero_contact_capacitance_with_series_inductance_is_refused():
     # no inductance in series, or a snubber across the contact: allowed
     SwitchCircuit(load=ResistiveLoad(), wiring=Wiring(0.0, 0.0), contact_capacitance=0.0)
     SwitchCircuit(contact_capacitance=0.0, snubber=Snubber())
+
+
+def test_isolated_start_restores_the_working_directory_and_home_even_on_error(tmp_path, monkeypatch):
+    from circuit.ngspice import isolated_start
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    with pytest.raises(RuntimeError):
+        with isolated_start() as folder:
+            assert Path.cwd() == Path(folder) and os.environ["HOME"] == folder
+            assert (Path(folder) / ".spiceinit").read_text().startswith("*")  # a comment: no command
+            assert sorted(p.name for p in Path(folder).iterdir()) == [".spiceinit"]
+            raise RuntimeError("boom")
+    assert Path.cwd() == tmp_path and os.environ["HOME"] == str(tmp_path / "home")
+    assert not Path(folder).exists()

@@ -66,3 +66,9 @@ def test_netlist_that_ngspice_rejects_is_an_input_error_not_a_traceback(tmp_path
                            'netlist = "relay.cir"\n')
     code, text = run_cli(capsys, "run", str(path), "--out", str(tmp_path / "out"), "--quiet")
     assert code == 2 and "ngspice could not parse the netlist" in text and "Traceback" not in text
+
+
+def test_tribology_fit_naming_a_system_file_echoes_none_of_it(tmp_path, capsys):
+    path = scene(tmp_path, '[tribology]\nfit = "/etc/passwd"\n')
+    code, text = run_cli(capsys, "run", str(path), "--out", str(tmp_path / "out"), "--quiet")
+    assert code == 2 and "not a readable tribometer fit" in text and "root:" not in text
