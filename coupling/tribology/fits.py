@@ -471,7 +471,16 @@ def _problem_from(load: np.ndarray, current: np.ndarray) -> _Problem:
     key *= len(current_values)
     key += current_code
     del load_code, current_code
-    cell_of_row, cell_keys = pd.factorize(key)
+    n_keys = len(load_values) * len(current_values)
+    if n_keys <= 4 * len(key) + 1024:
+        # a direct table of the (load, current) pairs: no second hash table
+        present = np.bincount(key, minlength=n_keys) > 0
+        cell_keys = np.flatnonzero(present)
+        table = np.cumsum(present) - 1
+        cell_of_row = table[key]
+        del table, present
+    else:
+        cell_of_row, cell_keys = pd.factorize(key)
     del key
     count = np.bincount(cell_of_row, minlength=len(cell_keys)).astype(float)
     c_load = np.asarray(load_values, float)[cell_keys // len(current_values)]
