@@ -18,8 +18,11 @@ class NgspiceError(RuntimeError):
         super().__init__(text)
 
 
-class NetlistError(NgspiceError):
-    """ngspice could not parse the netlist (unknown element or model, bad value...)."""
+class NetlistError(NgspiceError, ValueError):
+    """ngspice could not parse the netlist (unknown element or model, bad value...).
+
+    Also a ValueError: the netlist is bad input, reported as such (exit status 2 from
+    the command line), not as a failure of the simulation."""
 
 
 class TimestepTooSmallError(NgspiceError):
@@ -52,3 +55,9 @@ class ConductanceError(ValueError):
 
 class GapError(ValueError):
     """The gap-distance callable returned a value that is not finite and >= 0 (m)."""
+
+
+class NetlistInputError(ValueError):
+    """A netlist (or a file it includes) was refused before ngspice saw it: a construct
+    that could run a command or read a file, or a line that is not valid input. The
+    message names the file and line, never the line's text."""

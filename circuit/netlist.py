@@ -19,6 +19,10 @@ switchsim replaces that line by its contact element (and the arc path, when an
     Rcoil coil c1 240
     Lcoil c1 0 50m
 
+The netlist and the files it includes (``.include``, ``.lib FILE SECTION``, paths
+relative to the including file's folder) are read and checked by switchsim before
+ngspice sees them: see ``netlist_check`` and docs/circuit.md (threat model).
+
 Reserved (do not use): elements Vcontact, Bcontact, Bcontact_geff, Vcontact_g, Varc*
 (Varc, Varc_gap), Barc*, Iarc_on, Rarc_on; nodes contact_s, contact_g, contact_geff, arc_*.
 """
@@ -26,7 +30,7 @@ Reserved (do not use): elements Vcontact, Bcontact, Bcontact_geff, Vcontact_g, V
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from PySpice.Spice.Netlist import Circuit
@@ -35,12 +39,13 @@ from .arc import ArcModel, add_arc
 from .contact import (
     CONDUCTANCE_NODE, DEFAULT_LEAKAGE, EFFECTIVE_NODE, SENSE_SOURCE, add_contact, check_current_factor,
 )
+from .errors import NetlistInputError
+from .netlist_check import DECK_TITLE, NetlistLine, check_lines, logical_lines, read_netlist
 from .probes import Probes
 from .validation import check_range
 
 _RESERVED_ELEMENTS = re.compile(r"^(vcontact|bcontact|bcontact_geff|vcontact_g|varc\w*|barc\w*|iarc_on|rarc_on)$", re.I)
 _RESERVED_NODES = re.compile(r"^(contact_s|contact_g|contact_geff|arc_\w+)$", re.I)
-_ANALYSIS = re.compile(r"^\.(tran|op|ac|dc|noise|tf|disto|sens|pz|control|endc|end)\b", re.I)
 
 
 @dataclass(frozen=True)
@@ -52,6 +57,8 @@ class NetlistCircuit:
     leakage_conductance: open-contact conductance, S.
     contact_current_factor: optional ngspice expression g(I) of the contact current I (A);
         the contact conductance is then G(t)/g(I) (see contact.py).
+    origins: (file, line) where each line of ``text`` starts, for messages (set by
+        ``from_file``; ``text`` is then the inlined netlist).
     """
 
     text: str
@@ -59,54 +66,68 @@ class NetlistCircuit:
     arc: ArcModel | None = None
     leakage_conductance: float = DEFAULT_LEAKAGE
     contact_current_factor: str | None = None
+    origins: tuple[tuple[str, int], ...] | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         if not isinstance(self.text, str) or not self.text.strip():
             raise ValueError("NetlistCircuit.text: must be a non-empty netlist string")
         if self.arc is not None and not isinstance(self.arc, ArcModel):
             raise ValueError(f"NetlistCircuit.arc = {self.arc!r}: must be an ArcModel or None")
+        if self.load_probe is not None and not (isinstance(self.load_probe, str)
+                                                and re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", self.load_probe)):
+            raise ValueError(f"NetlistCircuit.load_probe = {self.load_probe!r}: the name of a voltage source "
+                             "(letters, digits, _) or None")
         check_range("NetlistCircuit", "leakage_conductance", self.leakage_conductance, "S", 0.0, 1e-3)
         check_current_factor("NetlistCircuit", self.contact_current_factor)
         self._parse()  # fail early, before anything runs
 
     @classmethod
     def from_file(cls, path: str | Path, **kwargs) -> "NetlistCircuit":
-        return cls(Path(path).read_text(), **kwargs)
+        """Read a netlist file, inlining its includes (relative to the file's folder), and check it."""
+        lines = read_netlist(path)
+        return cls("\n".join(line.text for line in lines), origins=tuple((l.file, l.line) for l in lines), **kwargs)
 
-    def _parse(self) -> tuple[list[str], int, str, str, bool]:
-        lines = self.text.splitlines()
+    def _lines(self) -> list[NetlistLine]:
+        if self.origins is None:
+            lines = logical_lines(self.text, "<text>")
+            check_lines(lines)
+            return lines
+        texts = self.text.split("\n")
+        if len(texts) != len(self.origins):
+            raise ValueError("NetlistCircuit.origins: one (file, line) per line of text")
+        lines = [NetlistLine(t, f, n) for t, (f, n) in zip(texts, self.origins)]
+        # the text was checked when read; checked again since the object may be built by hand
+        check_lines(lines)
+        return lines
+
+    def _parse(self) -> tuple[list[NetlistLine], int, str, str, bool]:
+        lines = self._lines()
         contact_rows = []
         has_load_probe = False
         for i, line in enumerate(lines):
-            tokens = line.split()
-            if i == 0 or not tokens or tokens[0].startswith(("*", "+")):
+            if i == 0:
                 continue
+            tokens = line.text.split()
             head = tokens[0]
-            if _ANALYSIS.match(head):
-                if head.lower() == ".end":
-                    continue
-                raise ValueError(
-                    f"netlist line {i + 1} {line!r}: remove analysis/control lines; "
-                    "the transient is set by t_end and SimulationOptions"
-                )
+            where = f"netlist {line.file} line {line.line}"
             if head.lower() == "xcontact":
                 if len(tokens) != 3:
-                    raise ValueError(f"netlist line {i + 1} {line!r}: the contact line is 'XCONTACT node_a node_b'")
+                    raise NetlistInputError(f"{where}: the contact line is 'XCONTACT node_a node_b'")
                 contact_rows.append(i)
                 continue
             if _RESERVED_ELEMENTS.match(head):
-                raise ValueError(f"netlist line {i + 1} {line!r}: element name {head} is reserved by switchsim")
+                raise NetlistInputError(f"{where}: element name {head} is reserved by switchsim")
             if head[0].isalpha() and any(_RESERVED_NODES.match(t) for t in tokens[1:3]):
-                raise ValueError(f"netlist line {i + 1} {line!r}: node names contact_s, contact_g, arc_* are reserved")
+                raise NetlistInputError(f"{where}: node names contact_s, contact_g, arc_* are reserved")
             if self.load_probe is not None and head.lower() == self.load_probe.lower():
                 has_load_probe = True
         if len(contact_rows) != 1:
-            raise ValueError(
+            raise NetlistInputError(
                 f"the netlist must contain exactly one 'XCONTACT node_a node_b' line (found {len(contact_rows)}); "
                 "the first line is the title"
             )
         row = contact_rows[0]
-        _, node_a, node_b = lines[row].split()
+        _, node_a, node_b = lines[row].text.split()
         return lines, row, node_a, node_b, has_load_probe
 
     @property
@@ -122,12 +143,14 @@ class NetlistCircuit:
         )
 
     def netlist(self) -> str:
-        """The netlist with the XCONTACT line expanded (title first, no analysis, no .end)."""
+        """The checked netlist with the XCONTACT line expanded (switchsim's own title first,
+        comments dropped, no analysis, no .end)."""
         lines, row, node_a, node_b, _ = self._parse()
         scratch = Circuit("contact")
         add_contact(scratch, node_a, node_b, self.leakage_conductance, self.contact_current_factor)
         if self.arc is not None:
             add_arc(scratch, self.arc, node_a, node_b)
         expansion = [line for line in str(scratch).splitlines()[1:] if line.strip()]
-        expanded = lines[:row] + expansion + lines[row + 1 :]
+        texts = [line.text for line in lines]
+        expanded = [DECK_TITLE] + texts[1:row] + expansion + texts[row + 1 :]
         return "\n".join(line for line in expanded if line.strip().lower() != ".end")

@@ -14,6 +14,7 @@ import os
 import re
 import shutil
 import subprocess
+import tempfile
 import threading
 import time
 import weakref
@@ -25,6 +26,7 @@ from PySpice.Spice.NgSpice.Shared import NgSpiceShared, ffi
 
 from .arc import GAP_SOURCE
 from .contact import LANDING_TOLERANCE
+from .netlist_check import check_deck
 from .errors import (
     ConductanceError,
     ConvergenceError,
@@ -103,6 +105,47 @@ def _ldconfig_lookup(name: str) -> str | None:
     return None
 
 
+#: Environment variables pointed at the empty start-up folder while ngspice initializes
+#: (a build that looks for ~/.spiceinit through $HOME then finds the empty one).
+_START_ENV = ("HOME", "USERPROFILE")
+
+
+@contextlib.contextmanager
+def isolated_start():
+    """Working directory and home of the process while ngspice initializes: a fresh, private,
+    empty folder holding an empty ``.spiceinit``.
+
+    ngspice's shared library, in ``ngSpice_Init``, sources ``./.spiceinit`` if it exists
+    and otherwise ``<home>/.spiceinit`` (home from the password database, not $HOME, in
+    ngspice 39), and those files may hold any command (``shell ...``). With the empty
+    ``.spiceinit`` in the working directory ngspice reads that one and never looks in the
+    real working directory or the home folder; $HOME (and %USERPROFILE%) point at the
+    same folder for builds that use them. The system's ``spinit`` (from the ngspice
+    installation, SPICE_LIB_DIR / SPICE_SCRIPTS) is still read: it belongs to the
+    installation, not to a shared folder; a relative SPICE_SCRIPTS resolves in the empty
+    folder. The working directory and environment are restored afterwards.
+    """
+    try:
+        previous_cwd = os.getcwd()
+    except OSError:  # the working directory was deleted
+        previous_cwd = None
+    saved = {name: os.environ.get(name) for name in _START_ENV}
+    with tempfile.TemporaryDirectory(prefix="switchsim-ngspice-") as folder:
+        Path(folder, ".spiceinit").write_text("* switchsim: empty ngspice start-up file\n")
+        try:
+            for name in _START_ENV:
+                os.environ[name] = folder
+            os.chdir(folder)
+            yield folder
+        finally:
+            os.chdir(previous_cwd if previous_cwd is not None else tempfile.gettempdir())
+            for name, value in saved.items():
+                if value is None:
+                    os.environ.pop(name, None)
+                else:
+                    os.environ[name] = value
+
+
 # Lines ngspice prints on success that PySpice 1.5 mistakes for errors, or that are
 # progress chatter; never part of an error message.
 _CHATTER = re.compile(
@@ -164,7 +207,8 @@ class NgspiceSession(NgSpiceShared):
         # current types checked).
         pyspice_logger.setLevel(logging.ERROR)
         try:
-            super().__init__(ngspice_id=0, send_data=False, verbose=False)
+            with isolated_start():
+                super().__init__(ngspice_id=0, send_data=False, verbose=False)
         finally:
             pyspice_logger.setLevel(previous)
         self._feed_pyspice = False
@@ -377,7 +421,12 @@ class NgspiceSession(NgSpiceShared):
         self.source_calls = 0
 
     def load(self, lines: list[str]) -> None:
-        """Load a deck (title line first, ``.end`` last); raises NetlistError with ngspice's message."""
+        """Load a deck (title line first, ``.end`` last); raises NetlistError with ngspice's message.
+
+        The deck passes ``netlist_check.check_deck`` first (its title is replaced by
+        switchsim's own): no line that could run an ngspice command or read a file gets
+        through, whoever built the deck (NetlistInputError)."""
+        lines = check_deck(list(lines))
         self.clear()
         self._check_alive()
         keep = [ffi.new("char[]", line.encode("utf-8")) for line in lines] + [ffi.NULL]

@@ -216,8 +216,9 @@ class SwitchCircuit:
     """A DC switch circuit around one contact. SI units throughout.
 
     contact_capacitance: parasitic capacitance across the contact, F (contact plus
-        wiring stray capacitance). It bounds the opening dv/dt; 0 is allowed but then
-        an inductive load without an arc model gives a numerics-set spike.
+        wiring stray capacitance). It bounds the opening dv/dt; 0 is refused when an
+        inductance is in series with the contact (wiring, or an inductive load without
+        a flyback diode) and there is no snubber: the opening would then abort.
     leakage_conductance: conductance of the open contact, S (insulation).
     contact_current_factor: optional ngspice expression g(I) of the contact current I
         (A): the contact conductance is then G(t)/g(I), solved by ngspice (see contact.py).
@@ -271,6 +272,14 @@ class SwitchCircuit:
                     "supply could not drive the set current even through the closed contact"
                 )
         check_range(name, "contact_capacitance", self.contact_capacitance, "F", 0.0, 1e-6)
+        series_l = self.wiring.inductance + (self.load.inductance if isinstance(self.load, InductiveLoad)
+                                             and self.flyback is None else 0.0)
+        if self.contact_capacitance == 0.0 and series_l > 0.0 and self.snubber is None:
+            raise ValueError(
+                f"{name}.contact_capacitance = 0 F with {series_l!r} H in series with the contact and no snubber: "
+                "opening the contact would stop an inductor current in zero time (ngspice aborts, 'timestep too "
+                "small'); give the contact's stray capacitance (> 0 F, default 1e-10 F) or a snubber"
+            )
         check_range(name, "leakage_conductance", self.leakage_conductance, "S", 0.0, 1e-3)
         check_current_factor(name, self.contact_current_factor)
         if not isinstance(self.title, str) or "\n" in self.title:

@@ -10,9 +10,20 @@ Scenario scripts::
     result.save("out/")     # summary.json, waveforms.csv/.parquet, PNG plots
 """
 
-from .master import CoSimulation, CoupledRunError, run
-from .results import CoupledResult
-from .scene import Scene, builtin_scene, default_scene, load_scene, scene_from_dict
+import importlib
 
 __all__ = ["CoSimulation", "CoupledResult", "CoupledRunError", "Scene", "builtin_scene", "default_scene", "load_scene",
            "run", "scene_from_dict"]
+
+# Imported on first use: `switchsim fit` and `coupling.tribology` need neither the
+# mechanics (numba) nor ngspice, which would double their start-up time and memory.
+_WHERE = {"CoSimulation": "master", "CoupledRunError": "master", "run": "master", "CoupledResult": "results",
+          "Scene": "scene", "builtin_scene": "scene", "default_scene": "scene", "load_scene": "scene", "scene_from_dict": "scene"}
+
+
+def __getattr__(name: str):
+    if name in _WHERE:
+        value = getattr(importlib.import_module(f".{_WHERE[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -110,7 +110,9 @@ class CoSimulation:
         mech = ImpactSolver(sc.mech, keep_dense=True)
         try:
             stepper = Stepper(sc.circuit.circuit, t_end, sc.circuit.options)
-        except Exception as err:  # e.g. a netlist line ngspice cannot parse: a failed run at t = 0
+        except ValueError:  # the netlist is bad input (ngspice refused it): an input error, exit 2
+            raise
+        except Exception as err:  # ngspice failed to start the circuit: a failed run at t = 0
             partial = None
             try:
                 partial = CoupledResult(scene=sc, mechanics=mech.result(), waveforms=None,

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from coupling.tribology.data import read_tribometer_csv
 from coupling.tribology.fits import AMBIGUOUS_DELTA, ModelFit, TribometerFit, fit_tribometer
-from coupling.tribology.plots import save_plots
 
 FIT_JSON = "fit.json"
 
@@ -33,10 +33,17 @@ def summary(fit: TribometerFit) -> str:
     )
     g = fit.friction.gamma
     ct = fit.friction.coulomb_test
+    ci = "(no interval: " + (fit.friction.mu_selection.chosen.note or "not estimable") + ")" if g.ci95 is None \
+        else f"[{g.ci95[0]:.4f}, {g.ci95[1]:.4f}] (95 % CI)"
     lines.append(
-        f"gamma = {g.value:.4f} [{g.ci95[0]:.4f}, {g.ci95[1]:.4f}] (95 % CI); vs Coulomb (gamma = 0): "
+        f"gamma = {g.value:.4f} {ci}; vs Coulomb (gamma = 0): "
         f"dBIC = {ct.delta_bic:.1f}, F-test p = {ct.p_value:.2g} -> {ct.preferred} preferred"
     )
+    for label, part in (("friction", fit.friction), ("resistance", fit.resistance)):
+        if part.n_outliers:
+            shown = "; ".join(f"{o.where} ({o.column} = {o.value:.4g}: {o.reason})" for o in part.outliers[:5])
+            more = f"; ... ({part.n_outliers - 5} more in fit.json)" if part.n_outliers > 5 else ""
+            lines.append(f"OUTLIERS left out of the {label} fit: {part.n_outliers} row(s): {shown}{more}")
     sel = fit.friction.mu_selection
     lines.append(f"mu(I) by {sel.criterion}: {sel.chosen.name}: {_params(sel.chosen, skip=('gamma',))} (N^gamma, A)")
     for label, s in (("mu(I)", sel), ("R_c", fit.resistance.selection)):
@@ -57,16 +64,31 @@ def summary(fit: TribometerFit) -> str:
     return "\n".join(lines)
 
 
+def _check_out(out_dir: str) -> Path:
+    """The output folder, checked before any work: not empty, not a file, writable."""
+    if not str(out_dir).strip():
+        raise ValueError("--out: give a folder name (an empty name would write into the current folder)")
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {str(out)!r}: exists and is not a folder")
+    parent = out if out.exists() else next((p for p in out.absolute().parents if p.exists()), None)
+    if parent is None or not os.access(parent, os.W_OK | os.X_OK):
+        raise ValueError(f"--out {str(out)!r}: cannot write there (no permission)")
+    return out
+
+
 def fit_command(data_path: str, out_dir: str) -> int:
     """Fit DATA.csv, write DIR/fit.json and the PNG figures, print a summary; returns 0.
 
     Bad input raises ValueError (or FileNotFoundError) with a one-line message.
     """
+    out = _check_out(out_dir)  # before the fit: a bad destination fails at once
     df = read_tribometer_csv(data_path)
     fit = fit_tribometer(df)
-    out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     fit.to_json(out / FIT_JSON)
+    from coupling.tribology.plots import save_plots  # matplotlib only once the fit is done
+
     pngs = save_plots(fit, df, out)
     print(summary(fit))
     print("wrote " + ", ".join(str(p) for p in [out / FIT_JSON, *pngs]))

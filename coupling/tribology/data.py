@@ -11,8 +11,10 @@ from __future__ import annotations
 
 import csv
 import difflib
+import re
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 import pandas as pd
@@ -29,20 +31,28 @@ def minimum_rows(n_current_levels: int) -> int:
     return n_current_levels + EXTRA_POINTS_NEEDED
 
 
-def read_tribometer_csv(path) -> pd.DataFrame:
-    """Read and validate a tribometer CSV; returns a DataFrame of the columns above.
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,40}")
 
-    path: str or Path. Raises ValueError naming the file, column, line and value for
-    missing or unknown columns, non-numeric or missing (NaN) values, loads that are
-    not > 0, negative or zero friction forces and resistances, non-finite currents,
-    and too few points for a fit. The comment lines are kept in
-    `df.attrs["header"]` and the path in `df.attrs["source"]`.
-    """
-    path = Path(path)
+
+def _decode(data: bytes, path: Path) -> str:
+    """UTF-8 text (an Excel "CSV UTF-8" export starts with a byte-order mark: dropped)."""
+    if b"\x00" in data[:65536]:
+        raise ValueError(f"{path}: not a text file (NUL bytes): expected a tribometer CSV")
+    if data.startswith(b"\xef\xbb\xbf"):
+        data = data[3:]
     try:
-        text = path.read_text()
-    except FileNotFoundError:
-        raise FileNotFoundError(f"{path}: no such tribometer CSV file") from None
+        return data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        start = err.start
+        line = data[:start].count(b"\n") + 1
+        column = start - (data.rfind(b"\n", 0, start) + 1) + 1
+        raise ValueError(f"{path}: line {line}, column {column}: byte 0x{data[start]:02x} is not UTF-8 text; "
+                         "save the file as CSV UTF-8 (or plain ASCII)") from None
+
+
+def _data_lines(text: str) -> tuple[list[str], list[list[str]], list[int]]:
+    """Comment lines, split data lines (header first) and their line numbers: the exact,
+    line-by-line reading, used for small files and to locate an error."""
     header: list[str] = []
     rows: list[list[str]] = []
     line_numbers: list[int] = []
@@ -55,27 +65,198 @@ def read_tribometer_csv(path) -> pd.DataFrame:
             continue
         rows.append([cell.strip() for cell in next(csv.reader([line]))])
         line_numbers.append(number)
-    if not rows:
+    return header, rows, line_numbers
+
+
+def _check_header(names: list[str], path: Path, line: int) -> None:
+    """Column names, without repeating a header that is not a tribometer header (the file
+    may be anything: a name is quoted only when the line has the shape of a CSV header)."""
+    shaped = len(names) >= len(NUMERIC_COLUMNS) - 1 and all(_NAME.fullmatch(n) for n in names)
+    allowed = NUMERIC_COLUMNS + OPTIONAL_COLUMNS
+    duplicated = sorted({c for c in names if names.count(c) > 1 and c in allowed})
+    if duplicated:
+        raise ValueError(f"{path}: duplicated column(s) {duplicated}")
+    unknown = [(k, c) for k, c in enumerate(names, start=1) if c not in allowed]
+    if unknown:
+        hints = []
+        for k, c in unknown:
+            close = difflib.get_close_matches(c, allowed, n=1)
+            label = f"{c!r}" if shaped else f"column {k}"
+            hints.append(label + (f" (did you mean {close[0]!r}?)" if close else ""))
+        raise ValueError(f"{path}: header line {line}: unknown column(s) {', '.join(hints)}; "
+                         f"allowed: {', '.join(allowed)}")
+
+
+def read_tribometer_csv(path) -> pd.DataFrame:
+    """Read and validate a tribometer CSV; returns a DataFrame of the columns above.
+
+    path: str or Path. Raises ValueError naming the file, column, line and value for
+    missing or unknown columns, non-numeric or missing (NaN) values, loads that are
+    not > 0, negative or zero friction forces and resistances, non-finite currents,
+    and too few points for a fit; FileNotFoundError for a missing file. A header that
+    is not a tribometer header is not repeated in the message (the path may name any
+    file). UTF-8 with or without a byte-order mark. The comment lines are kept in
+    `df.attrs["header"]` and the path in `df.attrs["source"]`.
+    """
+    path = Path(path)
+    try:
+        if path.is_dir():
+            raise ValueError(f"{path}: is a folder, not a tribometer CSV file")
+        scan = _scan(path)
+    except FileNotFoundError:
+        raise FileNotFoundError(f"{path}: no such tribometer CSV file") from None
+    except OSError as err:
+        raise ValueError(f"{path}: cannot read ({err.strerror or type(err).__name__})") from None
+    if not scan.ascii or scan.nul:
+        _decode(path.read_bytes(), path)  # raises with line and column if the file is not UTF-8 text
+    header = [c.decode("utf-8", "replace").strip().lstrip("#").strip() for c in scan.comments]
+    comment_only = scan.hashes == sum(c.count(b"#") for c in scan.comments)
+    first, header_line, quoted = scan.first, scan.first_line, scan.quoted
+    if first is None:
         raise ValueError(f"{path}: no header line and no data (expected columns {', '.join(NUMERIC_COLUMNS)})")
-    names = rows[0]
-    for cells, number in zip(rows[1:], line_numbers[1:]):
-        if len(cells) != len(names):
-            raise ValueError(
-                f"{path}: line {number} has {len(cells)} fields, the header line {line_numbers[0]} has "
-                f"{len(names)} ({', '.join(names)})"
-            )
-    raw = pd.DataFrame(rows[1:], columns=names) if len(rows) > 1 else pd.DataFrame(columns=names)
-    df = validate_tribometer_frame(raw, source=str(path), row_labels=[f"line {n}" for n in line_numbers[1:]])
-    df.attrs["header"] = tuple(header)
-    df.attrs["source"] = str(path)
+    names = [cell.strip() for cell in next(csv.reader([first]))]
+    _check_header(names, path, header_line)
+    df = _fast_frame(path, names) if comment_only and not quoted else None
+    if df is None:
+        # the exact reading: quoted cells, '#' inside data lines, or a malformed file (the error says where)
+        _, rows, line_numbers = _data_lines(_decode(path.read_bytes(), path))
+        for cells, number in zip(rows[1:], line_numbers[1:]):
+            if len(cells) != len(names):
+                raise ValueError(f"{path}: line {number} has {len(cells)} fields, the header line "
+                                 f"{line_numbers[0]} has {len(names)}")
+        raw = pd.DataFrame(rows[1:], columns=names) if len(rows) > 1 else pd.DataFrame(columns=names)
+        labels: Sequence[str] | Callable[[int], str] = [f"line {n}" for n in line_numbers[1:]]
+    else:
+        raw = df
+        labels = lambda k: f"line {lines_of_rows(path, [k])[0]}"  # noqa: E731
+    out = validate_tribometer_frame(raw, source=str(path), row_labels=labels)
+    out.attrs["header"] = tuple(header)
+    out.attrs["source"] = str(path)
+    out.attrs["csv"] = True  # rows are the file's data lines in order (outliers are reported by line)
+    return out
+
+
+_COMMENT_BYTES = re.compile(rb"^[ \t]*#[^\n]*", re.M)
+
+
+@dataclass
+class _Scan:
+    """What one streaming pass over the file's bytes tells: text or not, the comment lines,
+    how many '#' it holds, whether any cell is quoted, the header line and its number."""
+
+    ascii: bool = True
+    nul: bool = False
+    comments: list = field(default_factory=list)
+    hashes: int = 0
+    quoted: bool = False
+    first: str | None = None
+    first_line: int = 0
+    lines: int = 0
+
+
+def _scan(path: Path, block_size: int = 1 << 20) -> _Scan:
+    scan = _Scan()
+    carry = b""
+    with open(path, "rb") as handle:
+        start = True
+        while True:
+            block = handle.read(block_size)
+            if start:
+                block = block[3:] if block.startswith(b"\xef\xbb\xbf") else block
+                start = False
+            if not block:
+                if carry:
+                    _scan_lines(scan, carry)
+                break
+            scan.ascii = scan.ascii and block.isascii()
+            scan.nul = scan.nul or b"\x00" in block
+            buf = carry + block
+            cut = buf.rfind(b"\n")
+            if cut < 0:
+                carry = buf
+                continue
+            _scan_lines(scan, buf[: cut + 1])
+            carry = buf[cut + 1 :]
+    return scan
+
+
+def _scan_lines(scan: _Scan, chunk: bytes) -> None:
+    hashes = chunk.count(b"#")
+    scan.hashes += hashes
+    scan.quoted = scan.quoted or b'"' in chunk
+    if hashes:
+        scan.comments += [m.group(0) for m in _COMMENT_BYTES.finditer(chunk)]
+    if scan.first is None:
+        for number, line in enumerate(chunk.split(b"\n"), start=scan.lines + 1):
+            text = line.strip()
+            if text and not text.startswith(b"#"):
+                scan.first = line.decode("utf-8", "replace").rstrip("\r")
+                scan.first_line = number
+                break
+    scan.lines += chunk.count(b"\n")
+
+
+def lines_of_rows(path, rows: Sequence[int]) -> list[int]:
+    """File line numbers of data rows (0-based, in the order given), counting comment and
+    blank lines; one pass over the file."""
+    wanted = sorted(set(int(k) + 1 for k in rows))
+    found: dict[int, int] = {}
+    count = -1
+    i = 0
+    with open(path, encoding="utf-8-sig", errors="replace") as handle:
+        for number, line in enumerate(handle, start=1):
+            if i >= len(wanted):
+                break
+            stripped = line.strip()
+            if not stripped or stripped.startswith("#"):
+                continue
+            count += 1
+            if count == wanted[i]:
+                found[count] = number
+                i += 1
+    return [found.get(int(k) + 1, -1) for k in rows]
+
+
+def _fast_frame(path: Path, names: list[str]) -> pd.DataFrame | None:
+    """The table through pandas' C reader (large files, read in chunks), or None when a
+    row does not parse cleanly: wrong field count or a non-numeric or empty cell (the
+    exact reading then says where)."""
+    dtypes = {c: np.float64 for c in NUMERIC_COLUMNS if c in names}
+    options = dict(skipinitialspace=True, skip_blank_lines=True, comment="#", encoding="utf-8-sig", engine="c")
+    df = None
+    if "run" in names:
+        # numeric run ids (the usual case) as numbers: a third of the memory of labels
+        try:
+            df = pd.read_csv(path, dtype={**dtypes, "run": np.float64}, **options)
+        except (ValueError, pd.errors.ParserError, UnicodeDecodeError):
+            df = None
+        if df is not None:
+            run = df["run"].to_numpy()
+            if np.all(np.isfinite(run)) and np.all(run == np.round(run)) and np.all(np.abs(run) < 2**53):
+                df["run"] = run.astype(np.int64)
+        else:
+            dtypes["run"] = "category"
+    if df is None:
+        try:
+            df = pd.read_csv(path, dtype=dtypes, **options)
+        except (ValueError, pd.errors.ParserError, UnicodeDecodeError):
+            return None
+    if [str(c).strip() for c in df.columns] != names:
+        return None
+    df.columns = names
+    numeric = [c for c in NUMERIC_COLUMNS if c in names]
+    if df[numeric].isna().to_numpy().any():
+        return None  # an empty cell, NaN or a short row: located by the exact reading
     return df
 
 
-def validate_tribometer_frame(df: pd.DataFrame, source: str = "DataFrame", row_labels: Sequence[str] | None = None) -> pd.DataFrame:
+def validate_tribometer_frame(df: pd.DataFrame, source: str = "DataFrame",
+                              row_labels: Sequence[str] | Callable[[int], str] | None = None) -> pd.DataFrame:
     """Check a tribometer table and return a clean copy with float columns.
 
-    source names the data in the messages; row_labels (one per row) say where a bad
-    value sits (default: "row <index>"). Accepts string or numeric columns.
+    source names the data in the messages; row_labels (one per row, or a function of
+    the row position) say where a bad value sits (default: "row <index>"). Accepts
+    string or numeric columns.
     """
     columns = [str(c) for c in df.columns]
     duplicated = sorted({c for c in columns if columns.count(c) > 1})
@@ -98,20 +279,34 @@ def validate_tribometer_frame(df: pd.DataFrame, source: str = "DataFrame", row_l
             f"required: {', '.join(NUMERIC_COLUMNS)} (units in the names), optional: run"
         )
     if row_labels is None:
-        row_labels = [f"row {i}" for i in df.index]
-    out = pd.DataFrame(index=pd.RangeIndex(len(df)))
+        label = lambda k: f"row {df.index[k]}"  # noqa: E731
+    elif callable(row_labels):
+        label = row_labels
+    else:
+        label = row_labels.__getitem__
+    columns_out: dict[str, object] = {}
     for column in NUMERIC_COLUMNS:
-        values = df[column].to_numpy()
-        numbers = pd.to_numeric(pd.Series(values), errors="coerce").to_numpy(dtype=float)
-        for k, (raw, x) in enumerate(zip(values, numbers)):
+        series = df[column]
+        if pd.api.types.is_float_dtype(series.dtype) or pd.api.types.is_integer_dtype(series.dtype):
+            numbers = series.to_numpy(dtype=float)
+        else:
+            numbers = pd.to_numeric(series, errors="coerce").to_numpy(dtype=float)
+        bad = np.flatnonzero(~np.isfinite(numbers))
+        if bad.size:
+            k = int(bad[0])
+            raw, x = series.iloc[k], numbers[k]
             if np.isnan(x):
                 text = "" if raw is None else str(raw).strip()
+                shown = repr(text) if len(text) <= 24 else f"{text[:20]!r}..."
                 if text == "" or text.lower() in ("nan", "na", "none") or (isinstance(raw, float) and np.isnan(raw)):
-                    raise ValueError(f"{source}: column {column}, {row_labels[k]}: missing value (NaN: {text!r})")
-                raise ValueError(f"{source}: column {column}, {row_labels[k]}: non-numeric value {text!r}")
-            if not np.isfinite(x):
-                raise ValueError(f"{source}: column {column}, {row_labels[k]}: value {x} is not finite")
-        out[column] = numbers
+                    raise ValueError(f"{source}: column {column}, {label(k)}: missing value (NaN: {shown})")
+                raise ValueError(f"{source}: column {column}, {label(k)}: non-numeric value {shown}")
+            raise ValueError(f"{source}: column {column}, {label(k)}: value {x} is not finite")
+        columns_out[column] = numbers
+    if "run" in columns:
+        columns_out["run"] = df["run"].array
+    # no copy of the columns (a 1,000,000-row table is 32 MB per copy); pandas copies on write
+    out = pd.DataFrame(columns_out, index=pd.RangeIndex(len(df)), copy=False)
     for column, rule, bad in (
         ("load_N", "must be > 0 N (a point at zero load has no contact to measure)", out["load_N"] <= 0.0),
         ("friction_N", "must be > 0 N (the fits are in log space; a negative force is a sign error)", out["friction_N"] <= 0.0),
@@ -119,24 +314,28 @@ def validate_tribometer_frame(df: pd.DataFrame, source: str = "DataFrame", row_l
     ):
         if bad.any():
             k = int(np.flatnonzero(bad.to_numpy())[0])
-            raise ValueError(f"{source}: column {column}, {row_labels[k]}: value {float(out[column].iloc[k])!r} {rule}")
-    if "run" in columns:
-        out["run"] = df["run"].to_numpy()
-    levels = np.unique(np.abs(out["current_A"].to_numpy()))
+            raise ValueError(f"{source}: column {column}, {label(k)}: value {float(out[column].iloc[k])!r} {rule}")
+    # hashing, not sorting, the rows: linear time and little memory for large tables
+    level_of_row, levels = pd.factorize(np.abs(out["current_A"].to_numpy()))
+    levels = np.asarray(levels, float)
     needed = minimum_rows(len(levels))
     if len(out) < needed:
         raise ValueError(
             f"{source}: {len(out)} data row(s) are too few for a fit: at least {needed} are needed "
             f"({len(levels)} current level(s) -> one mu each, plus gamma, plus one to estimate the scatter)"
         )
-    loads = np.unique(out["load_N"].to_numpy())
+    loads = np.sort(pd.unique(out["load_N"].to_numpy()))
     if len(loads) < 2:
         raise ValueError(
             f"{source}: all points are at load {loads[0]} N; at least 2 different loads are needed "
             "to fit gamma and the load dependence of the resistance"
         )
-    per_level = out.groupby(np.abs(out["current_A"]))["load_N"].nunique()
-    if per_level.max() < 2:
+    load = out["load_N"].to_numpy()
+    lowest = np.full(len(levels), np.inf)
+    highest = np.full(len(levels), -np.inf)
+    np.minimum.at(lowest, level_of_row, load)
+    np.maximum.at(highest, level_of_row, load)
+    if not np.any(highest > lowest):
         raise ValueError(
             f"{source}: every current level has a single load, so gamma cannot be told apart from mu(I): "
             "at least one current level needs points at 2 or more different loads"

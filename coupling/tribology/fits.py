@@ -5,6 +5,21 @@ multiplicative (a few % of the reading at every load), so ln F_t and ln R_c have
 constant variance. Uncertainties are the usual Gauss-Newton covariance
 s^2 (J^T J)^-1 with Student-t 95 % intervals. Candidates are ranked by BIC (AICc is
 reported alongside); docs/tribology.md gives the reasons.
+
+Rows are reduced to their (load, |I|) cells before fitting: a least-squares fit on ln
+values depends on the rows only through each cell's count, its mean ln value and the
+within-cell sum of squares, so the estimates, the residual sum of squares and the
+covariance are exactly those of the row-by-row fit, at the cost of the number of cells
+(a 1,000,000-row file of repeated settings fits as fast as its few dozen cells).
+
+Outliers (`fit_tribometer`): rows far from the rest are flagged and left out of the fit,
+by a stated rule (docs/tribology.md): (1) gross values, whose ln lies more than
+GROSS_MADS robust standard deviations (1.4826 MAD) and more than a factor GROSS_FACTOR
+from the column's median (a 1e308 N load, a 1e-320 N friction); (2) then, in up to MAX_ROUNDS
+rounds, rows whose externally studentized ln residual from the chosen model exceeds the
+Bonferroni limit of the Student t distribution for a 1 % chance of flagging any row of
+Gaussian data (the Bonferroni outlier test), refitting after each round. The flagged rows and the
+reason are reported in the fit (and fit.json, and `switchsim fit`).
 """
 
 from __future__ import annotations
@@ -51,6 +66,26 @@ class ParameterEstimate:
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> "ParameterEstimate":
         return cls(d["name"], d["value"], d["stderr"], None if d["ci95"] is None else tuple(d["ci95"]), d["unit"])
+
+
+@dataclass(frozen=True)
+class Outlier:
+    """A data row left out of a fit: its position in the table (0-based), where it is
+    ("line 57" of the CSV, or "row 12"), the column and value, and why (the rule)."""
+
+    row: int
+    where: str
+    column: str
+    value: float
+    reason: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"row": self.row, "where": self.where, "column": self.column, "value": self.value,
+                "reason": self.reason}
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> "Outlier":
+        return cls(int(d["row"]), str(d["where"]), str(d["column"]), float(d["value"]), str(d["reason"]))
 
 
 @dataclass(frozen=True)
@@ -248,6 +283,8 @@ class FrictionFit:
     coulomb_test: CoulombComparison
     mu_selection: ModelSelection
     law: MuLaw
+    outliers: tuple[Outlier, ...] = ()  # at most MAX_LISTED_OUTLIERS; n_outliers counts all
+    n_outliers: int = 0
 
     @property
     def gamma(self) -> ParameterEstimate:
@@ -257,13 +294,15 @@ class FrictionFit:
     def to_dict(self) -> dict[str, Any]:
         return {"gamma": self.gamma.to_dict(), "per_current": [c.to_dict() for c in self.per_current],
                 "coulomb_test": self.coulomb_test.to_dict(), "mu_selection": self.mu_selection.to_dict(),
-                "law": self.law.to_dict()}
+                "law": self.law.to_dict(), "n_outliers": self.n_outliers,
+                "outliers": [o.to_dict() for o in self.outliers]}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> "FrictionFit":
         return cls(tuple(CurrentLevelMu.from_dict(c) for c in d["per_current"]),
                    CoulombComparison.from_dict(d["coulomb_test"]), ModelSelection.from_dict(d["mu_selection"]),
-                   MuLaw.from_dict(d["law"]))
+                   MuLaw.from_dict(d["law"]), tuple(Outlier.from_dict(o) for o in d.get("outliers", ())),
+                   int(d.get("n_outliers", 0)))
 
 
 @dataclass(frozen=True)
@@ -272,13 +311,17 @@ class ResistanceFit:
 
     selection: ModelSelection
     law: ResistanceLaw
+    outliers: tuple[Outlier, ...] = ()  # at most MAX_LISTED_OUTLIERS; n_outliers counts all
+    n_outliers: int = 0
 
     def to_dict(self) -> dict[str, Any]:
-        return {"selection": self.selection.to_dict(), "law": self.law.to_dict()}
+        return {"selection": self.selection.to_dict(), "law": self.law.to_dict(), "n_outliers": self.n_outliers,
+                "outliers": [o.to_dict() for o in self.outliers]}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> "ResistanceFit":
-        return cls(ModelSelection.from_dict(d["selection"]), ResistanceLaw.from_dict(d["law"]))
+        return cls(ModelSelection.from_dict(d["selection"]), ResistanceLaw.from_dict(d["law"]),
+                   tuple(Outlier.from_dict(o) for o in d.get("outliers", ())), int(d.get("n_outliers", 0)))
 
 
 @dataclass(frozen=True)
@@ -345,21 +388,41 @@ class TribometerFit:
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> "TribometerFit":
+        """Rebuild a saved fit. The ``laws`` block must be the one the fit wrote: an edited
+        law would no longer match the fit's estimates, intervals and model selection, so
+        it is refused (give your own laws inline in the scene instead)."""
+        if not isinstance(d, Mapping):
+            raise ValueError(f"not a tribometer fit: expected a JSON object, got a JSON {type(d).__name__}")
         if d.get("format") != FORMAT or d.get("version") != FORMAT_VERSION:
             raise ValueError(
-                f"not a tribometer fit: expected format {FORMAT!r} version {FORMAT_VERSION}, "
-                f"got {d.get('format')!r} version {d.get('version')!r}"
+                f"not a tribometer fit: expected \"format\": {FORMAT!r} and \"version\": {FORMAT_VERSION}"
             )
-        return cls(d["source"], tuple(d["header"]), DataRange.from_dict(d["data_range"]),
-                   FrictionFit.from_dict(d["friction"]), ResistanceFit.from_dict(d["resistance"]))
+        fit = cls(d["source"], tuple(d["header"]), DataRange.from_dict(d["data_range"]),
+                  FrictionFit.from_dict(d["friction"]), ResistanceFit.from_dict(d["resistance"]))
+        if "laws" in d and ContactLaws.from_dict(d["laws"]).to_dict() != fit.laws.to_dict():
+            raise ValueError(
+                "the 'laws' block differs from the laws the fit found (edited by hand?): a fit file "
+                "is a record of a fit and is used as written; put your own laws inline in the scene "
+                "([tribology.mu] and [tribology.resistance], docs/tribology.md)"
+            )
+        return fit
 
     @classmethod
     def from_json(cls, path) -> "TribometerFit":
         path = Path(path)
         try:
-            return cls.from_dict(json.loads(path.read_text()))
-        except (KeyError, TypeError, json.JSONDecodeError) as err:
-            raise ValueError(f"{path}: not a readable tribometer fit ({type(err).__name__}: {err})") from None
+            if path.is_dir():
+                raise ValueError("is a folder, not a fit.json file")
+            data = path.read_bytes()
+            return cls.from_dict(json.loads(data.decode("utf-8-sig")))
+        except UnicodeDecodeError as err:
+            raise ValueError(f"{path}: not a readable tribometer fit (byte {err.start} is not UTF-8)") from None
+        except json.JSONDecodeError as err:
+            raise ValueError(f"{path}: not a readable tribometer fit (invalid JSON at line {err.lineno}, "
+                             f"column {err.colno})") from None
+        except (KeyError, TypeError, ValueError, AttributeError, IndexError) as err:
+            text = str(err) if isinstance(err, ValueError) else f"{type(err).__name__}: {str(err)[:60]}"
+            raise ValueError(f"{path}: not a readable tribometer fit ({text})") from None
 
 
 # ---------------------------------------------------------------------------------
@@ -368,22 +431,90 @@ class TribometerFit:
 
 @dataclass(frozen=True)
 class _Problem:
-    """Data in the form the fits use: ln responses, ln loads, |I|, and repeat groups."""
+    """The used rows reduced to their (load, |I|) cells (see the module docstring).
+
+    Per cell: load (N), |I| (A), ln load, row count and its square root (the weight of
+    the cell's mean residual); levels: the distinct |I|, level_index: each cell's level;
+    cell_of_row: each used row's cell; n: rows used.
+    """
 
     load: np.ndarray
     current: np.ndarray
     ln_load: np.ndarray
-    groups: np.ndarray  # index of the (load, |I|) cell of each row
-    levels: np.ndarray  # distinct |I|
+    count: np.ndarray
+    sqrt_w: np.ndarray
+    levels: np.ndarray
     level_index: np.ndarray
+    cell_of_row: np.ndarray
+    n: int
+
+    @property
+    def n_cells(self) -> int:
+        return len(self.load)
+
+
+@dataclass(frozen=True)
+class _Response:
+    """A ln response over the cells: cell means, within-cell and total sums of squares."""
+
+    mean: np.ndarray
+    ss_within: float
+    tss: float
+    n: int
+
+
+def _problem_from(load: np.ndarray, current: np.ndarray) -> _Problem:
+    # cells by hashing (no sort of the rows: memory and time linear in the rows)
+    load_code, load_values = pd.factorize(load)
+    current_code, current_values = pd.factorize(np.abs(current))
+    key = load_code.astype(np.int64)
+    key *= len(current_values)
+    key += current_code
+    del load_code, current_code
+    n_keys = len(load_values) * len(current_values)
+    if n_keys <= 4 * len(key) + 1024:
+        # a direct table of the (load, current) pairs: no second hash table
+        present = np.bincount(key, minlength=n_keys) > 0
+        cell_keys = np.flatnonzero(present)
+        table = np.cumsum(present) - 1
+        cell_of_row = table[key]
+        del table, present
+    else:
+        cell_of_row, cell_keys = pd.factorize(key)
+    del key
+    count = np.bincount(cell_of_row, minlength=len(cell_keys)).astype(float)
+    c_load = np.asarray(load_values, float)[cell_keys // len(current_values)]
+    c_current = np.asarray(current_values, float)[cell_keys % len(current_values)]
+    levels, level_index = np.unique(c_current, return_inverse=True)
+    return _Problem(c_load, c_current, np.log(c_load), count, np.sqrt(count), levels, level_index.ravel(),
+                    cell_of_row, len(load))
+
+
+def _subproblem(P: _Problem, use: np.ndarray) -> _Problem:
+    """The problem of the rows in boolean mask ``use`` (over P's rows), without sorting again."""
+    count = np.bincount(P.cell_of_row[use], minlength=P.n_cells).astype(float)
+    keep = count > 0
+    new_index = np.cumsum(keep) - 1
+    levels_used = np.unique(P.level_index[keep])
+    level_map = np.full(len(P.levels), -1)
+    level_map[levels_used] = np.arange(len(levels_used))
+    return _Problem(P.load[keep], P.current[keep], P.ln_load[keep], count[keep], np.sqrt(count[keep]),
+                    P.levels[levels_used], level_map[P.level_index[keep]], new_index[P.cell_of_row[use]],
+                    int(use.sum()))
 
 
 def _problem(df: pd.DataFrame) -> _Problem:
-    load = df["load_N"].to_numpy(float)
-    current = np.abs(df["current_A"].to_numpy(float))
-    levels, level_index = np.unique(current, return_inverse=True)
-    _, groups = np.unique(np.c_[load, current], axis=0, return_inverse=True)
-    return _Problem(load, current, np.log(load), groups.ravel(), levels, level_index.ravel())
+    return _problem_from(df["load_N"].to_numpy(float), df["current_A"].to_numpy(float))
+
+
+def _response(P: _Problem, y: np.ndarray) -> _Response:
+    mean = np.bincount(P.cell_of_row, weights=y, minlength=P.n_cells) / P.count
+    d = mean[P.cell_of_row]
+    np.subtract(y, d, out=d)
+    ss_within = float(d @ d)
+    np.subtract(y, y.mean(), out=d)
+    tss = float(d @ d)
+    return _Response(mean, ss_within, tss, len(y))
 
 
 def _jacobian(residual: Callable[[np.ndarray], np.ndarray], x: np.ndarray) -> np.ndarray:
@@ -398,17 +529,12 @@ def _jacobian(residual: Callable[[np.ndarray], np.ndarray], x: np.ndarray) -> np
     return np.column_stack(cols) if cols else np.zeros((len(residual(x)), 0))
 
 
-def _lack_of_fit_p(r: np.ndarray, groups: np.ndarray, n_params: int) -> float | None:
-    n = len(r)
-    n_cells = groups.max() + 1
+def _lack_of_fit_p(rss: float, resp: _Response, n_cells: int, n_params: int) -> float | None:
+    n = resp.n
     df_pe = n - n_cells
     df_lof = n - n_params - df_pe
-    if df_pe <= 0 or df_lof <= 0:
-        return None
-    means = np.bincount(groups, weights=r) / np.bincount(groups)
-    ss_pe = float(np.sum((r - means[groups]) ** 2))
-    rss = float(r @ r)
-    if ss_pe <= 0.0:
+    ss_pe = resp.ss_within
+    if df_pe <= 0 or df_lof <= 0 or ss_pe <= 0.0:
         return None
     f = ((rss - ss_pe) / df_lof) / (ss_pe / df_pe)
     return float(stats.f.sf(max(f, 0.0), df_lof, df_pe))
@@ -416,20 +542,20 @@ def _lack_of_fit_p(r: np.ndarray, groups: np.ndarray, n_params: int) -> float | 
 
 def _model_fit(
     name: str, formula: str, names: tuple[str, ...], units: tuple[str, ...], x: np.ndarray,
-    residual: Callable[[np.ndarray], np.ndarray], y: np.ndarray, groups: np.ndarray,
+    residual: Callable[[np.ndarray], np.ndarray], resp: _Response, n_cells: int,
     active: np.ndarray | None = None,
 ) -> ModelFit:
+    """Statistics of a fit whose ``residual`` is the weighted cell residual sqrt(n_c) (mean - f)."""
     r = residual(x)
-    n, p = len(r), len(x)
-    rss = float(r @ r)
+    n, p = resp.n, len(x)
+    rss = float(r @ r) + resp.ss_within
     dof = n - p
     s2 = rss / dof
     k = p + 1  # the scatter is a parameter too
     loglik_term = n * np.log(max(rss, 1e-300) / n)
     aicc = float(loglik_term + 2 * k + 2 * k * (k + 1) / (n - k - 1)) if n - k - 1 > 0 else float("inf")
     bic = float(loglik_term + k * np.log(n))
-    tss = float(np.sum((y - y.mean()) ** 2))
-    r2 = None if tss == 0.0 else 1.0 - rss / tss
+    r2 = None if resp.tss == 0.0 else 1.0 - rss / resp.tss
     note = ""
     cov = None
     at_bound = [] if active is None else [names[j] for j in np.flatnonzero(active)]
@@ -438,7 +564,7 @@ def _model_fit(
     elif p:
         J = _jacobian(residual, x)
         jtj = J.T @ J
-        if np.linalg.cond(jtj) > 1e14:
+        if not np.all(np.isfinite(jtj)) or np.linalg.cond(jtj) > 1e14:
             note = "parameters not identifiable from these data (singular J^T J); no covariance"
         else:
             cov = s2 * np.linalg.inv(jtj)
@@ -453,7 +579,7 @@ def _model_fit(
     return ModelFit(
         name, formula, tuple(params),
         None if cov is None else tuple(tuple(float(v) for v in row) for row in cov),
-        n, rss, float(np.sqrt(s2)), r2, aicc, bic, _lack_of_fit_p(r, groups, p), note,
+        n, rss, float(np.sqrt(s2)), r2, aicc, bic, _lack_of_fit_p(rss, resp, n_cells, p), note,
     )
 
 
@@ -508,72 +634,83 @@ def _mu_starts(model: str, levels: np.ndarray, mu_k: np.ndarray) -> list[np.ndar
 
 
 def fit_friction(df: pd.DataFrame, mu_models: list[str] | None = None) -> FrictionFit:
-    """Fit gamma and mu(I) to the friction column of a validated tribometer table.
+    """Fit gamma and mu(I) to the friction column of a validated tribometer table (all rows).
 
     Steps: (1) free mu per current level with a shared gamma (linear in ln), and the
     same with gamma = 0 (Coulomb), compared by F-test and BIC; (2) each mu(I) candidate
     (all of `models.MU_FAMILIES`, or the names in mu_models) fitted jointly with gamma,
-    ranked by BIC.
+    ranked by BIC. `fit_tribometer` adds the outlier rule.
     """
+    P = _problem(df)
+    return _fit_friction(P, np.log(df["friction_N"].to_numpy(float)), mu_models)[0]
+
+
+def _fit_friction(P: _Problem, y: np.ndarray, mu_models: list[str] | None) -> tuple[FrictionFit, np.ndarray, int]:
+    """The friction fit on cells; also the chosen model's ln prediction per cell and its parameter count."""
     if mu_models is None:
         mu_models = list(MU_FAMILIES)
     unknown = [m for m in mu_models if m not in MU_FAMILIES]
     if unknown or not mu_models:
         raise ValueError(f"mu models must be among {list(MU_FAMILIES)}, got {unknown or mu_models}")
-    P = _problem(df)
-    y = np.log(df["friction_N"].to_numpy(float))
+    resp = _response(P, y)
+    ybar, w, m = resp.mean, P.sqrt_w, P.n_cells
+    n = resp.n
     L = len(P.levels)
-    X = np.zeros((len(y), L + 1))
-    X[np.arange(len(y)), P.level_index] = 1.0
+    X = np.zeros((m, L + 1))
+    X[np.arange(m), P.level_index] = 1.0
     X[:, L] = -P.ln_load  # column for gamma: ln F_t = ln mu_k + ln F_n - gamma ln F_n
     level_names = tuple(f"ln_mu_at_{i:g}A" for i in P.levels)
     level_units = ("ln(N^gamma)",) * L
+    target = ybar - P.ln_load
 
     def r_power(x):
-        return y - P.ln_load - X @ x
+        return w * (target - X @ x)
 
-    x_pow, *_ = np.linalg.lstsq(X, y - P.ln_load, rcond=None)
+    x_pow, *_ = np.linalg.lstsq(w[:, None] * X, w * target, rcond=None)
     power = _model_fit("per_current_power_law", "F_t = mu_k F_n^(1-gamma), one mu_k per current",
-                       level_names + ("gamma",), level_units + ("1",), x_pow, r_power, y, P.groups)
+                       level_names + ("gamma",), level_units + ("1",), x_pow, r_power, resp, m)
 
     Xc = X[:, :L]
 
     def r_coulomb(x):
-        return y - P.ln_load - Xc @ x
+        return w * (target - Xc @ x)
 
-    x_c, *_ = np.linalg.lstsq(Xc, y - P.ln_load, rcond=None)
+    x_c, *_ = np.linalg.lstsq(w[:, None] * Xc, w * target, rcond=None)
     coulomb = _model_fit("per_current_coulomb", "F_t = mu_k F_n, one mu_k per current (gamma = 0)",
-                         level_names, level_units, x_c, r_coulomb, y, P.groups)
-    dof = len(y) - (L + 1)
-    f_stat = (coulomb.rss_log - power.rss_log) / (power.rss_log / dof)
+                         level_names, level_units, x_c, r_coulomb, resp, m)
+    dof = n - (L + 1)
+    f_stat = (coulomb.rss_log - power.rss_log) / (power.rss_log / dof) if power.rss_log > 0 else float("inf")
     comparison = CoulombComparison(
         power, coulomb, float(f_stat), float(stats.f.sf(max(f_stat, 0.0), 1, dof)),
         coulomb.aicc - power.aicc, coulomb.bic - power.bic,
     )
 
-    cov = np.array(power.covariance)
     t = float(stats.t.ppf(0.975, dof))
-    counts = np.bincount(P.level_index, minlength=L)
+    counts = np.bincount(P.level_index, weights=P.count, minlength=L)
+    if power.covariance is None:
+        se = np.full(L, np.nan)
+    else:
+        se = np.sqrt(np.diag(np.array(power.covariance))[:L])
     per_current = tuple(
-        CurrentLevelMu(float(P.levels[k]), int(counts[k]), float(np.exp(x_pow[k])), float(np.sqrt(cov[k, k])),
-                       (float(np.exp(x_pow[k] - t * np.sqrt(cov[k, k]))), float(np.exp(x_pow[k] + t * np.sqrt(cov[k, k])))))
+        CurrentLevelMu(float(P.levels[k]), int(counts[k]), float(np.exp(x_pow[k])), float(se[k]),
+                       (float(np.exp(x_pow[k] - t * se[k])), float(np.exp(x_pow[k] + t * se[k]))))
         for k in range(L)
     )
 
     gamma0 = x_pow[L]
     mu_k = np.exp(x_pow[:L])
-    fitted, skipped = [], []
+    fitted, skipped, predictions = [], [], {}
     for model in mu_models:
         family = MU_FAMILIES[model]
         if L < len(family.parameters):
             skipped.append((model, f"needs >= {len(family.parameters)} current levels, data have {L}"))
             continue
-        if len(y) - len(family.parameters) - 3 < 0:
-            skipped.append((model, f"needs >= {len(family.parameters) + 3} points, data have {len(y)}"))
+        if n - len(family.parameters) - 3 < 0:
+            skipped.append((model, f"needs >= {len(family.parameters) + 3} points, data have {n}"))
             continue
 
         def residual(x, model=model):
-            return y - _ln_mu(model, x[1:], P.current) - (1.0 - x[0]) * P.ln_load
+            return w * (ybar - _ln_mu(model, x[1:], P.current) - (1.0 - x[0]) * P.ln_load)
 
         lower = np.r_[-np.inf, family.lower]
         upper = np.r_[1.0 - 1e-9, family.upper]
@@ -586,14 +723,15 @@ def fit_friction(df: pd.DataFrame, mu_models: list[str] | None = None) -> Fricti
             skipped.append((model, "fitted mu is not > 0 over the measured currents"))
             continue
         fitted.append(_model_fit(model, f"F_t = ({family.formula}) F_n^(1-gamma)", ("gamma",) + family.parameters,
-                                 ("1",) + family.units, res.x, residual, y, P.groups, res.active_mask))
+                                 ("1",) + family.units, res.x, residual, resp, m, res.active_mask))
+        predictions[model] = ybar - residual(res.x) / w
     if not fitted:
         raise ValueError(f"no mu(I) model could be fitted: {'; '.join(f'{n}: {r}' for n, r in skipped)}")
     selection = ModelSelection(CRITERION, _rank(fitted), tuple(skipped))
     chosen = selection.chosen
     law = MuLaw(chosen.value("gamma"), chosen.name, tuple((p.name, p.value) for p in chosen.parameters[1:]),
                 (float(P.levels[0]), float(P.levels[-1])))
-    return FrictionFit(per_current, comparison, selection, law)
+    return FrictionFit(per_current, comparison, selection, law), predictions[chosen.name], chosen.n_parameters
 
 
 # ---------------------------------------------------------------------------------
@@ -622,46 +760,57 @@ def _current_grid(current_model: str, scale: float) -> list[tuple[float, ...]]:
     return [(c, r) for c in scales for r in (0.1, 0.3, 0.5, 0.7, 0.9, 1.2)]
 
 
-def _load_start(load_model: str, F: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, float]:
-    """Best load parameters for a given current-corrected resistance R (relative least squares)."""
+def _load_start(load_model: str, F: np.ndarray, R: np.ndarray, count: np.ndarray) -> tuple[np.ndarray, float]:
+    """Best load parameters for a given current-corrected resistance R per cell (relative
+    least squares, each cell weighted by its row count)."""
     fam = LOAD_FAMILIES[load_model]
     fixed = dict(fam.fixed)
+    w = np.sqrt(count)
     if load_model == "power_law":
-        slope, icpt = np.polyfit(np.log(F), np.log(R), 1)
+        slope, icpt = np.polyfit(np.log(F), np.log(R), 1, w=w)
         x = np.array([np.exp(icpt), min(max(-slope, 1e-3), 5.0)])
     elif "r_film_ohm" in fam.parameters:
         m = fixed["load_exponent"]
         A = np.c_[np.ones_like(F), F ** (-m)] / R[:, None]
-        coef, *_ = np.linalg.lstsq(A, np.ones_like(F), rcond=None)
+        coef, *_ = np.linalg.lstsq(w[:, None] * A, w, rcond=None)
         if coef[0] < 0.0 or coef[1] <= 0.0:
-            coef = np.array([0.0, np.exp(np.mean(np.log(R * F**m)))])
+            coef = np.array([0.0, np.exp(np.average(np.log(R * F**m), weights=count))])
         x = coef
     else:
         m = fixed["load_exponent"]
-        x = np.array([np.exp(np.mean(np.log(R * F**m)))])
+        x = np.array([np.exp(np.average(np.log(R * F**m), weights=count))])
     pred = load_law_parameters(load_model, dict(zip(fam.parameters, x)))
     model = pred[0] + pred[1] * F ** (-pred[2])
-    return x, float(np.sum(np.log(R / model) ** 2))
+    return x, float(np.sum(count * np.log(R / model) ** 2))
 
 
 def fit_resistance(df: pd.DataFrame, candidates: list[tuple[str, str]] | None = None) -> ResistanceFit:
-    """Fit R_c(F_n, I) = g(I) (R_f + R_1 F^-m): every load law x current factor, ranked by BIC.
+    """Fit R_c(F_n, I) = g(I) (R_f + R_1 F^-m): every load law x current factor, ranked by BIC (all rows).
 
     candidates: (load model, current model) pairs to rank instead of all of
-    `resistance_candidates()`, e.g. to keep only the Holm laws.
+    `resistance_candidates()`, e.g. to keep only the Holm laws. `fit_tribometer` adds
+    the outlier rule.
     """
+    P = _problem(df)
+    return _fit_resistance(P, np.log(df["resistance_ohm"].to_numpy(float)), candidates)[0]
+
+
+def _fit_resistance(P: _Problem, y: np.ndarray, candidates: list[tuple[str, str]] | None
+                    ) -> tuple[ResistanceFit, np.ndarray, int]:
+    """The resistance fit on cells; also the chosen model's ln prediction per cell and its parameter count."""
     if candidates is None:
         candidates = resistance_candidates()
     unknown = [c for c in candidates if tuple(c) not in resistance_candidates()]
     if unknown or not candidates:
         raise ValueError(f"resistance candidates must be among {resistance_candidates()}, got {unknown or candidates}")
-    P = _problem(df)
-    R = df["resistance_ohm"].to_numpy(float)
-    y = np.log(R)
+    resp = _response(P, y)
+    ybar, w, m = resp.mean, P.sqrt_w, P.n_cells
+    n = resp.n
+    R = np.exp(ybar)  # geometric mean per cell
     n_loads = len(np.unique(P.load))
     L = len(P.levels)
     scale = P.levels.max() if P.levels.max() > 0 else 1.0
-    fitted, skipped = [], []
+    fitted, skipped, predictions = [], [], {}
     for load_model, current_model in candidates:
         name = f"{load_model}+{current_model}"
         lf, cf = LOAD_FAMILIES[load_model], CURRENT_FAMILIES[current_model]
@@ -671,20 +820,20 @@ def fit_resistance(df: pd.DataFrame, candidates: list[tuple[str, str]] | None = 
         if L < len(cf.parameters) + 1:
             skipped.append((name, f"needs >= {len(cf.parameters) + 1} current levels, data have {L}"))
             continue
-        if len(y) - len(lf.parameters) - len(cf.parameters) - 3 < 0:
-            skipped.append((name, f"needs >= {len(lf.parameters) + len(cf.parameters) + 3} points, data have {len(y)}"))
+        if n - len(lf.parameters) - len(cf.parameters) - 3 < 0:
+            skipped.append((name, f"needs >= {len(lf.parameters) + len(cf.parameters) + 3} points, data have {n}"))
             continue
         trials = []
         for c in _current_grid(current_model, scale):
             g = cf.function(P.current, *c)
             if np.any(g <= 0.0):
                 continue
-            xl, sse = _load_start(load_model, P.load, R / g)
+            xl, sse = _load_start(load_model, P.load, R / g, P.count)
             trials.append((sse, np.r_[xl, c]))
         trials.sort(key=lambda t: t[0])
 
         def residual(x, lm=load_model, cm=current_model):
-            return y - _ln_resistance(lm, cm, x, P.load, P.current)
+            return w * (ybar - _ln_resistance(lm, cm, x, P.load, P.current))
 
         lower = np.r_[lf.lower, cf.lower]
         upper = np.r_[lf.upper, cf.upper]
@@ -694,7 +843,8 @@ def fit_resistance(df: pd.DataFrame, candidates: list[tuple[str, str]] | None = 
             continue
         formula = f"R_c = ({cf.formula}) * ({lf.formula}), F in N"
         fitted.append(_model_fit(name, formula, lf.parameters + cf.parameters, lf.units + cf.units,
-                                 res.x, residual, y, P.groups, res.active_mask))
+                                 res.x, residual, resp, m, res.active_mask))
+        predictions[name] = ybar - residual(res.x) / w
     if not fitted:
         raise ValueError(f"no R_c model could be fitted: {'; '.join(f'{n}: {r}' for n, r in skipped)}")
     selection = ModelSelection(CRITERION, _rank(fitted), tuple(skipped))
@@ -702,30 +852,158 @@ def fit_resistance(df: pd.DataFrame, candidates: list[tuple[str, str]] | None = 
     load_model, current_model = chosen.name.split("+")
     law = ResistanceLaw(load_model, current_model, tuple((p.name, p.value) for p in chosen.parameters),
                         (float(P.levels[0]), float(P.levels[-1])))
-    return ResistanceFit(selection, law)
+    return ResistanceFit(selection, law), predictions[chosen.name], chosen.n_parameters
 
 
 # ---------------------------------------------------------------------------------
-# Entry point and confidence bands
+# Outliers
+
+#: Gross-value rule: ln value beyond this many robust standard deviations from the
+#: column's median, and beyond GROSS_FACTOR (a factor) from it.
+GROSS_MADS = 10.0
+GROSS_FACTOR = 1e3
+#: Residual rule: overall chance of flagging any row of Gaussian data (Bonferroni).
+FALSE_ALARM = 0.01
+MAX_ROUNDS = 3
+#: More flagged rows than this fraction: the data do not follow one law (an error).
+MAX_OUTLIER_FRACTION = 0.2
+MAX_LISTED_OUTLIERS = 100
+_MAD_TO_SD = 1.4826
+
+
+def t_crit(n: int, p: int) -> float:
+    """Limit of the externally studentized ln residual for n rows and p parameters: the
+    two-sided Student-t quantile (n - p - 1 degrees of freedom) for a FALSE_ALARM chance
+    over all n rows (Bonferroni outlier test)."""
+    return float(stats.t.isf(FALSE_ALARM / (2.0 * max(n, 1)), max(n - p - 1, 1)))
+
+
+def _robust_sd(r: np.ndarray) -> float:
+    med = np.median(r)
+    return _MAD_TO_SD * float(np.median(np.abs(r - med)))
+
+
+def _gross(ln_values: np.ndarray) -> tuple[np.ndarray, float, float]:
+    """Rows whose ln value is gross (see GROSS_MADS, GROSS_FACTOR); the median and the limit."""
+    med = float(np.median(ln_values))
+    sd = _robust_sd(ln_values)
+    limit = max(GROSS_MADS * sd, float(np.log(GROSS_FACTOR)))
+    return np.abs(ln_values - med) > limit, med, limit
+
+
+def _with_rejection(P_all: _Problem, fit: Callable, y: np.ndarray, use: np.ndarray,
+                    flagged: dict[int, tuple[str, str]], column: str) -> Any:
+    """Fit on the rows in ``use``; flag rows whose externally studentized ln residual
+    |r_k| / s_(k), s_(k)^2 = (RSS - r_k^2) / (n - p - 1), exceeds t_crit; refit; at most
+    MAX_ROUNDS rounds of flagging."""
+    for round_ in range(MAX_ROUNDS + 1):
+        P = P_all if use.all() else _subproblem(P_all, use)
+        y_used = y if use.all() else y[use]
+        result, prediction, p = fit(P, y_used)
+        if round_ == MAX_ROUNDS:
+            break
+        r = y_used - prediction[P.cell_of_row]
+        del y_used
+        n = len(r)
+        if n - p - 1 <= 0:
+            break
+        # externally studentized residuals, in place: |r_k| / sqrt((RSS - r_k^2) / (n - p - 1))
+        s_k = r * r
+        rss = float(s_k.sum())
+        np.subtract(rss, s_k, out=s_k)
+        np.maximum(s_k, 1e-24 * (n - p - 1), out=s_k)
+        s_k /= n - p - 1
+        np.sqrt(s_k, out=s_k)
+        z = np.abs(r, out=r)
+        z /= s_k
+        del s_k
+        limit = t_crit(n, p)
+        bad = z > limit
+        if not bad.any():
+            break
+        rows = np.flatnonzero(use)[bad]
+        for k, row in zip(np.flatnonzero(bad), rows):
+            flagged[int(row)] = (column, f"studentized ln residual {z[k]:.3g} of the fit (Bonferroni "
+                                         f"limit {limit:.3g})")
+        use[rows] = False
+    return result
 
 
 def fit_tribometer(
     df: pd.DataFrame, mu_models: list[str] | None = None, resistance_candidates: list[tuple[str, str]] | None = None,
 ) -> TribometerFit:
-    """Fit gamma, mu(I) and R_c(F_n, I) to a tribometer table (see `read_tribometer_csv`).
+    """Fit gamma, mu(I) and R_c(F_n, I) to a tribometer table (see `read_tribometer_csv`), leaving out outliers.
 
     df: columns load_N (N), current_A (A), friction_N (N), resistance_ohm (ohm), optional
     run. Validated again here, so a hand-built DataFrame gets the same clear errors.
     mu_models, resistance_candidates: restrict the candidates ranked (default: all;
-    see `fit_friction`, `fit_resistance`).
+    see `fit_friction`, `fit_resistance`). Outliers are flagged by the rule of the
+    module docstring and reported in `friction.outliers` / `resistance.outliers`.
     """
     source = str(df.attrs.get("source", "DataFrame"))
     header = tuple(df.attrs.get("header", ()))
     clean = validate_tribometer_frame(df, source=source)
-    P = _problem(clean)
-    data_range = DataRange(len(clean), tuple(float(v) for v in np.unique(P.load)), tuple(float(v) for v in P.levels))
-    return TribometerFit(source, header, data_range, fit_friction(clean, mu_models),
-                         fit_resistance(clean, resistance_candidates))
+    P_all = _problem(clean)
+    ln_load = P_all.ln_load[P_all.cell_of_row]
+    y_f = np.log(clean["friction_N"].to_numpy(float))
+    y_r = np.log(clean["resistance_ohm"].to_numpy(float))
+    n = len(clean)
+
+    results = []
+    for column, y, fit in (("friction_N", y_f, lambda P, yy: _fit_friction(P, yy, mu_models)),
+                           ("resistance_ohm", y_r, lambda P, yy: _fit_resistance(P, yy, resistance_candidates))):
+        flagged: dict[int, tuple[str, str]] = {}
+        for col, values in (("load_N", ln_load), (column, y)):
+            bad, med, limit = _gross(values)
+            for k in np.flatnonzero(bad):
+                flagged[int(k)] = (col, f"gross value: ln is {abs(values[k] - med):.3g} from the column's median "
+                                        f"(limit {limit:.3g})")
+        use = np.ones(n, dtype=bool)
+        use[list(flagged)] = False
+        _check_usable(clean.iloc[np.flatnonzero(use)], source, column, len(flagged), n)
+        result = _with_rejection(P_all, fit, y, use, flagged, column)
+        if len(flagged) > MAX_OUTLIER_FRACTION * n:
+            raise ValueError(f"{source}: {len(flagged)} of {n} rows are outliers of the {column} fit by the "
+                             f"stated rule (more than {MAX_OUTLIER_FRACTION:.0%}): the data do not follow one "
+                             "law; check units and columns (docs/tribology.md, outliers)")
+        outliers = _outliers(flagged, clean, df, source)
+        results.append((result, outliers, len(flagged), use))
+    (friction, f_out, f_n, f_use), (resistance, r_out, r_n, r_use) = results
+    friction = FrictionFit(friction.per_current, friction.coulomb_test, friction.mu_selection, friction.law,
+                           f_out, f_n)
+    resistance = ResistanceFit(resistance.selection, resistance.law, r_out, r_n)
+    used = f_use & r_use  # the validity range: rows neither fit left out
+    P = _subproblem(P_all, used)
+    data_range = DataRange(int(used.sum()), tuple(float(v) for v in np.unique(P.load)),
+                           tuple(float(v) for v in P.levels))
+    return TribometerFit(source, header, data_range, friction, resistance)
+
+
+def _check_usable(rows: pd.DataFrame, source: str, column: str, n_flagged: int, n: int) -> None:
+    if n_flagged > MAX_OUTLIER_FRACTION * n:
+        raise ValueError(f"{source}: {n_flagged} of {n} rows hold gross values (load or {column} more than "
+                         f"a factor {GROSS_FACTOR:g} and {GROSS_MADS:g} robust SD from the median): check units "
+                         "and columns (docs/tribology.md, outliers)")
+    try:
+        validate_tribometer_frame(rows.reset_index(drop=True), source=f"{source} (outliers left out)")
+    except ValueError as err:
+        raise ValueError(f"{err}") from None
+
+
+def _outliers(flagged: dict[int, tuple[str, str]], clean: pd.DataFrame, df: pd.DataFrame,
+              source: str) -> tuple[Outlier, ...]:
+    rows = sorted(flagged)[:MAX_LISTED_OUTLIERS]
+    if not rows:
+        return ()
+    where = None
+    if df.attrs.get("csv") and Path(source).is_file():
+        from coupling.tribology.data import lines_of_rows
+
+        where = [f"line {k}" for k in lines_of_rows(source, rows)]
+    if where is None:
+        where = [f"row {clean.index[k]}" for k in rows]
+    return tuple(Outlier(k, w, flagged[k][0], float(clean[flagged[k][0]].iloc[k]), flagged[k][1])
+                 for k, w in zip(rows, where))
 
 
 def _log_band(model: ModelFit, predict_log: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

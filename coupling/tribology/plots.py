@@ -17,6 +17,9 @@ from coupling.tribology.fits import TribometerFit, friction_band, mu_band, resis
 # The paper's symbols for 0, 1, 2, 5 A, then more for other levels.
 MARKERS = ("o", "^", "*", "D", "s", "v", "P", "X")
 FRICTION_RESISTANCE_PNG = "friction_resistance_vs_load.png"
+#: Most data points drawn: a larger table is shown by a fixed random subset of this size
+#: (seed 0; the fit uses every row), said in the figure's title.
+MAX_PLOTTED_POINTS = 20_000
 MU_CURRENT_PNG = "mu_vs_current.png"
 
 
@@ -32,6 +35,15 @@ def plot_friction_resistance(fit: TribometerFit, df: pd.DataFrame) -> Figure:
     """
     fig = Figure(figsize=(10.0, 4.2), layout="constrained")
     ax_f, ax_r = fig.subplots(1, 2)
+    shown = ""
+    left_out = sorted({o.row for o in fit.friction.outliers + fit.resistance.outliers})
+    if left_out:
+        df = df.drop(index=df.index[left_out])
+        shown = f", {len(left_out)} outlier row(s) not shown"
+    if len(df) > MAX_PLOTTED_POINTS:
+        keep = np.sort(np.random.default_rng(0).choice(len(df), MAX_PLOTTED_POINTS, replace=False))
+        shown += f", {MAX_PLOTTED_POINTS} of {len(df)} points shown"
+        df = df.iloc[keep]
     lo, hi = fit.data_range.load_range_N
     loads = np.linspace(lo, hi, 100)
     current = np.abs(df["current_A"].to_numpy(float))
@@ -58,7 +70,7 @@ def plot_friction_resistance(fit: TribometerFit, df: pd.DataFrame) -> Figure:
     for ax in (ax_f, ax_r):
         ax.legend(title="current", fontsize=8)
         ax.grid(alpha=0.3)
-    fig.suptitle(f"Tribometer fit, 95 % confidence bands{_illustrative_note(fit)}", fontsize=11)
+    fig.suptitle(f"Tribometer fit, 95 % confidence bands{shown}{_illustrative_note(fit)}", fontsize=11)
     return fig
 
 

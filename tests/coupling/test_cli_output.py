@@ -239,18 +239,19 @@ def test_a_mechanics_only_failure_states_its_time_the_same_way(tmp_path):
     assert t_fail > 0.0 and t_fail == pytest.approx(pd.read_csv(out / "history.csv").time.iloc[-1], rel=1e-12)
 
 
-def test_a_netlist_line_ngspice_cannot_parse_writes_a_failed_result(tmp_path, capsys):
+def test_a_netlist_line_that_cannot_be_parsed_is_bad_input_before_anything_runs(tmp_path, capsys):
+    # (was: a failed result written at t = 0; a netlist ngspice refuses is bad input, like
+    # one switchsim's own check refuses: exit 2, one line, no result folder)
     (tmp_path / "relay.cir").write_text("* relay\nV1 supply 0 24\nR1 supply a 12\nXCONTACT a 0\n"
                                         "garbage line here %%%\n")
     text = COUPLED.replace('template = "resistive"\nvoltage = 24.0\nload_resistance = 12.0',
                            'template = "netlist"\nnetlist = "relay.cir"')
     scene = write(tmp_path, "relay.toml", text)
     out = tmp_path / "out"
-    assert main(["run", str(scene), "--out", str(out), "--quiet"]) == 1
+    assert main(["run", str(scene), "--out", str(out), "--quiet"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "could not parse" in err[0]
-    summary = json.loads((out / "summary.json").read_text())
-    assert summary["status"].startswith("failed at t = 0.0 s") and "could not parse" in summary["status"]
+    assert not out.exists()
 
 
 LONG = textwrap.dedent("""
