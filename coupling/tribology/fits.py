@@ -16,7 +16,6 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 import pandas as pd
-from scipy import optimize, stats
 
 from coupling.tribology.data import validate_tribometer_frame
 from coupling.tribology.laws import ContactLaws, MuLaw, ResistanceLaw
@@ -399,6 +398,8 @@ def _jacobian(residual: Callable[[np.ndarray], np.ndarray], x: np.ndarray) -> np
 
 
 def _lack_of_fit_p(r: np.ndarray, groups: np.ndarray, n_params: int) -> float | None:
+    from scipy import stats  # lazily: a scene with a fitted law loads it without scipy.stats
+
     n = len(r)
     n_cells = groups.max() + 1
     df_pe = n - n_cells
@@ -419,6 +420,8 @@ def _model_fit(
     residual: Callable[[np.ndarray], np.ndarray], y: np.ndarray, groups: np.ndarray,
     active: np.ndarray | None = None,
 ) -> ModelFit:
+    from scipy import stats  # lazily: a scene with a fitted law loads it without scipy.stats
+
     r = residual(x)
     n, p = len(r), len(x)
     rss = float(r @ r)
@@ -458,6 +461,8 @@ def _model_fit(
 
 
 def _solve(residual, starts, lower, upper):
+    from scipy import optimize  # lazily: a scene with a fitted law loads it without scipy.optimize
+
     best = None
     for x0 in starts:
         x0 = np.clip(np.asarray(x0, float), lower, upper)
@@ -515,6 +520,8 @@ def fit_friction(df: pd.DataFrame, mu_models: list[str] | None = None) -> Fricti
     (all of `models.MU_FAMILIES`, or the names in mu_models) fitted jointly with gamma,
     ranked by BIC.
     """
+    from scipy import stats  # lazily: a scene with a fitted law loads it without scipy.stats
+
     if mu_models is None:
         mu_models = list(MU_FAMILIES)
     unknown = [m for m in mu_models if m not in MU_FAMILIES]
@@ -730,6 +737,8 @@ def fit_tribometer(
 
 def _log_band(model: ModelFit, predict_log: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Curve and pointwise 95 % confidence band (delta method on the ln prediction)."""
+    from scipy import stats  # lazily: a scene with a fitted law loads it without scipy.stats
+
     x = np.array([p.value for p in model.parameters])
     center = predict_log(x)
     if model.covariance is None:
