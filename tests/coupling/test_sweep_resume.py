@@ -58,12 +58,12 @@ def _write(tmp_path: Path) -> Path:
 @pytest.fixture(scope="module")
 def scheduler():
     """One Dask cluster (a worker process with its nanny) shared by the sweeps of this module
-    through --scheduler: the worker imports once (the local-cluster path is the killed-worker test)."""
-    from distributed import LocalCluster
-
+    through --scheduler: the worker imports once. (The local-cluster path, `--workers`, is
+    the same `local_cluster` the example test runs.)"""
     env = {"PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None,
-                      silence_logs=40, env=env) as cluster:
+    from coupling.sweep import local_cluster
+
+    with local_cluster(1, env=env) as cluster:
         yield cluster.scheduler_address
 
 
@@ -144,17 +144,19 @@ def test_interrupted_sweep_resumes_without_losing_or_redoing_runs(tmp_path, how,
     _check_complete(out, before)
 
 
-def test_a_killed_worker_loses_no_run_and_resume_then_has_nothing_to_do(tmp_path):
+def test_a_killed_worker_loses_no_run_and_resume_then_has_nothing_to_do(tmp_path, scheduler):
+    from distributed import Client
+
+    with Client(scheduler, timeout="30s") as client:
+        pids = list(client.run(os.getpid).values())
     sweep, out = _write(tmp_path), tmp_path / "out"
-    proc = _start(sweep, out, "--workers", "1")  # the default: a local cluster, its workers our children
+    proc = _start(sweep, out, "--scheduler", scheduler)
     _wait_rows(out, proc, 2)
-    workers = [p for p in _children(proc) if "spawn_main" in " ".join(p.cmdline())]
-    assert workers, "no worker process found"
-    workers[0].kill()  # the nanny starts a new worker; Dask reruns the run that was on it
+    psutil.Process(pids[0]).kill()  # the nanny starts a new worker; Dask reruns the run that was on it
     _, err = proc.communicate(timeout=300)
     assert proc.returncode == 0, err.decode()[-2000:]
     df = read_results(out)
     assert sorted(df.run_id) == [f"run{k:04d}" for k in range(RUNS)] and (df.status == "ok").all()
-    _resume(sweep, out)  # nothing to redo: no new rows
+    _resume(sweep, out, "--scheduler", scheduler)  # nothing to redo: no new rows
     again = read_results(out)
     assert len(again) == RUNS and again.session.nunique() == 1
