@@ -465,7 +465,7 @@ def read_waveforms(out_dir, run_id: str):
     return pd.read_parquet(path)
 
 
-class _RowWriter:
+class RowWriter:
     """Appends rows to OUT/results as Parquet batch files, each written whole (rename), a batch
     every ``every`` seconds or ``size`` rows, and on close."""
 
@@ -618,7 +618,7 @@ def run_sweep(sweep: Sweep, out_dir, *, workers: int | None = None, scheduler: s
 
     tick = time.monotonic()
     session = f"{time.strftime('%Y%m%dT%H%M%S')}-{uuid.uuid4().hex[:6]}"
-    writer = _RowWriter(out / "results", session)
+    writer = RowWriter(out / "results", session)
     sweep_doc = dict(base=sweep.base, base_dir=str(Path(sweep.base_dir).resolve()), base_name=sweep.base_name,
                      common=sweep.common, waveforms=sweep.waveforms)
     cluster = None

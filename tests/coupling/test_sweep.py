@@ -15,7 +15,7 @@ import pandas as pd
 import pytest
 
 from coupling.scene import scene_from_dict
-from coupling.sweep import Sweep, _RowWriter, apply_changes, flatten_summary, load_sweep, read_results, \
+from coupling.sweep import Sweep, RowWriter, apply_changes, flatten_summary, load_sweep, read_results, \
     run_sweep_inline
 
 TINY = """
@@ -146,7 +146,7 @@ def test_flatten_summary_keeps_scalars_with_dotted_keys():
 def test_batches_with_different_columns_read_back_as_one_dataset(tmp_path):
     """A failed run's batch lacks the summary columns and may hold only nulls in a numeric one;
     the dataset is still one table, nulls where a batch had no value."""
-    writer = _RowWriter(tmp_path / "results", "s1", every=math.inf, size=10)
+    writer = RowWriter(tmp_path / "results", "s1", every=math.inf, size=10)
     writer.add({"run_id": "a", "x": 1.0, "bounce.bounces": 2, "status": "ok", "error": None})
     writer.flush()
     writer.add({"run_id": "b", "x": 2.0, "status": "failed", "error": "boom"})
