@@ -97,6 +97,38 @@ def on_cluster(sweep, workers: int, tmp: Path, repeat: int) -> float:
         return best
 
 
+def _timed_runs(n: int = 4) -> list[float]:
+    """s: n runs of the 3 ms default coupled scene, each timed, in the calling process (after a warm-up)."""
+    from coupling import run
+    from coupling.scene import default_scene
+
+    scene = default_scene().set("solver.t_end", 0.003)
+    run(scene)
+    times = []
+    for _ in range(n):
+        tick = time.perf_counter()
+        run(scene)
+        times.append(time.perf_counter() - tick)
+    return times
+
+
+def profiler_cost() -> dict:
+    """The same runs timed inside one Dask worker task with the worker's statistical profiler
+    on (Dask's default) and off (local_cluster's setting), and in this process."""
+    import dask
+    from distributed import Client, LocalCluster
+
+    env = {"PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    out = {}
+    for label, enabled in (("worker, profiler on", True), ("worker, profiler off", False)):
+        with dask.config.set({"distributed.worker.profile.enabled": enabled}):
+            with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None,
+                              silence_logs=40, env=env) as cluster, Client(cluster) as client:
+                out[label] = client.submit(_timed_runs, pure=False).result()
+    out["this process"] = _timed_runs()
+    return out
+
+
 CLIENT = textwrap.dedent("""
     import json, resource, sys, tomllib, tracemalloc
     sys.path.insert(0, sys.argv[4])
@@ -137,6 +169,9 @@ def main() -> None:
     print(f"sweep, 1 worker: {t1:.2f} s", flush=True)
     t2 = on_cluster(sweep, 2, tmp, args.repeat)
     print(f"sweep, 2 workers: {t2:.2f} s", flush=True)
+    prof = profiler_cost()
+    for label, times in prof.items():
+        print(f"{label}: {', '.join(f'{t * 1e3:.0f}' for t in times)} ms", flush=True)
     memory = []
     for n in [int(x) for x in args.memory_runs.split(",")]:
         m = client_memory(n, tmp)
@@ -160,6 +195,10 @@ def main() -> None:
              f"- 2 workers / 1 worker: **{speedup:.2f}x** (target >= 1.8x: {'met' if speedup >= 1.8 else 'not met'}).",
              f"- Overhead of the sweep machinery per run (1 worker against bare): **{100 * overhead:+.1f} %** "
              f"(target <= 10 %: {'met' if overhead <= 0.10 else 'not met'}).", "",
+             "Dask's worker profiler (the same 3 ms default coupled run, timed 4 times inside one task, "
+             "after a warm-up run):", "",
+             "| where | per run |", "|---|---|",
+             *[f"| {label} | {min(t) * 1e3:.0f}-{max(t) * 1e3:.0f} ms |" for label, t in prof.items()], "",
              "Client memory (a tiny coupled scene, waveforms kept, 2 workers; tracemalloc peak of the client's "
              "Python allocations during run_sweep, and its whole-process ru_maxrss):", "",
              "| runs | traced peak | ru_maxrss |", "|---|---|---|"]
