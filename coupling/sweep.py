@@ -672,8 +672,8 @@ def run_sweep(sweep: Sweep, out_dir, *, workers: int | None = None, scheduler: s
             if closable is not None:
                 try:
                     closable.close()
-                except Exception:  # noqa: BLE001 - closing after Ctrl-C or a lost scheduler: best effort
-                    pass
+                except (Exception, KeyboardInterrupt):  # noqa: BLE001 - after Ctrl-C or a lost scheduler
+                    report.interrupted = True  # best effort; the rows are already written
     return report
 
 
@@ -704,11 +704,16 @@ def sweep_command(path: str, out_dir: str, *, workers: int | None = None, schedu
                   resume: bool = False, quiet: bool = False) -> int:
     """`switchsim sweep SWEEP.toml --out DIR`: 0 when every run has a row, 1 if some failed,
     130 when interrupted (continue with --resume)."""
-    sweep = load_sweep(path)
-    if not quiet:
-        print(f"switchsim sweep: {len(sweep.runs)} runs of {sweep.base_name}, varying "
-              f"{', '.join(sweep.parameters) or 'nothing'}", file=sys.stderr)
-    report = run_sweep(sweep, out_dir, workers=workers, scheduler=scheduler, resume=resume, progress=not quiet)
+    try:
+        sweep = load_sweep(path)
+        if not quiet:
+            print(f"switchsim sweep: {len(sweep.runs)} runs of {sweep.base_name}, varying "
+                  f"{', '.join(sweep.parameters) or 'nothing'}", file=sys.stderr)
+        report = run_sweep(sweep, out_dir, workers=workers, scheduler=scheduler, resume=resume, progress=not quiet)
+    except KeyboardInterrupt:  # before the runs started, or a second Ctrl-C while stopping
+        print(f"switchsim sweep: interrupted; the rows written are in {out_dir}/results; continue with --resume",
+              file=sys.stderr)
+        return 130
     if report.interrupted:
         print(f"switchsim sweep: interrupted; {report.skipped + report.done} of {report.total} runs have rows in "
               f"{out_dir}/results; continue with --resume", file=sys.stderr)

@@ -1,9 +1,10 @@
 """An interrupted sweep loses nothing and redoes nothing: Ctrl-C, a killed client, a killed worker.
 
 Each test runs `switchsim sweep` in a subprocess on a small sweep of tiny mechanics-only
-scenes (one local worker), interrupts it once some rows are on disk, resumes it, and
-checks the results dataset: every run exactly once, the rows written before the
-interruption untouched (same session, same values), the rest written by the resume.
+scenes (one worker; ~0.2 s a run, so the interruption lands mid-sweep), interrupts it
+once some rows are on disk, resumes it, and checks the results dataset: every run
+exactly once, the rows written before the interruption untouched (same session, same
+values), the rest written by the resume.
 """
 
 from __future__ import annotations
@@ -24,20 +25,20 @@ psutil = pytest.importorskip("psutil")
 from coupling.sweep import finished_run_ids, read_results  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
-RUNS = 14
+RUNS = 10
 
 SCENE = """
 [bar]
 length = 0.1
 diameter = 0.006
 tip_radius = 0.003
-modes = 2
+modes = 8
 [initial]
 height = 0.0001
 angle_deg = 30.0
 velocity = [0.0, 0.0, -1.0]
 [solver]
-t_end = 0.002
+t_end = 0.004
 """
 
 
@@ -151,7 +152,7 @@ def test_a_killed_worker_loses_no_run_and_resume_then_has_nothing_to_do(tmp_path
         pids = list(client.run(os.getpid).values())
     sweep, out = _write(tmp_path), tmp_path / "out"
     proc = _start(sweep, out, "--scheduler", scheduler)
-    _wait_rows(out, proc, 2)
+    assert _wait_rows(out, proc, 2) < RUNS and proc.poll() is None  # the sweep is still running
     psutil.Process(pids[0]).kill()  # the nanny starts a new worker; Dask reruns the run that was on it
     _, err = proc.communicate(timeout=300)
     assert proc.returncode == 0, err.decode()[-2000:]
