@@ -10,20 +10,24 @@ Scenario scripts::
     result.save("out/")     # summary.json, waveforms.csv/.parquet, PNG plots
 """
 
-import importlib
+__all__ = ["CoSimulation", "CoupledResult", "CoupledRunError", "Scene", "builtin_scene", "default_scene",
+           "load_scene", "run", "scene_from_dict"]
 
-__all__ = ["CoSimulation", "CoupledResult", "CoupledRunError", "Scene", "builtin_scene", "default_scene", "load_scene",
-           "run", "scene_from_dict"]
-
-# Imported on first use: `switchsim fit` and `coupling.tribology` need neither the
-# mechanics (numba) nor ngspice, which would double their start-up time and memory.
-_WHERE = {"CoSimulation": "master", "CoupledRunError": "master", "run": "master", "CoupledResult": "results",
-          "Scene": "scene", "builtin_scene": "scene", "default_scene": "scene", "load_scene": "scene", "scene_from_dict": "scene"}
+# Imported on first use (PEP 562): `import coupling.scene` or the CLI's argument parsing
+# must not pay for the solvers, pandas or numba.
+_LAZY = {"CoSimulation": "master", "CoupledRunError": "master", "run": "master", "CoupledResult": "results",
+         "Scene": "scene", "builtin_scene": "scene", "default_scene": "scene", "load_scene": "scene", "scene_from_dict": "scene"}
 
 
 def __getattr__(name: str):
-    if name in _WHERE:
-        value = getattr(importlib.import_module(f".{_WHERE[name]}", __name__), name)
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
         globals()[name] = value
         return value
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

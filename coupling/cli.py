@@ -25,6 +25,14 @@ def _build_parser() -> argparse.ArgumentParser:
     fit = sub.add_parser("fit", help="fit gamma, mu(I) and R_c(F_n, I) to tribometer data")
     fit.add_argument("data", help="tribometer CSV (see docs/tribology.md for its form)")
     fit.add_argument("--out", required=True, help="output directory (created if missing)")
+    # --- sweep: coupling/sweep.py ---
+    sweep = sub.add_parser("sweep", help="run a design sweep of a scene on Dask (see docs/sweeps.md)")
+    sweep.add_argument("sweep", help="sweep TOML file: base scene and the parameters to vary")
+    sweep.add_argument("--out", required=True, help="output directory (results/ is a Parquet dataset)")
+    sweep.add_argument("--workers", type=int, default=None, help="local worker processes (default: CPUs)")
+    sweep.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler, tcp://host:port")
+    sweep.add_argument("--resume", action="store_true", help="continue the sweep in --out; finished runs are kept")
+    sweep.add_argument("--quiet", action="store_true", help="no progress output")
     return parser
 
 
@@ -39,6 +47,11 @@ def main(argv: list[str] | None = None) -> int:
             from coupling.tribology.command import fit_command
 
             return fit_command(args.data, args.out)
+        if args.command == "sweep":
+            from coupling.sweep import sweep_command
+
+            return sweep_command(args.sweep, args.out, workers=args.workers, scheduler=args.scheduler,
+                                 resume=args.resume, quiet=args.quiet)
     except (ValueError, FileNotFoundError) as err:
         # Input errors: one clear line, no traceback.
         print(f"switchsim: error: {_one_line(err)}", file=sys.stderr)

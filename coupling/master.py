@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 import sys
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -89,7 +90,14 @@ class CoSimulation:
         self.scene = scene
         self.laws = scene.tribology.laws
         self.feedback = scene.tribology.feedback
-        self.progress = Progress(scene.t_end, progress)
+        self.progress_enabled = progress
+        self.policy = StepPolicy.from_options(scene.coupling)
+        self._reset()
+
+    def _reset(self) -> None:
+        """Fresh per-run state: ``run`` starts from it each time, so one CoSimulation (and one
+        worker process) can run many times with the same results."""
+        self.progress = Progress(self.scene.t_end, self.progress_enabled)
         self.mu_log: list[tuple[float, float, float, float]] = []
         self.stats = dict(macro_steps=0, aligned_steps=0, contact_steps=0, mech_seconds=0.0,
                           circuit_seconds=0.0)
@@ -102,8 +110,10 @@ class CoSimulation:
     def run(self) -> CoupledResult:
         from circuit import Stepper
 
+        self._reset()
         sc = self.scene
         opts = sc.coupling
+        policy = self.policy
         t_end = sc.t_end
         rl = self.laws.resistance_law
         tick = time.perf_counter()
@@ -132,27 +142,12 @@ class CoSimulation:
                 while t < t_end * (1.0 - 1e-14):
                     touching = jump_since_prev or bool(np.any(mech.friction_engaged())) or bool(
                         np.any(mech.contact_now()[:, 0] > 0.0))
-                    t_next = min(t + (opts.macro_step if touching else opts.free_step), t_end)
-                    if t_end - t_next < 1e-3 * opts.macro_step:
-                        t_next = t_end  # no sliver step at the end
+                    t_next = policy.base_end(t, t_end, touching)
                     if opts.scheme == "jacobi":
                         i_now, t = self._jacobi_step(mech, stepper, rl, t, t_next, i_now)
                     else:
-                        probe = _probe_step(opts.macro_step)
-                        if jump_since_prev:
-                            # Right after a make/break the current has jumped and is known only
-                            # at the jump: a short step (H^2 / PROBE_TIME) fetches it, so the
-                            # zero-order hold costs O(H^2), not O(H): still second order.
-                            t_next = min(t + probe, t_end)
-                            slope = 0.0
-                        else:
-                            # Taylor step with the circuit's own slope at t. While the current
-                            # moves on a time scale shorter than the step (an L/R rise after a
-                            # make is ~100 ns) no slope extrapolates over it: the step shrinks
-                            # to half that time scale, at least the probe length.
-                            slope = rate
-                            if touching and abs(rate) * (t_next - t) > CHANGE_FRACTION * (abs(i_now) + CURRENT_FLOOR):
-                                t_next = min(t_next, t + max(probe, TIME_SCALE_FRACTION * scale))
+                        t_next, slope = policy.plan(t, t_next, t_end, touching=touching, jumped=jump_since_prev,
+                                                    current=i_now, rate=rate, scale=scale)
                         t_new, current, jumped, (rate, scale) = self._mechanics_first_step(
                             mech, stepper, rl, t, t_next, i_now, slope, scale)
                         i_now, t = current, t_new
@@ -184,10 +179,10 @@ class CoSimulation:
     # --- schemes -----------------------------------------------------------------------
 
     def _mechanics_first_step(self, mech, stepper, rl, t, t_next, i_now, slope, horizon=math.inf):
+        policy = self.policy
+
         def current_at(s):
-            # linear, but not beyond the current's time scale: an exponential approach
-            # extrapolated over its time constant lands on its asymptote
-            return i_now + slope * min(s - t, horizon)
+            return policy.extrapolate(i_now, slope, s - t, horizon)
 
         mu0 = self._mu(current_at(t))
         touching = mech.friction_engaged()
@@ -195,17 +190,9 @@ class CoSimulation:
         tick = time.perf_counter()
         seg = mech.advance(t_next, mu=(mu0, self._mu(current_at(t_next))))
         switching = [e["time"] for e in seg.events if e["kind"] in CONTACT_EVENTS]
-        opts = self.scene.coupling
-        guard = 1e-9 * opts.macro_step
-        probe = _probe_step(opts.macro_step)
         aligned = False
         if cp is not None and switching:
-            if t + guard < switching[0] < t_next - guard:
-                end = switching[0]  # end the step at the make/break
-            elif switching[0] <= t + guard and t_next - t > probe * (1.0 + 1e-9):
-                end = t + probe  # it happened at the step start: only a short step past it
-            else:
-                end = None
+            end = policy.aligned_end(t, t_next, switching[0])
             if end is not None:
                 t_next = end
                 mech.restore(cp)
@@ -231,8 +218,7 @@ class CoSimulation:
             self._tail_t, self._tail_i = self._tail_t[-1:], self._tail_i[-1:]
         # a step cut at a make/break ends at a current jump even when the re-run mechanics
         # stops a round-off short of the event (it is then found at the next step's start)
-        return t_next, _coupling_current(step), jumped, _end_rate(self._tail_t, self._tail_i,
-                                                                  self.scene.coupling.macro_step)
+        return t_next, _coupling_current(step), jumped, end_rate(self._tail_t, self._tail_i, policy.macro_step)
 
     def _jacobi_step(self, mech, stepper, rl, t, t_next, i_now):
         mu = self._mu(i_now)
@@ -361,13 +347,86 @@ CURRENT_FLOOR = 1e-3  # A: floor of |I| in the cautious time scale |I|/|dI/dt|
 TAIL_POINTS = 8  # circuit points kept across macro steps for the slope and its curvature
 
 
-def _probe_step(macro_step: float) -> float:
-    """s, the short step that fetches the current right after a make/break (H^2 / PROBE_TIME).
-    The run loop takes it and the event alignment must recognise it: both call this."""
-    return macro_step ** 2 / PROBE_TIME
+@dataclass(frozen=True)
+class StepPolicy:
+    """The co-simulation's step rules, pure (no solver, no ngspice): where a macro step ends
+    and how the loop current is extrapolated over it. Times in s, currents in A.
+
+    - ``base_end``: a macro step while a tip touches (or right after a jump), the longer
+      ``free_step`` while both are free; no sliver step (< 1e-3 H) left before t_end.
+    - ``plan`` (scheme mechanics_first): right after a make/break the current has jumped
+      and is known only at the jump, so a short probe step H^2 / probe_time with the current
+      held (zero-order hold: O(H^2) error, still second order); otherwise a Taylor step
+      with the circuit's own slope, no longer than time_scale_fraction of the current's
+      time scale where the step would change it by more than change_fraction of
+      (|I| + current_floor).
+    - ``extrapolate``: I(t + s) = I + slope min(s, horizon): linear, but not beyond the
+      current's time scale (an exponential approach extrapolated over its time constant
+      lands on its asymptote).
+    - ``aligned_end``: where a step that saw a make/break at t_e is cut: at t_e inside it,
+      at t + probe when t_e is at its start, else not cut (None).
+    """
+
+    macro_step: float
+    free_step: float
+    probe_time: float = PROBE_TIME
+    time_scale_fraction: float = TIME_SCALE_FRACTION
+    change_fraction: float = CHANGE_FRACTION
+    current_floor: float = CURRENT_FLOOR
+
+    def __post_init__(self):
+        for name in ("macro_step", "free_step", "probe_time", "time_scale_fraction", "current_floor"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ValueError(f"StepPolicy.{name} = {value!r}: must be a finite number > 0")
+        if self.free_step < self.macro_step:
+            raise ValueError(f"StepPolicy.free_step = {self.free_step!r}: must be >= macro_step = {self.macro_step!r}")
+        if not (math.isfinite(self.change_fraction) and self.change_fraction >= 0):
+            raise ValueError(f"StepPolicy.change_fraction = {self.change_fraction!r}: must be a finite number >= 0")
+
+    @classmethod
+    def from_options(cls, options) -> "StepPolicy":
+        """From a scene's CouplingOptions (macro_step, free_step)."""
+        return cls(macro_step=float(options.macro_step), free_step=float(options.free_step))
+
+    @property
+    def probe(self) -> float:
+        """s: the short step that fetches the current right after a make/break (H^2 / probe_time)."""
+        return self.macro_step ** 2 / self.probe_time
+
+    def base_end(self, t: float, t_end: float, touching: bool) -> float:
+        """s: the end of the next step before the current is looked at."""
+        t_next = min(t + (self.macro_step if touching else self.free_step), t_end)
+        if t_end - t_next < 1e-3 * self.macro_step:
+            t_next = t_end  # no sliver step at the end
+        return t_next
+
+    def plan(self, t: float, t_next: float, t_end: float, *, touching: bool, jumped: bool, current: float,
+             rate: float, scale: float) -> tuple[float, float]:
+        """(end of the step in s, slope in A/s to extrapolate the current with) for a step from t
+        proposed to end at t_next, given the current (A), its rate dI/dt (A/s) and time scale (s)."""
+        if jumped:
+            return min(t + self.probe, t_end), 0.0
+        if touching and abs(rate) * (t_next - t) > self.change_fraction * (abs(current) + self.current_floor):
+            t_next = min(t_next, t + max(self.probe, self.time_scale_fraction * scale))
+        return t_next, rate
+
+    @staticmethod
+    def extrapolate(current: float, slope: float, elapsed: float, horizon: float = math.inf) -> float:
+        """A: the current ``elapsed`` s after a point where it is ``current`` with ``slope``."""
+        return current + slope * min(elapsed, horizon)
+
+    def aligned_end(self, t: float, t_next: float, event: float) -> float | None:
+        """s: where to end a step [t, t_next] in which the first make/break is at ``event``; None: keep it."""
+        guard = 1e-9 * self.macro_step
+        if t + guard < event < t_next - guard:
+            return event
+        if event <= t + guard and t_next - t > self.probe * (1.0 + 1e-9):
+            return t + self.probe  # it happened at the step start: only a short step past it
+        return None
 
 
-def _end_rate(t: np.ndarray, i: np.ndarray, span: float) -> tuple[float, float]:
+def end_rate(t: np.ndarray, i: np.ndarray, span: float) -> tuple[float, float]:
     """(dI/dt in A/s, its time scale |dI/dt| / |d2I/dt2| in s) of the loop current at the last
     of the circuit points (t, i) (several steps' worth: a short step may hold only one or
     two), with differences over at least 1e-3 of ``span`` (s) so a sliver landing step does

@@ -12,8 +12,6 @@ from functools import lru_cache
 
 import numpy as np
 from numba import njit
-from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
 from scipy.special import beta as _beta_fn
 
 # t_c = 2.943275 delta_max / v0 for an undamped Hertz impact: 2 int_0^1 (1 - x^2.5)^-1/2 dx
@@ -103,6 +101,8 @@ def _scaled_restitution(c_hat: float, beta: float) -> float:
 
     left.terminal = True
     left.direction = -1
+    from scipy.integrate import solve_ivp  # lazily: only a restitution calibration needs it
+
     sol = solve_ivp(rhs, (0.0, 50.0), [0.0, 1.0], method="DOP853", rtol=1e-11, atol=1e-13,
                     events=[force_gone, left], first_step=1e-4)
     return float(-sol.y[1, -1])
@@ -111,6 +111,8 @@ def _scaled_restitution(c_hat: float, beta: float) -> float:
 @lru_cache(maxsize=256)
 def _scaled_damping(restitution: float, beta: float) -> float:
     """c_hat giving ``restitution`` in the dimensionless single impact (root-find, cached)."""
+    from scipy.optimize import brentq
+
     if restitution >= 1.0:
         return 0.0
     f = lambda log_c: _scaled_restitution(math.exp(log_c), beta) - restitution

@@ -11,7 +11,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 # Free-free Euler-Bernoulli: cos(b) cosh(b) = 1. Written as cos(b) - 1/cosh(b) = 0, which
 # stays well scaled for large b; the n-th root lies within 0.02 of (n + 1/2) pi.
@@ -19,6 +18,8 @@ from scipy.optimize import brentq
 
 def free_free_roots(count: int) -> np.ndarray:
     """beta_n L of the first ``count`` elastic free-free bending modes (4.730041, 7.853205, ...)."""
+    from scipy.optimize import brentq
+
     roots = []
     for n in range(1, count + 1):
         guess = (n + 0.5) * math.pi

@@ -8,7 +8,6 @@ an independent integration route in the tests (DOP853, Radau).
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from .integrator import DONE, EVENT, NOT_FINITE, events_from_aux
 from .kernel import (
@@ -25,6 +24,8 @@ def scipy_segment(solver, t_target: float, method: str):
     Returns (status, t_new, h_next, n_records, event_index) like the compiled loop and
     writes the accepted steps into the solver's record buffers.
     """
+    from scipy.integrate import solve_ivp  # lazily: only the scipy backends import it
+
     if method not in METHODS:
         raise ValueError(f"backend method = {method!r}: allowed values are {', '.join(METHODS)}")
     m = solver.model

@@ -7,7 +7,10 @@ parameters, and `TribometerFit.from_json` for a saved fit. See docs/tribology.md
 
 from __future__ import annotations
 
+import hashlib
+import json
 from functools import cache
+from pathlib import Path
 
 from coupling.tribology.data import read_tribometer_csv, validate_tribometer_frame
 from coupling.tribology.fits import TribometerFit, fit_tribometer
@@ -26,7 +29,38 @@ def illustrative_data_path():
     return ILLUSTRATIVE_CSV
 
 
+# The default scene's fit, stored: fitting it (and importing scipy.optimize and
+# scipy.stats for it) was a large part of the start of every default run. It is used only
+# while its key, a hash of the dataset and of the fitting code, matches; otherwise the
+# dataset is fitted as before (tests/coupling/test_tribology_data.py checks it is current).
+DEFAULT_FIT_CACHE = Path(__file__).resolve().parent.parent / "data" / "tribometer_illustrative_fit.json"
+_FIT_SOURCES = ("data.py", "fits.py", "laws.py", "models.py")
+
+
+def default_fit_key() -> str:
+    """sha256 of the illustrative CSV and of the modules that read and fit it."""
+    digest = hashlib.sha256(Path(illustrative_data_path()).read_bytes())
+    for name in _FIT_SOURCES:
+        digest.update((Path(__file__).resolve().parent / name).read_bytes())
+    return digest.hexdigest()
+
+
 @cache
 def default_fit() -> TribometerFit:
-    """The fit of the shipped illustrative dataset, computed once per process."""
+    """The fit of the shipped illustrative dataset, once per process: from the stored fit
+    when it is current, else fitted."""
+    try:
+        doc = json.loads(DEFAULT_FIT_CACHE.read_text())
+        if doc.get("key") == default_fit_key():
+            return TribometerFit.from_dict(doc["fit"])
+    except (OSError, ValueError, KeyError):
+        pass
     return fit_tribometer(read_tribometer_csv(illustrative_data_path()))
+
+
+def write_default_fit_cache() -> Path:
+    """Fit the illustrative dataset and store the fit for default_fit (after changing the
+    dataset or the fitting code)."""
+    fit = fit_tribometer(read_tribometer_csv(illustrative_data_path()))
+    DEFAULT_FIT_CACHE.write_text(json.dumps({"key": default_fit_key(), "fit": fit.to_dict()}, indent=1) + "\n")
+    return DEFAULT_FIT_CACHE

@@ -31,7 +31,6 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 import pandas as pd
-from scipy import optimize, stats
 
 from coupling.tribology.data import validate_tribometer_frame
 from coupling.tribology.laws import ContactLaws, MuLaw, ResistanceLaw
@@ -530,6 +529,7 @@ def _jacobian(residual: Callable[[np.ndarray], np.ndarray], x: np.ndarray) -> np
 
 
 def _lack_of_fit_p(rss: float, resp: _Response, n_cells: int, n_params: int) -> float | None:
+    from scipy import stats  # lazily: a scene with a fitted law loads it without scipy.stats
     n = resp.n
     df_pe = n - n_cells
     df_lof = n - n_params - df_pe
@@ -546,6 +546,7 @@ def _model_fit(
     active: np.ndarray | None = None,
 ) -> ModelFit:
     """Statistics of a fit whose ``residual`` is the weighted cell residual sqrt(n_c) (mean - f)."""
+    from scipy import stats  # lazily: a scene with a fitted law loads it without scipy.stats
     r = residual(x)
     n, p = resp.n, len(x)
     rss = float(r @ r) + resp.ss_within
@@ -584,6 +585,8 @@ def _model_fit(
 
 
 def _solve(residual, starts, lower, upper):
+    from scipy import optimize  # lazily: a scene with a fitted law loads it without scipy.optimize
+
     best = None
     for x0 in starts:
         x0 = np.clip(np.asarray(x0, float), lower, upper)
@@ -647,6 +650,7 @@ def fit_friction(df: pd.DataFrame, mu_models: list[str] | None = None) -> Fricti
 
 def _fit_friction(P: _Problem, y: np.ndarray, mu_models: list[str] | None) -> tuple[FrictionFit, np.ndarray, int]:
     """The friction fit on cells; also the chosen model's ln prediction per cell and its parameter count."""
+    from scipy import stats  # lazily: a scene with a fitted law loads it without scipy.stats
     if mu_models is None:
         mu_models = list(MU_FAMILIES)
     unknown = [m for m in mu_models if m not in MU_FAMILIES]
@@ -875,6 +879,7 @@ def t_crit(n: int, p: int) -> float:
     """Limit of the externally studentized ln residual for n rows and p parameters: the
     two-sided Student-t quantile (n - p - 1 degrees of freedom) for a FALSE_ALARM chance
     over all n rows (Bonferroni outlier test)."""
+    from scipy import stats  # lazily: a scene with a fitted law loads it without scipy.stats
     return float(stats.t.isf(FALSE_ALARM / (2.0 * max(n, 1)), max(n - p - 1, 1)))
 
 
@@ -1008,6 +1013,8 @@ def _outliers(flagged: dict[int, tuple[str, str]], clean: pd.DataFrame, df: pd.D
 
 def _log_band(model: ModelFit, predict_log: Callable[[np.ndarray], np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Curve and pointwise 95 % confidence band (delta method on the ln prediction)."""
+    from scipy import stats  # lazily: a scene with a fitted law loads it without scipy.stats
+
     x = np.array([p.value for p in model.parameters])
     center = predict_log(x)
     if model.covariance is None:

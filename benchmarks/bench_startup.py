@@ -1,0 +1,197 @@
+"""Benchmark: whole-process `switchsim run`, against the interpreter's own start in the same run.
+
+Targets (issue 12), whole process (start to exit, as /usr/bin/time -v counts it):
+- a mechanics-only scene (6 mm bar, 20 modes per family, 0.9 ms): <= 0.6 s;
+- the default coupled scene with its default outputs (summary, CSVs, Parquet, 5 PNGs): <= 1.0 s.
+Baselines measured in the same run: `python -c pass` and `python -c "import numpy"`;
+on a loaded machine everything scales, so the ratios to them are printed too.
+
+Then where the time goes: a fresh interpreter timing its own phases (imports, scene,
+run, each output). Not a test: run by hand,
+
+    .venv/bin/python benchmarks/bench_startup.py [--repeat 5] [--no-write]
+
+It rewrites the block between the bench_startup markers in docs/benchmarks.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import textwrap
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+DOC = ROOT / "docs" / "benchmarks.md"
+BEGIN, END = "<!-- bench_startup:begin -->", "<!-- bench_startup:end -->"
+
+MECH_SCENE = """\
+# mechanics only: a 6 mm steel bar, 20 modes per family, 0.9 ms (SI units)
+[bar]
+length = 0.3
+diameter = 0.006
+tip_radius = 0.003
+modes = 20
+[initial]
+height = 0.0005
+angle_deg = 30.0
+velocity = [0.0, 0.0, -1.0]
+[solver]
+t_end = 0.0009
+"""
+
+NO_OUTPUT = "\n[output]\ncsv = false\nparquet = false\nplots = false\nhistory = false\n"
+
+
+def _env() -> dict:
+    return dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""),
+                MPLBACKEND="Agg")
+
+
+def whole_process(cmd: list[str], repeat: int) -> tuple[float, float, float]:
+    """(median wall s, min wall s, max peak RSS MiB) of a command started `repeat` times."""
+    walls, rss = [], []
+    for _ in range(repeat):
+        tick = time.perf_counter()
+        proc = subprocess.Popen(cmd, env=_env(), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        _, status, usage = os.wait4(proc.pid, 0)
+        walls.append(time.perf_counter() - tick)
+        if os.waitstatus_to_exitcode(status) != 0:
+            raise RuntimeError(f"{' '.join(cmd)} failed: {proc.stderr.read().decode()[-2000:]}")
+        proc.stderr.close()
+        rss.append(usage.ru_maxrss / 1024.0)
+    return statistics.median(walls), min(walls), max(rss)
+
+
+PHASES = textwrap.dedent("""
+    import json, sys, time
+    marks = [("start", time.perf_counter())]
+    def mark(name): marks.append((name, time.perf_counter()))
+    import coupling.master, coupling.scene
+    mark("import coupling (numpy, pandas, numba, scipy.special, mech)")
+    from coupling.scene import default_scene, load_scene
+    scene = default_scene() if sys.argv[1] == "default" else load_scene(sys.argv[1])
+    mark("scene (validation; circuit: PySpice, tribology)")
+    result = coupling.master.run(scene)
+    solver = result.stats.get("wall_time", 0.0)
+    mark("run (numba cache load, ngspice start, solve)")
+    out = sys.argv[2]
+    import pathlib; o = pathlib.Path(out); o.mkdir(exist_ok=True)
+    (o / "summary.json").write_text(json.dumps(result.summary, indent=2))
+    mark("summary.json")
+    if result.waveforms is not None:
+        result.waveforms.to_csv(o / "waveforms.csv", index=False)
+        mark("waveforms.csv")
+        result.waveforms.to_parquet(o / "waveforms.parquet", index=False)
+        mark("waveforms.parquet (pyarrow)")
+    m = result.mechanics
+    m.history.to_csv(o / "history.csv", index=False)
+    m.contacts.to_csv(o / "contacts.csv", index=False); m.phases.to_csv(o / "phases.csv", index=False)
+    m.event_table.to_csv(o / "events.csv", index=False)
+    mark("mechanics CSVs")
+    import matplotlib; matplotlib.use("Agg"); import matplotlib.pyplot
+    mark("import matplotlib.pyplot")
+    from coupling.plots import save_plots
+    save_plots(result, o)
+    mark("PNG plots")
+    phases = [(b[0], b[1] - a[1]) for a, b in zip(marks, marks[1:])]
+    print(json.dumps(dict(phases=phases, solve=solver, total=marks[-1][1] - marks[0][1])))
+""")
+
+
+def phases(scene: str, out: str) -> dict:
+    done = subprocess.run([sys.executable, "-c", PHASES, scene, out], env=_env(), capture_output=True, text=True,
+                          check=True)
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--no-write", action="store_true", help="print only; leave docs/benchmarks.md alone")
+    args = parser.parse_args()
+    py = sys.executable
+    tmp = Path(tempfile.mkdtemp(prefix="bench_startup_"))
+    mech = tmp / "mech.toml"
+    mech.write_text(MECH_SCENE)
+    mech_quiet = tmp / "mech_no_output.toml"
+    mech_quiet.write_text(MECH_SCENE + NO_OUTPUT)
+    # the default scene's text read as a file: this process imports nothing heavy, so a
+    # child's peak RSS (counted from the fork) is its own
+    default_text = (ROOT / "coupling" / "scenes" / "default.toml").read_text()
+    coupled_quiet = tmp / "default_no_output.toml"
+    coupled_quiet.write_text(default_text.split("[output]")[0] + NO_OUTPUT)
+    run = [py, "-m", "coupling.cli", "run"]
+    # warm-up: the numba cache of this tree, ngspice, the OS file cache
+    for scene in (str(mech), None):
+        whole_process(run + ([scene] if scene else []) + ["--out", str(tmp / "warm"), "--quiet"], 1)
+
+    rows = []
+    for label, cmd in [
+        ("`python -c pass`", [py, "-c", "pass"]),
+        ("`python -c \"import numpy\"`", [py, "-c", "import numpy"]),
+        ("`import coupling.master, coupling.scene`", [py, "-c", "import coupling.master, coupling.scene"]),
+        ("mechanics-only scene, default outputs", run + [str(mech), "--out", str(tmp / "m1"), "--quiet"]),
+        ("mechanics-only scene, outputs off", run + [str(mech_quiet), "--out", str(tmp / "m2"), "--quiet"]),
+        ("default coupled scene, default outputs", run + ["--out", str(tmp / "c1"), "--quiet"]),
+        ("default coupled scene, outputs off", run + [str(coupled_quiet), "--out", str(tmp / "c2"), "--quiet"]),
+    ]:
+        med, best, rss = whole_process(cmd, args.repeat)
+        rows.append((label, med, best, rss))
+        print(f"{label:45s} {med:6.3f} s (best {best:.3f}), peak RSS {rss:.0f} MiB", flush=True)
+    base = rows[1][1]
+    mech_phases = phases(str(mech), str(tmp / "pm"))
+    coupled_phases = phases("default", str(tmp / "pc"))
+    try:
+        load = os.getloadavg()[0]
+    except OSError:
+        load = float("nan")
+
+    lines = [f"`.venv/bin/python benchmarks/bench_startup.py --repeat {args.repeat}` "
+             f"(load average {load:.1f} at the end; median of {args.repeat}, whole process, "
+             f"peak RSS from wait4)", "",
+             "| command | wall | best | / `import numpy` | peak RSS |", "|---|---|---|---|---|"]
+    for label, med, best, rss in rows:
+        lines.append(f"| {label} | {med:.3f} s | {best:.3f} s | {med / base:.1f}x | {rss:.0f} MiB |")
+    mech_run = rows[3][1]
+    coupled_run = rows[5][1]
+    lines += ["",
+              f"- Mechanics-only scene: **{mech_run:.2f} s** whole process (target <= 0.6 s: "
+              f"{'met' if mech_run <= 0.6 else 'not met'}); {rows[4][1]:.2f} s with every output off.",
+              f"- Default coupled scene with its default outputs: **{coupled_run:.2f} s** (target <= 1.0 s: "
+              f"{'met' if coupled_run <= 1.0 else 'not met'}); {rows[6][1]:.2f} s with every output off.",
+              f"- Scaled to this run's `import numpy` ({base:.3f} s): mechanics-only {mech_run / base:.1f}x, "
+              f"coupled {coupled_run / base:.1f}x.",
+              "", "Where the time goes (one fresh interpreter timing its own phases):", "",
+              "| phase | mechanics-only | default coupled |", "|---|---|---|"]
+    names = [n for n, _ in coupled_phases["phases"]]
+    mp = dict(mech_phases["phases"])
+    cp = dict(coupled_phases["phases"])
+    for name in names:
+        m = f"{mp[name]:.3f} s" if name in mp else "-"
+        lines.append(f"| {name} | {m} | {cp[name]:.3f} s |")
+    lines.append(f"| (of the run: its own wall_time, model build and cache load included) | {mech_phases['solve']:.3f} s | "
+                 f"{coupled_phases['solve']:.3f} s |")
+    lines.append(f"| total inside the interpreter | {mech_phases['total']:.3f} s | {coupled_phases['total']:.3f} s |")
+    block = "\n".join(lines)
+    print("\n" + block)
+    if not args.no_write:
+        text = DOC.read_text()
+        if BEGIN in text and END in text:
+            head, rest = text.split(BEGIN, 1)
+            text = head + BEGIN + "\n" + block + "\n" + END + rest.split(END, 1)[1]
+        else:
+            text = text.rstrip() + ("\n\n## Start-up: whole-process `switchsim run` (issue 12)\n"
+                                    "Written by benchmarks/bench_startup.py.\n\n" + BEGIN + "\n" + block + "\n" + END + "\n")
+        DOC.write_text(text)
+        print(f"\nwrote {DOC}")
+
+
+if __name__ == "__main__":
+    main()

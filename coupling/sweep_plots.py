@@ -1,0 +1,127 @@
+"""Plots of a sweep (matplotlib, Agg, no pyplot): a metric against one or two parameters,
+a metric as a map over two parameters, and overlays of the waveforms of selected runs.
+
+    from coupling.sweep import read_results
+    from coupling.sweep_plots import plot_metric, plot_map, plot_overlay
+    df = read_results("out/")
+    plot_metric(df, "bounce.peak_contact_voltage", "circuit.snubber.capacitance",
+                by="circuit.snubber.resistance").savefig("peak.png")
+    plot_overlay("out/", df.run_id[:4], "contact_voltage", label=["circuit.snubber.capacitance"])
+
+Every function returns a matplotlib Figure; only runs with status "ok" are drawn.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+
+def _figure(size=(7.5, 4.8)):
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=size, layout="constrained")
+
+
+def _ok(df, *columns):
+    missing = [c for c in columns if c not in df.columns]
+    if missing:
+        raise ValueError(f"no column {missing[0]!r} in the sweep results; columns: {', '.join(df.columns)}")
+    return df[df.status == "ok"] if "status" in df.columns else df
+
+
+def _log_axis(values) -> bool:
+    v = np.asarray(values, float)
+    v = v[np.isfinite(v)]
+    return len(v) > 1 and np.all(v > 0) and v.max() / v.min() >= 20.0
+
+
+def plot_metric(df, metric: str, x: str, *, by: str | None = None, limit: float | None = None):
+    """``metric`` against parameter ``x``; with ``by``, one line per value of that second
+    parameter. ``limit``: a horizontal line (a design limit). Log axes where values span
+    more than a factor 20."""
+    ok = _ok(df, metric, x, *([by] if by else []))
+    fig = _figure()
+    ax = fig.add_subplot()
+    groups = [(None, ok)] if by is None else list(ok.groupby(by, sort=True))
+    for value, part in groups:
+        part = part.sort_values(x)
+        ax.plot(part[x], part[metric], "o-", ms=4, lw=1.2, label=None if by is None else f"{by} = {value:g}"
+                if isinstance(value, (int, float)) else f"{by} = {value}")
+    if limit is not None:
+        ax.axhline(limit, color="k", ls="--", lw=0.9, label=f"limit {limit:g}")
+    if _log_axis(ok[x]):
+        ax.set_xscale("log")
+    if _log_axis(ok[metric]):
+        ax.set_yscale("log")
+    ax.set_xlabel(x)
+    ax.set_ylabel(metric)
+    ax.grid(alpha=0.3, which="both")
+    if by is not None or limit is not None:
+        ax.legend(fontsize=8)
+    return fig
+
+
+def plot_map(df, metric: str, x: str, y: str, *, cmap: str = "viridis"):
+    """``metric`` coloured over the (x, y) plane: cells for a grid design, points for a
+    sampled one."""
+    ok = _ok(df, metric, x, y)
+    fig = _figure()
+    ax = fig.add_subplot()
+    xs, ys = np.unique(ok[x].to_numpy(float)), np.unique(ok[y].to_numpy(float))
+    table = ok.pivot_table(index=y, columns=x, values=metric, aggfunc="mean")
+    if len(xs) * len(ys) == len(ok) and table.notna().all().all() and len(xs) > 1 and len(ys) > 1:
+        mesh = ax.pcolormesh(_edges(xs), _edges(ys), table.to_numpy(float), cmap=cmap, shading="flat")
+        for (i, yv) in enumerate(ys):
+            for (j, xv) in enumerate(xs):
+                ax.text(xv, yv, f"{table.iloc[i, j]:.3g}", ha="center", va="center", fontsize=7, color="w")
+    else:
+        mesh = ax.scatter(ok[x], ok[y], c=ok[metric], cmap=cmap, s=40)
+    fig.colorbar(mesh, ax=ax, label=metric)
+    ax.set_xlabel(x)
+    ax.set_ylabel(y)
+    return fig
+
+
+def _edges(values: np.ndarray) -> np.ndarray:
+    mid = 0.5 * (values[1:] + values[:-1])
+    return np.concatenate([[values[0] - (mid[0] - values[0])], mid, [values[-1] + (values[-1] - mid[-1])]])
+
+
+def plot_overlay(out_dir, run_ids, column: str = "contact_voltage", *, label: list[str] | None = None,
+                 window: tuple[float, float] | None = None, results=None):
+    """The ``column`` waveform of each run in ``run_ids`` over time (ms), one line each, from
+    the waveforms the sweep kept (sweep waveforms = true). label: parameters to name the
+    lines by; window: (t0, t1) in s."""
+    from .sweep import read_results, read_waveforms
+
+    rows = None
+    if label:
+        df = results if results is not None else read_results(out_dir)
+        rows = df.set_index("run_id")
+    fig = _figure()
+    ax = fig.add_subplot()
+    for run_id in run_ids:
+        w = read_waveforms(out_dir, run_id)
+        if column not in w.columns:
+            raise ValueError(f"run {run_id}: no column {column!r} in its waveforms; kept: {', '.join(w.columns)}")
+        if window is not None:
+            w = w[(w.time >= window[0]) & (w.time <= window[1])]
+        text = run_id
+        if rows is not None and run_id in rows.index:
+            text = ", ".join(f"{p.split('.')[-1]} = {rows.loc[run_id, p]:.3g}" for p in label)
+        ax.plot(w.time * 1e3, w[column], lw=0.9, label=text)
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel(column)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    return fig
+
+
+def save(fig, path) -> Path:
+    """Write a figure as PNG (dpi 120) and free it."""
+    path = Path(path)
+    fig.savefig(path, dpi=120)
+    fig.clear()
+    return path

@@ -1,0 +1,96 @@
+"""The import contract of `switchsim run`: a scene imports only what it uses.
+
+Each check runs the command in a fresh interpreter and lists the heavy packages it
+loaded: scipy.integrate only for the scipy backends (and, today, for a contact
+restitution calibration, which integrates one impact with solve_ivp: these scenes give
+contact.damping), matplotlib only when plotting, PySpice only with a circuit, Dask never.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+HEAVY = ("scipy.integrate", "scipy.stats", "matplotlib", "PySpice", "dask", "distributed")
+
+MECH = """
+[bar]
+length = 0.1
+diameter = 0.006
+tip_radius = 0.003
+modes = 2
+[initial]
+height = 0.0001
+angle_deg = 30.0
+velocity = [0.0, 0.0, -1.0]
+[contact]
+damping = 2e5
+[solver]
+t_end = 0.0003
+[output]
+plots = {plots}
+"""
+
+CIRCUIT = """
+[tribology]
+source = "illustrative"
+[circuit]
+template = "resistive"
+voltage = 24.0
+load_resistance = 12.0
+"""
+
+
+def _loaded(tmp_path: Path, scene_text: str, *args: str) -> set[str]:
+    scene = tmp_path / "scene.toml"
+    scene.write_text(scene_text)
+    code = textwrap.dedent(f"""
+        import json, sys
+        from coupling.cli import main
+        rc = main(["run", {str(scene)!r}, "--out", {str(tmp_path / 'out')!r}, "--quiet", *{list(args)!r}])
+        print(json.dumps([rc, sorted(sys.modules)]))
+    """)
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr[-2000:]
+    rc, modules = json.loads(done.stdout.strip().splitlines()[-1])
+    assert rc == 0
+    return {name for name in HEAVY if name in modules}
+
+
+def test_mechanics_only_scene_imports_no_integrate_matplotlib_pyspice_or_dask(tmp_path):
+    assert _loaded(tmp_path, MECH.format(plots="false")) == set()
+    assert (tmp_path / "out" / "summary.json").is_file()
+
+
+def test_plots_bring_matplotlib_and_nothing_else(tmp_path):
+    assert _loaded(tmp_path, MECH.format(plots="true")) == {"matplotlib"}
+    assert (tmp_path / "out" / "normal_force.png").stat().st_size > 0
+
+
+def test_coupled_scene_imports_pyspice_but_no_integrate_stats_or_matplotlib(tmp_path):
+    """The illustrative laws come from their stored fit: no scipy.stats, no fitting."""
+    assert _loaded(tmp_path, MECH.format(plots="false") + CIRCUIT) == {"PySpice"}
+
+
+def test_the_stored_default_fit_is_current_and_equals_a_fresh_fit():
+    """default_fit reads the stored fit only while its key matches; the stored fit must be
+    what fitting the shipped CSV gives now (else: coupling.tribology.write_default_fit_cache())."""
+    from coupling.tribology import DEFAULT_FIT_CACHE, default_fit_key, fit_tribometer, illustrative_data_path, \
+        read_tribometer_csv
+    from coupling.tribology.fits import TribometerFit
+
+    doc = json.loads(DEFAULT_FIT_CACHE.read_text())
+    assert doc["key"] == default_fit_key(), "stored fit is stale: run coupling.tribology.write_default_fit_cache()"
+    stored = TribometerFit.from_dict(doc["fit"])
+    fresh = fit_tribometer(read_tribometer_csv(illustrative_data_path()))
+    a, b = stored.laws.to_dict(), fresh.laws.to_dict()
+    assert json.dumps(a, sort_keys=True) == json.dumps(b, sort_keys=True)
+    assert stored.gamma == pytest.approx(fresh.gamma, rel=1e-12)

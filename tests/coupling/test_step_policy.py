@@ -1,0 +1,183 @@
+"""The co-simulation's step policy (a pure object) and re-running one CoSimulation.
+
+Policy checks use closed forms of the currents the policy is built for: an exponential
+approach I(t) = I_inf (1 - exp(-t / tau)) (an L/R rise after a make) and a ramp.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from coupling.master import StepPolicy, end_rate
+
+H = 5e-6  # s
+
+
+def policy(**kw) -> StepPolicy:
+    return StepPolicy(macro_step=kw.pop("macro_step", H), free_step=kw.pop("free_step", 1e-3), **kw)
+
+
+def exponential(t, i_inf=2.0, tau=1e-4):
+    return i_inf * (1.0 - np.exp(-t / tau))
+
+
+def test_saturating_extrapolation_lands_on_the_asymptote_of_an_exponential():
+    """I + I' tau = I_inf exactly for an exponential approach: with the horizon at its time
+    constant the extrapolation never overshoots, however long the step."""
+    tau, i_inf = 1e-4, 2.0
+    t0 = 0.3 * tau
+    i0 = float(exponential(t0, i_inf, tau))
+    slope = i_inf / tau * math.exp(-t0 / tau)
+    for elapsed in (tau, 3 * tau, 100 * tau):
+        assert StepPolicy.extrapolate(i0, slope, elapsed, horizon=tau) == pytest.approx(i_inf, rel=1e-12)
+    # without the horizon the linear extrapolation overshoots the asymptote
+    assert StepPolicy.extrapolate(i0, slope, 3 * tau) > 1.5 * i_inf
+
+
+def test_end_rate_gives_the_derivative_and_the_time_constant_of_an_exponential():
+    tau = 1e-4
+    t = np.linspace(0.0, 0.5 * tau, 8)
+    i = exponential(t, tau=tau)
+    rate, scale = end_rate(t, i, span=H)
+    exact = 2.0 / tau * math.exp(-t[-1] / tau)
+    assert rate == pytest.approx(exact, rel=0.05)  # a one-sided difference: O(dt) error
+    assert scale == pytest.approx(tau, rel=0.1)     # |I'/I''| = tau for an exponential
+
+
+def test_end_rate_of_a_ramp_has_no_finite_time_scale_and_too_few_points_give_none():
+    t = np.linspace(0.0, 1e-5, 6)
+    rate, scale = end_rate(t, 3.0 + 1e4 * t, span=H)
+    assert rate == pytest.approx(1e4, rel=1e-9)
+    assert scale > 1e3 * H  # curvature ~ round-off: nothing limits the step
+    assert end_rate(t[:1], t[:1], span=H) == (0.0, math.inf)
+
+
+def test_slope_extrapolation_is_second_order_in_the_step():
+    """Extrapolating with end_rate's slope: the error falls ~4x per halving of the step."""
+    tau = 1e-4
+    errors = []
+    for dt in (8e-6, 4e-6, 2e-6):
+        t = np.linspace(0.0, 4 * dt, 5) + 0.2 * tau  # the circuit's points of the last steps
+        i = exponential(t, tau=tau)
+        rate, scale = end_rate(t, i, span=dt)
+        guess = StepPolicy.extrapolate(float(i[-1]), rate, dt, scale)
+        errors.append(abs(guess - float(exponential(t[-1] + dt, tau=tau))))
+    assert errors[0] / errors[1] == pytest.approx(4.0, rel=0.3)
+    assert errors[1] / errors[2] == pytest.approx(4.0, rel=0.3)
+
+
+def test_after_a_jump_the_step_is_a_short_probe_with_the_current_held():
+    p = policy()
+    t_next, slope = p.plan(1e-3, 1e-3 + H, 1.0, touching=True, jumped=True, current=2.0, rate=5e4, scale=1e-7)
+    assert slope == 0.0
+    assert t_next - 1e-3 == pytest.approx(H * H / p.probe_time)
+    assert p.probe < H  # shorter than a macro step: the held current's error is O(H^2)
+
+
+def test_a_fast_current_shrinks_the_step_to_half_its_time_scale_but_not_below_the_probe():
+    p = policy()
+    t = 2e-3
+    # L/R = 1 us rise: the step shrinks to half the time scale
+    t_next, slope = p.plan(t, t + H, 1.0, touching=True, jumped=False, current=1.0, rate=1e6, scale=1e-6)
+    assert slope == 1e6 and t_next - t == pytest.approx(0.5e-6)
+    # a 1 ns time scale: the probe step is the floor
+    t_next, _ = p.plan(t, t + H, 1.0, touching=True, jumped=False, current=1.0, rate=1e9, scale=1e-9)
+    assert t_next - t == pytest.approx(p.probe)
+    # a current that would change by less than change_fraction over the step: full step
+    t_next, _ = p.plan(t, t + H, 1.0, touching=True, jumped=False, current=1.0, rate=1.0, scale=1e-6)
+    assert t_next == t + H
+    # both tips free: the current is not exchanged, no limit
+    t_next, _ = p.plan(t, t + 1e-3, 1.0, touching=False, jumped=False, current=1.0, rate=1e6, scale=1e-6)
+    assert t_next == t + 1e-3
+
+
+def test_base_step_lengths_and_no_sliver_at_the_end():
+    p = policy()
+    assert p.base_end(0.0, 1.0, touching=True) == H
+    assert p.base_end(0.0, 1.0, touching=False) == 1e-3
+    t_end = 10 * H + 1e-4 * H  # a step would leave 1e-4 H: the step takes it
+    assert p.base_end(9 * H, t_end, touching=True) == t_end
+    assert p.base_end(9.5 * H, t_end, touching=True) == t_end
+
+
+def test_a_step_is_cut_at_a_make_inside_it_and_after_a_probe_at_its_start():
+    p = policy()
+    t, t_next = 1e-3, 1e-3 + H
+    assert p.aligned_end(t, t_next, t + 0.3 * H) == t + 0.3 * H
+    assert p.aligned_end(t, t_next, t) == pytest.approx(t + p.probe)
+    assert p.aligned_end(t, t_next, t_next) is None  # at its end: the step already ends there
+    assert p.aligned_end(t, t + p.probe, t) is None  # already a probe step
+
+
+@pytest.mark.parametrize("field, value", [("macro_step", 0.0), ("free_step", 1e-9), ("probe_time", math.nan),
+                                          ("change_fraction", -1.0)])
+def test_bad_policy_values_are_named(field, value):
+    with pytest.raises(ValueError, match=field):
+        policy(**{field: value})
+
+
+def test_policy_follows_the_scene_coupling_options():
+    from coupling.scene import CouplingOptions
+
+    p = StepPolicy.from_options(CouplingOptions(macro_step=4e-6, max_macro_step=2e-4))
+    assert (p.macro_step, p.free_step) == (4e-6, 2e-4)
+    p = StepPolicy.from_options(CouplingOptions(scheme="jacobi", macro_step=4e-6, max_macro_step=2e-4))
+    assert p.free_step == 4e-6  # jacobi exchanges every macro step
+
+
+SHORT_COUPLED = """
+[bar]
+length = 0.3
+diameter = 0.01
+tip_radius = 0.005
+modes = 0
+[initial]
+height = 0.0002
+angle_deg = 60.0
+velocity = [0.2, 0.0, -0.5]
+[solver]
+t_end = 0.0012
+[tribology]
+source = "illustrative"
+[circuit]
+template = "inductive"
+voltage = 24.0
+load_resistance = 10.0
+load_inductance = 1e-3
+snubber = { resistance = 47.0, capacitance = 47e-9 }
+[coupling]
+macro_step = 1e-5
+[output]
+plots = false
+"""
+
+
+def test_one_cosimulation_runs_again_with_the_same_result_and_leaves_ngspice_free():
+    """A sweep worker runs many scenes in one process: a second run of the same CoSimulation
+    (and a run after a failed one) gives the same waveforms, mu log and statistics."""
+    import tomllib
+
+    from circuit import get_session
+    from coupling import CoSimulation, CoupledRunError
+    from coupling.scene import scene_from_dict
+
+    scene = scene_from_dict(tomllib.loads(SHORT_COUPLED))
+    sim = CoSimulation(scene)
+    first = sim.run()
+    log_first = list(sim.mu_log)
+    assert get_session().owner is None  # the Stepper released ngspice
+    # a failing run in between (the mechanics runs out of steps inside a macro step)
+    failing = scene.set("solver.max_steps", 3)
+    with pytest.raises(CoupledRunError):
+        CoSimulation(failing).run()
+    assert get_session().owner is None
+    second = sim.run()
+    assert sim.mu_log == log_first
+    for key in ("macro_steps", "aligned_steps", "contact_steps"):
+        assert second.stats[key] == first.stats[key]
+    assert second.summary["bounce"] == first.summary["bounce"]
+    np.testing.assert_array_equal(second.waveforms.contact_voltage.to_numpy(),
+                                  first.waveforms.contact_voltage.to_numpy())
