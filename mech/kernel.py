@@ -28,6 +28,7 @@ from numba import njit
 
 from .contact_laws import normal_force
 from .friction import friction_limit, regularized_scale
+from .inertia import inertia_matrix, inertia_terms
 
 # fpar indices
 F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MU0, F_MU_SLOPE, F_T_MU, F_MAX_RATIO, F_RTIP, F_VREG, F_BAUM, F_VBOUND = range(14)
@@ -260,73 +261,11 @@ def dynamics(t, y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, regim
     beta = fpar[F_BETA]
     Rtip = fpar[F_RTIP]
 
-    # Modal invariants as sparse lists (modal_basis.sparse_invariants):
-    # J(q) = J0 + sum J1_j q_j + sum J2_jk q_j q_k ; B[:, j] = sum_k q_k S_kj
-    inv_m = 1.0 / m
-    for a in range(3):
-        for b in range(3):
-            Jm[a, b] = J0[a, b]
-        sv[a] = 0.0  # dJ/dt w
-    for j in range(n):
-        f_e[j] = 0.0
-        for a in range(3):
-            B[a, j] = 0.0
-    for e in range(sp_ptr[0], sp_ptr[1]):
-        j = sp_idx[e, 0]
-        a = sp_idx[e, 1]
-        b = sp_idx[e, 2]
-        v = sp_val[e]
-        Jm[a, b] += v * q[j]
-        f_e[j] += 0.5 * v * w[a] * w[b]  # centrifugal: 1/2 w' dJ/dq_j w
-        sv[a] += v * eta[j] * w[b]
-    for e in range(sp_ptr[1], sp_ptr[2]):
-        j = sp_idx[e, 0]
-        kk = sp_idx[e, 1]
-        a = sp_idx[e, 2]
-        b = sp_idx[e, 3]
-        v = sp_val[e]
-        Jm[a, b] += v * q[j] * q[kk]
-        f_e[j] += v * q[kk] * w[a] * w[b]
-        # dJ/dq_j = sum_k (J2_jk + J2_jk^T) q_k, since J2_kj = J2_jk^T across families
-        ve = v * q[kk] * eta[j]
-        sv[a] += ve * w[b]
-        sv[b] += ve * w[a]
-    for e in range(sp_ptr[2], sp_ptr[3]):
-        j = sp_idx[e, 0]
-        kk = sp_idx[e, 1]
-        a = sp_idx[e, 2]
-        v = sp_val[e]
-        B[a, kk] += v * q[j]
-        f_e[j] += 2.0 * v * w[a] * eta[kk]  # gyroscopic 2 w . S_jk eta_k
-    for e in range(sp_ptr[3], sp_ptr[4]):
-        f_e[sp_idx[e, 0]] -= sp_val[e] * q[sp_idx[e, 1]]
-    d_modal = 0.0
-    for e in range(sp_ptr[4], sp_ptr[5]):
-        ce = sp_val[e] * eta[sp_idx[e, 1]]
-        f_e[sp_idx[e, 0]] -= ce
-        d_modal += eta[sp_idx[e, 0]] * ce
-    h0 = Jm[0, 0] * w[0] + Jm[0, 1] * w[1] + Jm[0, 2] * w[2]
-    h1 = Jm[1, 0] * w[0] + Jm[1, 1] * w[1] + Jm[1, 2] * w[2]
-    h2 = Jm[2, 0] * w[0] + Jm[2, 1] * w[1] + Jm[2, 2] * w[2]
-    for j in range(n):
-        h0 += B[0, j] * eta[j]
-        h1 += B[1, j] * eta[j]
-        h2 += B[2, j] * eta[j]
-    # f_r = -w x h - dJ/dt w
-    f_r[0] = -(w[1] * h2 - w[2] * h1) - sv[0]
-    f_r[1] = -(w[2] * h0 - w[0] * h2) - sv[1]
-    f_r[2] = -(w[0] * h1 - w[1] * h0) - sv[2]
+    # Inertia, centrifugal, gyroscopic, stiffness and damping terms (mech/inertia.py)
+    d_modal = inertia_terms(n, m, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, B, f_e, sv, f_r, Amat, Ainv)
     F[0] = 0.0
     F[1] = 0.0
     F[2] = -m * fpar[F_G]
-    # Schur complement A = J - B B^T / m
-    for a in range(3):
-        for b in range(3):
-            acc = 0.0
-            for j in range(n):
-                acc += B[a, j] * B[b, j]
-            Amat[a, b] = Jm[a, b] - acc * inv_m
-    inverse3(Amat, Ainv)
 
     mu = mu_at(t, fpar) if fmodel != FRICTION_NONE else 0.0
     gam = fpar[F_GAMMA]
@@ -645,18 +584,7 @@ def energies(y, fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, xc, work, out):
     r, R, q, V, w, eta, Jm, B = work[0], work[1], work[2], work[3], work[4], work[5], work[6], work[7]
     unpack(y, n, planar, r, R, q, V, w, eta)
     m = fpar[F_MASS]
-    for a in range(3):
-        for b in range(3):
-            Jm[a, b] = J0[a, b]
-    for j in range(n):
-        for a in range(3):
-            B[a, j] = 0.0
-    for e in range(sp_ptr[0], sp_ptr[1]):
-        Jm[sp_idx[e, 1], sp_idx[e, 2]] += sp_val[e] * q[sp_idx[e, 0]]
-    for e in range(sp_ptr[1], sp_ptr[2]):
-        Jm[sp_idx[e, 2], sp_idx[e, 3]] += sp_val[e] * q[sp_idx[e, 0]] * q[sp_idx[e, 1]]
-    for e in range(sp_ptr[2], sp_ptr[3]):
-        B[sp_idx[e, 2], sp_idx[e, 1]] += sp_val[e] * q[sp_idx[e, 0]]
+    inertia_matrix(n, q, J0, sp_ptr, sp_idx, sp_val, Jm, B)
     kin = 0.5 * m * (V[0] ** 2 + V[1] ** 2 + V[2] ** 2)
     for a in range(3):
         for b in range(3):
