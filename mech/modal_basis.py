@@ -130,31 +130,38 @@ def build_modal_basis(bar: Bar, planar: bool) -> ModalBasis:
     J1 = np.zeros((n, 3, 3))
     J2 = np.zeros((n, n, 3, 3))
     S = np.zeros((n, n, 3))
+    # d/dq_j of int rho A (s.s I - s s^T) at q = 0, with s = x e1: first moments m1[j, a]
+    m1 = psi.transpose(0, 2, 1) @ (rho_a * dx * x)  # (n, 3)
     for j in range(n):
-        pj = psi[j]
-        # d/dq_j of int rho A (s.s I - s s^T) at q = 0, with s = x e1.
-        axial_part = np.sum(rho_a * dx * x * pj[:, 0])
-        outer = np.einsum("p,p,i,pj->ij", rho_a * dx, x, e1, pj)
-        J1[j] = 2.0 * axial_part * eye - (outer + outer.T)
-        for k in range(n):
-            pk = psi[k]
-            dot = np.sum(rho_a * dx * np.sum(pj * pk, axis=1))
-            J2[j, k] = dot * eye - np.einsum("p,pi,pj->ij", rho_a * dx, pj, pk)
-            S[j, k] = np.sum(rho_a * dx[:, None] * np.cross(pj, pk), axis=0)
+        outer = np.outer(e1, m1[j])
+        J1[j] = 2.0 * m1[j, 0] * eye - (outer + outer.T)
+    # all pairs at once (a Python loop over pairs took 0.23 s at 23 modes)
+    wq = rho_a * dx
+    flat = psi.transpose(0, 2, 1).reshape(3 * n, len(wq))  # (j a, p)
+    outer2 = ((flat * wq) @ flat.T).reshape(n, 3, n, 3).transpose(0, 2, 1, 3)
+    dot = np.einsum("jkaa->jk", outer2)
+    J2[:] = dot[:, :, None, None] * eye - outer2
+    S[:, :, 0] = outer2[:, :, 1, 2] - outer2[:, :, 2, 1]
+    S[:, :, 1] = outer2[:, :, 2, 0] - outer2[:, :, 0, 2]
+    S[:, :, 2] = outer2[:, :, 0, 1] - outer2[:, :, 1, 0]
 
+    # stiffness: per family, the Gram matrix of the strain shapes (one product per family)
     K = np.zeros((n, n))
-    for j, (fam_j, _) in enumerate(modes):
-        for k, (fam_k, _) in enumerate(modes):
-            if fam_j != fam_k:
-                continue
-            if fam_j == "axial":
-                K[j, k] = np.sum(bar.youngs_modulus * bar.area * d1[j] * d1[k] * dx)
-            elif bar.bending == "euler_bernoulli":
-                d2 = shape_values(bar, [modes[j], modes[k]], xi, 2)
-                second = i33 if fam_j == "bend2" else i22
-                K[j, k] = np.sum(bar.youngs_modulus * second * d2[0] * d2[1] * dx)
-            else:  # the paper's shear-type energy (G/nu) A (d delta/dx)^2
-                K[j, k] = np.sum(bar.shear_modulus / bar.poisson_ratio * bar.area * d1[j] * d1[k] * dx)
+    bend_ix = [j for j, (f, _) in enumerate(modes) if f != "axial"]
+    d2 = np.zeros_like(d1)
+    if bar.bending == "euler_bernoulli" and bend_ix:
+        d2[bend_ix] = shape_values(bar, [modes[j] for j in bend_ix], xi, 2)
+    for fam in ("axial", "bend2", "bend3"):
+        ix = [j for j, (f, _) in enumerate(modes) if f == fam]
+        if not ix:
+            continue
+        if fam == "axial":
+            strain, coef = d1[ix], bar.youngs_modulus * bar.area
+        elif bar.bending == "euler_bernoulli":
+            strain, coef = d2[ix], bar.youngs_modulus * (i33 if fam == "bend2" else i22)
+        else:  # the paper's shear-type energy (G/nu) A (d delta/dx)^2
+            strain, coef = d1[ix], bar.shear_modulus / bar.poisson_ratio * bar.area
+        K[np.ix_(ix, ix)] = coef * (strain * dx) @ strain.T
     # Exact eigenmodes give a diagonal K; quadrature leaves round-off off the diagonal.
     if bar.bending == "euler_bernoulli":
         K = np.diag(np.diag(K))
