@@ -158,6 +158,7 @@ class BarModel:
         return self.basis.n
 
     sparse: tuple = ()
+    mode_count: object = None  # ModeCount when bar.modes = "auto" chose the counts, else None
 
     @property
     def arrays(self) -> tuple:
@@ -241,6 +242,7 @@ class BarModel:
 
 def build_model(scene: MechScene) -> BarModel:
     """Assemble the compiled model of ``scene`` (planar or 3D as the scene needs)."""
+    scene, mode_count = resolve_auto_modes(scene)
     mode = scene.solver.model
     planar_ok = is_planar(scene)
     if mode == "planar" and not planar_ok:
@@ -312,4 +314,52 @@ def build_model(scene: MechScene) -> BarModel:
         max_step = min(max_step, scene.solver.max_step)
     sl_model.max_step = max_step
     sl_model.sparse = sparse_invariants(basis)
+    sl_model.mode_count = mode_count
     return sl_model
+
+
+# --- bar.modes = "auto" (issue 9): counts from the contact time -----------------------
+
+def family_frequencies(bar, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Hz: the first ``count`` axial and bending frequencies of ``bar`` (bending in the
+    more flexible plane). Euler-Bernoulli closed forms; for the paper's shear-type bending,
+    sqrt(K_jj/m) of its stiffness on the free-free shapes (its K is full within a family)."""
+    from .modal_basis import _quadrature
+    from .modes import axial_frequencies, bending_frequencies, bending_shape, free_free_roots
+
+    axial = axial_frequencies(count, bar.length, bar.youngs_modulus, bar.density)
+    if bar.bending == "euler_bernoulli":
+        bend = bending_frequencies(count, bar.length, bar.youngs_modulus, min(bar.second_moments),
+                                   bar.area, bar.density)
+    else:
+        xi, w = _quadrature(400)
+        k = np.array([np.sum(bar.shear_modulus / bar.poisson_ratio * bar.area
+                             * (bending_shape(b, xi, 1) / bar.length) ** 2 * w * bar.length)
+                      for b in free_free_roots(count)])
+        bend = np.sqrt(k / bar.mass) / (2.0 * math.pi)
+    return axial, bend
+
+
+def resolve_auto_modes(scene: MechScene, safety: float | None = None):
+    """(scene with explicit mode counts, ModeCount or None). "auto" counts are chosen by
+    mech.mode_count.choose_mode_count from the Hertz contact time of the first impact
+    (rigid-bar effective mass and impact speed of ``contact_scales``); safety: the
+    factor of f_cut = safety / t_c (None: mode_count.SAFETY)."""
+    import dataclasses
+
+    from .mode_count import CAP, SAFETY, choose_mode_count
+
+    bar = scene.bar
+    if bar.axial_modes != "auto" and bar.bending_modes != "auto":
+        return scene, None
+    cs = contact_scales(scene, 0)
+    t_c = hertz_impact(cs.reference_mass, cs.stiffness, cs.reference_speed).contact_time
+    axial, bend = family_frequencies(bar, CAP)
+    choice = choose_mode_count(axial, bend, t_c, impact_speed=cs.reference_speed,
+                               safety=SAFETY if safety is None else safety)
+    bar = dataclasses.replace(
+        bar,
+        axial_modes=choice.axial if bar.axial_modes == "auto" else bar.axial_modes,
+        bending_modes=choice.bending if bar.bending_modes == "auto" else bar.bending_modes,
+    )
+    return dataclasses.replace(scene, bar=bar), choice

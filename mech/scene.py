@@ -48,7 +48,7 @@ tip_radius = 0.005
 youngs_modulus = 210e9
 poisson_ratio = 0.3
 density = 7850.0
-modes = 3
+modes = "auto"
 
 [block]
 youngs_modulus = 210e9
