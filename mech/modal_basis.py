@@ -131,7 +131,7 @@ def build_modal_basis(bar: Bar, planar: bool) -> ModalBasis:
     J2 = np.zeros((n, n, 3, 3))
     S = np.zeros((n, n, 3))
     # d/dq_j of int rho A (s.s I - s s^T) at q = 0, with s = x e1: first moments m1[j, a]
-    m1 = np.einsum("jpa,p->ja", psi, rho_a * dx * x)  # (n, 3)
+    m1 = psi.transpose(0, 2, 1) @ (rho_a * dx * x)  # (n, 3)
     for j in range(n):
         outer = np.outer(e1, m1[j])
         J1[j] = 2.0 * m1[j, 0] * eye - (outer + outer.T)
@@ -162,7 +162,7 @@ def build_modal_basis(bar: Bar, planar: bool) -> ModalBasis:
             strain, coef = d2[ix], bar.youngs_modulus * (i33 if fam == "bend2" else i22)
         else:  # the paper's shear-type energy (G/nu) A (d delta/dx)^2
             strain, coef = d1[ix], bar.shear_modulus / bar.poisson_ratio * bar.area
-        K[np.ix_(ix, ix)] = coef * np.einsum("jp,kp->jk", strain * dx, strain)
+        K[np.ix_(ix, ix)] = coef * (strain * dx) @ strain.T
     # Exact eigenmodes give a diagonal K; quadrature leaves round-off off the diagonal.
     if bar.bending == "euler_bernoulli":
         K = np.diag(np.diag(K))

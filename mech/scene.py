@@ -112,12 +112,14 @@ def _section(name: str, cls, table: dict, where: str):
 
 
 def _modes(value, where: str) -> dict:
-    """`modes = 3` (every family) or `modes = {axial = 3, bending = 2}`."""
+    """`modes = 3` (every family), `modes = "auto"` (the default: chosen from the contact
+    time, mech/mode_count.py) or `modes = {axial = 3, bending = 2}` (a family left out is
+    "auto")."""
     if isinstance(value, dict):
         unknown = set(value) - {"axial", "bending"}
         if unknown:
             raise ValueError(f"{where}[bar]: modes: unknown key(s) {sorted(unknown)}; allowed: axial, bending")
-        return {"axial_modes": value.get("axial", 3), "bending_modes": value.get("bending", 3)}
+        return {"axial_modes": value.get("axial", "auto"), "bending_modes": value.get("bending", "auto")}
     return {"axial_modes": value, "bending_modes": value}
 
 

@@ -116,3 +116,13 @@ def test_a_third_of_the_cutoff_misses_the_bounce_pattern():
     # The same check fails for f_cut = 1 / t_c on the stocky tilted bar: it can tell.
     d = _compare(SCENES[0], 1.0)
     assert d["contacts"][0] != d["contacts"][1] or d["mismatch"] > 2e-6 + 0.05 * d["total"]
+
+
+def test_scene_files_take_auto_counts_and_name_a_bad_value():
+    from mech import scene_from_dict
+
+    sc = scene_from_dict({"bar": {"modes": {"bending": 5}}})
+    assert (sc.bar.axial_modes, sc.bar.bending_modes) == ("auto", 5)
+    assert scene_from_dict({"bar": {"modes": "auto"}}).bar.axial_modes == "auto"
+    with pytest.raises(ValueError, match=r"bar\.axial_modes = 'many'.*\"auto\""):
+        scene_from_dict({"bar": {"modes": "many"}})
