@@ -28,6 +28,7 @@ from numba import njit
 
 from .contact_laws import normal_force
 from .friction import friction_limit, regularized_scale
+from .inertia import inertia_matrix, inertia_terms, inertia_terms_sparse
 
 # fpar indices (F_K, F_C, F_RTIP: the first contact point's values, kept for the scales;
 # the kernel reads each contact point's own from cpar)
@@ -35,8 +36,10 @@ from .friction import friction_limit, regularized_scale
  F_VBOUND, F_BLOCK_Z, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN) = range(20)
 N_FPAR = 20
 # ipar indices
-I_N, I_PLANAR, I_FRICTION, I_MOUNT, I_NLOAD = range(5)
-N_IPAR = 5
+I_N, I_PLANAR, I_FRICTION, I_MOUNT, I_NLOAD, I_INERTIA = range(6)
+N_IPAR = 6
+# inertia route (mech/inertia.py): Gram products (analytic free-free basis) or sparse list
+INERTIA_GRAM, INERTIA_SPARSE = 0, 1
 FRICTION_NONE, FRICTION_EXACT, FRICTION_REGULARIZED = 0, 1, 2
 # how the bar is held: free (6 rigid degrees of freedom), clamped at a base that moves
 # with a piecewise-constant velocity (none), pivoted about body y (rotation only, planar)
@@ -313,6 +316,34 @@ def _solve_accel(f_r, f_e, Ainv, B, m, n, wdot, etadot):
 
 
 @njit(cache=True)
+def _add_rotational_coupling(n, m, w, eta, cL, Jm, B, f_r, Amat, Ainv):
+    """Add a held bar's H_j (cL[:, n+1:], kg m) to B(q): the angular momentum gains H eta,
+    f_r = -w x h - dJ/dt w gains -w x (H eta), and the Schur complement J - B B'/m is redone.
+    (H only moves h: its q-independence leaves the modal forces as they are.)"""
+    h0 = 0.0
+    h1 = 0.0
+    h2 = 0.0
+    for j in range(n):
+        B[0, j] += cL[0, n + 1 + j]
+        B[1, j] += cL[1, n + 1 + j]
+        B[2, j] += cL[2, n + 1 + j]
+        h0 += cL[0, n + 1 + j] * eta[j]
+        h1 += cL[1, n + 1 + j] * eta[j]
+        h2 += cL[2, n + 1 + j] * eta[j]
+    f_r[0] -= w[1] * h2 - w[2] * h1
+    f_r[1] -= w[2] * h0 - w[0] * h2
+    f_r[2] -= w[0] * h1 - w[1] * h0
+    inv_m = 1.0 / m
+    for a in range(3):
+        for b in range(3):
+            acc = 0.0
+            for j in range(n):
+                acc += B[a, j] * B[b, j]
+            Amat[a, b] = Jm[a, b] - acc * inv_m
+    inverse3(Amat, Ainv)
+
+
+@njit(cache=True)
 def _solve_mounted(mount, F, f_r, f_e, Ainv, B, m, n, Vdot, wdot, etadot):
     """Accelerations from generalized forces for the bar as held by ``mount``.
 
@@ -403,62 +434,17 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work):
     beta = fpar[F_BETA]
     zb = fpar[F_BLOCK_Z]
 
-    # Modal invariants as sparse lists (modal_basis.sparse_invariants):
-    # J(q) = J0 + sum J1_j q_j + sum J2_jk q_j q_k ; B[:, j] = H_j + sum_k q_k S_kj
-    inv_m = 1.0 / m
-    for a in range(3):
-        for b in range(3):
-            Jm[a, b] = J0[a, b]
-        sv[a] = 0.0  # dJ/dt w
-    for j in range(n):
-        f_e[j] = 0.0
-        for a in range(3):
-            B[a, j] = cL[a, n + 1 + j]  # H_j: zero about a free bar's centroid
-    for e in range(sp_ptr[0], sp_ptr[1]):
-        j = sp_idx[e, 0]
-        a = sp_idx[e, 1]
-        b = sp_idx[e, 2]
-        v = sp_val[e]
-        Jm[a, b] += v * q[j]
-        f_e[j] += 0.5 * v * w[a] * w[b]  # centrifugal: 1/2 w' dJ/dq_j w
-        sv[a] += v * eta[j] * w[b]
-    for e in range(sp_ptr[1], sp_ptr[2]):
-        j = sp_idx[e, 0]
-        kk = sp_idx[e, 1]
-        a = sp_idx[e, 2]
-        b = sp_idx[e, 3]
-        v = sp_val[e]
-        Jm[a, b] += v * q[j] * q[kk]
-        f_e[j] += v * q[kk] * w[a] * w[b]
-        # dJ/dq_j = sum_k (J2_jk + J2_jk^T) q_k, since J2_kj = J2_jk^T across families
-        ve = v * q[kk] * eta[j]
-        sv[a] += ve * w[b]
-        sv[b] += ve * w[a]
-    for e in range(sp_ptr[2], sp_ptr[3]):
-        j = sp_idx[e, 0]
-        kk = sp_idx[e, 1]
-        a = sp_idx[e, 2]
-        v = sp_val[e]
-        B[a, kk] += v * q[j]
-        f_e[j] += 2.0 * v * w[a] * eta[kk]  # gyroscopic 2 w . S_jk eta_k
-    for e in range(sp_ptr[3], sp_ptr[4]):
-        f_e[sp_idx[e, 0]] -= sp_val[e] * q[sp_idx[e, 1]]
-    d_modal = 0.0
-    for e in range(sp_ptr[4], sp_ptr[5]):
-        ce = sp_val[e] * eta[sp_idx[e, 1]]
-        f_e[sp_idx[e, 0]] -= ce
-        d_modal += eta[sp_idx[e, 0]] * ce
-    h0 = Jm[0, 0] * w[0] + Jm[0, 1] * w[1] + Jm[0, 2] * w[2]
-    h1 = Jm[1, 0] * w[0] + Jm[1, 1] * w[1] + Jm[1, 2] * w[2]
-    h2 = Jm[2, 0] * w[0] + Jm[2, 1] * w[1] + Jm[2, 2] * w[2]
-    for j in range(n):
-        h0 += B[0, j] * eta[j]
-        h1 += B[1, j] * eta[j]
-        h2 += B[2, j] * eta[j]
-    # f_r = -w x h - dJ/dt w
-    f_r[0] = -(w[1] * h2 - w[2] * h1) - sv[0]
-    f_r[1] = -(w[2] * h0 - w[0] * h2) - sv[1]
-    f_r[2] = -(w[0] * h1 - w[1] * h0) - sv[2]
+    # Inertia, centrifugal, gyroscopic, stiffness and damping terms (mech/inertia.py):
+    # the Gram-product route for the analytic free-free basis, the sparse-list route for a
+    # finite-element basis (its families are orthogonal in the full mass, rivets' rotary
+    # inertia included, not in the plain product the Gram route relies on)
+    if ipar[I_INERTIA] == INERTIA_GRAM:
+        d_modal = inertia_terms(n, m, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, B, f_e, sv, f_r, Amat, Ainv)
+    else:
+        d_modal = inertia_terms_sparse(n, m, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, B, f_e, sv, f_r, Amat,
+                                       Ainv)
+    if mount != MOUNT_FREE:
+        _add_rotational_coupling(n, m, w, eta, cL, Jm, B, f_r, Amat, Ainv)
     F[0] = 0.0
     F[1] = 0.0
     F[2] = -m * fpar[F_G]
@@ -487,15 +473,6 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work):
         thd = sg * w[1]
         f_r[1] += sg * (fpar[F_PIV_T0] - fpar[F_PIV_K] * th - fpar[F_PIV_C] * thd)
         d_load += fpar[F_PIV_C] * thd * thd
-    # Schur complement A = J - B B^T / m
-    for a in range(3):
-        for b in range(3):
-            acc = 0.0
-            for j in range(n):
-                acc += B[a, j] * B[b, j]
-            Amat[a, b] = Jm[a, b] - acc * inv_m
-    inverse3(Amat, Ainv)
-
     mu = mu_at(t, fpar) if fmodel != FRICTION_NONE else 0.0
     gam = fpar[F_GAMMA]
     maxr = fpar[F_MAX_RATIO]
@@ -849,18 +826,24 @@ def energies(y, mdl, work, out):
     r, R, q, V, w, eta, Jm, B = work[0], work[1], work[2], work[3], work[4], work[5], work[6], work[7]
     unpack(y, n, planar, r, R, q, V, w, eta)
     m = fpar[F_MASS]
-    for a in range(3):
-        for b in range(3):
-            Jm[a, b] = J0[a, b]
-    for j in range(n):
+    if ipar[I_INERTIA] == INERTIA_GRAM:
+        inertia_matrix(n, q, J0, sp_ptr, sp_idx, sp_val, Jm, B)
+    else:
         for a in range(3):
-            B[a, j] = cL[a, n + 1 + j]
-    for e in range(sp_ptr[0], sp_ptr[1]):
-        Jm[sp_idx[e, 1], sp_idx[e, 2]] += sp_val[e] * q[sp_idx[e, 0]]
-    for e in range(sp_ptr[1], sp_ptr[2]):
-        Jm[sp_idx[e, 2], sp_idx[e, 3]] += sp_val[e] * q[sp_idx[e, 0]] * q[sp_idx[e, 1]]
-    for e in range(sp_ptr[2], sp_ptr[3]):
-        B[sp_idx[e, 2], sp_idx[e, 1]] += sp_val[e] * q[sp_idx[e, 0]]
+            for b in range(3):
+                Jm[a, b] = J0[a, b]
+        for j in range(n):
+            for a in range(3):
+                B[a, j] = 0.0
+        for e in range(sp_ptr[0], sp_ptr[1]):
+            Jm[sp_idx[e, 1], sp_idx[e, 2]] += sp_val[e] * q[sp_idx[e, 0]]
+        for e in range(sp_ptr[1], sp_ptr[2]):
+            Jm[sp_idx[e, 2], sp_idx[e, 3]] += sp_val[e] * q[sp_idx[e, 0]] * q[sp_idx[e, 1]]
+        for e in range(sp_ptr[2], sp_ptr[3]):
+            B[sp_idx[e, 2], sp_idx[e, 1]] += sp_val[e] * q[sp_idx[e, 0]]
+    for j in range(n):  # H_j, the q-independent coupling of a held bar's modes (0 when free)
+        for a in range(3):
+            B[a, j] += cL[a, n + 1 + j]
     kin = 0.5 * m * (V[0] ** 2 + V[1] ** 2 + V[2] ** 2)
     for a in range(3):
         for b in range(3):

@@ -19,7 +19,7 @@ from .kernel import (
     F_BAUM, F_BETA, F_C, F_G, F_GAMMA, F_VBOUND, F_K, F_MASS, F_MAX_RATIO, F_MU0, F_MU_SLOPE, F_RTIP,
     F_T_MU, F_VREG, FRICTION_EXACT, FRICTION_NONE, FRICTION_REGULARIZED, I_FRICTION, I_N,
     I_PLANAR, I_MOUNT, I_NLOAD, MOUNT_CLAMP, MOUNT_FREE, MOUNT_PIVOT, N_FPAR,
-    F_PIV_C, F_PIV_K, F_PIV_PHI0, F_PIV_SIGN, F_PIV_T0, L_L0, N_IPAR, N_LOAD, NQ, NQ_FREE, C_C, C_K, C_ON, C_R, layout,
+    F_PIV_C, F_PIV_K, F_PIV_PHI0, F_PIV_SIGN, F_PIV_T0, L_L0, I_INERTIA, INERTIA_GRAM, INERTIA_SPARSE, N_IPAR, N_LOAD, NQ, NQ_FREE, C_C, C_K, C_ON, C_R, layout,
 )
 from .mechanism import (
     MechanismArrays, build_arrays, closing_work, contact_parameters, contact_points,
@@ -245,6 +245,7 @@ class BarModel:
         return self.basis.n
 
     sparse: tuple = ()
+    mode_count: object = None  # ModeCount when bar.modes = "auto" chose the counts, else None
 
     points: tuple = ()  # (psi, theta, xc): contact caps (rows 0, 1) then load points
     cpar: np.ndarray | None = None  # (2, 4) per contact point: k, c, cap radius, on
@@ -390,6 +391,7 @@ class BarModel:
 
 def build_model(scene: MechScene) -> BarModel:
     """Assemble the compiled model of ``scene`` (planar or 3D as the scene needs)."""
+    scene, mode_count = resolve_auto_modes(scene)
     mode = scene.solver.model
     planar_ok = is_planar(scene)
     if mode == "planar" and not planar_ok:
@@ -431,6 +433,7 @@ def build_model(scene: MechScene) -> BarModel:
     ipar[I_N] = n
     ipar[I_PLANAR] = int(planar)
     ipar[I_FRICTION] = fmodel
+    ipar[I_INERTIA] = INERTIA_SPARSE if arr is not None else INERTIA_GRAM
     if arr is not None:
         ipar[I_MOUNT] = {"free": MOUNT_FREE, "clamp": MOUNT_CLAMP, "pivot": MOUNT_PIVOT}[scene.mount.kind]
         ipar[I_NLOAD] = len(arr.load)
@@ -489,4 +492,79 @@ def build_model(scene: MechScene) -> BarModel:
         sl_model.load = arr.load.copy()
         sl_model.tables = arr.tables
         _set_up_mount(sl_model, scene)
+    sl_model.mode_count = mode_count
     return sl_model
+
+
+# --- bar.modes = "auto" (issue 9): counts from the contact time -----------------------
+
+def family_frequencies(bar, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Hz: the first ``count`` axial and bending frequencies of ``bar`` (bending in the
+    more flexible plane). Euler-Bernoulli closed forms; for the paper's shear-type bending,
+    sqrt(K_jj/m) of its stiffness on the free-free shapes (its K is full within a family)."""
+    from .modal_basis import _quadrature
+    from .modes import axial_frequencies, bending_frequencies, bending_shape, free_free_roots
+
+    axial = axial_frequencies(count, bar.length, bar.youngs_modulus, bar.density)
+    if bar.bending == "euler_bernoulli":
+        bend = bending_frequencies(count, bar.length, bar.youngs_modulus, min(bar.second_moments),
+                                   bar.area, bar.density)
+    else:
+        xi, w = _quadrature(400)
+        k = np.array([np.sum(bar.shear_modulus / bar.poisson_ratio * bar.area
+                             * (bending_shape(b, xi, 1) / bar.length) ** 2 * w * bar.length)
+                      for b in free_free_roots(count)])
+        bend = np.sqrt(k / bar.mass) / (2.0 * math.pi)
+    return axial, bend
+
+
+def resolve_auto_modes(scene: MechScene, safety: float | None = None):
+    """(scene with explicit mode counts, ModeCount or None). "auto" counts are chosen by
+    mech.mode_count.choose_mode_count from the Hertz contact time of the first impact
+    (rigid-bar effective mass and impact speed of ``contact_scales``); safety: the
+    factor of f_cut = safety / t_c (None: mode_count.SAFETY)."""
+    import dataclasses
+
+    from .mode_count import CAP, SAFETY, choose_mode_count
+
+    bar = scene.bar
+    if bar.axial_modes != "auto" and bar.bending_modes != "auto":
+        return scene, None
+    if needs_mechanism(scene):
+        axial, bend, t_c, speed = _mechanism_auto_inputs(scene, CAP)
+        cs = None
+    else:
+        cs = contact_scales(scene, 0)
+        t_c = hertz_impact(cs.reference_mass, cs.stiffness, cs.reference_speed).contact_time
+        axial, bend = family_frequencies(bar, CAP)
+        speed = cs.reference_speed
+    choice = choose_mode_count(axial, bend, t_c, impact_speed=speed,
+                               safety=SAFETY if safety is None else safety)
+    bar = dataclasses.replace(
+        bar,
+        axial_modes=choice.axial if bar.axial_modes == "auto" else bar.axial_modes,
+        bending_modes=choice.bending if bar.bending_modes == "auto" else bar.bending_modes,
+    )
+    return dataclasses.replace(scene, bar=bar), choice
+
+
+def _mechanism_auto_inputs(scene: MechScene, cap: int):
+    """(axial Hz, bending Hz, contact time s, impact speed m/s) for "auto" on a mechanism
+    scene: the frequencies of the bar as held (finite-element modes, rivets' masses on
+    it; bending in its more flexible plane) and the Hertz time of the first contact
+    point's impact on its effective mass (mechanism_scales, from a small basis)."""
+    import dataclasses
+
+    from .beam_fe import beam_modes
+    from .mechanism import fe_beam
+
+    bar = scene.bar
+    beam = fe_beam(scene)
+    axial = beam_modes(beam, "axial", cap).frequencies
+    i22, i33 = bar.second_moments
+    bend = beam_modes(beam, "bend3" if i22 <= i33 else "bend2", cap).frequencies
+    small = dataclasses.replace(scene, bar=dataclasses.replace(bar, axial_modes=1, bending_modes=3))
+    arr = build_arrays(small, True)
+    cs = mechanism_scales(small, arr, arr.basis.n)
+    t_c = hertz_impact(cs.reference_mass, cs.stiffness, cs.reference_speed).contact_time
+    return axial, bend, t_c, cs.reference_speed

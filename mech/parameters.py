@@ -66,9 +66,12 @@ def check_vector3(name: str, value) -> tuple[float, float, float]:
     return tuple(check_finite(f"{name}[{i}]", v) for i, v in enumerate(items))
 
 
-def _check_count(name: str, value, high: int = 40) -> int:
+def _check_count(name: str, value, high: int = 40, auto: bool = False):
+    if auto and value == "auto":  # chosen from the scene (mech/mode_count.py)
+        return value
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise ValueError(f"{name} = {value!r}: expected a whole number in [0, {high}]")
+        raise ValueError(f"{name} = {value!r}: expected a whole number in [0, {high}]"
+                         + (' or "auto"' if auto else ""))
     if not 0 <= value <= high:
         raise ValueError(f"{name} = {value!r}: allowed range is [0, {high}]")
     return int(value)
@@ -84,7 +87,8 @@ class Bar:
     section's largest half-width so the cap spans the section.
     youngs_modulus: Pa. poisson_ratio: -, in (-1, 0.5). density: kg/m^3.
     axial_modes, bending_modes: free-free modes per family (bending counts per plane);
-    0 and 0 is the rigid bar.
+    0 and 0 is the rigid bar; "auto" (default): chosen from the scene's contact time
+    (mech/mode_count.py), resolved when the model is built.
     bending: "euler_bernoulli" (default, U = 1/2 int E I (d2 delta/dx2)^2 dx) or
     "paper_shear" (the source paper's U = 1/2 int (G/nu) A (d delta/dx)^2 dx).
     modal_damping: damping ratio of every elastic mode (default 0: none).
@@ -98,8 +102,8 @@ class Bar:
     youngs_modulus: float = 210e9
     poisson_ratio: float = 0.3
     density: float = 7850.0
-    axial_modes: int = 3
-    bending_modes: int = 3
+    axial_modes: int | str = "auto"
+    bending_modes: int | str = "auto"
     bending: Literal["euler_bernoulli", "paper_shear"] = "euler_bernoulli"
     modal_damping: float = 0.0
 
@@ -121,8 +125,8 @@ class Bar:
         check_positive("bar.youngs_modulus", self.youngs_modulus)
         check_range("bar.poisson_ratio", self.poisson_ratio, -1.0, 0.5)
         check_positive("bar.density", self.density)
-        _check_count("bar.axial_modes", self.axial_modes)
-        _check_count("bar.bending_modes", self.bending_modes)
+        _check_count("bar.axial_modes", self.axial_modes, auto=True)
+        _check_count("bar.bending_modes", self.bending_modes, auto=True)
         check_choice("bar.bending", self.bending, ("euler_bernoulli", "paper_shear"))
         check_range("bar.modal_damping", self.modal_damping, 0.0, 1.0, closed_low=True)
         half = self.section_half_width

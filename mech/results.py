@@ -317,7 +317,8 @@ class ImpactResult:
         m = self.model
         return dict(self.stats, model="planar" if m.planar else "3d", modes=m.n, states=m.state_size,
                     friction=("none", "exact", "regularized")[int(m.ipar[2])],
-                    damping=m.contact.damping, stiffness=m.contact.stiffness)
+                    damping=m.contact.damping, stiffness=m.contact.stiffness,
+                    modes_rule=m.mode_count.reason if m.mode_count is not None else "explicit")
 
     def to_summary(self) -> dict:
         """The JSON summary: contacts, restitution, energy, solver, flags."""

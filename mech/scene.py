@@ -65,7 +65,7 @@ tip_radius = 0.005
 youngs_modulus = 210e9
 poisson_ratio = 0.3
 density = 7850.0
-modes = 3
+modes = "auto"
 
 [block]
 youngs_modulus = 210e9
@@ -132,15 +132,17 @@ def _section(name: str, cls, table: dict, where: str):
 
 
 def _modes(value, where: str) -> dict:
-    """`modes = 3` (every family) or `modes = {axial = 3, bending = 2}`; errors name the key
-    the user wrote (bar.modes, bar.modes.axial), not the field it maps to."""
+    """`modes = 3` (every family), `modes = "auto"` (the default: chosen from the contact
+    time, mech/mode_count.py) or `modes = {axial = 3, bending = 2}` (a family left out is
+    "auto"); errors name the key the user wrote (bar.modes, bar.modes.axial),
+    not the field it maps to."""
     if isinstance(value, dict):
         unknown = set(value) - {"axial", "bending"}
         if unknown:
             raise ValueError(f"{where}[bar]: modes: unknown key(s) {sorted(unknown)}; allowed: axial, bending")
-        return {"axial_modes": _check_count("bar.modes.axial", value.get("axial", 3)),
-                "bending_modes": _check_count("bar.modes.bending", value.get("bending", 3))}
-    count = _check_count("bar.modes", value)
+        return {"axial_modes": _check_count("bar.modes.axial", value.get("axial", "auto"), auto=True),
+                "bending_modes": _check_count("bar.modes.bending", value.get("bending", "auto"), auto=True)}
+    count = _check_count("bar.modes", value, auto=True)
     return {"axial_modes": count, "bending_modes": count}
 
 

@@ -1,0 +1,79 @@
+"""``modes = "auto"``: how many free-free modes per family a scene needs.
+
+Rule: every mode whose frequency lies below the cutoff f_cut = SAFETY / t_c, with t_c
+the Hertz contact duration of the scene's first impact (rigid-bar effective mass of the
+impacting tip, the scene's impact speed, the contact stiffness), counted per family
+(axial; bending, the more flexible plane for a rectangular section), then held within
+[FLOOR, CAP]. Modes well above 1/t_c respond quasi-statically to a contact pulse and
+change neither the contact intervals nor the forces; the factor SAFETY was chosen by
+measurement (benchmarks/bench_mode_count.py, table in docs/accuracy-modes.md).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+SAFETY = 3.0  # f_cut = SAFETY / t_c
+CAP = 40  # the largest count bar.modes accepts
+FLOOR = 3  # the paper's count, and never fewer than an explicit default used to give
+
+
+@dataclass(frozen=True)
+class ModeCount:
+    """The count chosen per family and why. cutoff: Hz. contact_time: s. impact_speed: m/s."""
+
+    axial: int
+    bending: int
+    cutoff: float
+    contact_time: float
+    impact_speed: float
+    safety: float
+    capped: tuple[str, ...] = ()
+    floored: tuple[str, ...] = ()
+
+    @property
+    def reason(self) -> str:
+        """One line for summary.solver, e.g. "auto: 3 axial, 7 bending modes below 26.6 kHz
+        = 2 / t_c (t_c = 75.2 us at 0.99 m/s)"."""
+        text = (f"auto: {self.axial} axial, {self.bending} bending modes below {self.cutoff / 1e3:.3g} kHz "
+                f"= {self.safety:g} / t_c (t_c = {self.contact_time * 1e6:.3g} us at {self.impact_speed:.3g} m/s)")
+        notes = [f"{fam} capped at {CAP}" for fam in self.capped]
+        notes += [f"{fam} raised to the floor {FLOOR}" for fam in self.floored]
+        return text + ("; " + ", ".join(notes) if notes else "")
+
+
+def count_below(frequencies, cutoff: float) -> int:
+    """Number of entries of ``frequencies`` (Hz, ascending) strictly below ``cutoff`` (Hz)."""
+    f = np.asarray(frequencies, dtype=float)
+    return int(np.count_nonzero(f < cutoff))
+
+
+def choose_mode_count(axial_frequencies, bending_frequencies, contact_time: float, *,
+                      impact_speed: float = math.nan, safety: float = SAFETY, cap: int = CAP,
+                      floor: int = FLOOR) -> ModeCount:
+    """Modes per family below f_cut = safety / contact_time, held within [floor, cap].
+
+    axial_frequencies, bending_frequencies: Hz, ascending, the first ``cap`` (at least)
+    of each family. contact_time: s, > 0. impact_speed: m/s, only reported.
+    """
+    if not (contact_time > 0.0 and math.isfinite(contact_time)):
+        raise ValueError(f"contact_time = {contact_time!r}: must be a finite time > 0 s")
+    if not safety > 0.0:
+        raise ValueError(f"safety = {safety!r}: must be > 0")
+    cutoff = safety / contact_time
+    counts, capped, floored = {}, [], []
+    for fam, freqs in (("axial", axial_frequencies), ("bending", bending_frequencies)):
+        k = count_below(freqs, cutoff)
+        if k >= cap:
+            k = cap
+            capped.append(fam)
+        elif k < floor:
+            k = floor
+            floored.append(fam)
+        counts[fam] = k
+    return ModeCount(axial=counts["axial"], bending=counts["bending"], cutoff=cutoff,
+                     contact_time=contact_time, impact_speed=impact_speed, safety=safety,
+                     capped=tuple(capped), floored=tuple(floored))

@@ -1,0 +1,128 @@
+"""modes = "auto": the counting rule against closed forms, and auto against twice its
+count on short scenes (the convergence the rule promises; docs/accuracy-modes.md)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from mech import Bar, Contact, Friction, ImpactSolver, Initial, MechScene, SolverOptions
+from mech.contact_laws import hertz_stiffness
+from mech.mode_count import CAP, FLOOR, SAFETY, choose_mode_count
+from mech.model import build_model, resolve_auto_modes
+from mech.modes import axial_frequencies, bending_frequencies
+
+
+def test_counts_are_the_modes_below_the_cutoff_with_floor_and_cap():
+    L, E, rho = 0.3, 210e9, 7850.0
+    c = math.sqrt(E / rho)
+    t_c = 50e-6
+    axial = axial_frequencies(CAP, L, E, rho)
+    bend = bending_frequencies(CAP, L, E, math.pi * 0.006**4 / 64, math.pi * 0.006**2 / 4, rho)
+    ch = choose_mode_count(axial, bend, t_c, safety=3.0)
+    f_cut = 3.0 / t_c
+    # axial k c / (2L) < f_cut  <=>  k < 2 L f_cut / c
+    assert ch.axial == max(FLOOR, math.ceil(2 * L * f_cut / c) - 1)
+    # bending (beta_k L)^2 ~ ((k + 1/2) pi)^2 for k >= 2: count from the asymptotic roots
+    f1 = math.sqrt(E * 0.006**2 / 16 / rho) / (2 * math.pi * L**2)
+    assert ch.bending == sum(1 for k in range(1, CAP + 1) if f1 * ((k + 0.5) * math.pi) ** 2 < f_cut)
+    assert ch.cutoff == pytest.approx(f_cut, rel=1e-15)
+    assert "3 / t_c" in ch.reason and f"{ch.bending} bending" in ch.reason
+    # a very short contact: everything below the cutoff, capped; a long one: the floor
+    short = choose_mode_count(axial, bend, 1e-9)
+    assert (short.axial, short.bending) == (CAP, CAP) and short.capped == ("axial", "bending")
+    long = choose_mode_count(axial, bend, 1.0)
+    assert (long.axial, long.bending) == (FLOOR, FLOOR) and "floor" in long.reason
+    with pytest.raises(ValueError, match="contact_time"):
+        choose_mode_count(axial, bend, 0.0)
+
+
+def test_contact_time_of_a_vertical_drop_is_the_hertz_closed_form():
+    # Vertical bar: the impacting tip's effective mass is the bar's mass.
+    bar = Bar(diameter=0.012, tip_radius=0.006)
+    scene = MechScene(bar=bar, initial=Initial(height=0.0, angle_deg=90.0, velocity=(0.0, 0.0, -0.8)),
+                      gravity=0.0)
+    resolved, ch = resolve_auto_modes(scene)
+    k = hertz_stiffness(0.006, 210e9, 0.3, 210e9, 0.3)
+    dmax = (5 * bar.mass * 0.8**2 / (4 * k)) ** 0.4
+    assert ch.contact_time == pytest.approx(2.943275 * dmax / 0.8, rel=1e-5)
+    assert (resolved.bar.axial_modes, resolved.bar.bending_modes) == (ch.axial, ch.bending)
+    # an explicit family count is kept, the other is chosen
+    mixed, ch2 = resolve_auto_modes(MechScene(bar=Bar(diameter=0.012, tip_radius=0.006, axial_modes=5),
+                                              initial=scene.initial, gravity=0.0))
+    assert mixed.bar.axial_modes == 5 and mixed.bar.bending_modes == ch2.bending
+    model = build_model(scene)
+    assert model.n == ch.axial + ch.bending  # planar: axial + one bending family
+
+
+def _scene(diameter, angle, elastic, modes, t_end=1.0e-3):
+    con = dict(damping=0.0, restitution=None) if elastic else dict(restitution=0.8)
+    fr = dict(mu=0.0) if elastic else dict(mu=0.3, gamma=0.7)
+    return MechScene(
+        bar=Bar(diameter=diameter, tip_radius=diameter / 2, axial_modes=modes[0], bending_modes=modes[1]),
+        contact=Contact(**con), friction=Friction(**fr),
+        initial=Initial(height=1e-4, angle_deg=angle, velocity=(0.0, 0.0, -1.0)),
+        solver=SolverOptions(t_end=t_end))
+
+
+def _intervals(res):
+    c = res.contacts
+    return [[(a, b) for a, b in zip(c.t_start[c.tip == i], c.t_end[c.tip == i])] for i in (0, 1)]
+
+
+def _mismatch(a, b):
+    """Total time where 'tip i touches' differs between two runs (s), summed over tips."""
+    total = 0.0
+    for ia, ib in zip(a, b):
+        cuts = sorted({x for iv in ia + ib for x in iv})
+        for lo, hi in zip(cuts[:-1], cuts[1:]):
+            mid = 0.5 * (lo + hi)
+            if any(s <= mid <= e for s, e in ia) != any(s <= mid <= e for s, e in ib):
+                total += hi - lo
+    return total
+
+
+def _compare(scene_args, safety):
+    base = _scene(*scene_args, modes=("auto", "auto"))
+    n = resolve_auto_modes(base, safety=safety)[0].bar
+    auto = ImpactSolver(_scene(*scene_args, modes=(n.axial_modes, n.bending_modes))).run()
+    ref = ImpactSolver(_scene(*scene_args, modes=(min(CAP, 2 * n.axial_modes), min(CAP, 2 * n.bending_modes)))).run()
+    ca, cr = auto.contacts, ref.contacts
+    total = float((cr.t_end - cr.t_start).sum())
+    return dict(mismatch=_mismatch(_intervals(auto), _intervals(ref)), total=total,
+                contacts=(len(ca), len(cr)),
+                peak=abs(ca.peak_force.max() / cr.peak_force.max() - 1.0),
+                last=abs(ca.t_end.max() - cr.t_end.max()),
+                restitution=abs(ca.kinematic_restitution.iloc[0] - cr.kinematic_restitution.iloc[0]))
+
+
+# (diameter m, angle deg, elastic): stocky tilted and grazing, slender tilted with friction
+SCENES = [(0.012, 30.0, True), (0.012, 10.0, False), (0.006, 30.0, False)]
+
+
+@pytest.mark.parametrize("scene_args", SCENES)
+def test_auto_agrees_with_twice_its_count(scene_args):
+    d = _compare(scene_args, SAFETY)
+    # docs/accuracy-modes.md tolerances: the bounce pattern and its forces
+    assert d["contacts"][0] == d["contacts"][1]
+    assert d["mismatch"] <= 2e-6 + 0.05 * d["total"]
+    assert d["last"] <= 1e-6 + 0.03 * d["total"]
+    assert d["peak"] <= 0.05
+    assert d["restitution"] <= 0.05
+
+
+def test_a_third_of_the_cutoff_misses_the_bounce_pattern():
+    # The same check fails for f_cut = 1 / t_c on the stocky tilted bar: it can tell.
+    d = _compare(SCENES[0], 1.0)
+    assert d["contacts"][0] != d["contacts"][1] or d["mismatch"] > 2e-6 + 0.05 * d["total"]
+
+
+def test_scene_files_take_auto_counts_and_name_a_bad_value():
+    from mech import scene_from_dict
+
+    sc = scene_from_dict({"bar": {"modes": {"bending": 5}}})
+    assert (sc.bar.axial_modes, sc.bar.bending_modes) == ("auto", 5)
+    assert scene_from_dict({"bar": {"modes": "auto"}}).bar.axial_modes == "auto"
+    with pytest.raises(ValueError, match=r"bar\.modes = 'many'.*\"auto\""):  # the key the user wrote
+        scene_from_dict({"bar": {"modes": "many"}})
