@@ -17,6 +17,8 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("scene", nargs="?", default=None, help="scene TOML file (SI units)")
     run.add_argument("--out", required=True, help="output directory (created if missing)")
     run.add_argument("--quiet", action="store_true", help="no progress output")
+    run.add_argument("--check", action="store_true",
+                     help="rerun refined (modes, rtol, macro step, RELTOL) and report the error (summary.accuracy)")
 
     fit = sub.add_parser("fit", help="fit gamma, mu(I) and R_c(F_n, I) to tribometer data")
     fit.add_argument("data", help="tribometer CSV (see docs/tribology.md for its form)")
@@ -30,7 +32,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "run":
             from coupling.commands import run_command
 
-            return run_command(args.scene, args.out, quiet=args.quiet)
+            return run_command(args.scene, args.out, quiet=args.quiet, check=args.check)
         if args.command == "fit":
             from coupling.tribology.command import fit_command
 

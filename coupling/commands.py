@@ -6,7 +6,7 @@ import sys
 from pathlib import Path
 
 
-def run_command(scene_path: str | None, out_dir: str, *, quiet: bool = False) -> int:
+def run_command(scene_path: str | None, out_dir: str, *, quiet: bool = False, check: bool = False) -> int:
     from .master import CoupledRunError, run
     from .scene import default_scene, load_scene
 
@@ -15,7 +15,7 @@ def run_command(scene_path: str | None, out_dir: str, *, quiet: bool = False) ->
     if not quiet:
         print(f"switchsim: running {scene.name} ({scene.kind}, t_end = {scene.t_end * 1e3:g} ms)", file=sys.stderr)
     try:
-        result = run(scene, progress=not quiet)
+        result = run(scene, progress=not quiet, check=check)
     except CoupledRunError as err:
         if err.partial is not None:
             err.partial.save(out)
@@ -36,6 +36,8 @@ def run_command(scene_path: str | None, out_dir: str, *, quiet: bool = False) ->
                   f"{summary['restitution']}, energy residual {summary['energy']['relative_residual']:.2g}")
         for flag in summary.get("flags", []):
             print(f"switchsim: flag: {flag}")
+    if check:
+        print(f"switchsim: accuracy: {result.accuracy['verdict']}")
         print(f"switchsim: wrote {out}", file=sys.stderr)
     return 0
 

@@ -72,6 +72,7 @@ class CoupledResult:
     waveforms: pd.DataFrame | None
     stats: dict
     status: str = "ok"
+    accuracy: dict | None = None  # summary.accuracy of run(scene, check=True) (coupling/accuracy.py)
     _cache: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -109,6 +110,8 @@ class CoupledResult:
                                 "feedback": self.scene.tribology.feedback,
                                 "laws": self.scene.tribology.laws.to_dict()}
         out["run"] = _jsonable(self.stats)
+        if self.accuracy is not None:
+            out["accuracy"] = _jsonable(self.accuracy)
         return out
 
     def save(self, out_dir) -> Path:
