@@ -100,6 +100,28 @@ def main(arg: str) -> dict:
             if not ke1 <= 1e-3 * ke0:
                 silent.append(f"not at rest at the end: kinetic+elastic {ke1 / ke0:.3g} of the initial")
     w = result.waveforms
+    if w is not None and scene.circuit is not None:
+        arc_on = getattr(scene.circuit.circuit, "arc", None) is not None
+        supply = float(doc.get("circuit", {}).get("voltage", 24.0))
+        peak = result.bounce.get("peak_contact_voltage") or 0.0
+        if arc_on and peak > max(10.0 * supply, 300.0):
+            silent.append(f"{peak:.4g} V across the opening contact with the arc model on ({supply:g} V supply): "
+                          "a gap of micrometres would break down (no breakdown is modelled)")
+    reference = checks.get("reference_changes")
+    if reference is not None and w is not None and out["status"] == "ok":
+        # the same scene with a fine, trusted setting: the case must agree with it
+        from coupling.accuracy import metrics_of, mismatch_time, tip_intervals
+
+        ref = run(scene.update(reference))
+        a, b = metrics_of(result), metrics_of(ref)
+        mism = sum(mismatch_time(tip_intervals(result)[i], tip_intervals(ref)[i]) for i in (0, 1))
+        out["reference_arc_energy"] = b["arc_energy"]
+        if a["bounces"] != b["bounces"]:
+            silent.append(f"bounces {a['bounces']}, {b['bounces']} with {reference}")
+        if not abs((a["arc_energy"] or 0.0) - (b["arc_energy"] or 0.0)) <= 0.05 * abs(b["arc_energy"] or 0.0) + 1e-6:
+            silent.append(f"arc energy {a['arc_energy']:.3g} J, {b['arc_energy']:.3g} J with {reference}")
+        if mism > 0.05 * b["contact_time"]:
+            silent.append(f"contact-state mismatch {mism * 1e6:.3g} us against {reference}")
     if w is not None:
         numeric = w.select_dtypes("number").drop(columns=["contact_resistance"], errors="ignore")
         if not bool(numeric.apply(lambda s: s.map(math.isfinite)).all().all()):

@@ -85,9 +85,9 @@ def cases() -> list[tuple[str, str, dict]]:
     for gamma in (0.0, 0.99):
         add("friction", f"gamma = {gamma:g}, mu = 0.3", mech({"friction.mu": 0.3, "friction.gamma": gamma,
                                                               "initial.velocity": [0.5, 0.0, -1.0]}))
-    for e in (0.01, 0.1, 0.5, 1.0):
-        add("restitution", f"restitution {e:g} (rigid bar, upright)",
-            mech({"bar.modes": 0, "initial.angle_deg": 90.0, "contact.restitution": e},
+    for e in (0.01, 0.05, 0.1, 0.5, 1.0):
+        add("restitution", f"restitution {e:g} (rigid bar, upright, 20 ms)",
+            mech({"bar.modes": 0, "initial.angle_deg": 90.0, "contact.restitution": e, "solver.t_end": 0.02},
                  {"restitution_target": e}))
     add("rest", "coming to rest: 2 deg, 1 mm drop, e = 0.5, mu = 0.3, 1 s",
         mech({"initial.angle_deg": 2.0, "initial.height": 1e-3, "contact.restitution": 0.5,
@@ -107,9 +107,11 @@ def cases() -> list[tuple[str, str, dict]]:
         coupled({"circuit.template": "inductive", "circuit.load_inductance": 1e-2}))
     add("circuit", "inductive load 12 ohm, 10 mH, no arc",
         coupled({"circuit.template": "inductive", "circuit.load_inductance": 1e-2, "circuit.arc": False}))
+    fine = {"reference_changes": {"coupling.macro_step": 2.5e-6}}
     add("circuit", "macro step 200 us (longer than a contact)",
-        coupled({"coupling.macro_step": 2e-4}))
-    add("circuit", "macro step 200 us, jacobi", coupled({"coupling.macro_step": 2e-4, "coupling.scheme": "jacobi"}))
+        coupled({"coupling.macro_step": 2e-4}, fine))
+    add("circuit", "macro step 200 us, jacobi", coupled({"coupling.macro_step": 2e-4, "coupling.scheme": "jacobi"},
+                                                       fine))
     return out
 
 
@@ -152,9 +154,10 @@ def main() -> None:
     for (group, label, case), r in zip(todo, results):
         detail = r.get("message", "") or ""
         if r.get("flags"):
-            detail = "; ".join(r["flags"])[:200]
+            more = f" (+{len(r['flags']) - 1} more flags)" if len(r["flags"]) > 1 else ""
+            detail = (detail + "; flag: " if detail else "flag: ") + r["flags"][0][:200] + more
         if r.get("silent"):
-            detail = "SILENT: " + "; ".join(r["silent"]) + (f" (flags: {'; '.join(r['flags'])[:120]})" if r["flags"] else "")
+            detail = "SILENT: " + "; ".join(r["silent"]) + (f" ({detail})" if detail else "")
         extra = []
         for key, name in (("restitution", "e"), ("final_energy_fraction", "final energy"),
                           ("peak_contact_voltage", "peak V"), ("arc_energy", "arc J"), ("bounces", "bounces")):

@@ -154,8 +154,13 @@ def metrics_of(result) -> dict:
 
 
 def mode_counts(result) -> dict:
-    """{"axial": n, "bending": n} modes per family the run used (from its modal basis)."""
-    fams = list(result.mechanics.model.basis.families)
+    """{"axial": n, "bending": n} modes per family the run used (from its modal basis; the
+    scene's counts when the result carries no basis)."""
+    basis = getattr(getattr(result.mechanics, "model", None), "basis", None)
+    if basis is None:
+        bar = result.scene.mech.bar
+        return {"axial": int(bar.axial_modes), "bending": int(bar.bending_modes)}
+    fams = list(basis.families)
     return {"axial": fams.count("axial"), "bending": max(fams.count("bend2"), fams.count("bend3"))}
 
 
