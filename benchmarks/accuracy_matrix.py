@@ -76,6 +76,10 @@ def cases() -> list[tuple[str, str, dict]]:
                   "solver.t_end": height / v + 1e-3}))
     for angle in (90.0, 89.5, 0.5, 0.0):
         add("incidence", f"bar at {angle:g} deg", mech({"initial.angle_deg": angle}))
+    for label, velocity in (("0.5 deg from the normal", [0.00873, 0.0, -1.0]),
+                            ("89.5 deg from the normal (grazing)", [1.0, 0.0, -0.00873])):
+        add("incidence", f"velocity {label}, mu = 0.3",
+            mech({"initial.velocity": velocity, "initial.height": 1e-6, "friction.mu": 0.3}))
     # sliding impacts: mu up to and past the jam (Painleve) range, bare Coulomb (max_ratio inf)
     for mu in (0.0, 0.3, 1.0, 3.0, 10.0):
         for vx in (1.0, -1.0):
@@ -85,10 +89,13 @@ def cases() -> list[tuple[str, str, dict]]:
     for gamma in (0.0, 0.99):
         add("friction", f"gamma = {gamma:g}, mu = 0.3", mech({"friction.mu": 0.3, "friction.gamma": gamma,
                                                               "initial.velocity": [0.5, 0.0, -1.0]}))
+    # without gravity: the calibration's target is the gravity-free restitution (with gravity
+    # a 1 cm/s rebound of a tip still ~10 um inside the block is caught by the bar's weight
+    # and the bar comes to rest standing on its tip: a physical outcome, not an error)
     for e in (0.01, 0.05, 0.1, 0.5, 1.0):
-        add("restitution", f"restitution {e:g} (rigid bar, upright, 20 ms)",
-            mech({"bar.modes": 0, "initial.angle_deg": 90.0, "contact.restitution": e, "solver.t_end": 0.02},
-                 {"restitution_target": e}))
+        add("restitution", f"restitution {e:g} (rigid bar, upright, no gravity, 5 ms)",
+            mech({"bar.modes": 0, "initial.angle_deg": 90.0, "contact.restitution": e, "solver.t_end": 5e-3,
+                  "environment.gravity": 0.0}, {"restitution_target": e}))
     add("rest", "coming to rest: 2 deg, 1 mm drop, e = 0.5, mu = 0.3, 1 s",
         mech({"initial.angle_deg": 2.0, "initial.height": 1e-3, "contact.restitution": 0.5,
               "friction.mu": 0.3, "solver.t_end": 1.0}, {"at_rest": True}))
