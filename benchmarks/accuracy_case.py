@@ -12,7 +12,8 @@ solver.energy_tolerance unless the result flags it.
 
 status: "ok" | "ok, flagged" (the result carries flags) | "rejected" (a clear error
 before the run) | "failed" (a run error with a message) | "crash" (an unexpected
-exception: a bug) ; "silent" lists physics checks that failed without any flag.
+exception: a bug) ; "silent" lists physics checks that failed while the result carries
+no flag at all ("flagged_failures" those of a flagged result).
 """
 
 from __future__ import annotations
@@ -60,7 +61,7 @@ def main(arg: str) -> dict:
         except Exception as err:  # noqa: BLE001
             out.update(status="crash", message=f"summary: {type(err).__name__}: {err}")
             return out
-        out["flags"] = list(summary["flags"])
+        out["flags"] = list(result.summary.get("flags", summary["flags"]))
         c = mr.contacts
         out["contacts"] = int(len(c))
         out["events"] = int(mr.stats.get("events", 0))
@@ -132,6 +133,9 @@ def main(arg: str) -> dict:
         out["arc_energy"] = b.get("arc_energy")
     if out["status"] == "ok" and out["flags"]:
         out["status"] = "ok, flagged"
+    if out["flags"] and silent:
+        # the result warns: what the checks found is reported, not silent
+        out["flagged_failures"], out["silent"] = list(silent), []
     return out
 
 

@@ -165,6 +165,8 @@ def main() -> None:
             detail = (detail + "; flag: " if detail else "flag: ") + r["flags"][0][:200] + more
         if r.get("silent"):
             detail = "SILENT: " + "; ".join(r["silent"]) + (f" ({detail})" if detail else "")
+        elif r.get("flagged_failures"):
+            detail = "flagged, and: " + "; ".join(r["flagged_failures"]) + f" ({detail})"
         extra = []
         for key, name in (("restitution", "e"), ("final_energy_fraction", "final energy"),
                           ("peak_contact_voltage", "peak V"), ("arc_energy", "arc J"), ("bounces", "bounces")):
