@@ -112,6 +112,9 @@ def cases() -> list[tuple[str, str, dict]]:
     add("circuit", "wiring 10 mH", coupled({"circuit.wiring_inductance": 1e-2}))
     add("circuit", "inductive load 12 ohm, 10 mH, with arc",
         coupled({"circuit.template": "inductive", "circuit.load_inductance": 1e-2}))
+    add("circuit", "inductive load 12 ohm, 10 mH, arc with breakdown at 300 V",
+        coupled({"circuit.template": "inductive", "circuit.load_inductance": 1e-2,
+                 "circuit.arc": {"column_gradient": 2000.0, "breakdown_voltage": 300.0}}))
     add("circuit", "inductive load 12 ohm, 10 mH, no arc",
         coupled({"circuit.template": "inductive", "circuit.load_inductance": 1e-2, "circuit.arc": False}))
     fine = {"reference_changes": {"coupling.macro_step": 2.5e-6}}
