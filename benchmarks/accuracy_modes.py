@@ -13,6 +13,7 @@ from accuracy_common import Section, dump, errors_against, fmt, mech_metrics, me
 
 BARS = {
     "slender (6 mm x 0.3 m, 3 mm tips)": {"length": 0.3, "diameter": 0.006, "tip_radius": 0.003},
+    "paper's link (10 mm x 0.3 m, 5 mm tips)": {"length": 0.3, "diameter": 0.01, "tip_radius": 0.005},
     "stocky (20 mm x 0.1 m, 10 mm tips)": {"length": 0.1, "diameter": 0.02, "tip_radius": 0.01},
 }
 MODES = (1, 2, 3, 5, 7, 10, 14, 20, 28, 40)
@@ -35,7 +36,7 @@ def main() -> None:
             "sequence: contact and bounce counts and the contact-state mismatch time (both tips).", "")
     rows, data = [], {}
     p = plt()
-    fig, axes = p.subplots(1, 2, figsize=(12, 4.5))
+    fig, axes = p.subplots(1, len(BARS), figsize=(17, 4.5))
     for b, (label, bar) in enumerate(BARS.items()):
         ref_res, ref_wall = run_mech(scene(bar, REFERENCE))
         ref = mech_metrics(ref_res)
