@@ -6,7 +6,7 @@ VENV    := .venv
 STAMP   := $(VENV)/.installed
 OUT     ?= runs/default
 
-.PHONY: run test setup bench clean
+.PHONY: run test setup bench accuracy clean
 
 run: $(STAMP)
 	$(VENV)/bin/switchsim run --out $(OUT)
@@ -25,6 +25,11 @@ $(STAMP): pyproject.toml scripts/install-system-deps
 
 bench: $(STAMP)
 	for b in benchmarks/bench_*.py; do $(VENV)/bin/python $$b || exit 1; done
+
+# Regenerates docs/accuracy.md and its plots in docs/accuracy/ (~15 min on a loaded 2-core box)
+accuracy: $(STAMP)
+	for p in mech modes coupling circuit matrix; do $(VENV)/bin/python benchmarks/accuracy_$$p.py || exit 1; done
+	$(VENV)/bin/python benchmarks/accuracy_report.py
 
 clean:
 	rm -rf $(VENV) runs

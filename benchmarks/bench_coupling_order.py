@@ -23,22 +23,25 @@ from coupling.monolithic import run_monolithic
 SCENE = Path(__file__).resolve().parents[1] / "tests" / "coupling" / "scenes" / "impact_inrush.toml"
 
 
-def main() -> None:
-    base = load_scene(SCENE)
+STEPS = (8e-5, 4e-5, 2e-5, 1e-5, 5e-6, 2.5e-6, 1.25e-6, 6.25e-7)
+SCHEMES = ("mechanics_first", "jacobi")
+
+
+def reference(base):
+    """(monolithic CoupledResult, wall s)."""
     tick = time.perf_counter()
     ref = run_monolithic(base)
-    t_ref = time.perf_counter() - tick
+    return ref, time.perf_counter() - tick
+
+
+def study(base, ref, schemes=SCHEMES, steps=STEPS):
+    """One co-simulation per scheme and macro step against the monolithic ``ref``: yields
+    dicts with scheme, h (s), the CoupledResult, wall (s), speed error (m/s), RMS current error (A)."""
     href, wref = ref.mechanics.history, ref.waveforms
     grid = np.linspace(0.01, 1.0, 600) * base.t_end
-    print(f"monolithic reference (Radau, rtol {base.mech.solver.rtol:g}): {t_ref:.2f} s, "
-          f"{ref.mechanics.stats['steps']} steps")
-    print()
-    print("| scheme | macro step | speed error (m/s) | RMS current error (A) | wall time | macro steps |")
-    print("|---|---|---|---|---|---|")
     run(base)  # warm-up
-    errors: dict = {}
-    for scheme in ("mechanics_first", "jacobi"):
-        for h in (8e-5, 4e-5, 2e-5, 1e-5, 5e-6, 2.5e-6, 1.25e-6, 6.25e-7):
+    for scheme in schemes:
+        for h in steps:
             sc = base.set("coupling.scheme", scheme).set("coupling.macro_step", h)
             tick = time.perf_counter()
             r = run(sc)
@@ -47,8 +50,23 @@ def main() -> None:
             dv = np.max(np.abs(np.interp(grid, hh.time, hh.vx) - np.interp(grid, href.time, href.vx)))
             di = np.sqrt(np.mean((np.interp(grid, w.time, w.load_current)
                                   - np.interp(grid, wref.time, wref.load_current)) ** 2))
-            print(f"| {scheme} | {h * 1e6:g} us | {dv:.2e} | {di:.2e} | {wall * 1e3:.0f} ms | {r.stats['macro_steps']} |")
-            errors.setdefault(scheme, []).append((h, dv))
+            yield dict(scheme=scheme, h=h, result=r, wall=wall, speed_error=float(dv), current_error=float(di))
+
+
+def main() -> None:
+    base = load_scene(SCENE)
+    ref, t_ref = reference(base)
+    print(f"monolithic reference (Radau, rtol {base.mech.solver.rtol:g}): {t_ref:.2f} s, "
+          f"{ref.mechanics.stats['steps']} steps")
+    print()
+    print("| scheme | macro step | speed error (m/s) | RMS current error (A) | wall time | macro steps |")
+    print("|---|---|---|---|---|---|")
+    errors: dict = {}
+    for row in study(base, ref):
+        scheme, h, r = row["scheme"], row["h"], row["result"]
+        print(f"| {scheme} | {h * 1e6:g} us | {row['speed_error']:.2e} | {row['current_error']:.2e} | "
+              f"{row['wall'] * 1e3:.0f} ms | {r.stats['macro_steps']} |")
+        errors.setdefault(scheme, []).append((h, row["speed_error"]))
     for scheme, pairs in errors.items():
         hs, es = np.array(pairs).T
         print(f"observed order ({scheme}, speed error, least squares over all steps): "

@@ -21,6 +21,8 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--overwrite", action="store_true",
                      help="replace a non-empty --out folder that is not a previous result of this scene")
     run.add_argument("--quiet", action="store_true", help="no progress output (the result lines stay)")
+    run.add_argument("--check", action="store_true",
+                     help="rerun refined (modes, rtol, macro step, RELTOL) and report the error (summary.accuracy)")
 
     fit = sub.add_parser("fit", help="fit gamma, mu(I) and R_c(F_n, I) to tribometer data")
     fit.add_argument("data", help="tribometer CSV (see docs/tribology.md for its form)")
@@ -42,7 +44,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "run":
             from coupling.commands import run_command
 
-            return run_command(args.scene, args.out, quiet=args.quiet, overwrite=args.overwrite)
+            return run_command(args.scene, args.out, quiet=args.quiet, overwrite=args.overwrite, check=args.check)
         if args.command == "fit":
             from coupling.tribology.command import fit_command
 

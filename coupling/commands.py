@@ -23,7 +23,7 @@ def default_out(scene_path: str | None) -> str:
 
 
 def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = False,
-                overwrite: bool = False) -> int:
+                overwrite: bool = False, check: bool = False) -> int:
     from .master import CoupledRunError, RunInterrupted, run
     from .output import ResultFolder, scene_identity
     from .scene import default_scene, load_scene
@@ -37,7 +37,7 @@ def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = Fa
     out = folder.path
     _chatter(quiet, f"running {scene.name} ({scene.kind}, t_end = {scene.t_end * 1e3:g} ms)")
     try:
-        result = run(scene, progress=not quiet)
+        result = run(scene, progress=not quiet, check=check)
     except RunInterrupted as err:
         return _write_partial(folder, err.partial, extra, f"{err}", EXIT_INTERRUPTED)
     except CoupledRunError as err:
@@ -99,6 +99,8 @@ def _result_lines(summary: dict) -> None:
         print(f"switchsim: flag: {flag}")
     for line in summary.get("warnings", []):  # coupling.diagnostics
         print(f"switchsim: warning: {line}")
+    if "accuracy" in summary:  # --check
+        print(f"switchsim: accuracy: {summary['accuracy']['verdict']}")
     sys.stdout.flush()
 
 

@@ -462,8 +462,13 @@ def _coupling_current(step) -> float:
     return current if np.isfinite(current) else float(step.contact_current)
 
 
-def run(scene: Scene, *, progress: bool = False) -> CoupledResult:
-    """Run any scene: mechanics only, circuit only (prescribed schedule) or coupled."""
+def run(scene: Scene, *, progress: bool = False, check: bool = False) -> CoupledResult:
+    """Run any scene: mechanics only, circuit only (prescribed schedule) or coupled.
+    check: also rerun it refined and write summary.accuracy (coupling/accuracy.py)."""
+    if check:
+        from .accuracy import run_checked
+
+        return run_checked(scene, progress=progress)
     if scene.kind == "coupled":
         return CoSimulation(scene, progress=progress).run()
     if scene.kind == "mechanics":
