@@ -140,9 +140,14 @@ class CoSimulation:
         try:
             with stepper:
                 while t < t_end * (1.0 - 1e-14):
-                    touching = jump_since_prev or bool(np.any(mech.friction_engaged())) or bool(
-                        np.any(mech.contact_now()[:, 0] > 0.0))
+                    # a bar held at rest (mech: loads constant, contacts quiet) changes nothing
+                    # the circuit sees until the hold ends: the long step, up to that end
+                    resting = mech.at_rest and not jump_since_prev
+                    touching = not resting and (jump_since_prev or bool(np.any(mech.friction_engaged())) or bool(
+                        np.any(mech.contact_now()[:, 0] > 0.0)))
                     t_next = policy.base_end(t, t_end, touching)
+                    if resting and mech.hold_until < t_next:
+                        t_next = mech.hold_until
                     if opts.scheme == "jacobi":
                         i_now, t = self._jacobi_step(mech, stepper, rl, t, t_next, i_now)
                     else:

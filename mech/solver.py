@@ -432,6 +432,17 @@ class ImpactSolver:
         result[order] = out
         return result
 
+    @property
+    def at_rest(self) -> bool:
+        """True while the bar is held at rest (see _watch_rest): nothing in it changes before
+        ``hold_until`` unless mu changes enough to unstick a contact."""
+        return self._hold_until > self.t
+
+    @property
+    def hold_until(self) -> float:
+        """s: when the current hold at rest ends (the next load or base change; inf: none)."""
+        return self._hold_until if self.at_rest else self.t
+
     def friction_engaged(self) -> np.ndarray:
         """(2,) bool: each contact point is sliding or sticking (in a friction regime) now."""
         return self.regime != FREE
