@@ -93,7 +93,7 @@ def _result_lines(summary: dict) -> None:
               f"peak contact voltage {peak or 0:.3g} V, arc energy {b.get('arc_energy') or 0:.3g} J")
     if "contacts" in summary:
         residual = summary.get("energy", {}).get("relative_residual")
-        print(f"switchsim: {len(summary['contacts'])} tip contact(s), first restitution "
+        print(f"switchsim: {len(summary['contacts'])} contact(s), first restitution "
               f"{summary.get('restitution')}, energy residual {residual if residual is None else f'{residual:.2g}'}")
     for flag in summary.get("flags", []):
         print(f"switchsim: flag: {flag}")

@@ -344,7 +344,7 @@ def test_quiet_keeps_the_result_lines_and_drops_the_chatter(tmp_path, capsys):
     loud = capsys.readouterr()
     assert main(["run", str(scene), "--out", str(tmp_path / "quiet"), "--quiet"]) == 0
     quiet = capsys.readouterr()
-    assert "tip contact(s)" in quiet.out and quiet.out == loud.out
+    assert "contact(s), first restitution" in quiet.out and quiet.out == loud.out
     assert "running" in loud.err and "running" not in quiet.err
 
 
