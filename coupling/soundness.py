@@ -32,7 +32,6 @@ import math
 
 import numpy as np
 
-from mech.kernel import A_Y
 
 BOUND_MARGIN = 0.01  # relative slack on the energy-derived bounds
 RINGING_FACTOR = 2.0  # a passive loop's step response reaches at most twice its final value
@@ -118,7 +117,7 @@ def assess(result) -> dict:
         residual = float(np.max(np.abs(mres.energy_table.residual.to_numpy())))
         # from the records themselves, not the history table (a long run's table is large)
         speed = float(np.max(np.linalg.norm(mres.states[:, mres.model.slices()["vel"]], axis=1)))
-        pen = float(max(np.max(mres.aux[:, :, A_Y]), 0.0))
+        pen = mres.deepest_penetration
         v_max = speed_bound(scale, scene.bar.mass)
         y_max = penetration_bound(scale, float(mres.solver["stiffness"]), scene.bar.mass * scene.gravity)
         kinetic = float(mres.energy_table.kinetic.max())

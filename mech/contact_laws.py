@@ -60,7 +60,7 @@ def hertz_impact(mass: float, stiffness: float, speed: float) -> HertzImpact:
 
 
 # Hunt-Crossley-type laws write the damping as c = chi k / v0 with beta = 1.5; their
-# published chi(e) are approximations (NOTES.md: target 0.6 gives 0.712, 0.756, 0.577).
+# published chi(e) are approximations (measured: target 0.6 gives 0.712, 0.756, 0.577).
 _CHI_FORMULAS = {
     "hunt_crossley": lambda e: 1.5 * (1.0 - e),
     "lankarani_nikravesh": lambda e: 0.75 * (1.0 - e * e),

@@ -5,7 +5,7 @@ failure, and returns to Python, which switches regimes and restarts. Events are
 located on the 4th-order continuous extension by the Illinois method; the returned
 time is the end of the final bracket, so the state is on the new side of the event.
 
-Why compiled: NOTES.md measured 40-150 us of Python per solve_ivp step against ~1 us
+Why compiled: a measurement on this kind of machine gave 40-150 us of Python per solve_ivp step against ~1 us
 for this right-hand side; benchmarks/bench_mech.py re-measures the ratio.
 """
 

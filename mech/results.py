@@ -299,6 +299,11 @@ class ImpactResult:
         return max(e_in + work + m.basis.mass * scene.gravity * drop, 1e-300)
 
     @property
+    def deepest_penetration(self) -> float:
+        """m: the deepest penetration of any contact point into the block over the run (0: none)."""
+        return float(max(np.max(self.aux[:, :, A_Y]), 0.0)) if len(self.aux) else 0.0
+
+    @property
     def flags(self) -> list[str]:
         """Warnings about this result (energy residual above tolerance, invalid contact geometry)."""
         out = []

@@ -45,7 +45,7 @@ def test_calibrated_damping_gives_the_target_restitution_in_the_full_solver(law)
     ("hunt_crossley", 0.712), ("lankarani_nikravesh", 0.756), ("flores", 0.577),
 ])
 def test_closed_form_damping_formulas_miss_the_target_as_the_notes_measured(law, obtained):
-    # NOTES.md: target 0.6 -> 0.712 (Hunt-Crossley), 0.756 (Lankarani-Nikravesh), 0.577 (Flores).
+    # Measured: target 0.6 -> 0.712 (Hunt-Crossley), 0.756 (Lankarani-Nikravesh), 0.577 (Flores).
     k = steel_stiffness(0.005)
     m = 0.185
     c = damping_formula(law, 0.6, V0, k)

