@@ -36,8 +36,8 @@ SEC_J1, SEC_J2, SEC_S, SEC_K, SEC_C, SEC_LAYOUT, SEC_NORM, SEC_GRAM = range(8)
 
 
 @njit(cache=True)
-def _inverse3(A, out):
-    """Inverse of a 3x3 matrix by cofactors."""
+def inverse3(A, out):
+    """Inverse of a 3x3 matrix by cofactors (the Schur complement is symmetric positive definite)."""
     c00 = A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1]
     c01 = A[1, 2] * A[2, 0] - A[1, 0] * A[2, 2]
     c02 = A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]
@@ -249,7 +249,7 @@ def _rotational_rhs(n, m, w, eta, Jm, B, sv, f_r, Amat, Ainv):
                 acc += B[a, j] * B[b, j]
             Amat[a, b] = Jm[a, b] - acc * inv_m
             Amat[b, a] = Amat[a, b]
-    _inverse3(Amat, Ainv)
+    inverse3(Amat, Ainv)
 
 
 @njit(cache=True)
@@ -341,5 +341,5 @@ def inertia_terms_sparse(n, m, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, B, f_e
             for j in range(n):
                 acc += B[a, j] * B[b, j]
             Amat[a, b] = Jm[a, b] - acc * inv_m
-    _inverse3(Amat, Ainv)
+    inverse3(Amat, Ainv)
     return d_modal

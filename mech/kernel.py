@@ -28,7 +28,7 @@ from numba import njit
 
 from .contact_laws import normal_force
 from .friction import friction_limit, regularized_scale
-from .inertia import inertia_matrix, inertia_terms, inertia_terms_sparse
+from .inertia import inertia_matrix, inertia_terms, inertia_terms_sparse, inverse3
 
 # fpar indices (F_K, F_C, F_RTIP: the first contact point's values, kept for the scales;
 # the kernel reads each contact point's own from cpar)
@@ -133,25 +133,6 @@ def unpack(y, n, planar, r, R, q, V, w, eta):
             w[i] = y[10 + n + i]
         for j in range(n):
             eta[j] = y[13 + n + j]
-
-
-@njit(cache=True)
-def inverse3(A, out):
-    """Inverse of a 3x3 matrix by cofactors (the Schur complement is symmetric positive definite)."""
-    c00 = A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1]
-    c01 = A[1, 2] * A[2, 0] - A[1, 0] * A[2, 2]
-    c02 = A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]
-    det = A[0, 0] * c00 + A[0, 1] * c01 + A[0, 2] * c02
-    inv = 1.0 / det
-    out[0, 0] = c00 * inv
-    out[1, 0] = c01 * inv
-    out[2, 0] = c02 * inv
-    out[0, 1] = (A[0, 2] * A[2, 1] - A[0, 1] * A[2, 2]) * inv
-    out[1, 1] = (A[0, 0] * A[2, 2] - A[0, 2] * A[2, 0]) * inv
-    out[2, 1] = (A[0, 1] * A[2, 0] - A[0, 0] * A[2, 1]) * inv
-    out[0, 2] = (A[0, 1] * A[1, 2] - A[0, 2] * A[1, 1]) * inv
-    out[1, 2] = (A[0, 2] * A[1, 0] - A[0, 0] * A[1, 2]) * inv
-    out[2, 2] = (A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]) * inv
 
 
 @njit(cache=True)

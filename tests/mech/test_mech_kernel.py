@@ -317,3 +317,17 @@ def test_accelerations_at_rest_solve_brute_force_mass_matrix_with_virtual_work_f
                 F[0:2] = -limit * eref[tip]
             Q += contact_point_jacobian(model, q, R, tip).T @ F
         np.testing.assert_allclose(M @ udot, Q, rtol=1e-9, atol=1e-9 * np.max(np.abs(Q)))
+
+
+def test_the_compiled_cache_folder_follows_the_mechanics_sources(tmp_path):
+    """A changed source file (any of the package's) must compile afresh: the cache folder's
+    key is a hash of every .py file, so editing one changes it and restoring it restores it."""
+    from mech.compiled_cache import source_key
+
+    for name, text in (("kernel.py", "x = 1\n"), ("integrator.py", "y = 2\n")):
+        (tmp_path / name).write_text(text)
+    before = source_key(tmp_path)
+    (tmp_path / "kernel.py").write_text("x = 3\n")
+    changed = source_key(tmp_path)
+    (tmp_path / "kernel.py").write_text("x = 1\n")
+    assert changed != before and source_key(tmp_path) == before

@@ -1,0 +1,36 @@
+"""Where numba keeps the compiled mechanics: a cache folder keyed by the mechanics' sources.
+
+numba's on-disk cache (``cache=True``) checks each function against its own file only: a
+compiled integrator that inlines the right-hand side of kernel.py is reused after
+kernel.py changed (seen here: a stale cache ran the old inertia route). Keying the folder
+by a hash of every source file of the package makes any change compile afresh; an
+unchanged package reuses its cache. ``configure`` runs when ``mech`` is imported, before
+any compiled function is defined.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parent
+
+
+def source_key(folder: Path = PACKAGE) -> str:
+    """12 hex digits of the SHA-1 of the package's .py files (names and contents, in order)."""
+    digest = hashlib.sha1()
+    for path in sorted(folder.glob("*.py")):
+        digest.update(path.name.encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()[:12]
+
+
+def configure() -> Path:
+    """Point numba's cache at <NUMBA_CACHE_DIR or mech/__pycache__>/numba-<source key>."""
+    import numba
+
+    root = Path(os.environ.get("NUMBA_CACHE_DIR") or PACKAGE / "__pycache__")
+    folder = root / f"numba-{source_key()}"
+    numba.config.CACHE_DIR = str(folder)
+    return folder
