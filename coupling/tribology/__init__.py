@@ -7,6 +7,7 @@ parameters, and `TribometerFit.from_json` for a saved fit. See docs/tribology.md
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 from functools import cache
@@ -52,7 +53,8 @@ def default_fit() -> TribometerFit:
     try:
         doc = json.loads(DEFAULT_FIT_CACHE.read_text())
         if doc.get("key") == default_fit_key():
-            return TribometerFit.from_dict(doc["fit"])
+            # stored without the machine's path to the dataset: it is this installation's
+            return dataclasses.replace(TribometerFit.from_dict(doc["fit"]), source=str(illustrative_data_path()))
     except (OSError, ValueError, KeyError):
         pass
     return fit_tribometer(read_tribometer_csv(illustrative_data_path()))
@@ -62,5 +64,7 @@ def write_default_fit_cache() -> Path:
     """Fit the illustrative dataset and store the fit for default_fit (after changing the
     dataset or the fitting code)."""
     fit = fit_tribometer(read_tribometer_csv(illustrative_data_path()))
-    DEFAULT_FIT_CACHE.write_text(json.dumps({"key": default_fit_key(), "fit": fit.to_dict()}, indent=1) + "\n")
+    doc = fit.to_dict()
+    doc["source"] = "coupling/data/" + illustrative_data_path().name  # default_fit puts the installed path back
+    DEFAULT_FIT_CACHE.write_text(json.dumps({"key": default_fit_key(), "fit": doc}, indent=1) + "\n")
     return DEFAULT_FIT_CACHE
