@@ -371,16 +371,24 @@ class ImpactSolver:
         Order of the modes: ``self.model.basis.families``/``orders``. The run's first
         record and the regimes are redone for the new state.
         """
+        self.start_from(**{name: value for name, value in (("q", q), ("eta", eta)) if value is not None})
+
+    def start_from(self, **parts) -> None:
+        """Overwrite named parts of the initial state before integrating: any key of
+        ``model.slices()`` except "quad" (pos, angle or quat, q, vel, omega, eta; SI, the
+        solver's frame). For what a scene cannot say: a modal initial condition, a start
+        already in contact. The run's first record and the regimes are redone."""
         if self.t != 0.0 or self._n != 1:
-            raise ValueError("set_modal_state: only before the first advance")
+            raise ValueError("start_from: only before the first advance")
         sl = self.model.slices()
-        n = self.model.n
-        for name, value in (("q", q), ("eta", eta)):
-            if value is None:
-                continue
-            arr = np.asarray(value, dtype=float)
-            if arr.shape != (n,) or not np.all(np.isfinite(arr)):
-                raise ValueError(f"{name}: expected {n} finite numbers (one per mode), got {value!r}")
+        for name, value in parts.items():
+            if name not in sl or name == "quad":
+                raise ValueError(f"start_from: unknown part {name!r}; allowed: "
+                                 f"{', '.join(k for k in sl if k != 'quad')}")
+            size = sl[name].stop - sl[name].start
+            arr = np.asarray(value, dtype=float).reshape(-1)
+            if arr.shape != (size,) or not np.all(np.isfinite(arr)):
+                raise ValueError(f"{name}: expected {size} finite number(s), got {value!r}")
             self.y[sl[name]] = arr
         self._initial_state = self.y.copy()
         self._n = 0

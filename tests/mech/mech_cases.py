@@ -38,22 +38,9 @@ def make_scene(*, bar=None, block=None, contact=None, friction=None, initial=Non
 
 
 def start_from(solver: ImpactSolver, **parts) -> ImpactSolver:
-    """Overwrite named parts of the solver's initial state (keys of ``model.slices()``:
-    pos, quat/angle, q, vel, omega, eta) and record it as the start of the history.
-
-    The scene format only describes a rigid bar at rest on its modes; a modal initial
-    condition or a start already in contact needs the state set directly. This uses the
-    solver's private recording (``_resolve``, ``_n``, ``_record_point``) because mech has
-    no public way to do it (reported to the lead).
-    """
-    if solver._n != 1 or solver.t != 0.0:
-        raise RuntimeError("start_from: only before the solver has advanced")
-    sl = solver.model.slices()
-    for name, value in parts.items():
-        solver.y[sl[name]] = value
-    solver._resolve(triggered=None)
-    solver._n = 0
-    solver._record_point()
+    """Overwrite named parts of the solver's initial state (ImpactSolver.start_from) and
+    return the solver."""
+    solver.start_from(**parts)
     return solver
 
 
