@@ -7,6 +7,7 @@ give the rigid bar, and zero friction switches the tangential machinery off.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -286,7 +287,7 @@ class BarModel:
                 out.append((None, 0.0))
         return out + [(None, 0.0)] * (2 - len(out))
 
-    @property
+    @functools.cached_property
     def rest_window(self) -> float:
         """s: how long a contact must stay quiet before the solver holds it at rest: two
         periods of the slowest oscillation it could still hide (the lowest elastic mode,

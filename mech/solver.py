@@ -242,11 +242,13 @@ class ImpactSolver:
         if not math.isfinite(t_target) or t_target < self.t:
             raise ValueError(f"t_target = {t_target!r}: must be a finite time >= the current {self.t!r} s")
         if mu is not None:
+            fpar = self.model.fpar
+            mu_now = fpar[F_MU0] + fpar[F_MU_SLOPE] * (self.t - fpar[F_T_MU])
             if np.ndim(mu) == 0:
                 self.set_friction_coefficient(float(mu))
             else:
                 self.set_friction_coefficient(float(mu[0]), float(mu[1]), t_target)
-            if self.model.ipar[I_FRICTION] == FRICTION_EXACT:
+            if self.model.ipar[I_FRICTION] == FRICTION_EXACT and fpar[F_MU0] != max(mu_now, 0.0):
                 self._resolve(triggered=None)  # a new mu may change what can stick
         n_first = self._n
         ev_first = len(self.events)
