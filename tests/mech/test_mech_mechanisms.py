@@ -212,3 +212,26 @@ def test_free_bar_through_the_finite_element_route_matches_the_analytic_route():
 def test_bad_mechanism_input_is_a_named_error(over, message):
     with pytest.raises(ValueError, match=message.replace("[", r"\[").replace("]", r"\]").replace(".", r"\.")):
         scene_from_dict(blade(**over))
+
+
+def test_a_settled_blade_is_held_for_a_second_at_its_static_force_without_chatter():
+    """A contact at rest is the end of a closure: over 1 s the solver holds it (no event
+    chatter, a bounded number of steps) at the force the beam statics give."""
+    P, g = 2.0, 1e-4
+    doc = blade(force=[dict(position=0.01, magnitude=P)], solver=dict(t_end=1.0),
+                bar=dict(length=0.02, width=0.003, thickness=0.0003, tip_radius=0.0016, **STEEL,
+                         modes={"axial": 0, "bending": 10}, modal_damping=0.3))
+    solver = ImpactSolver(scene_from_dict(doc))
+    res = solver.run()
+    assert solver.holds and solver.holds[0][1] == math.inf  # held to the end: nothing changes
+    assert solver.holds[0][0] < 0.05
+    E, I = 210e9, 0.003 * 0.0003**3 / 12
+    a, b = 0.01, 0.02 - 0.0015
+    k = hertz_stiffness(0.0015, 210e9, 0.3, 210e9, 0.3)
+    R = brentq(lambda R: P * a**2 * (3 * b - a) / (6 * E * I) - R * b**3 / (3 * E * I) - g - (R / k) ** (2 / 3),
+               0.0, P)
+    assert res.history.normal_force_0.iloc[-1] == pytest.approx(R, rel=5e-3)
+    # the work it took: the settling, not the second it is held (a whole second at the
+    # settling's step would be > 1e5 steps)
+    assert res.stats["steps"] < 20_000 and len(res.events) < 200
+    assert abs(res.energy_table.residual.iloc[-1]) < 1e-3 * res.energy_scale
