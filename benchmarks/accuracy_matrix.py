@@ -40,9 +40,9 @@ def coupled(changes: dict, checks: dict | None = None) -> dict:
     """The built-in default coupled scene (arc, 24 V, 12 ohm), 20 um above the block, 2 ms."""
     import tomllib
 
-    from coupling.scene import default_scene_text
+    from coupling.scene import builtin_scene_text
 
-    doc = tomllib.loads(default_scene_text())
+    doc = tomllib.loads(builtin_scene_text("free_drop"))
     doc["initial"]["height"] = 2e-5
     doc["solver"]["t_end"] = 2e-3
     doc["output"] = {"plots": False, "csv": False, "parquet": False}

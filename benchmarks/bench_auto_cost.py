@@ -39,7 +39,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     args = ap.parse_args()
-    base = coupling.default_scene()
+    base = coupling.builtin_scene("free_drop")  # the former default coupled scene
     rows = []
     for label, value in (("auto", "auto"), ("3", 3)):
         sc = base.set("bar.modes", value)
