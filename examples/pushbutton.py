@@ -87,6 +87,28 @@ def lever_statics(sc) -> dict:
                 friction_band=mu * force(th) * depth / d)
 
 
+def rigid_lever_make(sc) -> float:
+    """s: when the rigid lever, I th'' = (F(t) d_F + weights) cos th - k_t th - c th' from
+    rest, brings the rivet onto the pad (scipy's solve_ivp, independent of mech)."""
+    from scipy.integrate import solve_ivp
+    m = sc.mech
+    bar, rv, f, mnt = m.bar, m.rivets[0], m.forces[0], m.mount
+    m_bar = bar.density * bar.area * bar.length
+    d, h, d_f = abs(mnt.position - rv.position), rv.offset, abs(mnt.position - f.position)
+    inertia = m_bar * (bar.length**2 / 3 + bar.thickness**2 / 12) + rv.mass * (d * d + h * h + 0.4 * rv.radius**2)
+    weights = m.gravity * (m_bar * abs(mnt.position - 0.5 * bar.length) + rv.mass * d)
+
+    def rhs(t, y):
+        torque = (np.interp(t, f.time, f.value) * d_f + weights) * math.cos(y[0]) + mnt.preload_torque
+        return [y[1], (torque - mnt.stiffness * y[0] - mnt.damping * y[1]) / inertia]
+
+    def touch(t, y):
+        return d * math.sin(y[0]) + h * (1 - math.cos(y[0])) - m.initial.height
+    touch.terminal, touch.direction = True, 1
+    sol = solve_ivp(rhs, (0.0, sc.t_end), [0.0, 0.0], events=touch, rtol=1e-10, atol=1e-14)
+    return float(sol.t_events[0][0]) if len(sol.t_events[0]) else float("nan")
+
+
 def analyse(name: str, result, release: float) -> dict:
     b = result.bounce
     closed = [(a, e) for a, e in result.closed_intervals if a < release]
@@ -149,6 +171,7 @@ def main(fast: bool = False, out: str | Path | None = None) -> dict:
     results = {name: run(sc) for name, sc in scenes.items()}
     results["with friction"].save(out)
     numbers = dict(release_start=release, statics=lever_statics(scenes["with friction"]),
+                   rigid_lever_make=rigid_lever_make(scenes["with friction"]),
                    variants=[analyse(k, r, release) for k, r in results.items()])
     plot(results, out)
     (out / "example.json").write_text(json.dumps(numbers, indent=2))
@@ -160,7 +183,8 @@ def _summary(n: dict) -> str:
     lines = [f"rigid lever at rest: angle {math.degrees(s['angle']):.3f} deg, finger torque "
              f"{s['finger_torque'] * 1e3:.3f} mN m, return spring {s['spring_torque'] * 1e3:.3f} mN m, arm "
              f"{s['arm'] * 1e3:.3f} mm: contact force R0 = {s['contact_force']:.4f} N "
-             f"(friction band +-{s['friction_band']:.4f} N)"]
+             f"(friction band +-{s['friction_band']:.4f} N); the rigid lever touches at "
+             f"{n['rigid_lever_make'] * 1e3:.4f} ms"]
     for v in n["variants"]:
         lines.append(f"{v['variant']}: {v['closing_bounces']} bounce(s), first make {v['first_make'] * 1e3:.3f} ms, "
                      f"settle time {v['settle_time'] * 1e3:.3f} ms; held force {v['held_force']:.4f} N at "
