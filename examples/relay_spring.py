@@ -151,15 +151,16 @@ def plot(results: dict, out: Path) -> list[Path]:
     first = min(r.bounce["first_make"] for r in shown.values())
     last = max(r.bounce["last_make"] for r in shown.values())
     pad = 0.1 * (last - first) + 50e-6
-    fig, axes = plt.subplots(2, 1, sharex=True, figsize=(9, 6.5))
-    for k, r in shown.items():
+    n = len(shown)
+    fig, axes = plt.subplots(n + 1, 1, sharex=True, figsize=(9, 2.4 * (n + 1)))
+    for row, (k, r) in enumerate(shown.items()):
         w = r.waveforms
         sel = (w.time >= first - pad) & (w.time <= last + pad)
-        axes[0].plot(w.time[sel] * 1e3, w.contact_voltage[sel], lw=0.9, label=k)
-        axes[1].plot(w.time[sel] * 1e3, w.normal_force[sel], lw=0.9, label=k)
-    axes[0].set_ylabel("contact voltage (V)")
-    axes[1].set_ylabel("contact force (N)")
-    axes[1].set_xlabel("time (ms)")
+        axes[row].plot(w.time[sel] * 1e3, w.contact_voltage[sel], lw=0.8, color=f"C{row}", label=k)
+        axes[row].set_ylabel("contact voltage (V)")
+        axes[n].plot(w.time[sel] * 1e3, w.normal_force[sel], lw=0.9, color=f"C{row}", label=k)
+    axes[n].set_ylabel("contact force (N)")
+    axes[n].set_xlabel("time (ms)")
     axes[0].set_title("relay contact spring closing: 24 V, 10 ohm against 10 ohm + 10 mH")
     for ax in axes:
         ax.grid(alpha=0.3)
