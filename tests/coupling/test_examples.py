@@ -394,3 +394,213 @@ def test_paper_flexible_bar_rebounds_lower_than_the_rigid_bar(paper):
     for png in ("tip_velocity_1A.png", "friction_resistance_vs_load.png", "mu_vs_current.png"):
         assert (out / png).stat().st_size > 0
     assert json.loads((out / "example.json").read_text()).keys() == numbers.keys()
+
+
+# --- relay_spring -------------------------------------------------------------------------
+
+
+def _relay_closed_form(doc: dict, gravity: float = 9.80665) -> tuple[float, float]:
+    """(R0 N, relative friction band) of the relay blade: cantilever statics + Hertz of the
+    rivet pair, from the TOML's values alone."""
+    from scipy.optimize import brentq
+    bar, rv, blk, f = doc["bar"], doc["rivet"][0], doc["block"], doc["force"][0]
+    clamp = doc["mount"]["position"]
+    EI = bar["youngs_modulus"] * bar["width"] * bar["thickness"] ** 3 / 12.0
+    a, b, span = clamp - f["position"], clamp - rv["position"], clamp
+    e_star = 1.0 / ((1 - rv["poisson_ratio"] ** 2) / rv["youngs_modulus"]
+                    + (1 - blk["poisson_ratio"] ** 2) / blk["youngs_modulus"])
+    k = 4.0 / 3.0 * e_star * math.sqrt(rv["radius"] * blk["radius"] / (rv["radius"] + blk["radius"]))
+    q = bar["density"] * bar["width"] * bar["thickness"] * gravity
+    P = max(f["value"])
+    w_free = (P * a * a * (3 * b - a) / (6 * EI) + q * b * b * (6 * span**2 - 4 * span * b + b * b) / (24 * EI)
+              + rv["mass"] * gravity * b**3 / (3 * EI))
+    R0 = brentq(lambda R: w_free - R * b**3 / (3 * EI) - doc["initial"]["height"] - (R / k) ** (2 / 3), 0.0, 10 * P)
+    band = doc["tribology"]["mu"] * (abs(rv["offset"]) + rv["radius"]) * 1.5 / b
+    return R0, band
+
+
+@pytest.fixture(scope="module")
+def relay_spring(tmp_path_factory):
+    return _run(tmp_path_factory, "relay_spring")
+
+
+def test_relay_spring_held_force_is_beam_statics(relay_spring):
+    numbers, _ = relay_spring
+    R0, band = _relay_closed_form(_toml("relay_spring"))
+    v = {row["variant"]: row for row in numbers["variants"]}
+    # friction made negligible: the closed form itself (residual ringing averaged over 0.5 ms)
+    assert v["resistive, frictionless, closing only"]["held_force"] == pytest.approx(R0, rel=5e-3)
+    # with mu = 0.3 the rivet's tangential force bends the blade too: within the friction band
+    for name in ("resistive", "inductive"):
+        assert abs(v[name]["held_force"] / R0 - 1.0) <= band * 1.02
+        assert v[name]["settled"] and v[name]["closing_bounces"] >= 1
+
+
+def test_relay_spring_loads_and_break(relay_spring):
+    numbers, _ = relay_spring
+    doc = _toml("relay_spring")
+    c = doc["circuit"]
+    E, R = c["voltage"], _series_resistance(c)
+    v = {row["variant"]: row for row in numbers["variants"]}
+    res, ind = v["resistive"], v["inductive"]
+    # the mechanics does not see the load: same makes and bounces
+    assert res["first_make"] == pytest.approx(ind["first_make"], abs=1e-9)
+    assert res["closing_bounces"] == ind["closing_bounces"]
+    # first make: the quasi-static time, when the ramped armature force's static deflection
+    # at the rivet reaches the gap, give or take the blade's dynamic lag: each mode's response
+    # to a ramp, r (t - sin(w t)/w), differs from the static one by at most r/w, so the make
+    # lies within 1/w1 (w1: the bare blade's clamped-free fundamental, the rivet lowers it)
+    bar, rv, f = doc["bar"], doc["rivet"][0], doc["force"][0]
+    clamp = doc["mount"]["position"]
+    EI = bar["youngs_modulus"] * bar["width"] * bar["thickness"] ** 3 / 12.0
+    a, b = clamp - f["position"], clamp - rv["position"]
+    p_make = doc["initial"]["height"] * 6 * EI / (a * a * (3 * b - a))
+    t_qs = np.interp(p_make, f["value"][:2], f["time"][:2])
+    w1 = 1.875104**2 / clamp**2 * math.sqrt(EI / (bar["density"] * bar["width"] * bar["thickness"]))
+    assert abs(res["first_make"] - t_qs) < 1.0 / w1
+    # both open after the release and end open
+    for row in (res, ind):
+        assert row["final_state"] == "open"
+        assert row["break_time"] > numbers["release_start"]
+    # the coil current builds with L/R: while the contact bounces (within ~1 ms of the
+    # first make) it is far below E/R, so the bounce gaps draw much less arc energy
+    # than the resistive load's
+    assert ind["bounce_arc_energy"] < 0.1 * res["bounce_arc_energy"]
+    # at the break the coil carries its full current E/(R + R_c), at most E/R
+    assert ind["current_at_break"] <= E / R * 1.001
+    assert ind["current_at_break"] > 0.95 * E / R
+    # energy of the break: while the arc burns, E i - R i^2 >= 0 (i <= E/R), so the supply
+    # pays at least the load's losses and the arc takes at least what the coil gives up
+    # from the break current to I_min, 1/2 L (I^2 - I_min^2), less what the gap
+    # capacitance holds at the peak (1/2 C V^2)
+    L = 10e-3
+    arc = c["arc"]
+    bound = 0.5 * L * (ind["current_at_break"] ** 2 - arc["min_current"] ** 2) \
+        - 0.5 * c["contact_capacitance"] * ind["break_peak_voltage"] ** 2
+    assert ind["break_arc_energy"] >= bound
+    assert ind["break_arc_energy"] > res["break_arc_energy"]
+    # resistive break: the wiring's ringing after the arc goes out is bounded by E + I_min sqrt(L/C)
+    bound = E + arc["min_current"] * math.sqrt(c["wiring_inductance"] / c["contact_capacitance"])
+    assert res["break_peak_voltage"] <= bound
+    # the coil's chopped current is clamped by the gap's breakdown, at most the breakdown of the largest gap
+    assert ind["break_peak_voltage"] > bound
+    assert ind["break_peak_voltage"] <= E + arc["min_current"] * math.sqrt(L / c["contact_capacitance"])
+
+
+# --- pushbutton ---------------------------------------------------------------------------
+
+
+def _lever_closed_form(doc: dict, gravity: float = 9.80665) -> tuple[float, float, float]:
+    """(angle rad, R0 N, friction band N) of the rigid lever at rest, from the TOML alone."""
+    from scipy.optimize import brentq
+    bar, rv, blk, f, mnt = doc["bar"], doc["rivet"][0], doc["block"], doc["force"][0], doc["mount"]
+    d, h, g = mnt["position"] - rv["position"], rv["offset"], doc["initial"]["height"]
+    e_star = 1.0 / ((1 - rv["poisson_ratio"] ** 2) / rv["youngs_modulus"]
+                    + (1 - blk["poisson_ratio"] ** 2) / blk["youngs_modulus"])
+    k = 4.0 / 3.0 * e_star * math.sqrt(rv["radius"])
+    m_bar = bar["density"] * bar["width"] * bar["thickness"] * bar["length"]
+    torque = max(f["value"]) * (mnt["position"] - f["position"]) + gravity * (
+        m_bar * (mnt["position"] - bar["length"] / 2) + rv["mass"] * d)
+
+    def R(th):
+        return k * max(d * math.sin(th) + h * (1 - math.cos(th)) - g, 0.0) ** 1.5
+
+    th = brentq(lambda th: torque * math.cos(th) - mnt["stiffness"] * th - R(th) * (d * math.cos(th) + h * math.sin(th)),
+                math.asin(g / d), 0.5)
+    depth = abs(h * math.cos(th) - d * math.sin(th)) + rv["radius"]
+    return th, R(th), doc["tribology"]["mu"] * R(th) * depth / d
+
+
+@pytest.fixture(scope="module")
+def pushbutton(tmp_path_factory):
+    return _run(tmp_path_factory, "pushbutton")
+
+
+def test_pushbutton_held_force_is_the_lever_moment_balance(pushbutton):
+    numbers, _ = pushbutton
+    th, R0, band = _lever_closed_form(_toml("pushbutton"))
+    v = {row["variant"]: row for row in numbers["variants"]}
+    free = v["frictionless"]
+    # (finger torque - spring torque at that angle) / arm, the lever nearly rigid (2 mm steel)
+    assert free["held_angle"] == pytest.approx(th, rel=2e-3)
+    assert free["held_force"] == pytest.approx(R0, rel=2e-3)
+    fr = v["with friction"]
+    assert fr["held_angle"] == pytest.approx(th, rel=2e-3)
+    assert abs(fr["held_force"] - R0) <= band
+    # friction's moment about the hinge accounts for the difference: F_t at the contact
+    # point's depth below the hinge, over the arm
+    depth = abs(_toml("pushbutton")["rivet"][0]["offset"]) + _toml("pushbutton")["rivet"][0]["radius"] \
+        + (_toml("pushbutton")["mount"]["position"] - _toml("pushbutton")["rivet"][0]["position"]) * math.sin(th)
+    arm = _toml("pushbutton")["mount"]["position"] - _toml("pushbutton")["rivet"][0]["position"]
+    assert abs(fr["held_force"] - R0) == pytest.approx(abs(fr["held_friction"]) * depth / arm, rel=0.05)
+
+
+def test_pushbutton_first_make_is_the_rigid_lever_ode(pushbutton):
+    # the lever (2 mm steel) turns as a rigid body until it touches: I th'' = (F(t) d_F +
+    # weights) cos th - k_t th - c th', integrated here independently of mech; the make is
+    # when the rivet reaches the pad
+    from scipy.integrate import solve_ivp
+    numbers, _ = pushbutton
+    doc = _toml("pushbutton")
+    bar, rv, f, mnt = doc["bar"], doc["rivet"][0], doc["force"][0], doc["mount"]
+    g = 9.80665
+    m_bar = bar["density"] * bar["width"] * bar["thickness"] * bar["length"]
+    d, h, d_f = mnt["position"] - rv["position"], rv["offset"], mnt["position"] - f["position"]
+    inertia = m_bar * (bar["length"] ** 2 / 3 + bar["thickness"] ** 2 / 12) + rv["mass"] * (
+        d * d + h * h + 0.4 * rv["radius"] ** 2)
+    weights = g * (m_bar * (mnt["position"] - bar["length"] / 2) + rv["mass"] * d)
+
+    def rhs(t, y):
+        torque = (np.interp(t, f["time"], f["value"]) * d_f + weights) * math.cos(y[0])
+        return [y[1], (torque - mnt["stiffness"] * y[0] - mnt["damping"] * y[1]) / inertia]
+
+    def touch(t, y):
+        return d * math.sin(y[0]) + h * (1 - math.cos(y[0])) - doc["initial"]["height"]
+    touch.terminal, touch.direction = True, 1
+    sol = solve_ivp(rhs, (0.0, numbers["release_start"]), [0.0, 0.0], events=touch, rtol=1e-10, atol=1e-14)
+    t_make = float(sol.t_events[0][0])
+    for row in numbers["variants"]:
+        assert row["first_make"] == pytest.approx(t_make, rel=1e-3)
+
+
+def test_pushbutton_opens_after_release(pushbutton):
+    numbers, _ = pushbutton
+    doc = _toml("pushbutton")
+    for row in numbers["variants"]:
+        assert row["settled"]
+        assert row["final_state"] == "open"
+        assert row["break_time"] > numbers["release_start"]
+        # the return spring turns the lever back towards its start: the gap at the end is positive,
+        # at most twice the travel (an undamped swing through the start and back)
+        assert 0.0 < row["final_gap"] <= 2.0 * doc["initial"]["height"]
+        # 5 V, no arc: the contact voltage never exceeds the supply by more than the wiring's ringing
+        c = doc["circuit"]
+        assert row["bounce_peak_voltage"] <= c["voltage"] + c["voltage"] / _series_resistance(c) * math.sqrt(
+            c["wiring_inductance"] / c["contact_capacitance"])
+
+
+# --- free_drop ----------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def free_drop(tmp_path_factory):
+    return _run(tmp_path_factory, "free_drop")
+
+
+def test_free_drop_is_the_builtin_scene():
+    assert _toml("free_drop") == tomllib.loads(
+        (EXAMPLES.parent / "coupling" / "scenes" / "free_drop.toml").read_text())
+
+
+def test_free_drop_touches_down_in_free_fall_and_flies_off(free_drop):
+    numbers, _ = free_drop
+    doc = _toml("free_drop")
+    g = 9.80665
+    v0, h = -doc["initial"]["velocity"][2], doc["initial"]["height"]
+    v = math.sqrt(v0 * v0 + 2 * g * h)
+    first = numbers["contacts"][0]
+    assert first["t_start"] == pytest.approx((v - v0) / g, rel=1e-4)
+    assert first["normal_speed_in"] == pytest.approx(v, rel=1e-4)
+    assert 0.0 < first["kinematic_restitution"] < 1.0
+    assert numbers["final_state"] == "open"
+    assert numbers["flight_acceleration"] == pytest.approx(-g, rel=1e-3)
