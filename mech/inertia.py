@@ -241,6 +241,12 @@ def _rotational_rhs(n, m, w, eta, Jm, B, sv, f_r, Amat, Ainv):
     f_r[0] = -(w[1] * h2 - w[2] * h1) - sv[0]
     f_r[1] = -(w[2] * h0 - w[0] * h2) - sv[1]
     f_r[2] = -(w[0] * h1 - w[1] * h0) - sv[2]
+    schur_complement(n, m, Jm, B, Amat, Ainv)
+
+
+@njit(cache=True)
+def schur_complement(n, m, Jm, B, Amat, Ainv):
+    """Amat = J - B B'/m (kg m^2, symmetric) and its inverse into Ainv."""
     inv_m = 1.0 / m
     for a in range(3):
         for b in range(a, 3):

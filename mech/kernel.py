@@ -28,7 +28,7 @@ from numba import njit
 
 from .contact_laws import normal_force
 from .friction import friction_limit, regularized_scale
-from .inertia import inertia_matrix, inertia_terms, inertia_terms_sparse, inverse3
+from .inertia import inertia_matrix, inertia_terms, inertia_terms_sparse, schur_complement
 
 # fpar indices (F_K, F_C, F_RTIP: the first contact point's values, kept for the scales;
 # the kernel reads each contact point's own from cpar)
@@ -314,14 +314,7 @@ def _add_rotational_coupling(n, m, w, eta, cL, Jm, B, f_r, Amat, Ainv):
     f_r[0] -= w[1] * h2 - w[2] * h1
     f_r[1] -= w[2] * h0 - w[0] * h2
     f_r[2] -= w[0] * h1 - w[1] * h0
-    inv_m = 1.0 / m
-    for a in range(3):
-        for b in range(3):
-            acc = 0.0
-            for j in range(n):
-                acc += B[a, j] * B[b, j]
-            Amat[a, b] = Jm[a, b] - acc * inv_m
-    inverse3(Amat, Ainv)
+    schur_complement(n, m, Jm, B, Amat, Ainv)
 
 
 @njit(cache=True)
