@@ -312,6 +312,37 @@ class BarModel:
                 out += list(f.time)
         return sorted(out)
 
+    def contact_point_x(self, y: np.ndarray, i: int) -> float:
+        """m: world x of contact point i's cap centre in state y (modal deflection included)."""
+        sl = self.slices()
+        psi, _, xc = self.points
+        s_body = xc[i] + (psi[i].T @ y[sl["q"]] if self.n else 0.0)
+        if self.planar:
+            phi = float(y[sl["angle"]][0])
+            return float(y[sl["pos"]][0] + math.cos(phi) * s_body[0] + math.sin(phi) * s_body[2])
+        qw, qx, qy, qz = y[sl["quat"]] / np.linalg.norm(y[sl["quat"]])
+        row = np.array([1.0 - 2.0 * (qy * qy + qz * qz), 2.0 * (qx * qy - qz * qw), 2.0 * (qx * qz + qy * qw)])
+        return float(y[sl["pos"]][0] + row @ s_body)
+
+    @functools.cached_property
+    def sphere_top_x(self) -> float:
+        """m: world x of a spherical block's top: below the first contact point at the
+        start, shifted by block.offset."""
+        return self.contact_point_x(self.initial_state(), 0) + self.scene.block.offset
+
+    def loads_ramping(self, t: float) -> bool:
+        """True if some actuator force changes right after t (s): t lies inside a table
+        interval whose two ends differ, so the loads are not constant until the next
+        breakpoint and no hold at rest may start."""
+        for f in self.scene.forces:
+            if f.time is None:
+                continue
+            ts, vs = f.time, f.value
+            for k in range(len(ts) - 1):
+                if ts[k] <= t < ts[k + 1] and vs[k] != vs[k + 1]:
+                    return True
+        return False
+
     @property
     def nq(self) -> int:
         """Number of quadratures: the input-work and load-dissipation ones only when the

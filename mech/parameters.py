@@ -188,7 +188,9 @@ class Block:
     contact at the start, shifted by ``offset`` m along the bar's horizontal direction).
     The sphere is treated by its tangent plane at the top with the curvature in the Hertz
     stiffness (effective radius R1 R2 / (R1 + R2)): exact while the contact stays within a
-    small fraction of the radius from the top, which the run checks and flags.
+    small fraction of the radius from the top: the run flags a contact where the sphere lies
+    more than a tenth of the Hertz penetration scale below that plane (``block.offset``
+    misaligns the two contacts and is what such a flag usually means).
     """
 
     youngs_modulus: float = 210e9

@@ -514,7 +514,8 @@ class ImpactSolver:
         aux = self._evaluate()
         slipping = any(self.regime[i] == SLIP and math.hypot(aux[i, A_VTX], aux[i, A_VTY])
                        > self.scene.solver.stick_velocity_tol for i in range(2))
-        if quiet and not slipping:
+        # a force on a ramp is not a constant load, however slowly the bar follows it
+        if quiet and not slipping and not self.model.loads_ramping(self.t):
             later = [t for t in self.model.load_change_times if t > self.t]
             later += [t for t, _ in self._jumps[self._jump_index:] if t > self.t]
             self._hold_until = min(later) if later else math.inf
@@ -647,7 +648,9 @@ class ImpactSolver:
         ))
 
     def _check_cap(self, tip: int) -> None:
-        """Flag contacts whose normal leaves the spherical cap (the model then does not hold)."""
+        """Flag contacts whose normal leaves the spherical cap (the model then does not hold),
+        and contacts too far from the top of a spherical block for its tangent plane."""
+        self._check_sphere_block(tip)
         axis, half_angle = self.model.cap_axes[tip]
         if axis is None:
             return
@@ -666,6 +669,25 @@ class ImpactSolver:
                 penetration=0.0, penetration_rate=0.0, normal_force=0.0, slip_speed=0.0,
                 note=f"contact normal {math.degrees(angle):.1f} deg from the cap's axis, beyond the cap's "
                      f"{math.degrees(half_angle):.1f} deg: the bar's side would touch",
+            ))
+
+    def _check_sphere_block(self, tip: int) -> None:
+        """A spherical block is treated by its tangent plane at the top: a contact a
+        horizontal distance d from the top sees the sphere d^2 / (2 R) lower than that
+        plane. Flag a contact where that exceeds a tenth of the Hertz penetration scale."""
+        blk = self.scene.block
+        if blk.shape != "sphere":
+            return
+        x = self.model.contact_point_x(self.y, tip)
+        d = x - self.model.sphere_top_x
+        drop = d * d / (2.0 * blk.radius)
+        if drop > 0.1 * self.model.contact.penetration_scale:
+            self.events.append(dict(
+                time=self.t, tip=tip, kind="invalid_contact_geometry", regime_before="", regime_after="",
+                penetration=0.0, penetration_rate=0.0, normal_force=0.0, slip_speed=0.0,
+                note=f"contact {d * 1e3:.3g} mm from the top of the spherical block (radius {blk.radius * 1e3:.3g} mm): "
+                     f"the sphere lies {drop:.2g} m below its tangent plane there, more than a tenth of the "
+                     f"contact's penetration scale; the tangent-plane treatment does not hold (block.offset?)",
             ))
 
     def _resolve(self, triggered: int | None) -> None:
