@@ -20,8 +20,11 @@ t_n, held: mu(I_n) and the conductance G(F_n(t_n)).
 
 from __future__ import annotations
 
+import contextlib
 import math
+import signal
 import sys
+import threading
 import time
 from dataclasses import dataclass
 
@@ -50,6 +53,25 @@ class RunInterrupted(KeyboardInterrupt):
     def __init__(self, message: str, partial: CoupledResult | None):
         super().__init__(message)
         self.partial = partial
+
+
+@contextlib.contextmanager
+def _deferred_interrupt():
+    """While ngspice drives callbacks into Python, a KeyboardInterrupt raised inside one is
+    printed and swallowed by cffi, and the run goes on to "ok" (seen: Ctrl-C during a
+    coupled run exited 0). Here SIGINT only sets a flag, which the run loop checks between
+    macro steps and turns into a KeyboardInterrupt there. Yields the check. Outside the
+    main thread (a Dask worker) signals cannot be handled: the check is always False."""
+    if threading.current_thread() is not threading.main_thread() or (
+            signal.getsignal(signal.SIGINT) is signal.SIG_IGN):  # (or SIGINT is ignored, as asked)
+        yield lambda: False
+        return
+    hit = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: hit.append(signum))
+    try:
+        yield lambda: bool(hit)
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _failure_time(err: BaseException, t_step: float) -> float:
@@ -138,8 +160,10 @@ class CoSimulation:
         jump_since_prev = bool(np.any(mech.contact_now()[:, 0] > 0.0))
         rate, scale = 0.0, math.inf  # dI/dt of the loop current at t (A/s) and its time scale (s)
         try:
-            with stepper:
+            with stepper, _deferred_interrupt() as interrupted:
                 while t < t_end * (1.0 - 1e-14):
+                    if interrupted():  # Ctrl-C, taken here between macro steps
+                        raise KeyboardInterrupt
                     # a bar held at rest (mech: loads constant, contacts quiet) changes nothing
                     # the circuit sees until the hold ends: the long step, up to that end
                     resting = mech.at_rest and not jump_since_prev
