@@ -10,11 +10,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+from matplotlib.figure import Figure  # figures drawn without pyplot: no GUI backend, no global state
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+
+def _subplots(*grid, figsize, **kw):
+    """(figure, axes) like pyplot.subplots, on a standalone Agg-rendered Figure (pyplot's
+    import alone cost 0.4-0.7 s of each run's start-up, measured in benchmarks/bench_startup.py)."""
+    fig = Figure(figsize=figsize)
+    return fig, fig.subplots(*grid, **kw)
+
 
 LEGEND = dict(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, borderaxespad=0.0)
 
@@ -73,7 +78,7 @@ def plot_waveforms(result, whole_run: bool = False):
     window = (0.0, result.scene.t_end * 1e3) if whole_run else bounce_window(result)
     sel = _in(t, window)
     rows = 2 if whole_run else 4
-    fig, axes = plt.subplots(rows, 1, sharex=True, figsize=(10, 2.4 * rows + 1.2))
+    fig, axes = _subplots(rows, 1, sharex=True, figsize=(10, 2.4 * rows + 1.2))
     ax_v, ax_i = axes[0], axes[1]
     v = w.contact_voltage.to_numpy()
     ax_v.plot(t, v, lw=0.9, color="tab:blue", label="contact voltage")
@@ -149,7 +154,7 @@ def plot_log_voltage(result):
     w = result.waveforms
     t = w.time.to_numpy() * 1e3
     v = np.abs(w.contact_voltage.to_numpy())
-    fig, ax = plt.subplots(figsize=(10, 4))
+    fig, ax = _subplots(figsize=(10, 4))
     pos = v > 0
     ax.semilogy(t[pos], v[pos], lw=0.8, color="tab:blue", label="|contact voltage|")
     _shade(ax, result.closed_intervals)
@@ -167,7 +172,7 @@ def plot_log_voltage(result):
 def plot_openings(result):
     """Per-opening bars: open duration, peak voltage, arc energy (bounce openings and the final one)."""
     ops = result.openings
-    fig, axes = plt.subplots(1, 3, figsize=(11, 3.6))
+    fig, axes = _subplots(1, 3, figsize=(11, 3.6))
     if not len(ops):
         for ax in axes:
             ax.text(0.5, 0.5, "no openings", ha="center", va="center", transform=ax.transAxes)
@@ -195,7 +200,7 @@ def plot_openings(result):
 def _per_tip(result, column: str, scale: float, ylabel: str, window: bool):
     """A history column of both tips against time (ms)."""
     h = result.mechanics.history
-    fig, ax = plt.subplots(figsize=(10, 4))
+    fig, ax = _subplots(figsize=(10, 4))
     for i in range(2):
         ax.plot(h.time * 1e3, h[f"{column}_{i}"] * scale, lw=0.9, label=f"tip {i}")
     ax.set_xlabel("time (ms)")
@@ -237,7 +242,7 @@ def plot_tip_heights(result):
 def plot_energy(result):
     """Energy audit vs time: where the initial energy went (J), and the residual."""
     en = result.mechanics.energy_table
-    fig, (ax, ax_r) = plt.subplots(2, 1, sharex=True, figsize=(10, 6), height_ratios=(3, 1))
+    fig, (ax, ax_r) = _subplots(2, 1, sharex=True, figsize=(10, 6), height_ratios=(3, 1))
     t = en.time * 1e3
     parts = ["kinetic", "elastic", "contact_stored", "normal_dissipation", "friction_dissipation",
              "modal_dissipation"]
@@ -270,6 +275,5 @@ def save_plots(result, out_dir) -> list[Path]:
     for name, make in figures:
         fig = make(result)
         fig.savefig(out / name, dpi=110)
-        plt.close(fig)
         paths.append(out / name)
     return paths
