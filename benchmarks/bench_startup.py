@@ -130,7 +130,7 @@ def main() -> None:
     run = [py, "-m", "coupling.cli", "run"]
     # warm-up: the numba cache of this tree, ngspice, the OS file cache
     for scene in (str(mech), None):
-        whole_process(run + ([scene] if scene else []) + ["--out", str(tmp / "warm"), "--quiet"], 1)
+        whole_process(run + ([scene] if scene else []) + ["--out", str(tmp / "warm"), "--quiet", "--overwrite"], 1)
 
     rows = []
     for label, cmd in [
