@@ -22,7 +22,7 @@ import numpy as np
 
 from .beam_fe import FEBeam, PointMass, beam_basis, beam_invariants, point_shapes
 from .kernel import (
-    C_C, C_K, C_ON, C_R, L_AX, L_AY, L_AZ, L_BODY, L_C, L_DX, L_DY, L_DZ, L_K, L_KIND, L_L0, L_POINT,
+    L_AX, L_AY, L_AZ, L_BODY, L_C, L_DX, L_DY, L_DZ, L_K, L_KIND, L_POINT,
     L_T0, L_TN, LOAD_FORCE, LOAD_SPRING, N_LOAD,
 )
 from .modal_basis import ModalBasis

@@ -23,7 +23,7 @@ from .kernel import (
     F_PIV_C, F_PIV_K, F_PIV_PHI0, F_PIV_SIGN, F_PIV_T0, L_L0, I_INERTIA, INERTIA_GRAM, INERTIA_SPARSE, N_IPAR, N_LOAD, NQ, NQ_FREE, C_C, C_K, C_ON, C_R, layout,
 )
 from .mechanism import (
-    MechanismArrays, build_arrays, closing_work, contact_parameters, contact_points,
+    MechanismArrays, build_arrays, closing_work, contact_parameters,
     effective_contact_mass, frame_height, impulse_mass, needs_mechanism,
 )
 from .modal_basis import ModalBasis, build_modal_basis, sparse_invariants

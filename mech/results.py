@@ -19,7 +19,7 @@ import pandas as pd
 from numba import njit
 
 from .kernel import (
-    A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_Y, A_YDOT, NQ, Q_DFRICTION, Q_DMODAL, Q_DNORMAL,
+    A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_Y, A_YDOT, Q_DFRICTION, Q_DMODAL, Q_DNORMAL,
     Q_DLOAD, Q_IMPULSE, Q_WCOMP, Q_WIN, energies, make_work,
 )
 from .model import BarModel, matrix_to_quaternion, rotation_y, rotation_z
