@@ -19,7 +19,7 @@ from .contact_laws import (
 from .kernel import (
     F_BAUM, F_BETA, F_C, F_G, F_GAMMA, F_VBOUND, F_K, F_MASS, F_MAX_RATIO, F_MU0, F_MU_SLOPE, F_RTIP,
     F_T_MU, F_VREG, FRICTION_EXACT, FRICTION_NONE, FRICTION_REGULARIZED, I_FRICTION, I_N,
-    I_PLANAR, I_MOUNT, I_NLOAD, MOUNT_CLAMP, MOUNT_FREE, MOUNT_PIVOT, N_FPAR,
+    I_PLANAR, I_MOUNT, I_NLOAD, MOUNT_CLAMP, MOUNT_FREE, MOUNT_PIVOT, N_FPAR, quat_to_matrix,
     F_PIV_C, F_PIV_K, F_PIV_PHI0, F_PIV_SIGN, F_PIV_T0, L_L0, I_INERTIA, INERTIA_GRAM, INERTIA_SPARSE, N_IPAR, N_LOAD, NQ, NQ_FREE, C_C, C_K, C_ON, C_R, layout,
 )
 from .mechanism import (
@@ -117,18 +117,23 @@ def _first_impact(scene: MechScene) -> tuple[float, float]:
     return speed, m_eff
 
 
+def contact_damping(con, v_ref: float, k: float, m_eff: float) -> float:
+    """c of the contact law: given, the law's closed form, or calibrated so a single impact
+    of m_eff (kg) at v_ref (m/s) on stiffness k (N/m^1.5) rebounds with the target restitution."""
+    if con.damping is not None:
+        return con.damping
+    if con.calibration == "formula":
+        return damping_formula(con.law, con.restitution, v_ref, k)
+    return calibrate_damping(con.law, con.restitution, v_ref, k, m_eff)
+
+
 def contact_scales(scene: MechScene, n_modes: int) -> ContactScales:
     bar, blk, con = scene.bar, scene.block, scene.contact
     k = con.stiffness or hertz_stiffness(bar.tip_radius, bar.youngs_modulus, bar.poisson_ratio,
                                          blk.youngs_modulus, blk.poisson_ratio)
     speed_est, m_eff = _first_impact(scene)
     v_ref = con.reference_speed or speed_est
-    if con.damping is not None:
-        c = con.damping
-    elif con.calibration == "formula":
-        c = damping_formula(con.law, con.restitution, v_ref, k)
-    else:
-        c = calibrate_damping(con.law, con.restitution, v_ref, k, m_eff)
+    c = contact_damping(con, v_ref, k, m_eff)
     ini = scene.initial
     m = bar.mass
     ke0 = 0.5 * m * float(np.dot(ini.velocity, ini.velocity)) + 0.5 * m * bar.length**2 / 12.0 * float(
@@ -171,14 +176,7 @@ def mechanism_scales(scene: MechScene, arr: MechanismArrays, n_modes: int) -> Co
         e_avail = (0.5 * m * float(np.dot(ini.velocity, ini.velocity)) + work
                    + m * scene.gravity * (ini.height + scene.bar.length))
     v_ref = con.reference_speed or v_est
-    dampings = []
-    for k in ks:
-        if con.damping is not None:
-            dampings.append(con.damping)
-        elif con.calibration == "formula":
-            dampings.append(damping_formula(con.law, con.restitution, v_ref, k))
-        else:
-            dampings.append(calibrate_damping(con.law, con.restitution, v_ref, k, m_eff))
+    dampings = [contact_damping(con, v_ref, k, m_eff) for k in ks]
     # lightest mass an impact can meet: a held bar's impulse mass from its modes; a free
     # bar's bound as in contact_scales (|phi_j| <= 2 at a point)
     m_min = impulse_mass(arr, scene) if scene.mount.held else m_eff / (4.0 * (1.0 + n_modes))
@@ -312,17 +310,21 @@ class BarModel:
                 out += list(f.time)
         return sorted(out)
 
+    def rotation(self, y: np.ndarray) -> np.ndarray:
+        """Body -> solver-frame rotation matrix of state y (planar: about y by the angle)."""
+        sl = self.slices()
+        if self.planar:
+            return rotation_y(float(y[sl["angle"]][0]))
+        R = np.empty((3, 3))
+        quat_to_matrix(*y[sl["quat"]], R)
+        return R
+
     def contact_point_x(self, y: np.ndarray, i: int) -> float:
         """m: world x of contact point i's cap centre in state y (modal deflection included)."""
         sl = self.slices()
         psi, _, xc = self.points
         s_body = xc[i] + (psi[i].T @ y[sl["q"]] if self.n else 0.0)
-        if self.planar:
-            phi = float(y[sl["angle"]][0])
-            return float(y[sl["pos"]][0] + math.cos(phi) * s_body[0] + math.sin(phi) * s_body[2])
-        qw, qx, qy, qz = y[sl["quat"]] / np.linalg.norm(y[sl["quat"]])
-        row = np.array([1.0 - 2.0 * (qy * qy + qz * qz), 2.0 * (qx * qy - qz * qw), 2.0 * (qx * qz + qy * qw)])
-        return float(y[sl["pos"]][0] + row @ s_body)
+        return float(y[sl["pos"]][0] + self.rotation(y)[0] @ s_body)
 
     @functools.cached_property
     def sphere_top_x(self) -> float:

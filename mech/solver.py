@@ -33,7 +33,7 @@ from .integrator import (
 from .kernel import (
     A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_COMPRESSION, EV_CONTACT,
     EV_SLIP, EV_STICK, F_MU0, F_MU_SLOPE, F_T_MU, FREE, FRICTION_EXACT, I_FRICTION, NAUX, NEV_TIP, SLIP,
-    STICK, F_MASS, Q_WIN, dynamics, energies, make_work, project_to_stick, quat_to_matrix,
+    STICK, F_MASS, Q_WIN, dynamics, energies, make_work, project_to_stick,
 )
 from .contact_laws import hertz_impact
 from .mechanism import base_velocity_jumps
@@ -537,16 +537,8 @@ class ImpactSolver:
         e = np.empty(5)
         energies(self.y, m.arrays, self._work, e)
         ke_before = e[0]
-        if m.planar:
-            self.y[sl["vel"]] += (dv[0], dv[2])
-            phi = float(self.y[sl["angle"]][0])
-            R = np.array([[math.cos(phi), 0.0, math.sin(phi)], [0.0, 1.0, 0.0],
-                          [-math.sin(phi), 0.0, math.cos(phi)]])
-        else:
-            self.y[sl["vel"]] += dv
-            quat = self.y[sl["quat"]]
-            R = np.empty((3, 3))
-            quat_to_matrix(quat[0], quat[1], quat[2], quat[3], R)
+        R = m.rotation(self.y)
+        self.y[sl["vel"]] += (dv[0], dv[2]) if m.planar else dv
         L = m.first_moments[:, 1:n + 1]
         self.y[sl["eta"]] -= (L.T @ (R.T @ dv)) / m.fpar[F_MASS]
         energies(self.y, m.arrays, self._work, e)
@@ -654,13 +646,7 @@ class ImpactSolver:
         axis, half_angle = self.model.cap_axes[tip]
         if axis is None:
             return
-        R = np.empty((3, 3))
-        if self.model.planar:
-            phi = self.y[2]
-            R = np.array([[math.cos(phi), 0.0, math.sin(phi)], [0.0, 1.0, 0.0],
-                          [-math.sin(phi), 0.0, math.cos(phi)]])
-        else:
-            quat_to_matrix(*self.y[3:7], R)
+        R = self.model.rotation(self.y)
         outward_z = float(R[2] @ axis)  # z of the cap's outward axis
         angle = math.acos(max(-1.0, min(1.0, -outward_z)))  # between outward axis and -z
         if angle > half_angle + 1e-9:
