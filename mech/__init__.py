@@ -9,10 +9,6 @@ switching, repeated impacts and an energy audit. SI units throughout.
     result.contacts, result.history, result.energy
 """
 
-from .compiled_cache import configure as _configure_compiled_cache
-
-_configure_compiled_cache()  # before any compiled function is defined (mech/compiled_cache.py)
-
 from .parameters import Bar, Block, Contact, Friction, Initial, MechScene, SolverOptions
 from .results import ImpactResult
 from .scene import default_scene, load_scene, scene_from_dict, scene_to_dict

@@ -1,7 +1,7 @@
 """Normal contact laws: Hertz stiffness, damping laws and their calibration to a restitution.
 
-Pure functions (SI units). ``normal_force`` is compiled with numba because the
-integrator calls it inside its loop; it is also callable from Python as is.
+Pure functions (SI units). ``normal_force`` is also compiled into the kernel (mech.kernel),
+which calls it inside the integration loop; here it is plain Python, the readable reference.
 """
 
 from __future__ import annotations
@@ -10,12 +10,10 @@ import math
 from dataclasses import dataclass
 from functools import lru_cache
 
-import numpy as np
-from numba import njit
-from scipy.special import beta as _beta_fn
 
 # t_c = 2.943275 delta_max / v0 for an undamped Hertz impact: 2 int_0^1 (1 - x^2.5)^-1/2 dx
-HERTZ_TIME_FACTOR = 0.8 * _beta_fn(0.4, 0.5)
+# = 0.8 B(0.4, 0.5), B the Euler beta function
+HERTZ_TIME_FACTOR = 0.8 * math.gamma(0.4) * math.gamma(0.5) / math.gamma(0.9)
 
 
 def effective_modulus(e1: float, nu1: float, e2: float, nu2: float) -> float:
@@ -32,7 +30,6 @@ def hertz_stiffness(radius: float, e1: float, nu1: float, e2: float, nu2: float)
     return 4.0 / 3.0 * effective_modulus(e1, nu1, e2, nu2) * math.sqrt(radius)
 
 
-@njit(cache=True)
 def normal_force(y: float, ydot: float, k: float, c: float, beta: float) -> float:
     """N: F_n = k y^1.5 + c y^beta dy/dt for penetration y > 0 (m), clipped at 0."""
     if y <= 0.0:

@@ -15,10 +15,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
 
-
-@njit(cache=True)
 def friction_limit(normal_force: float, mu: float, gamma: float, max_ratio: float) -> float:
     """N: largest friction force the contact can carry, min(mu F_n^(1-gamma), r_max F_n).
 
@@ -40,7 +37,6 @@ def transition_force(mu: float, gamma: float, max_ratio: float) -> float:
     return (mu / max_ratio) ** (1.0 / gamma)
 
 
-@njit(cache=True)
 def regularized_scale(slip_speed: float, regularization_speed: float) -> float:
     """-: the factor |v_t| / sqrt(|v_t|^2 + v_s^2) of the regularized law (speeds in m/s)."""
     return slip_speed / math.sqrt(slip_speed * slip_speed + regularization_speed * regularization_speed)

@@ -29,7 +29,8 @@ are zero), the norms d_j, and G's non-zero entries
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .jit import njit
 
 # sections of the sparse invariant list
 SEC_J1, SEC_J2, SEC_S, SEC_K, SEC_C, SEC_LAYOUT, SEC_NORM, SEC_GRAM = range(8)

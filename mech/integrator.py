@@ -14,17 +14,16 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
+from .jit import njit
 from .kernel import (
     A_FN, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_COMPRESSION, EV_CONTACT, EV_SLIP, EV_STICK,
     C_C, C_K, C_ON, C_R, F_BETA, F_BLOCK_Z, F_VBOUND, FRICTION_EXACT, I_FRICTION, I_N, I_PLANAR, NEV_TIP, SLIP, STICK,
-    dynamics, tip_offset, unpack,
+    dynamics, normal_force, tip_offset, unpack,
 )
-from .contact_laws import normal_force
-
-DONE, EVENT, BUFFER_FULL, STEP_TOO_SMALL, NOT_FINITE, MAX_STEPS = range(6)
-STATUS_TEXT = ("done", "event", "buffer full", "step size too small", "non-finite state", "too many steps")
+from .kernel_layout import (  # noqa: F401  (re-exported: the integrator's status codes)
+    BUFFER_FULL, DONE, EVENT, MAX_STEPS, NOT_FINITE, STATUS_TEXT, STEP_TOO_SMALL,
+)
 
 # Dormand-Prince tableau (Hairer, Norsett & Wanner, Solving ODEs I, Table 5.2).
 C2, C3, C4, C5 = 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0

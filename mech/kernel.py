@@ -24,74 +24,31 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
-from .contact_laws import normal_force
-from .friction import friction_limit, regularized_scale
+from . import contact_laws as _contact_laws, friction as _friction, rotations as _rotations
+from .jit import njit
 from .inertia import inertia_matrix, inertia_terms, inertia_terms_sparse, schur_complement
+from .kernel_layout import (  # noqa: F401  (re-exported: the kernel's own names)
+    F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MU0, F_MU_SLOPE, F_T_MU, F_MAX_RATIO, F_RTIP,
+    F_VREG, F_BAUM, F_VBOUND, F_BLOCK_Z, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN,
+    N_FPAR, I_N, I_PLANAR, I_FRICTION, I_MOUNT, I_NLOAD, I_INERTIA, N_IPAR, INERTIA_GRAM,
+    INERTIA_SPARSE, FRICTION_NONE, FRICTION_EXACT, FRICTION_REGULARIZED, MOUNT_FREE, MOUNT_CLAMP,
+    MOUNT_PIVOT, C_K, C_C, C_R, C_ON, LOAD_FORCE, LOAD_SPRING, L_KIND, L_POINT, L_BODY, L_DX,
+    L_DY, L_DZ, L_T0, L_TN, L_AX, L_AY, L_AZ, L_K, L_C, L_L0, N_LOAD, FREE, SLIP, STICK,
+    Q_DNORMAL, Q_DFRICTION, Q_DMODAL, Q_WCOMP, Q_IMPULSE, Q_WIN, Q_DLOAD, NQ_FREE, NQ, A_Y,
+    A_YDOT, A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_MARGIN, NAUX, EV_CONTACT, EV_CLIP, EV_SLIP,
+    EV_STICK, EV_COMPRESSION, NEV_TIP,
+    state_sizes,
+)
 
-# fpar indices (F_K, F_C, F_RTIP: the first contact point's values, kept for the scales;
-# the kernel reads each contact point's own from cpar)
-(F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MU0, F_MU_SLOPE, F_T_MU, F_MAX_RATIO, F_RTIP, F_VREG, F_BAUM,
- F_VBOUND, F_BLOCK_Z, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN) = range(20)
-N_FPAR = 20
-# ipar indices
-I_N, I_PLANAR, I_FRICTION, I_MOUNT, I_NLOAD, I_INERTIA = range(6)
-N_IPAR = 6
-# inertia route (mech/inertia.py): Gram products (analytic free-free basis) or sparse list
-INERTIA_GRAM, INERTIA_SPARSE = 0, 1
-FRICTION_NONE, FRICTION_EXACT, FRICTION_REGULARIZED = 0, 1, 2
-# how the bar is held: free (6 rigid degrees of freedom), clamped at a base that moves
-# with a piecewise-constant velocity (none), pivoted about body y (rotation only, planar)
-MOUNT_FREE, MOUNT_CLAMP, MOUNT_PIVOT = 0, 1, 2
-# per contact point (cpar rows 0, 1): Hertz stiffness N/m^1.5, damping c, cap radius m,
-# 1.0 when the point exists
-C_K, C_C, C_R, C_ON = range(4)
-# per load (rows of ``load``): actuator force (a time table of magnitude times a unit
-# direction, world or body frame) or linear spring-dashpot to a world anchor
-LOAD_FORCE, LOAD_SPRING = 0, 1
-(L_KIND, L_POINT, L_BODY, L_DX, L_DY, L_DZ, L_T0, L_TN, L_AX, L_AY, L_AZ, L_K, L_C, L_L0) = range(14)
-N_LOAD = 14
-# regimes of a tip
-FREE, SLIP, STICK = 0, 1, 2
-# quadratures: dissipations; per tip i, compression work at Q_WCOMP + 2i, restitution
-# work at Q_WCOMP + 2i + 1, normal impulse at Q_IMPULSE + i; work put in by actuators
-# and by a moving clamp (Q_WIN); dashpot dissipation of springs and pivot (Q_DLOAD)
-# (the last two exist only in models with loads or a mount: NQ_FREE quadratures otherwise,
-# so a plain free bar's state and error norm are what they were)
-Q_DNORMAL, Q_DFRICTION, Q_DMODAL, Q_WCOMP, Q_IMPULSE, Q_WIN, Q_DLOAD = 0, 1, 2, 3, 7, 9, 10
-NQ_FREE = 9
-NQ = 11
-# aux columns per tip
-A_Y, A_YDOT, A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_MARGIN = range(8)
-NAUX = 8
-# events per tip: contact (y), force clip, slip direction, stick margin, compression
-# turn (dy/dt = 0: splits the normal work into compression and restitution exactly)
-EV_CONTACT, EV_CLIP, EV_SLIP, EV_STICK, EV_COMPRESSION = range(5)
-NEV_TIP = 5
+# the pure-Python laws and layout, compiled for the loop (their modules stay numba-free)
+layout = njit(cache=True)(state_sizes)
+normal_force = njit(cache=True)(_contact_laws.normal_force)
+friction_limit = njit(cache=True)(_friction.friction_limit)
+regularized_scale = njit(cache=True)(_friction.regularized_scale)
 
 
-@njit(cache=True)
-def layout(n, planar):
-    """(position size, velocity size) of the state for n modes."""
-    if planar:
-        return 3 + n, 3 + n
-    return 7 + n, 6 + n
-
-
-@njit(cache=True)
-def quat_to_matrix(qw, qx, qy, qz, R):
-    """Body->world rotation matrix of a (not necessarily unit) quaternion, into R."""
-    s = 1.0 / (qw * qw + qx * qx + qy * qy + qz * qz)
-    R[0, 0] = 1.0 - 2.0 * s * (qy * qy + qz * qz)
-    R[0, 1] = 2.0 * s * (qx * qy - qz * qw)
-    R[0, 2] = 2.0 * s * (qx * qz + qy * qw)
-    R[1, 0] = 2.0 * s * (qx * qy + qz * qw)
-    R[1, 1] = 1.0 - 2.0 * s * (qx * qx + qz * qz)
-    R[1, 2] = 2.0 * s * (qy * qz - qx * qw)
-    R[2, 0] = 2.0 * s * (qx * qz - qy * qw)
-    R[2, 1] = 2.0 * s * (qy * qz + qx * qw)
-    R[2, 2] = 1.0 - 2.0 * s * (qx * qx + qy * qy)
+quat_to_matrix = njit(cache=True)(_rotations.quat_to_matrix)
 
 
 @njit(cache=True)
@@ -866,3 +823,16 @@ def energies(y, mdl, work, out):
     out[2] = fpar[F_G] * (m * r[2] + R[2, 0] * cq[0] + R[2, 1] * cq[1] + R[2, 2] * cq[2])
     out[3] = hz
     out[4] = sp
+
+
+@njit(cache=True)
+def energy_table(Y, mdl):
+    """(records, 5): ``energies`` of every row of the state history Y."""
+    n = mdl[1][0]
+    work = make_work(n)
+    out = np.empty((Y.shape[0], 5))
+    e = np.empty(5)
+    for k in range(Y.shape[0]):
+        energies(Y[k], mdl, work, e)
+        out[k] = e
+    return out

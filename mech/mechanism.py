@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .beam_fe import FEBeam, PointMass, beam_basis, beam_invariants, point_shapes
-from .kernel import (
+from .kernel_layout import (
     L_AX, L_AY, L_AZ, L_BODY, L_C, L_DX, L_DY, L_DZ, L_K, L_KIND, L_POINT,
     L_T0, L_TN, LOAD_FORCE, LOAD_SPRING, N_LOAD,
 )

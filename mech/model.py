@@ -16,11 +16,11 @@ import numpy as np
 from .contact_laws import (
     calibrate_damping, damping_formula, hertz_impact, hertz_stiffness,
 )
-from .kernel import (
+from .kernel_layout import (
     F_BAUM, F_BETA, F_C, F_G, F_GAMMA, F_VBOUND, F_K, F_MASS, F_MAX_RATIO, F_MU0, F_MU_SLOPE, F_RTIP,
     F_T_MU, F_VREG, FRICTION_EXACT, FRICTION_NONE, FRICTION_REGULARIZED, I_FRICTION, I_N,
-    I_PLANAR, I_MOUNT, I_NLOAD, MOUNT_CLAMP, MOUNT_FREE, MOUNT_PIVOT, N_FPAR, quat_to_matrix,
-    F_PIV_C, F_PIV_K, F_PIV_PHI0, F_PIV_SIGN, F_PIV_T0, L_L0, I_INERTIA, INERTIA_GRAM, INERTIA_SPARSE, N_IPAR, N_LOAD, NQ, NQ_FREE, C_C, C_K, C_ON, C_R, layout,
+    I_PLANAR, I_MOUNT, I_NLOAD, MOUNT_CLAMP, MOUNT_FREE, MOUNT_PIVOT, N_FPAR,
+    F_PIV_C, F_PIV_K, F_PIV_PHI0, F_PIV_SIGN, F_PIV_T0, L_L0, I_INERTIA, INERTIA_GRAM, INERTIA_SPARSE, N_IPAR, N_LOAD, NQ, NQ_FREE, C_C, C_K, C_ON, C_R, state_sizes,
 )
 from .mechanism import (
     MechanismArrays, build_arrays, closing_work, contact_parameters,
@@ -28,35 +28,7 @@ from .mechanism import (
 )
 from .modal_basis import ModalBasis, build_modal_basis, sparse_invariants
 from .parameters import MechScene
-
-
-def rotation_z(angle: float) -> np.ndarray:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def rotation_y(angle: float) -> np.ndarray:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def matrix_to_quaternion(R: np.ndarray) -> np.ndarray:
-    """Unit quaternion (w, x, y, z) of a rotation matrix (Shepperd's method)."""
-    tr = np.trace(R)
-    if tr > 0:
-        s = 2.0 * math.sqrt(tr + 1.0)
-        q = [0.25 * s, (R[2, 1] - R[1, 2]) / s, (R[0, 2] - R[2, 0]) / s, (R[1, 0] - R[0, 1]) / s]
-    elif R[0, 0] > R[1, 1] and R[0, 0] > R[2, 2]:
-        s = 2.0 * math.sqrt(1.0 + R[0, 0] - R[1, 1] - R[2, 2])
-        q = [(R[2, 1] - R[1, 2]) / s, 0.25 * s, (R[0, 1] + R[1, 0]) / s, (R[0, 2] + R[2, 0]) / s]
-    elif R[1, 1] > R[2, 2]:
-        s = 2.0 * math.sqrt(1.0 + R[1, 1] - R[0, 0] - R[2, 2])
-        q = [(R[0, 2] - R[2, 0]) / s, (R[0, 1] + R[1, 0]) / s, 0.25 * s, (R[1, 2] + R[2, 1]) / s]
-    else:
-        s = 2.0 * math.sqrt(1.0 + R[2, 2] - R[0, 0] - R[1, 1])
-        q = [(R[1, 0] - R[0, 1]) / s, (R[0, 2] + R[2, 0]) / s, (R[1, 2] + R[2, 1]) / s, 0.25 * s]
-    q = np.array(q)
-    return q / np.linalg.norm(q)
+from .rotations import matrix_to_quaternion, quat_to_matrix, rotation_y, rotation_z  # noqa: F401
 
 
 def is_planar(scene: MechScene, tol: float = 1e-12) -> bool:
@@ -264,7 +236,7 @@ class BarModel:
 
     @property
     def state_size(self) -> int:
-        npos, nvel = layout(self.n, self.planar)
+        npos, nvel = state_sizes(self.n, self.planar)
         return npos + nvel + self.nq
 
     @property
@@ -478,7 +450,7 @@ def build_model(scene: MechScene) -> BarModel:
     L = scene.bar.length
     dstar = cs.penetration_scale
     vstar = cs.reference_speed
-    npos, nvel = layout(n, planar)
+    npos, nvel = state_sizes(n, planar)
     nq = NQ if (ipar[I_MOUNT] != MOUNT_FREE or ipar[I_NLOAD] > 0) else NQ_FREE
     atol = np.empty(npos + nvel + nq)
     rel = np.zeros_like(atol)

@@ -16,27 +16,16 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from numba import njit
 
-from .kernel import (
+from .compiled import energy_table
+from .kernel_layout import (
     A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_Y, A_YDOT, Q_DFRICTION, Q_DMODAL, Q_DNORMAL,
-    Q_DLOAD, Q_IMPULSE, Q_WCOMP, Q_WIN, energies, make_work,
+    Q_DLOAD, Q_IMPULSE, Q_WCOMP, Q_WIN,
 )
-from .model import BarModel, matrix_to_quaternion, rotation_y, rotation_z
+from .model import BarModel
+from .rotations import matrix_to_quaternion, rotation_y, rotation_z
 
 REGIME_NAMES = ("free", "slip", "stick")
-
-
-@njit(cache=True)
-def _energy_table(Y, mdl):
-    n = mdl[1][0]
-    work = make_work(n)
-    out = np.empty((Y.shape[0], 5))
-    e = np.empty(5)
-    for k in range(Y.shape[0]):
-        energies(Y[k], mdl, work, e)
-        out[k] = e
-    return out
 
 
 @dataclass
@@ -105,7 +94,7 @@ class ImpactResult:
         """Per record: kinetic, elastic, potential (change), contact_stored, dissipations, residual (J)."""
         if "energy" not in self._cache:
             m = self.model
-            E = _energy_table(self.states, m.arrays)
+            E = energy_table(self.states, m.arrays)
             qd = self.states[:, m.slices()["quad"]]
             df = pd.DataFrame({
                 "time": self.t,

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .integrator import DONE, EVENT, NOT_FINITE, events_from_aux
-from .kernel import (
-    A_FN, A_Y, A_YDOT, EV_CLIP, EV_COMPRESSION, EV_SLIP, EV_STICK, F_MU0, FRICTION_EXACT, I_FRICTION, NAUX,
-    NEV_TIP, SLIP, STICK, dynamics,
+from .compiled import dynamics, events_from_aux
+from .kernel_layout import (
+    A_FN, A_Y, A_YDOT, DONE, EV_CLIP, EV_COMPRESSION, EV_SLIP, EV_STICK, EVENT, F_MU0, FRICTION_EXACT,
+    I_FRICTION, NAUX, NEV_TIP, NOT_FINITE, SLIP, STICK,
 )
 
 METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")

@@ -26,14 +26,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .integrator import (
-    BUFFER_FULL, DONE, EVENT, STATUS_TEXT, dense_contact, dense_eval, dense_tip_forces, events_from_aux,
-    integrate,
+from .compiled import (
+    dense_contact, dense_eval, dense_tip_forces, dynamics, energies, events_from_aux, integrate, make_work,
+    project_to_stick,
 )
-from .kernel import (
-    A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_COMPRESSION, EV_CONTACT,
-    EV_SLIP, EV_STICK, F_MU0, F_MU_SLOPE, F_T_MU, FREE, FRICTION_EXACT, I_FRICTION, NAUX, NEV_TIP, SLIP,
-    STICK, F_MASS, Q_WIN, dynamics, energies, make_work, project_to_stick,
+from .kernel_layout import (
+    A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, BUFFER_FULL, DONE, EV_CLIP, EV_COMPRESSION,
+    EV_CONTACT, EV_SLIP, EV_STICK, EVENT, F_MASS, F_MU0, F_MU_SLOPE, F_T_MU, FREE, FRICTION_EXACT,
+    I_FRICTION, NAUX, NEV_TIP, Q_WIN, SLIP, STATUS_TEXT, STICK,
 )
 from .contact_laws import hertz_impact
 from .mechanism import base_velocity_jumps
