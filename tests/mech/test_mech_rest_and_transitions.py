@@ -94,6 +94,23 @@ def test_lsoda_event_location_never_raises_on_a_grazing_drop(rtol):
         assert len(res.contacts) == len(ref.contacts) == 2
 
 
+@pytest.mark.parametrize("rtol", [1e-9, 1e-11])
+def test_the_scipy_route_never_steps_into_the_block_without_a_contact(rtol):
+    """The clip and compression events were gated by each evaluation's penetration: at a
+    touchdown they jumped from their constant to their value, and a compression "root"
+    located there before the contact's own ended the segment without a contact start.
+    DOP853 at rtol 1e-11 then missed the tilted drop's fifth contact (the tip 4.6 um
+    inside the block with no force), at 1e-9 its last two (the study's table)."""
+    doc = dict(TILTED, solver={"t_end": 1.5e-3})
+    ref = ImpactSolver(mech_scene(doc, rtol=1e-9)).run()
+    res = ImpactSolver(mech_scene(doc, rtol=rtol), backend="scipy:DOP853").run()
+    assert len(ref.contacts) == 5
+    np.testing.assert_allclose(res.contacts[["t_start", "t_end"]], ref.contacts[["t_start", "t_end"]], atol=1e-8)
+    # no record is inside the block while its tip is free
+    free_inside = (res.regimes == 0) & (res.aux[:, :, 0] > 1e-9 * res.model.contact.penetration_scale)
+    assert not free_inside.any()
+
+
 def assert_held_at_weight(solver, res, *, steps: int, events: int):
     bar = solver.scene.bar
     weight = bar.mass * solver.scene.gravity
