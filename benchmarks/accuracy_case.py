@@ -10,8 +10,9 @@ restitution <= 1 in every complete contact, Hertz penetration < 10 % of the tip 
 (beyond it the law is outside its validity), energy residual within
 solver.energy_tolerance unless the result flags it.
 
-status: "ok" | "ok, flagged" (the result carries flags) | "rejected" (a clear error
-before the run) | "failed" (a run error with a message) | "crash" (an unexpected
+status: "ok" | "ok, flagged" (the result carries flags or warnings) | "unsound" (the
+soundness bounds of coupling.soundness fail: switchsim run's exit 3) | "rejected" (a clear
+error before the run) | "failed" (a run error with a message) | "crash" (an unexpected
 exception: a bug) ; "silent" lists physics checks that failed while the result carries
 no flag at all ("flagged_failures" those of a flagged result).
 """
@@ -61,7 +62,14 @@ def main(arg: str) -> dict:
         except Exception as err:  # noqa: BLE001
             out.update(status="crash", message=f"summary: {type(err).__name__}: {err}")
             return out
-        out["flags"] = list(result.summary.get("flags", summary["flags"]))
+        # the result's flags and its warnings (coupling.diagnostics: printed by switchsim run)
+        out["flags"] = list(result.summary.get("flags", summary["flags"])) + list(result.warnings)
+        if out["status"] == "ok":
+            from coupling.soundness import assess
+
+            problems = assess(result)["problems"]
+            if problems:  # what switchsim run reports as "unsound" (exit 3)
+                out.update(status="unsound", message="; ".join(problems))
         c = mr.contacts
         out["contacts"] = int(len(c))
         out["events"] = int(mr.stats.get("events", 0))

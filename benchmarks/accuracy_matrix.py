@@ -152,7 +152,8 @@ def main() -> None:
             "default bar (10 mm steel, 0.3 m, 5 mm tips, 3 modes per family) 10 um above a steel block at 30 deg, "
             "1 m/s down, restitution 0.8, rtol 1e-6, 1 ms, and change what the case names; circuit cases start "
             "from the built-in default coupled scene (24 V, 12 ohm, arc) 20 um above the block, 2 ms. "
-            "Status: ok / ok, flagged (the result carries a flag) / rejected (a clear error before the run) / "
+            "Status: ok / ok, flagged (the result carries a flag or a warning) / unsound (a soundness bound "
+            "fails: switchsim run's exit 3) / rejected (a clear error before the run) / "
             "failed (a run error with a message) / crash (an unexpected exception) / timeout. "
             "Silent: physics checks that failed with no flag: finite output, energetic restitution <= 1, "
             "penetration < 10 % of the tip radius, energy residual within tolerance or flagged, a contact "
@@ -181,7 +182,8 @@ def main() -> None:
         if r["status"] in ("crash", "timeout") or r.get("silent"):
             findings.append(f"- **{label}** ({group}): {r['status']}"
                             + (f"; silent: {'; '.join(r['silent'])}" if r.get("silent") else "")
-                            + (f"; {r.get('message', '')[:300]}" if r["status"] in ("crash", "timeout", "failed") else ""))
+                            + (f"; {r.get('message', '')[:300]}" if r["status"] in ("crash", "timeout", "failed")
+                               else ""))
         print(f"{label}: {r['status']} {r.get('wall')}", file=sys.stderr)
     sec.table(["group", "case", "status", "run (s)", "energy residual", "contacts", "events", "results",
                "error / flags / silent failures"], rows)

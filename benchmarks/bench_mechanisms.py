@@ -217,23 +217,45 @@ def part_b(repeat: int) -> dict:
 
 
 def part_d(repeat: int) -> list:
-    """The free bar lying flat at rest (mech.default_scene(): steel, 10 mm, 0.3 m, friction
-    mu = 0.3, gamma = 0.7; initial.resting, angle 0) for 1 s, planar and 3D."""
+    """Free bars at rest for 1 s (mech.default_scene(): steel, 10 mm, 0.3 m, automatic mode
+    count, friction mu = 0.3, gamma = 0.7): lying flat (initial.resting, angle 0) planar
+    and 3D, standing on a tip (angle 90), and coming to rest from a 1 mm drop at 2 deg
+    (e = 0.5, Coulomb mu = 0.3; the stiff-and-extreme study's case), flexible and rigid.
+    Each with its final total normal force over the weight (static equilibrium: 1)."""
     from mech import default_scene
 
     base = default_scene()
-    rows = []
+    fric = dataclasses.replace(base.friction, gamma=0.0, mu=0.3)
+    cases = []
     for model in ("auto", "3d"):
-        sc = dataclasses.replace(
-            base, initial=dataclasses.replace(base.initial, angle_deg=0.0, height=0.0, velocity=(0.0, 0.0, 0.0),
-                                              resting=True),
-            solver=dataclasses.replace(base.solver, t_end=1.0, model=model))
+        cases.append(("lying flat", dataclasses.replace(
+            base, initial=dataclasses.replace(base.initial, angle_deg=0.0, height=0.0,
+                                                        velocity=(0.0, 0.0, 0.0), resting=True),
+            solver=dataclasses.replace(base.solver, t_end=1.0, model=model))))
+    cases.append(("standing on a tip", dataclasses.replace(
+        base, initial=dataclasses.replace(base.initial, angle_deg=90.0, height=0.0,
+                                                    velocity=(0.0, 0.0, 0.0), resting=True),
+        solver=dataclasses.replace(base.solver, t_end=1.0))))
+    for label, bar in (("coming to rest", base.bar),
+                       ("coming to rest, rigid", dataclasses.replace(base.bar, axial_modes=0, bending_modes=0))):
+        contact = dataclasses.replace(base.contact, restitution=0.5)
+        cases.append((label, dataclasses.replace(
+            base, bar=bar, contact=contact, friction=fric,
+            initial=dataclasses.replace(base.initial, angle_deg=2.0, height=1e-3, velocity=(0.0, 0.0, -1.0)),
+            solver=dataclasses.replace(base.solver, t_end=1.0))))
+    rows = []
+    for label, sc in cases:
         wall, solver, res = timed_run(sc, repeat)
-        rows.append(dict(model="planar" if solver.planar else "3d", wall=wall, steps=res.stats["steps"],
-                         events=res.stats["events"], holds=[list(h) for h in solver.holds],
+        h = res.history
+        weight = sc.bar.mass * sc.gravity
+        rows.append(dict(case=label, model="planar" if solver.planar else "3d", wall=wall,
+                         steps=res.stats["steps"], events=res.stats["events"],
+                         holds=[list(h_) for h_ in solver.holds],
+                         force_ratio=float(h.normal_force_0.iloc[-1] + h.normal_force_1.iloc[-1]) / weight,
+                         residual=float(res.energy["relative_residual"]),
                          gamma=sc.friction.gamma, mu=sc.friction.mu_at(0.0)))
-        print(f"(d) flat free bar at rest, {rows[-1]['model']}: {wall:.3f} s, {res.stats['steps']} steps, "
-              f"{res.stats['events']} events, holds {solver.holds}")
+        print(f"(d) {label}, {rows[-1]['model']}: {wall:.3f} s, {res.stats['steps']} steps, "
+              f"{res.stats['events']} events, holds {solver.holds}, F/W {rows[-1]['force_ratio']:.9f}")
     return rows
 
 
@@ -349,12 +371,17 @@ def render(a: dict, b: dict, c: dict, d: list, base: float, load: tuple, repeat:
           "here (the coupled run also redoes the steps that end at a make or break).", "",
           f"Target solver time < {TARGET_C:g} s: **{'met' if ok else 'not met'}** ({c['solver']:.3f} s, "
           f"{c['solver'] / base:.2f}x this run's `import numpy`)."]
-    L += ["", f"**(d) The free bar lying flat at rest for 1 s** (`mech.default_scene()`, `initial.resting`, "
-          f"angle 0; friction mu = {d[0]['mu']:g}, gamma = {d[0]['gamma']:g}):", "",
-          "| model | solver wall | steps | events | holds [start, end] (s) |", "|---|---|---|---|---|"]
+    L += ["", "**(d) Free bars at rest for 1 s** (`mech.default_scene()`, automatic mode count: lying flat "
+          f"and standing on a tip from `initial.resting` (friction mu = {d[0]['mu']:g}, gamma = "
+          f"{d[0]['gamma']:g}); coming to rest from a 1 mm drop at 2 deg, 1 m/s, e = 0.5, Coulomb mu = "
+          f"{d[-1]['mu']:g}). Final force: both contacts' normal force over the weight (the static "
+          "equilibrium is 1):", "",
+          "| case | model | solver wall | steps | events | holds [start, end] (s) | final force / weight | "
+          "energy residual |", "|---|---|---|---|---|---|---|---|"]
     for r in d:
         holds_txt = "; ".join(f"[{h[0]:.5f}, {h[1]:g}]" for h in r["holds"]) or "none"
-        L.append(f"| {r['model']} | {r['wall']:.3f} s | {r['steps']} | {r['events']} | {holds_txt} |")
+        L.append(f"| {r['case']} | {r['model']} | {r['wall']:.3f} s | {r['steps']} | {r['events']} | {holds_txt} | "
+                 f"{r['force_ratio']:.9f} | {r['residual']:.2g} |")
     return "\n".join(L)
 
 

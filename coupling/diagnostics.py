@@ -17,6 +17,11 @@ Each is one line that says what was seen, when, and what to add to the scene. Ch
 3. More arc ignitions and extinctions than ``[metrics] arc_toggle_limit`` (a showering arc).
 4. A contact law used outside the data it was fitted on (normal force or current range),
    or outside a material law's stated validity range.
+5. Hertz's law stretched: a contact point's deepest penetration y puts the paraboloid
+   y / (4 R) off the sphere at the contact's edge by more than 1 % (y > 0.04 R; beyond 5 %
+   the run is unsound, coupling.soundness).
+6. The arc model on without a breakdown voltage, when an open gap's voltage passes air
+   breakdown: that gap would re-ignite (item 1 names the setting to add).
 """
 
 from __future__ import annotations
@@ -26,6 +31,7 @@ import math
 import numpy as np
 
 from .metrics import ARC_BURNING_CURRENT, arc_toggles
+from .soundness import HERTZ_UNSOUND_ERROR, HERTZ_WARN_ERROR, contact_depths, hertz_gap_error, hertz_validity_line
 
 PASCHEN_A = 15.0  # 1/(cm Torr), air
 PASCHEN_B = 365.0  # V/(cm Torr), air
@@ -46,8 +52,18 @@ def air_breakdown_voltage(gap_m, pressure_torr: float = ATMOSPHERE_TORR):
     return np.maximum(paschen, PASCHEN_MINIMUM_V)
 
 
-def breakdown_warning(t, v, gap, open_mask) -> str | None:
-    """The worst open-gap sample whose |V| exceeds air breakdown, as a warning line."""
+NO_ARC_ADVICE = ("add the arc model ([circuit] arc = true, with breakdown_voltage), a snubber or the "
+                 "contact capacitance")
+# the arc model is on, but an extinguished gap never re-ignites without a breakdown voltage
+NO_BREAKDOWN_ADVICE = ("the arc model is on without [circuit.arc] breakdown_voltage, so its gap never "
+                       "re-ignites and the circuit alone limits the voltage: set breakdown_voltage (air: "
+                       "~330 V across micrometre gaps, Paschen's minimum; with breakdown_gradient ~3e6 V/m "
+                       "for mm gaps), or add a snubber")
+
+
+def breakdown_warning(t, v, gap, open_mask, advice: str = NO_ARC_ADVICE) -> str | None:
+    """The worst open-gap sample whose |V| exceeds air breakdown, as a warning line ending
+    with what to add (``advice``)."""
     t, v, gap = (np.asarray(x, float) for x in (t, v, gap))
     sel = open_mask & np.isfinite(gap) & (gap > 0.0)
     if not sel.any():
@@ -59,8 +75,14 @@ def breakdown_warning(t, v, gap, open_mask) -> str | None:
     n = int(np.count_nonzero(ratio > 1.0))
     return (f"contact voltage {abs(v[k]):.4g} V across a {gap[k] * 1e6:.4g} um gap at t = {t[k] * 1e3:.6g} ms "
             f"exceeds air breakdown (~{float(air_breakdown_voltage(gap[k])):.4g} V; {n} sample(s)): the gap would "
-            "break down; add the arc model ([circuit] arc = true, with breakdown_voltage), a snubber or the "
-            "contact capacitance")
+            f"break down; {advice}")
+
+
+def hertz_warnings(mres) -> list[str]:
+    """A line per contact point whose deepest penetration stretches Hertz's law past
+    HERTZ_WARN_ERROR (and not past HERTZ_UNSOUND_ERROR, which makes the run unsound)."""
+    return [hertz_validity_line(y, r, name) for name, y, r in contact_depths(mres)
+            if HERTZ_WARN_ERROR < hertz_gap_error(y, r) <= HERTZ_UNSOUND_ERROR]
 
 
 def overcurrent_warning(t, currents: dict, limit: float, source: str) -> str | None:
@@ -128,6 +150,8 @@ def run_warnings(result) -> list[str]:
     """All warnings for a CoupledResult."""
     out: list[str] = []
     scene = result.scene
+    if result.mechanics is not None:
+        out += hertz_warnings(result.mechanics)
     w = result.waveforms
     if w is not None and len(w):
         t = w.time.to_numpy()
@@ -137,7 +161,9 @@ def run_warnings(result) -> list[str]:
         gap = _gap_series(result, t)
         if gap is not None:
             open_mask = (w.contact_conductance.to_numpy() <= 0.0) & ~burning
-            line = breakdown_warning(t, v, gap, open_mask)
+            arc = getattr(getattr(scene.circuit, "circuit", None), "arc", None)
+            advice = NO_BREAKDOWN_ADVICE if arc is not None and arc.breakdown_voltage is None else NO_ARC_ADVICE
+            line = breakdown_warning(t, v, gap, open_mask, advice)
             if line:
                 out.append(line)
         limit = _current_limit(scene)

@@ -17,6 +17,12 @@ it out):
 - penetration: the Hertz spring stores (2/5) k y^(5/2), at most E plus the work of the
   weight W = m g over the penetration itself, so no tip goes deeper than the root of
   (2/5) k y^(5/2) = E + W y (m; (5 E / (2 k))^(2/5) without gravity);
+- contact law: Hertz's law treats the cap as a paraboloid on a half-space, valid while
+  the contact radius a = sqrt(R y) stays small against the cap radius R; the paraboloid
+  is off the sphere by y / (4 R) of the gap at the contact's edge. Beyond 5 % (y > 0.2 R,
+  a > 0.45 R) the result is unsound; between 1 % and 5 % (y > 0.04 R) it carries a
+  warning (coupling.diagnostics), its forces and contact times being approximate to
+  about that fraction;
 - circuit (template circuits): the loop current through the load is at most
   2 V / (R_source + R_wiring + R_load) (A): the supply across the series loop, plus one
   full overshoot of the loop's ringing. A netlist circuit's topology is not known: no
@@ -97,6 +103,51 @@ def penetration_problem(max_penetration: float, bound: float, tip_radius: float)
             f"deeper than the {bound:.3g} m the scene's energy allows; {FIX}")
 
 
+HERTZ_WARN_ERROR = 0.01  # the paraboloid's gap error y / (4 R) above which a run is warned
+HERTZ_UNSOUND_ERROR = 0.05  # ... and above which it is unsound
+
+
+def hertz_gap_error(penetration: float, radius: float) -> float:
+    """-: how far Hertz's paraboloid r^2 / (2 R) is from the sphere at the edge of a contact
+    of penetration y (m) on a cap of radius R (m), relative to the gap there: a^2 / (4 R^2)
+    = y / (4 R) to leading order (a = sqrt(R y) the contact radius)."""
+    return max(penetration, 0.0) / (4.0 * radius)
+
+
+def hertz_validity_line(penetration: float, radius: float, name: str) -> str:
+    err = hertz_gap_error(penetration, radius)
+    return (f"contact law: {name} went {penetration:.3g} m into the block, {penetration / radius:.2g} of its "
+            f"{radius:.3g} m radius (contact radius {math.sqrt(radius * penetration) / radius:.2g} R): Hertz's "
+            f"small-deformation law is off by ~{100 * err:.2g} % there; a stiffer material, a larger cap or "
+            "a slower impact keeps it valid")
+
+
+def hertz_problem(penetration: float, radius: float, name: str) -> str | None:
+    """None unless the deepest penetration (m) of a cap of radius R (m) puts Hertz's law
+    beyond HERTZ_UNSOUND_ERROR."""
+    if hertz_gap_error(penetration, radius) <= HERTZ_UNSOUND_ERROR:
+        return None
+    return hertz_validity_line(penetration, radius, name)
+
+
+def contact_depths(mres) -> list[tuple[str, float, float]]:
+    """(name, deepest penetration m, effective radius m) of each contact point of a
+    mechanics result: the cap's radius, against a spherical block R1 R2 / (R1 + R2)."""
+    from mech.kernel_layout import A_Y, C_ON, C_R
+
+    model = mres.model
+    block = model.scene.block
+    out = []
+    for i in range(2):
+        if model.cpar[i, C_ON] == 0.0 or not len(mres.aux):
+            continue
+        r = float(model.cpar[i, C_R])
+        if block.shape == "sphere":
+            r = r * block.radius / (r + block.radius)
+        out.append((f"contact point {i}", float(np.max(mres.aux[:, i, A_Y])), r))
+    return out
+
+
 def current_problem(max_current: float, bound: float) -> str | None:
     """None if the largest |loop current| (A) respects the circuit's bound (A)."""
     if max_current <= bound * (1.0 + BOUND_MARGIN):
@@ -127,6 +178,7 @@ def assess(result) -> dict:
         problems += [p for p in (energy_problem(residual, scale, scene.solver.energy_tolerance),
                                  kinetic_problem(kinetic, scale), speed_problem(speed, v_max),
                                  penetration_problem(pen, y_max, scene.bar.tip_radius)) if p]
+        problems += [p for p in (hertz_problem(y, r, name) for name, y, r in contact_depths(mres)) if p]
     bound = _circuit_current_bound(result.scene)
     waves = result.waveforms
     if bound is not None and waves is not None and len(waves) and "load_current" in waves:

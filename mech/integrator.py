@@ -18,9 +18,10 @@ import numpy as np
 from .jit import njit
 from .kernel import (
     A_FN, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_COMPRESSION, EV_CONTACT, EV_SLIP, EV_STICK,
-    C_C, C_K, C_ON, C_R, F_BETA, F_BLOCK_Z, F_VBOUND, FRICTION_EXACT, I_FRICTION, I_N, I_PLANAR, NEV_TIP, SLIP, STICK,
+    C_C, C_K, C_ON, C_R, F_BETA, F_BLOCK_Z, F_VBOUND, F_VREG, FRICTION_EXACT, I_FRICTION, I_N, I_PLANAR, NEV_TIP, SLIP, STICK,
     dynamics, normal_force, tip_offset, unpack,
 )
+from .friction import REVERSAL_DEADBAND
 from .kernel_layout import (  # noqa: F401  (re-exported: the integrator's status codes)
     BUFFER_FULL, DONE, EVENT, MAX_STEPS, NOT_FINITE, STATUS_TEXT, STEP_TOO_SMALL,
 )
@@ -61,6 +62,7 @@ def _dense_coefficients(y, ynew, h, k1, k3, k4, k5, k6, k7, coef):
 def events_from_aux(aux, eref, mdl, g):
     """Event function values (see kernel.event_values) from a dynamics evaluation's aux."""
     beta = mdl[0][F_BETA]
+    vres = mdl[0][F_VREG]
     cpar = mdl[9]
     for i in range(2):
         k_h = cpar[i, C_K]
@@ -69,7 +71,10 @@ def events_from_aux(aux, eref, mdl, g):
         pp = pen if pen > 0.0 else 0.0
         g[NEV_TIP * i + EV_CONTACT] = pen
         g[NEV_TIP * i + EV_CLIP] = k_h * pp ** (1.5 - beta) + c_h * aux[i, A_YDOT]
-        g[NEV_TIP * i + EV_SLIP] = aux[i, A_VTX] * eref[i, 0] + aux[i, A_VTY] * eref[i, 1]
+        # the slip stops or reverses past a dead band (mech/friction.py REVERSAL_DEADBAND of the
+        # speed resolution F_VREG = solver.stick_velocity_tol), where slip_direction turns to e_ref
+        g[NEV_TIP * i + EV_SLIP] = (aux[i, A_VTX] * eref[i, 0] + aux[i, A_VTY] * eref[i, 1]
+                                    + REVERSAL_DEADBAND * vres)
         g[NEV_TIP * i + EV_STICK] = aux[i, A_MARGIN]
         g[NEV_TIP * i + EV_COMPRESSION] = aux[i, A_YDOT]
 

@@ -46,6 +46,7 @@ layout = njit(cache=True)(state_sizes)
 normal_force = njit(cache=True)(_contact_laws.normal_force)
 friction_limit = njit(cache=True)(_friction.friction_limit)
 regularized_scale = njit(cache=True)(_friction.regularized_scale)
+slip_direction = njit(cache=True)(_friction.slip_direction)
 
 
 quat_to_matrix = njit(cache=True)(_rotations.quat_to_matrix)
@@ -478,19 +479,16 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work):
             ftx = 0.0
             fty = 0.0
             if fmodel == FRICTION_EXACT and regime[i] == SLIP:
-                # Friction opposes the slip velocity while it points to the side of the
-                # reference direction; past that (v_t . e_ref <= 0, only in trial stages
-                # of a step that crosses the slip event) it keeps the reference direction,
-                # so the slip speed goes through zero and the event sees it. Following the
-                # actual direction there would pin v_t at zero inside the step (measured:
-                # 1e-10 s steps, 1.3 M steps for 1 ms).
-                vt = math.sqrt(vP[i, 0] ** 2 + vP[i, 1] ** 2)
-                if vt > 1e-14 and vP[i, 0] * eref[i, 0] + vP[i, 1] * eref[i, 1] > 0.0:
-                    ftx = -lim * vP[i, 0] / vt
-                    fty = -lim * vP[i, 1] / vt
-                else:
-                    ftx = -lim * eref[i, 0]
-                    fty = -lim * eref[i, 1]
+                # Friction opposes the slip velocity; below the speed resolution (F_VREG:
+                # solver.stick_velocity_tol) its direction blends from the reference
+                # direction, and a slow slip past the reference (only in trial stages of a
+                # step that crosses the slip event) keeps the reference direction, so the
+                # slip speed goes through zero and the event sees it. Following the actual
+                # direction there would pin v_t at zero inside the step (measured: 1e-10 s
+                # steps, 1.3 M steps for 1 ms). (mech/friction.py slip_direction)
+                dxs, dys = slip_direction(vP[i, 0], vP[i, 1], eref[i, 0], eref[i, 1], fpar[F_VREG])
+                ftx = -lim * dxs
+                fty = -lim * dys
             elif fmodel == FRICTION_REGULARIZED:
                 vt = math.sqrt(vP[i, 0] ** 2 + vP[i, 1] ** 2)
                 if vt > 0.0:

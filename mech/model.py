@@ -425,7 +425,10 @@ def build_model(scene: MechScene) -> BarModel:
     fpar[F_T_MU] = 0.0
     fpar[F_MAX_RATIO] = fr.max_ratio if math.isfinite(fr.max_ratio) else 1e300
     fpar[F_RTIP] = scene.bar.tip_radius
-    fpar[F_VREG] = fr.regularization_speed
+    # the friction's speed scale: the regularized law's v_s; for the exact law the slip
+    # speed it resolves (below it the slip direction blends from the reference, and a
+    # reversal is recognised past a thousandth of it: kernel slip_direction, events)
+    fpar[F_VREG] = fr.regularization_speed if fr.model == "regularized" else scene.solver.stick_velocity_tol
     # Stick drift correction: slip velocity decays on a time scale of a few contact times.
     fpar[F_BAUM] = 1.0 / cs.shortest_contact
     fpar[F_VBOUND] = cs.speed_bound
