@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .validation import check_range
+from .validation import check_choice, check_range
 
 _METHODS = ("trap", "gear")
 
@@ -51,8 +51,7 @@ class SimulationOptions:
         check_range(name, "vntol", self.vntol, "V", 1e-12, 1e-1)
         check_range(name, "chgtol", self.chgtol, "C", 1e-20, 1e-6)
         check_range(name, "temperature", self.temperature, "degC", -273.15, 1000.0)
-        if self.method not in _METHODS:
-            raise ValueError(f"SimulationOptions.method = {self.method!r}: allowed {', '.join(_METHODS)}")
+        check_choice(name, "method", self.method, _METHODS)
         if self.wall_timeout is not None:
             check_range(name, "wall_timeout", self.wall_timeout, "s", 0.0, math.inf, low_open=True, allow_inf=True)
 

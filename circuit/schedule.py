@@ -100,22 +100,18 @@ class ContactSchedule:
         object.__setattr__(self, "_corners", sorted(corners))
 
     @classmethod
-    def from_events(
-        cls,
-        make: Sequence[float],
-        brk: Sequence[float],
-        closed_resistance: float | Resistance = 0.01,
-        edge_time: float = 10e-9,
-        opening_speed: float | None = None,
-    ) -> "ContactSchedule":
-        """From make instants and break instants (s); one more make than breaks leaves it closed."""
+    def from_events(cls, make: Sequence[float], brk: Sequence[float], **fields) -> "ContactSchedule":
+        """From make instants and break instants (s); one more make than breaks leaves it closed.
+        ``fields``: closed_resistance, edge_time, opening_speed (omitted: the field's default)."""
+        if any(isinstance(v, (str, bytes, dict)) or not hasattr(v, "__len__") for v in (make, brk)):
+            raise ValueError(f"ContactSchedule.intervals: make = {make!r}, break = {brk!r}: expected lists of times (s)")
         make, brk = list(make), list(brk)
         if len(brk) not in (len(make), len(make) - 1):
             raise ValueError(
                 f"ContactSchedule.from_events: {len(make)} makes need {len(make)} or {len(make) - 1} breaks, got {len(brk)}"
             )
         ends = brk + [math.inf] * (len(make) - len(brk))
-        return cls(tuple(zip(make, ends)), closed_resistance, edge_time, opening_speed)
+        return cls(tuple(zip(make, ends)), **fields)
 
     # -- as a function of time --
 

@@ -1,4 +1,10 @@
-"""Range checks for parameter dataclasses: errors name the class, the field, the value and the allowed range."""
+"""The value checks of circuit's parameter dataclasses: errors name the class, the field, the value and what is allowed.
+
+The one validation module of circuit: every frozen dataclass (templates, arc, options,
+schedule, netlist) checks its fields with these, once, in ``__post_init__``. A scene
+reports the errors under its own key names (coupling.scene translates 'Class.field' into
+'circuit.key'; docs/scene_keys.md, "Where values are checked").
+"""
 
 from __future__ import annotations
 
@@ -33,3 +39,10 @@ def check_range(
         lower = f"{low:g} < value" if low_open else f"{low:g} <= value"
         raise ValueError(f"{owner}.{field} = {number:g}{u} is out of range: allowed {lower} <= {high:g}{u}")
     return number
+
+
+def check_choice(owner: str, field: str, value: object, choices) -> str:
+    """Return ``value`` if it is one of ``choices``."""
+    if isinstance(value, (list, dict)) or value not in choices:
+        raise ValueError(f"{owner}.{field} = {value!r}: allowed values are {', '.join(map(repr, choices))}")
+    return value

@@ -146,10 +146,21 @@ def _law_ranges(scene):
     return None
 
 
+def fit_warnings(scene) -> list[str]:
+    """The rows the scene's tribometer fit left out as outliers (a fit on the fly from
+    ``data =`` reports them nowhere else)."""
+    trib = scene.tribology
+    if trib is None or trib.fit is None or not (trib.fit.friction.n_outliers or trib.fit.resistance.n_outliers):
+        return []
+    from coupling.tribology.command import outlier_lines
+
+    return [f"contact laws from {trib.source}: {line}" for line in outlier_lines(trib.fit)]
+
+
 def run_warnings(result) -> list[str]:
     """All warnings for a CoupledResult."""
-    out: list[str] = []
     scene = result.scene
+    out = fit_warnings(scene)
     if result.mechanics is not None:
         out += hertz_warnings(result.mechanics)
     w = result.waveforms

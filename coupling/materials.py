@@ -36,6 +36,8 @@ from typing import Any
 
 import numpy as np
 
+from mech.validation import check_choice, check_keys, check_nonnegative, check_positive, check_whole, unknown
+
 MIN_SPOT_RADIUS = 0.1e-6  # m: a >> the electron mean free path (Holm's diffusive constriction)
 YIELD_PRESSURE_OVER_HARDNESS = 0.57  # Hertz peak pressure at first yield / hardness
 GREENWOOD_COEFFICIENT = 16.0 / (3.0 * math.pi ** 2)  # interaction term of spots in a cluster
@@ -125,7 +127,7 @@ MATERIALS = load_materials()
 def material(name: str, where: str = "material") -> Material:
     """The library entry ``name``; ValueError naming the known ones."""
     if name not in MATERIALS:
-        raise ValueError(f"{where}: unknown contact material {name!r}; known: {', '.join(MATERIALS)}")
+        raise unknown(where, name, MATERIALS, kind="contact material")
     return MATERIALS[name]
 
 
@@ -175,9 +177,7 @@ class ConstantResistance(_ForceLaw):
     value: float
 
     def __post_init__(self):
-        v = self.value
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not (math.isfinite(v) and v > 0.0):
-            raise ValueError(f"resistance value = {v!r}: expected a finite number > 0 (ohm)")
+        check_positive("tribology.resistance.value", self.value)  # ohm
 
     name = "constant"
     load_exponent = 0.0
@@ -212,18 +212,13 @@ class HolmResistance(_ForceLaw):
     name = "holm"
 
     def __post_init__(self):
-        where = "[tribology] resistance"
-        m1, m2 = (material(m, f"{where} materials") for m in self.materials)
-        if self.regime not in ("plastic", "elastic"):
-            raise ValueError(f"{where} regime = {self.regime!r}: allowed values are 'plastic', 'elastic'")
-        if isinstance(self.spots, bool) or not isinstance(self.spots, int) or self.spots < 1:
-            raise ValueError(f"{where} spots = {self.spots!r}: expected a whole number >= 1")
-        if self.radius is not None and (isinstance(self.radius, bool) or not isinstance(self.radius, (int, float))
-                                        or not (math.isfinite(self.radius) and self.radius > 0.0)):
-            raise ValueError(f"{where} radius = {self.radius!r}: expected a finite number > 0 (m)")
-        f = self.film_resistivity
-        if isinstance(f, bool) or not isinstance(f, (int, float)) or not (math.isfinite(f) and f >= 0.0):
-            raise ValueError(f"{where} film_resistivity = {f!r}: expected a finite number >= 0 (ohm m^2)")
+        where = "tribology.resistance"
+        m1, m2 = (material(m, f"{where}.materials") for m in self.materials)
+        check_choice(f"{where}.regime", self.regime, ("plastic", "elastic"))
+        check_whole(f"{where}.spots", self.spots, 1)
+        if self.radius is not None:
+            check_positive(f"{where}.radius", self.radius)  # m
+        check_nonnegative(f"{where}.film_resistivity", self.film_resistivity)  # ohm m^2
         if self.radius is None and (self.regime == "elastic" or self.spots > 1):
             need = "the elastic (Hertz) regime" if self.regime == "elastic" else f"spots = {self.spots}"
             raise ValueError(f"{where}: {need} needs radius = the rivet's spherical radius (m)")
@@ -292,20 +287,12 @@ HOLM_KEYS = {"law", "materials", "regime", "spots", "radius", "film_resistivity"
 CONSTANT_KEYS = {"law", "value"}
 
 
-def resistance_law_from_table(table: dict, where: str = "[tribology] resistance"):
+def resistance_law_from_table(table: dict, where: str = "tribology.resistance"):
     """A material or constant R_c law from a scene table (``law = "holm"`` or ``"constant"``)."""
     if not isinstance(table, dict):
         raise ValueError(f"{where}: expected a table, got {table!r}")
-    law = table.get("law")
-    if law == "constant":
-        allowed = CONSTANT_KEYS
-    elif law == "holm":
-        allowed = HOLM_KEYS
-    else:
-        raise ValueError(f"{where} law = {law!r}: allowed values are 'holm', 'constant'")
-    for key in table:
-        if key not in allowed:
-            raise ValueError(f"{where}: unknown key {key!r} for law = {law!r}; allowed: {', '.join(sorted(allowed))}")
+    law = check_choice(f"{where}.law", table.get("law"), ("holm", "constant"))
+    check_keys(f"{where} (law = {law!r})", table, CONSTANT_KEYS if law == "constant" else HOLM_KEYS)
     if law == "constant":
         if "value" not in table:
             raise ValueError(f"{where}: law = 'constant' needs value = R_c (ohm)")
@@ -314,7 +301,7 @@ def resistance_law_from_table(table: dict, where: str = "[tribology] resistance"
     if isinstance(mats, str):
         mats = [mats, mats]
     if not (isinstance(mats, list) and len(mats) == 2 and all(isinstance(m, str) for m in mats)):
-        raise ValueError(f"{where} materials = {table.get('materials')!r}: expected two names "
+        raise ValueError(f"{where}.materials = {table.get('materials')!r}: expected two names "
                          f"[\"rivet\", \"counter-contact\"] (or one for both) from: {', '.join(MATERIALS)}")
     kw = {k: table[k] for k in ("regime", "spots", "radius", "film_resistivity") if k in table}
     return HolmResistance(tuple(mats), **kw)

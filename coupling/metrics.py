@@ -26,10 +26,11 @@ Definitions (SI: s, V, A, J), documented for users in docs/coupling.md ("Bounce 
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
+
+from mech.validation import check_nonnegative, check_whole
 
 ARC_BURNING_CURRENT = 1e-3  # A
 DEFAULT_SETTLE_WINDOW = 1e-3  # s
@@ -52,13 +53,10 @@ class MetricSettings:
     arc_toggle_limit: int = DEFAULT_ARC_TOGGLE_LIMIT
 
     def __post_init__(self):
-        for name in ("settle_window",) + (("make_guard",) if self.make_guard is not None else ()):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
-                raise ValueError(f"metrics.{name} = {value!r}: expected a finite number >= 0 (s)")
-        limit = self.arc_toggle_limit
-        if isinstance(limit, bool) or not isinstance(limit, int) or limit < 0:
-            raise ValueError(f"metrics.arc_toggle_limit = {limit!r}: expected a whole number >= 0")
+        check_nonnegative("metrics.settle_window", self.settle_window)
+        if self.make_guard is not None:
+            check_nonnegative("metrics.make_guard", self.make_guard)
+        check_whole("metrics.arc_toggle_limit", self.arc_toggle_limit)
 
     def guard(self, t_end: float) -> float:
         """s: the make guard for a run of length t_end."""

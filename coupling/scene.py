@@ -27,14 +27,18 @@ A scene names only what it needs, and only that is built:
     [metrics]     settle_window (s), make_guard (s), arc_toggle_limit (coupling.metrics)
 
 SI units everywhere. File paths are relative to the scene file. Every error names the
-section and key and says what is allowed, before any solver starts.
+file, the section and key as written and says what is allowed, before any solver starts.
+
+This module holds no value checks of its own: it maps each TOML section 1:1 onto its
+dataclass (mech's, circuit's, or the coupling sections' below, which use mech/validation.py),
+checks the structure (sections, key names, which sections go together, files) and reports
+the dataclasses' errors in the scene's words (docs/scene_keys.md, "Where values are checked").
 """
 
 from __future__ import annotations
 
 import copy
 import dataclasses
-import difflib
 import re
 import tomllib
 from dataclasses import dataclass, field
@@ -42,30 +46,22 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from mech.parameters import Friction, MechScene, check_nonnegative, check_positive
+from mech.parameters import Friction, MechScene, SolverOptions
 from mech.scene import SCENE_SECTIONS as MECH_SECTIONS
 from mech.scene import read_toml
 from mech.scene import scene_from_dict as mech_scene_from_dict
-from mech.scene import suggest
+from mech.validation import (
+    check_bool, check_choice, check_file, check_keys, check_nonnegative, check_positive, check_whole,
+)
 
 COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output", "metrics")
 TEMPLATES = ("resistive", "inductive", "capacitive", "current_source", "netlist")
 SCHEMES = ("mechanics_first", "jacobi")
 
 
-def _unknown(where: str, key: str, allowed) -> ValueError:
-    return ValueError(f"{where}: unknown key {key!r}{suggest(key, allowed)}; allowed keys: {', '.join(sorted(allowed))}")
-
-
 def _table(where: str, value) -> dict:
     if not isinstance(value, dict):
         raise ValueError(f"{where}: expected a table of keys, got {value!r}")
-    return value
-
-
-def _bool(where: str, value) -> bool:
-    if not isinstance(value, bool):
-        raise ValueError(f"{where} = {value!r}: expected true or false")
     return value
 
 
@@ -94,16 +90,14 @@ class CouplingOptions:
     onset_penetration: float = 10e-9
 
     def __post_init__(self):
-        if self.scheme not in SCHEMES:
-            raise ValueError(f"coupling.scheme = {self.scheme!r}: allowed values are {', '.join(map(repr, SCHEMES))}")
+        check_choice("coupling.scheme", self.scheme, SCHEMES)
         check_positive("coupling.macro_step", self.macro_step)
         if self.max_macro_step is not None:
             check_positive("coupling.max_macro_step", self.max_macro_step)
             if self.max_macro_step < self.macro_step:
                 raise ValueError(f"coupling.max_macro_step = {self.max_macro_step!r}: must be >= "
                                  f"coupling.macro_step = {self.macro_step!r}")
-        if not isinstance(self.align_events, bool):
-            raise ValueError(f"coupling.align_events = {self.align_events!r}: expected true or false")
+        check_bool("coupling.align_events", self.align_events)
         check_nonnegative("coupling.onset_penetration", self.onset_penetration)
 
     @property
@@ -132,11 +126,9 @@ class OutputOptions:
 
     def __post_init__(self):
         for name in ("csv", "parquet", "plots", "history", "html"):
-            _bool(f"output.{name}", getattr(self, name))
+            check_bool(f"output.{name}", getattr(self, name))
         check_nonnegative("output.history_resolution", self.history_resolution)
-        rows = self.history_max_rows
-        if isinstance(rows, bool) or not isinstance(rows, int) or rows < 0:
-            raise ValueError(f"output.history_max_rows = {rows!r}: expected a whole number >= 0 (0: no limit)")
+        check_whole("output.history_max_rows", self.history_max_rows, note=" (0: no limit)")
 
     def history_interval(self, duration: float) -> float:
         """s: the history's resolution for a run of ``duration`` s (0: every record)."""
@@ -191,10 +183,9 @@ class Scene:
     @property
     def t_end(self) -> float:
         """s: length of the run ([solver] t_end)."""
-        t_end = _table("[solver]", self.raw.get("solver", {})).get("t_end")
-        if t_end is not None:
-            return float(t_end)
-        return self.mech.solver.t_end if self.mech is not None else MechScene().solver.t_end
+        if self.mech is not None:
+            return self.mech.solver.t_end
+        return SolverOptions(**self.raw.get("solver", {})).t_end  # a schedule scene: [solver] t_end alone
 
     def set(self, key: str, value) -> "Scene":
         """A new scene with ``key`` ("section.key" or "section.sub.key") set to value, re-validated.
@@ -243,78 +234,74 @@ class Scene:
 # ------------------------------------------------------------------------------------
 
 
-def _tribology(table: dict, base_dir: Path, where: str) -> TribologySpec:
+TRIBOLOGY_KEYS = ("source", "fit", "data", "mu", "resistance", "feedback")
+
+
+def _input_file(key: str, value, base_dir: Path) -> Path:
+    """The file a scene key names, relative to the scene's folder (mech.validation.check_file)."""
+    if not isinstance(value, str) or not value:
+        raise ValueError(f"{key} = {value!r}: expected a file name (a string), relative to the scene's folder")
+    return check_file(f"{key} = {value!r}", base_dir / value)
+
+
+def _tribology(table: dict, base_dir: Path) -> TribologySpec:
     """[tribology]; ``resistance = { law = "holm" | "constant", ... }`` takes R_c from
     contact materials (coupling.materials) instead of a fit, with mu from the fit or
     ``mu = number`` (Coulomb, gamma = 0)."""
-    table = _table(where, table)
+    table = check_keys("[tribology]", _table("[tribology]", table), TRIBOLOGY_KEYS)
+    feedback = check_bool("tribology.feedback", table.get("feedback", True))
     resistance = table.get("resistance")
     if not (isinstance(resistance, dict) and "law" in resistance):
-        return _tribology_fitted(table, base_dir, where)
+        return _tribology_fitted(table, base_dir, feedback)
     from coupling.materials import resistance_law_from_table
     from coupling.tribology import ContactLaws, MuLaw
 
-    law = resistance_law_from_table(resistance, f"{where} resistance")
+    law = resistance_law_from_table(resistance, "tribology.resistance")
     rest = {k: v for k, v in table.items() if k != "resistance"}
     mu = rest.get("mu")
+    fitted = [k for k in ("source", "fit", "data") if k in rest]
     if isinstance(mu, (int, float)) and not isinstance(mu, bool):
-        for key in ("source", "fit", "data"):
-            if key in rest:
-                raise ValueError(f"{where}: mu = {mu!r} and {key} = both give mu; remove one")
-        if not (mu > 0 and mu < float("inf")):
-            raise ValueError(f"{where} mu = {mu!r}: expected a finite number > 0 (Coulomb friction coefficient)")
-        feedback = _bool(f"{where} feedback", rest.get("feedback", True))
-        for key in rest:
-            if key not in ("mu", "feedback"):
-                raise _unknown(where, key, {"mu", "feedback", "resistance", "source", "fit", "data"})
-        mu_law = MuLaw(0.0, "constant", (("mu0", float(mu)),), (0.0, 1e6))
+        if fitted:
+            raise ValueError(f"tribology.mu = {mu!r} and tribology.{fitted[0]} both give mu; remove one")
+        mu = check_positive("tribology.mu", mu)  # Coulomb's coefficient
+        mu_law = MuLaw(0.0, "constant", (("mu0", mu),), (0.0, 1e6))
         return TribologySpec(ContactLaws(mu_law, law), f"materials ({law.name}), mu = {mu:g}", feedback)
-    if "mu" in rest and not any(k in rest for k in ("source", "fit", "data")):
-        mu_law = MuLaw.from_dict(_table(f"{where} mu", rest["mu"]))
-        return TribologySpec(ContactLaws(mu_law, law), f"materials ({law.name}), inline mu",
-                             _bool(f"{where} feedback", rest.get("feedback", True)))
-    if not any(k in rest for k in ("source", "fit", "data")):
-        raise ValueError(f"{where}: resistance = {{ law = {resistance['law']!r} }} gives R_c only; give mu too: "
+    if "mu" in rest and not fitted:
+        mu_law = MuLaw.from_dict(_table("tribology.mu", rest["mu"]))
+        return TribologySpec(ContactLaws(mu_law, law), f"materials ({law.name}), inline mu", feedback)
+    if not fitted:
+        raise ValueError(f"[tribology]: resistance = {{ law = {resistance['law']!r} }} gives R_c only; give mu too: "
                          "mu = 0.3 (Coulomb), or source/fit/data for the fitted mu(I)")
-    spec = _tribology_fitted(rest, base_dir, where)
+    spec = _tribology_fitted(rest, base_dir, feedback)
     return TribologySpec(ContactLaws(spec.laws.mu_law, law), f"{spec.source} (mu); materials ({law.name}) (R_c)",
                          spec.feedback, spec.fit)
 
 
-def _tribology_fitted(table: dict, base_dir: Path, where: str) -> TribologySpec:
+def _tribology_fitted(table: dict, base_dir: Path, feedback: bool) -> TribologySpec:
     from coupling.tribology import ContactLaws, TribometerFit, default_fit, fit_tribometer, read_tribometer_csv
 
-    allowed = {"source", "fit", "data", "mu", "resistance", "feedback"}
-    for key in table:
-        if key not in allowed:
-            raise _unknown(where, key, allowed)
-    feedback = _bool(f"{where} feedback", table.get("feedback", True))
     given = [k for k in ("source", "fit", "data") if k in table] + (["inline mu/resistance"] if (
         "mu" in table or "resistance" in table) else [])
     if len(given) != 1:
-        raise ValueError(f"{where}: give exactly one of source = \"illustrative\", fit = \"fit.json\", "
-                         f"data = \"data.csv\", or inline [tribology.mu] and [tribology.resistance] tables "
+        raise ValueError("[tribology]: give exactly one of source = \"illustrative\", fit = \"fit.json\", "
+                         "data = \"data.csv\", or inline [tribology.mu] and [tribology.resistance] tables "
                          f"(found {', '.join(given) or 'none'})")
     if "source" in table:
         if table["source"] != "illustrative":
-            raise ValueError(f"{where} source = {table['source']!r}: the only built-in source is \"illustrative\" "
+            raise ValueError(f"tribology.source = {table['source']!r}: the only built-in source is \"illustrative\" "
                              "(the shipped, not measured, dataset); for your data use fit = or data =")
         fit = default_fit()
         return TribologySpec(fit.laws, "illustrative (not measured)", feedback, fit)
     if "fit" in table:
-        path = base_dir / str(table["fit"])
-        if not path.is_file():
-            raise FileNotFoundError(f"{where} fit = {str(table['fit'])!r}: file {str(path)!r} not found")
+        path = _input_file("tribology.fit", table["fit"], base_dir)
         fit = TribometerFit.from_json(path)
         return TribologySpec(fit.laws, f"fit file {path.name}", feedback, fit)
     if "data" in table:
-        path = base_dir / str(table["data"])
-        if not path.is_file():
-            raise FileNotFoundError(f"{where} data = {str(table['data'])!r}: file {str(path)!r} not found")
+        path = _input_file("tribology.data", table["data"], base_dir)
         fit = fit_tribometer(read_tribometer_csv(path))
         return TribologySpec(fit.laws, f"fit of {path.name}", feedback, fit)
     if "mu" not in table or "resistance" not in table:
-        raise ValueError(f"{where}: inline laws need both [tribology.mu] and [tribology.resistance]")
+        raise ValueError("[tribology]: inline laws need both [tribology.mu] and [tribology.resistance]")
     laws = ContactLaws.from_dict({"mu": table["mu"], "resistance": table["resistance"]})
     return TribologySpec(laws, "inline laws", feedback)
 
@@ -344,7 +331,7 @@ _SCHEDULE = {"make": "intervals", "break": "intervals", "closed_resistance": "cl
              "edge_time": "edge_time", "opening_speed": "opening_speed"}
 
 
-def _template_keys(template: str) -> set:
+def template_keys(template: str) -> set:
     """The [circuit] keys a template uses (besides template, schedule and the ngspice options)."""
     if template == "netlist":
         return set(_NETLIST) | {"arc"}
@@ -352,7 +339,7 @@ def _template_keys(template: str) -> set:
     return set(source) | set(_WIRING) | set(_LOADS[template]) | set(_TEMPLATE_CIRCUIT) | set(_PARTS)
 
 
-CIRCUIT_KEYS = frozenset({"template", "schedule", "probes", *_OPTION_KEYS}.union(*(_template_keys(t) for t in TEMPLATES)))
+CIRCUIT_KEYS = frozenset({"template", "schedule", "probes", *_OPTION_KEYS}.union(*(template_keys(t) for t in TEMPLATES)))
 
 
 def circuit_key_names(ck) -> dict:
@@ -384,44 +371,36 @@ def _fields(table: dict, keys: dict) -> dict:
     return {name: table[key] for key, name in keys.items() if key in table and name}
 
 
-def _part(table: dict, name: str, cls, where: str):
+def _part(table: dict, name: str, cls):
     """A sub-table (snubber, flyback, arc): false/absent -> None, true -> defaults, a table -> its fields."""
     value = table.get(name)
     if value is None or value is False:
         return None
     if value is True:
         if name == "snubber":
-            raise ValueError(f"{where}: circuit.snubber = true: give its resistance (ohm) and capacitance (F), "
+            raise ValueError("circuit.snubber = true: give its resistance (ohm) and capacitance (F), "
                              "e.g. snubber = {resistance = 100.0, capacitance = 100e-9}")
         return cls()
     if not isinstance(value, dict):
-        raise ValueError(f"{where}: circuit.{name} = {value!r}: expected true, false or a table of keys")
+        raise ValueError(f"circuit.{name} = {value!r}: expected true, false or a table of keys")
     allowed = [f.name for f in dataclasses.fields(cls)]
-    for key in value:
-        if key not in allowed:
-            raise _unknown(f"{where}: circuit.{name}", key, allowed)
+    check_keys(f"circuit.{name}", value, allowed)
     if name == "snubber" and len(value) != 2:
         missing = sorted(set(allowed) - set(value))
-        raise ValueError(f"{where}: circuit.snubber needs both resistance (ohm) and capacitance (F); "
+        raise ValueError("circuit.snubber needs both resistance (ohm) and capacitance (F); "
                          f"missing: {', '.join(missing)}")
     return cls(**value)
 
 
-def _circuit(table: dict, base_dir: Path, where: str, current_factor: str | None):
+def _circuit(table: dict, base_dir: Path, current_factor: str | None):
     import circuit as ck
 
-    table = _table(f"{where}: [circuit]", table)
-    for key in table:
-        if key not in CIRCUIT_KEYS:
-            raise _unknown(f"{where}: [circuit]", key, CIRCUIT_KEYS)
-    template = table.get("template", "resistive")
-    if template not in TEMPLATES:
-        raise ValueError(f"{where}: circuit.template = {template!r}: allowed values are "
-                         f"{', '.join(map(repr, TEMPLATES))}")
+    table = check_keys("[circuit]", _table("[circuit]", table), CIRCUIT_KEYS)
+    template = check_choice("circuit.template", table.get("template", "resistive"), TEMPLATES)
     if "voltage" in table and "current" in table:
-        raise ValueError(f"{where}: circuit.voltage and circuit.current both name a source: give one, current "
+        raise ValueError("circuit.voltage and circuit.current both name a source: give one, current "
                          "(A) with template = \"current_source\", or voltage (V) with a voltage-source template")
-    usable = _template_keys(template) | {"template", "schedule", "probes", *_OPTION_KEYS}
+    usable = template_keys(template) | {"template", "schedule", "probes", *_OPTION_KEYS}
     stray = sorted(set(table) - usable)
     if stray:
         hint = {"netlist": " (put it in the netlist)",
@@ -429,20 +408,15 @@ def _circuit(table: dict, base_dir: Path, where: str, current_factor: str | None
                                   "output_resistance)"}.get(template, "")
         if template not in ("netlist", "current_source") and set(stray) & set(_CURRENT_SOURCE):
             hint = " (a current source needs template = \"current_source\")"
-        raise ValueError(f"{where}: circuit.{', circuit.'.join(stray)} do(es) not apply to template {template!r}"
-                         f"{hint}; its keys: {', '.join(sorted(_template_keys(template)))}")
-    names = circuit_key_names(ck)
+        raise ValueError(f"circuit.{', circuit.'.join(stray)} do(es) not apply to template {template!r}"
+                         f"{hint}; its keys: {', '.join(sorted(template_keys(template)))}")
     try:
         options = ck.SimulationOptions(**{k: table[k] for k in _OPTION_KEYS if k in table})
-        arc = _part(table, "arc", ck.ArcModel, where)
+        arc = _part(table, "arc", ck.ArcModel)
         if template == "netlist":
             if "netlist" not in table:
-                raise ValueError(f"{where}: template \"netlist\" needs netlist = \"file.cir\" "
-                                 "(with one 'XCONTACT a b' line)")
-            path = base_dir / str(table["netlist"])
-            if not path.is_file():
-                raise FileNotFoundError(f"{where}: circuit.netlist = {str(table['netlist'])!r}: file "
-                                        f"{str(path)!r} not found")
+                raise ValueError("template \"netlist\" needs netlist = \"file.cir\" (with one 'XCONTACT a b' line)")
+            path = _input_file("circuit.netlist", table["netlist"], base_dir)
             circ = ck.NetlistCircuit.from_file(path, arc=arc, contact_current_factor=current_factor,
                                                **_fields(table, _NETLIST))
         else:
@@ -454,74 +428,75 @@ def _circuit(table: dict, base_dir: Path, where: str, current_factor: str | None
                 load = {"resistive": ck.ResistiveLoad, "inductive": ck.InductiveLoad,
                         "capacitive": ck.CapacitiveLoad}[template](**_fields(table, _LOADS[template]))
             circ = ck.SwitchCircuit(source=source, load=load, wiring=ck.Wiring(**_fields(table, _WIRING)),
-                                    snubber=_part(table, "snubber", ck.Snubber, where),
-                                    flyback=_part(table, "flyback", ck.FlybackDiode, where), arc=arc,
+                                    snubber=_part(table, "snubber", ck.Snubber),
+                                    flyback=_part(table, "flyback", ck.FlybackDiode), arc=arc,
                                     contact_current_factor=current_factor, **_fields(table, _TEMPLATE_CIRCUIT))
         schedule = None
         if "schedule" in table:
-            st = _table(f"{where}: circuit.schedule", table["schedule"])
-            for key in st:
-                if key not in _SCHEDULE:
-                    raise _unknown(f"{where}: circuit.schedule", key, _SCHEDULE)
+            st = check_keys("circuit.schedule", _table("circuit.schedule", table["schedule"]), _SCHEDULE)
             if "make" not in st or "break" not in st:
-                raise ValueError(f"{where}: circuit.schedule needs make = [...] and break = [...] (s)")
+                raise ValueError("circuit.schedule needs make = [...] and break = [...] (s)")
             schedule = ck.ContactSchedule.from_events(st["make"], st["break"], **_fields(st, {
                 k: k for k in ("closed_resistance", "edge_time", "opening_speed")}))
-    except ValueError as err:
-        message = _in_scene_words(err, names)
-        raise ValueError(message if message.startswith(where) else f"{where}: {message}") from None
+    except (TypeError, ValueError) as err:  # TypeError: a value of a type no check foresaw
+        raise ValueError(_in_scene_words(err, circuit_key_names(ck))) from None
     probes = ()
     if "probes" in table:  # validated against the deck's nodes and elements
         from circuit.deck import build_deck
         from circuit.probes import check_probes
 
-        probes = check_probes(table["probes"], build_deck(circ, 1.0, options)[0], f"{where}: [circuit] probes")
+        probes = check_probes(table["probes"], build_deck(circ, 1.0, options)[0], "[circuit] probes")
     return CircuitSpec(circ, options, schedule, template, probes)
 
 
 def scene_from_dict(doc: dict, *, base_dir: Path | str = ".", name: str = "scene") -> Scene:
-    """Validate a parsed scene document completely and build the Scene."""
-    where = name
-    doc = _table(where, doc)
-    base_dir = Path(base_dir)
-    known = set(MECH_SECTIONS) | set(COUPLING_SECTIONS)
-    for section in doc:
-        if section not in known:
-            close = difflib.get_close_matches(section, list(known), n=1)
-            hint = f" (did you mean [{close[0]}]?)" if close else ""
-            raise ValueError(f"{where}: unknown section [{section}]{hint}; allowed: {', '.join(sorted(known))}")
+    """Validate a parsed scene document completely and build the Scene. Every error names
+    the scene (``name``, its file) first."""
+    try:
+        return _build(doc, Path(base_dir), name)
+    except (ValueError, FileNotFoundError) as err:
+        message = str(err)
+        if message.startswith(f"{name}:"):
+            raise
+        raise type(err)(f"{name}: {message}") from None
+
+
+def _build(doc: dict, base_dir: Path, name: str) -> Scene:
+    doc = _table(name, doc)
+    check_keys(name, doc, set(MECH_SECTIONS) | set(COUPLING_SECTIONS), kind="section")
     circuit_table = doc.get("circuit")
     schedule_given = isinstance(circuit_table, dict) and "schedule" in circuit_table
     mech_given = [s for s in MECH_SECTIONS if s != "solver" and s in doc]
-    solver_only_t_end = set(_table("[solver]", doc.get("solver", {}))) <= {"t_end"}
+    solver_table = _table("[solver]", doc.get("solver", {}))
 
-    if schedule_given and (mech_given or not solver_only_t_end):
-        raise ValueError(f"{where}: [circuit.schedule] prescribes the contact, so the scene runs no mechanics; "
+    if schedule_given and (mech_given or set(solver_table) - {"t_end"}):
+        raise ValueError("[circuit.schedule] prescribes the contact, so the scene runs no mechanics; "
                          f"remove [{'], ['.join(mech_given or ['solver'])}] (only [solver] t_end may stay) "
                          "or remove [circuit.schedule]")
     if "coupling" in doc and (circuit_table is None or schedule_given):
-        raise ValueError(f"{where}: [coupling] settings need mechanics and a [circuit] to couple")
+        raise ValueError("[coupling] settings need mechanics and a [circuit] to couple")
     if circuit_table is not None and not schedule_given and "tribology" not in doc:
-        raise ValueError(f"{where}: a coupled scene needs [tribology] for R_c(F_n, I) and mu(I): "
+        raise ValueError("a coupled scene needs [tribology] for R_c(F_n, I) and mu(I): "
                          "source = \"illustrative\" (the shipped, not measured, fit), fit = \"fit.json\" "
                          "or data = \"data.csv\"")
     if schedule_given and "tribology" in doc:
-        raise ValueError(f"{where}: [tribology] is unused with [circuit.schedule] (the schedule gives the "
+        raise ValueError("[tribology] is unused with [circuit.schedule] (the schedule gives the "
                          "closed resistance); remove one of them")
 
-    tribology = _tribology(doc["tribology"], base_dir, f"{where} [tribology]") if "tribology" in doc else None
+    tribology = _tribology(doc["tribology"], base_dir) if "tribology" in doc else None
 
     mech = None
-    if not schedule_given:
+    if schedule_given:
+        SolverOptions(**solver_table)  # [solver] t_end alone: the run's length
+    else:
         mech_doc = {k: v for k, v in doc.items() if k in MECH_SECTIONS}
         if tribology is not None:
             fr = _table("[friction]", mech_doc.get("friction", {}))
             for key in ("mu", "gamma"):
                 if key in fr:
-                    raise ValueError(f"{where}: friction.{key} and [tribology] both set the friction law; "
+                    raise ValueError(f"friction.{key} and [tribology] both set the friction law; "
                                      f"remove friction.{key} (the laws give gamma and mu(I))")
-            mech_doc["friction"] = dict(fr)
-        mech = mech_scene_from_dict(mech_doc, where=where, extra_sections=COUPLING_SECTIONS)
+        mech = mech_scene_from_dict(mech_doc, where=name, extra_sections=COUPLING_SECTIONS)
         if tribology is not None:
             laws = tribology.laws
             fr = mech.friction
@@ -535,29 +510,20 @@ def scene_from_dict(doc: dict, *, base_dir: Path | str = ".", name: str = "scene
     if circuit_table is not None:
         # R_c(F, I) = g(|I|)/G_F(F): the current factor goes into ngspice (solved without lag)
         factor = tribology.laws.resistance_law.current_factor_expression("I") if tribology is not None else None
-        circuit = _circuit(circuit_table, base_dir, where, factor)
+        circuit = _circuit(circuit_table, base_dir, factor)
 
-    coupling = CouplingOptions(**_known(doc.get("coupling", {}), CouplingOptions, f"{where} [coupling]"))
-    output = OutputOptions(**_known(doc.get("output", {}), OutputOptions, f"{where} [output]"))
-    t_end = _table("[solver]", doc.get("solver", {})).get("t_end")
-    if t_end is not None:
-        check_positive("solver.t_end", t_end)
     from .metrics import MetricSettings
 
-    metrics = MetricSettings(**_known(doc.get("metrics", {}), MetricSettings, f"{where} [metrics]"))
+    coupling, output, metrics = (_section(doc, section, cls) for section, cls in (
+        ("coupling", CouplingOptions), ("output", OutputOptions), ("metrics", MetricSettings)))
     return Scene(raw=copy.deepcopy(doc), base_dir=base_dir, mech=mech, tribology=tribology, circuit=circuit,
                  coupling=coupling, output=output, name=name, metrics=metrics)
 
 
-def _known(table, cls, where: str) -> dict:
-    import dataclasses
-
-    table = _table(where, table)
-    allowed = [f.name for f in dataclasses.fields(cls)]
-    for key in table:
-        if key not in allowed:
-            raise _unknown(where, key, allowed)
-    return dict(table)
+def _section(doc: dict, section: str, cls):
+    """A section that is one dataclass, each key one field (an omitted key: the field's default)."""
+    table = _table(f"[{section}]", doc.get(section, {}))
+    return cls(**check_keys(f"[{section}]", table, [f.name for f in dataclasses.fields(cls)]))
 
 
 #: Exclusive key groups: (section, alternatives); setting keys of one drops the others.

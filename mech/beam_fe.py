@@ -44,7 +44,7 @@ from typing import Sequence
 import numpy as np
 import scipy.linalg
 
-from .parameters import check_choice, check_finite, check_nonnegative, check_positive
+from .validation import check_choice, check_finite, check_nonnegative, check_positive, check_whole
 
 FAMILIES = ("axial", "bend2", "bend3")
 SUPPORTS = ("free", "clamp", "pivot")
@@ -398,8 +398,7 @@ def assemble(beam: FEBeam, family: str, elements: int | None = None, count: int 
     cond = beam.condition(family) if condition is None else check_choice("condition", condition, CONDITIONS)
     if elements is None:
         elements = default_elements(count)
-    if isinstance(elements, bool) or not isinstance(elements, (int, np.integer)) or elements < 1:
-        raise ValueError(f"elements = {elements!r}: expected a whole number >= 1")
+    check_whole("elements", elements, 1)
     nodes = mesh(beam, int(elements))
     h = np.diff(nodes)
     ne = len(h)
@@ -587,12 +586,6 @@ def _package(beam, family, cond, system, lam, full) -> BeamModes:
                      nodes=nodes, coefficients=coeff)
 
 
-def _check_count(name: str, value) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 0:
-        raise ValueError(f"{name} = {value!r}: expected a whole number >= 0")
-    return int(value)
-
-
 def beam_modes(beam: FEBeam, family: str, count: int, elements: int | None = None,
                condition: str | None = None) -> BeamModes:
     """The lowest ``count`` elastic modes of ``family`` ("axial", "bend2", "bend3").
@@ -601,7 +594,7 @@ def beam_modes(beam: FEBeam, family: str, count: int, elements: int | None = Non
     family's boundary condition at the support ("free", "clamp", "pin"; e.g. a hinge that
     pins bend3 but clamps bend2).
     """
-    count = _check_count("count", count)
+    count = check_whole("count", count)
     system = assemble(beam, family, elements, max(count, 1), condition)
     cond = beam.condition(family) if condition is None else condition
     if count == 0:
@@ -619,8 +612,8 @@ def beam_basis(beam: FEBeam, axial: int, bending: int, planar: bool = False,
     conditions and the mass, so their shapes are the same and the eigenproblem is solved
     once; the frequencies scale with sqrt(E I).
     """
-    axial = _check_count("axial", axial)
-    bending = _check_count("bending", bending)
+    axial = check_whole("axial", axial)
+    bending = check_whole("bending", bending)
     if elements is None:
         elements = default_elements(max(axial, bending, 1))
     out = []

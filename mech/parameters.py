@@ -1,7 +1,9 @@
 """Validated, frozen parameter sets of the impact problem (SI units).
 
-Every dataclass checks its fields once, where it is built, and raises ``ValueError``
-naming the field, the value and what is allowed. Nothing downstream re-validates.
+Every dataclass checks its fields once, where it is built, with the checks of
+mech/validation.py, and raises ``ValueError`` naming the field, the value and what is
+allowed. Nothing downstream re-validates. The defaults of the fields are the defaults of
+the scene keys (docs/scene_keys.md, tested against it).
 """
 
 from __future__ import annotations
@@ -10,71 +12,12 @@ import math
 from dataclasses import dataclass, field
 from typing import Callable, Literal, Union
 
-import numpy as np
+from .validation import (
+    check_bool, check_choice, check_count, check_finite, check_nonnegative, check_position, check_positive,
+    check_range, check_table, check_vector3, check_whole,
+)
 
 MuLike = Union[float, Callable[[float], float]]
-
-
-def check_finite(name: str, value) -> float:
-    """Return ``value`` as float, or raise naming the field when it is not a finite number."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ValueError(f"{name} = {value!r}: expected a number")
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f"{name} = {value!r}: expected a finite number")
-    return value
-
-
-def check_positive(name: str, value) -> float:
-    value = check_finite(name, value)
-    if value <= 0.0:
-        raise ValueError(f"{name} = {value!r}: must be > 0")
-    return value
-
-
-def check_nonnegative(name: str, value) -> float:
-    value = check_finite(name, value)
-    if value < 0.0:
-        raise ValueError(f"{name} = {value!r}: must be >= 0")
-    return value
-
-
-def check_range(name: str, value, low: float, high: float, *, closed_low=False, closed_high=False) -> float:
-    """A number inside (low, high); ``closed_*`` makes that end inclusive."""
-    value = check_finite(name, value)
-    ok_low = value >= low if closed_low else value > low
-    ok_high = value <= high if closed_high else value < high
-    if not (ok_low and ok_high):
-        lo, hi = ("[" if closed_low else "("), ("]" if closed_high else ")")
-        raise ValueError(f"{name} = {value!r}: allowed range is {lo}{low}, {high}{hi}")
-    return value
-
-
-def check_choice(name: str, value, choices) -> str:
-    if value not in choices:
-        raise ValueError(f"{name} = {value!r}: allowed values are {', '.join(map(repr, choices))}")
-    return value
-
-
-def check_vector3(name: str, value) -> tuple[float, float, float]:
-    try:
-        items = list(value)
-    except TypeError:
-        raise ValueError(f"{name} = {value!r}: expected a list of 3 numbers") from None
-    if len(items) != 3:
-        raise ValueError(f"{name} = {value!r}: expected a list of 3 numbers")
-    return tuple(check_finite(f"{name}[{i}]", v) for i, v in enumerate(items))
-
-
-def _check_count(name: str, value, high: int = 40, auto: bool = False):
-    if auto and value == "auto":  # chosen from the scene (mech/mode_count.py)
-        return value
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise ValueError(f"{name} = {value!r}: expected a whole number in [0, {high}]"
-                         + (' or "auto"' if auto else ""))
-    if not 0 <= value <= high:
-        raise ValueError(f"{name} = {value!r}: allowed range is [0, {high}]")
-    return int(value)
 
 
 @dataclass(frozen=True)
@@ -125,8 +68,8 @@ class Bar:
         check_positive("bar.youngs_modulus", self.youngs_modulus)
         check_range("bar.poisson_ratio", self.poisson_ratio, -1.0, 0.5)
         check_positive("bar.density", self.density)
-        _check_count("bar.axial_modes", self.axial_modes, auto=True)
-        _check_count("bar.bending_modes", self.bending_modes, auto=True)
+        check_count("bar.axial_modes", self.axial_modes, auto=True)
+        check_count("bar.bending_modes", self.bending_modes, auto=True)
         check_choice("bar.bending", self.bending, ("euler_bernoulli", "paper_shear"))
         check_range("bar.modal_damping", self.modal_damping, 0.0, 1.0, closed_low=True)
         half = self.section_half_width
@@ -287,10 +230,7 @@ class Friction:
             check_nonnegative("friction.mu", self.mu)
         check_range("friction.gamma", self.gamma, 0.0, 1.0, closed_low=True)
         check_choice("friction.model", self.model, ("exact", "regularized"))
-        if not (isinstance(self.max_ratio, (int, float)) and self.max_ratio > 0):
-            raise ValueError(f"friction.max_ratio = {self.max_ratio!r}: must be > 0 (inf allowed)")
-        if math.isnan(self.max_ratio):
-            raise ValueError(f"friction.max_ratio = {self.max_ratio!r}: must be > 0 (inf allowed)")
+        check_positive("friction.max_ratio", self.max_ratio, allow_inf=True)
         check_positive("friction.regularization_speed", self.regularization_speed)
 
     @property
@@ -341,8 +281,7 @@ class Initial:
         object.__setattr__(
             self, "angular_velocity", check_vector3("initial.angular_velocity", self.angular_velocity)
         )
-        if not isinstance(self.resting, bool):
-            raise ValueError(f"initial.resting = {self.resting!r}: expected true or false")
+        check_bool("initial.resting", self.resting)
         if self.resting and not (abs(self.angle_deg) < 1e-9 or abs(abs(self.angle_deg) - 90.0) < 1e-9):
             raise ValueError(
                 f"initial.resting with angle_deg = {self.angle_deg!r}: a bar rests in static equilibrium only "
@@ -385,48 +324,7 @@ class SolverOptions:
             check_positive("solver.max_step", self.max_step)
         check_positive("solver.stick_velocity_tol", self.stick_velocity_tol)
         check_positive("solver.energy_tolerance", self.energy_tolerance)
-        if isinstance(self.max_steps, bool) or not isinstance(self.max_steps, int) or self.max_steps < 1:
-            raise ValueError(f"solver.max_steps = {self.max_steps!r}: must be a whole number >= 1")
-
-
-def check_table(name: str, times, values=None, *, width: int | None = None):
-    """A time table: times strictly increasing, finite, >= 0; values finite, one per time
-    (``width``: each value a list of that many numbers). Returns (times, values) as tuples."""
-    try:
-        ts = [float(v) for v in times]
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}.time = {times!r}: expected a list of numbers (s)") from None
-    if not ts:
-        raise ValueError(f"{name}.time: the table is empty; give at least one time")
-    for k, t in enumerate(ts):
-        if not math.isfinite(t) or t < 0.0:
-            raise ValueError(f"{name}.time[{k}] = {t!r}: times must be finite and >= 0 s")
-        if k and t <= ts[k - 1]:
-            raise ValueError(f"{name}.time[{k}] = {t!r}: times must increase strictly "
-                             f"(previous {ts[k - 1]!r})")
-    if values is None:
-        return tuple(ts), None
-    try:
-        vals = list(values)
-    except TypeError:
-        raise ValueError(f"{name}: expected a list of values, one per time") from None
-    if len(vals) != len(ts):
-        raise ValueError(f"{name}: {len(vals)} values for {len(ts)} times; give one value per time")
-    out = []
-    for k, v in enumerate(vals):
-        if width is None:
-            out.append(check_finite(f"{name}[{k}]", v))
-        else:
-            out.append(check_vector3(f"{name}[{k}]", v))
-    return tuple(ts), tuple(out)
-
-
-def check_position(name: str, value, length: float) -> float:
-    """A position along the bar (m from tip 0) inside [0, length]."""
-    x = check_finite(name, value)
-    if not 0.0 <= x <= length:
-        raise ValueError(f"{name} = {x!r}: must lie on the bar, in [0, {length!r}] m from tip 0")
-    return x
+        check_whole("solver.max_steps", self.max_steps, 1)
 
 
 MOUNT_KINDS = ("free", "clamp", "pivot")

@@ -1,6 +1,7 @@
 """Mechanics scenes as TOML (SI units): parsing, validation of keys, the default scene.
 
-Sections and keys (all optional; defaults are the documented default scene):
+Sections and keys (all optional; an omitted key takes its dataclass field's default, the
+default listed in docs/scene_keys.md; ``DEFAULT_SCENE_TOML`` is one scene, not the defaults):
 
     [bar]       length, diameter | (width, thickness), tip_radius, youngs_modulus,
                 poisson_ratio, density, modes (per family, or {axial = n, bending = n}),
@@ -19,21 +20,20 @@ Sections and keys (all optional; defaults are the documented default scene):
 
 Unknown sections or keys are errors that name them (a typo must not silently fall back
 to a default). Other packages (coupling) add their own sections and pass them through
-``extra_sections``.
+``extra_sections``. This module only maps the TOML structure onto the dataclasses of
+mech/parameters.py, 1:1 (``bar.modes`` is the one key that sets two fields); the values are
+checked by the dataclasses (mech/validation.py), and their errors are reported with the
+file and the key as the scene wrote it.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import math
 import tomllib
-from pathlib import Path
 
-from .parameters import (
-    Bar, Block, Contact, Friction, Initial, MechScene, Mount, PointForce, Rivet, SolverOptions, Spring,
-    _check_count,
-)
+from .parameters import Bar, Block, Contact, Friction, Initial, MechScene, Mount, PointForce, Rivet, SolverOptions, Spring
+from .validation import check_file, check_keys
 
 SECTIONS = {
     "bar": Bar,
@@ -91,59 +91,48 @@ t_end = 0.05
 """
 
 
-def _suggest(key: str, allowed) -> str:
-    close = difflib.get_close_matches(key, list(allowed), n=1)
-    return f" (did you mean {close[0]!r}?)" if close else ""
-
-
-suggest = _suggest  # public: the one did-you-mean of every scene section (coupling reuses it)
-
-
 def _field_names(cls) -> list[str]:
     return [f.name for f in dataclasses.fields(cls)]
 
 
 def _section(name: str, cls, table: dict, where: str):
+    """The dataclass of one section: each key one field; errors in the scene's words."""
     if not isinstance(table, dict):
-        raise ValueError(f"{where}[{name}]: expected a table of keys, got {table!r}")
-    allowed = _field_names(cls)
-    kwargs = {}
-    for key, value in table.items():
-        if name == "bar" and key == "modes":
-            kwargs.update(_modes(value, where))
-            continue
-        if key not in allowed:
-            extra = ["modes"] if name == "bar" else []
-            raise ValueError(f"{where}[{name}]: unknown key {key!r}{_suggest(key, allowed + extra)}; "
-                             f"allowed keys: {', '.join(sorted(allowed + extra))}")
-        kwargs[key] = value
+        raise ValueError(f"{where}: [{name}]: expected a table of keys, got {table!r}")
+    extra = ["modes"] if name == "bar" else []
+    check_keys(f"{where}: [{name}]", table, _field_names(cls) + extra)
+    kwargs = dict(table)
+    renamed = {}
+    if name == "bar" and "modes" in kwargs:
+        kwargs, renamed = _modes(kwargs, where)
     if name == "bar" and ("width" in kwargs or "thickness" in kwargs) and "diameter" not in kwargs:
         kwargs["diameter"] = None  # a rectangular section replaces the default round one
     if name == "contact" and "damping" in kwargs and "restitution" not in kwargs:
         kwargs["restitution"] = None  # c given directly replaces the default target restitution
-    if name == "friction" and isinstance(kwargs.get("max_ratio"), str):
-        if kwargs["max_ratio"] != "inf":
-            raise ValueError(f"{where}[friction]: max_ratio = {kwargs['max_ratio']!r}: a number > 0 or \"inf\"")
-        kwargs["max_ratio"] = math.inf
+    if name == "friction" and kwargs.get("max_ratio") == "inf":
+        kwargs["max_ratio"] = math.inf  # how scene_to_dict writes an unbounded ratio
     try:
         return cls(**kwargs)
-    except TypeError as err:  # wrong value types reaching the constructor
-        raise ValueError(f"{where}[{name}]: {err}") from None
+    except (TypeError, ValueError) as err:  # TypeError: a value of a type no check foresaw
+        message = str(err)
+        for field_name, key in renamed.items():
+            message = message.replace(field_name, key)
+        raise ValueError(f"{where}: {message}") from None
 
 
-def _modes(value, where: str) -> dict:
+def _modes(kwargs: dict, where: str) -> tuple[dict, dict]:
     """`modes = 3` (every family), `modes = "auto"` (the default: chosen from the contact
     time, mech/mode_count.py) or `modes = {axial = 3, bending = 2}` (a family left out is
-    "auto"); errors name the key the user wrote (bar.modes, bar.modes.axial),
-    not the field it maps to."""
+    "auto"), as the fields axial_modes and bending_modes; and the names of those fields in
+    an error -> the key the user wrote (bar.modes, bar.modes.axial)."""
+    kwargs = dict(kwargs)
+    value = kwargs.pop("modes")
     if isinstance(value, dict):
-        unknown = set(value) - {"axial", "bending"}
-        if unknown:
-            raise ValueError(f"{where}[bar]: modes: unknown key(s) {sorted(unknown)}; allowed: axial, bending")
-        return {"axial_modes": _check_count("bar.modes.axial", value.get("axial", "auto"), auto=True),
-                "bending_modes": _check_count("bar.modes.bending", value.get("bending", "auto"), auto=True)}
-    count = _check_count("bar.modes", value, auto=True)
-    return {"axial_modes": count, "bending_modes": count}
+        check_keys(f"{where}: bar.modes", value, ("axial", "bending"))
+        kwargs.update(axial_modes=value.get("axial", "auto"), bending_modes=value.get("bending", "auto"))
+        return kwargs, {"bar.axial_modes": "bar.modes.axial", "bar.bending_modes": "bar.modes.bending"}
+    kwargs.update(axial_modes=value, bending_modes=value)
+    return kwargs, {"bar.axial_modes": "bar.modes", "bar.bending_modes": "bar.modes"}
 
 
 def scene_from_dict(doc: dict, *, where: str = "scene", extra_sections=()) -> MechScene:
@@ -154,11 +143,7 @@ def scene_from_dict(doc: dict, *, where: str = "scene", extra_sections=()) -> Me
     """
     if not isinstance(doc, dict):
         raise ValueError(f"{where}: expected a table of sections")
-    known = set(SECTIONS) | set(LIST_SECTIONS) | {"environment"} | set(extra_sections)
-    for name in doc:
-        if name not in known:
-            raise ValueError(f"{where}: unknown section [{name}]{_suggest(name, known)}; "
-                             f"allowed sections: {', '.join(sorted(known))}")
+    check_keys(where, doc, set(SCENE_SECTIONS) | set(extra_sections), kind="section")
     doc = _held_defaults(doc)
     parts = {name: _section(name, cls, doc.get(name, {}), where) for name, cls in SECTIONS.items()
              if name in doc}
@@ -167,23 +152,24 @@ def scene_from_dict(doc: dict, *, where: str = "scene", extra_sections=()) -> Me
             continue
         entries = doc[name]
         if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
-            raise ValueError(f"{where}[[{name}]]: expected an array of tables ([[{name}]] blocks)")
+            raise ValueError(f"{where}: [[{name}]]: expected an array of tables ([[{name}]] blocks)")
         items = []
         for k, entry in enumerate(entries):
-            if "name" in entry:
-                raise ValueError(f"{where}[[{name}]] #{k}: unknown key 'name'")
+            allowed = [f for f in _field_names(cls) if f != "name"]  # the name is the entry's place
+            check_keys(f"{where}: {name}[{k}]", entry, allowed)
             items.append(_section(name, cls, dict(entry, name=f"{name}[{k}]"), where))
         parts[fld] = tuple(items)
     env = doc.get("environment", {})
     if not isinstance(env, dict):
-        raise ValueError(f"{where}[environment]: expected a table of keys")
-    for key in env:
-        if key not in ENVIRONMENT_KEYS:
-            raise ValueError(f"{where}[environment]: unknown key {key!r}; allowed keys: gravity")
+        raise ValueError(f"{where}: [environment]: expected a table of keys")
+    check_keys(f"{where}: [environment]", env, ENVIRONMENT_KEYS)
     kwargs = dict(parts)
     if "gravity" in env:
         kwargs["gravity"] = env["gravity"]
-    return MechScene(**kwargs)
+    try:
+        return MechScene(**kwargs)  # environment.gravity and the checks across sections
+    except ValueError as err:
+        raise ValueError(f"{where}: {err}") from None
 
 
 def _held_defaults(doc: dict) -> dict:
@@ -206,14 +192,8 @@ def read_toml(path) -> dict:
     or device instead of a file, text that is not UTF-8 (with line and column), bad TOML,
     an empty document (an empty scene would silently run every default: refused).
     A UTF-8 byte-order mark, as some Windows editors write, is accepted."""
-    path = Path(path)
+    path = check_file("scene", path)
     name = str(path)
-    if path.is_dir():
-        raise ValueError(f"scene {name!r} is a folder, not a scene file")
-    if not path.exists():
-        raise FileNotFoundError(f"scene file {name!r} not found")
-    if not path.is_file():
-        raise ValueError(f"scene {name!r} is not a regular file (a device, pipe or socket); give a .toml file")
     try:
         data = path.read_bytes()
     except OSError as err:

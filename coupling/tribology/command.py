@@ -21,6 +21,17 @@ def _params(m: ModelFit, skip: tuple[str, ...] = ()) -> str:
     return ", ".join(parts)
 
 
+def outlier_lines(fit: TribometerFit, shown: int = 5) -> list[str]:
+    """One line per fit (friction, resistance) that left rows out, naming the first ``shown``."""
+    lines = []
+    for label, part in (("friction", fit.friction), ("resistance", fit.resistance)):
+        if part.n_outliers:
+            rows = "; ".join(f"{o.where} ({o.column} = {o.value:.4g}: {o.reason})" for o in part.outliers[:shown])
+            more = f"; ... ({part.n_outliers - shown} more in fit.json)" if part.n_outliers > shown else ""
+            lines.append(f"OUTLIERS left out of the {label} fit: {part.n_outliers} row(s): {rows}{more}")
+    return lines
+
+
 def summary(fit: TribometerFit) -> str:
     """A short human summary of a fit: chosen models, values with 95 % intervals, caveats."""
     dr = fit.data_range
@@ -39,11 +50,7 @@ def summary(fit: TribometerFit) -> str:
         f"gamma = {g.value:.4f} {ci}; vs Coulomb (gamma = 0): "
         f"dBIC = {ct.delta_bic:.1f}, F-test p = {ct.p_value:.2g} -> {ct.preferred} preferred"
     )
-    for label, part in (("friction", fit.friction), ("resistance", fit.resistance)):
-        if part.n_outliers:
-            shown = "; ".join(f"{o.where} ({o.column} = {o.value:.4g}: {o.reason})" for o in part.outliers[:5])
-            more = f"; ... ({part.n_outliers - 5} more in fit.json)" if part.n_outliers > 5 else ""
-            lines.append(f"OUTLIERS left out of the {label} fit: {part.n_outliers} row(s): {shown}{more}")
+    lines += outlier_lines(fit)
     sel = fit.friction.mu_selection
     lines.append(f"mu(I) by {sel.criterion}: {sel.chosen.name}: {_params(sel.chosen, skip=('gamma',))} (N^gamma, A)")
     for label, s in (("mu(I)", sel), ("R_c", fit.resistance.selection)):

@@ -10,7 +10,6 @@ skipped. The sign of the current is ignored by the fits (|I|).
 from __future__ import annotations
 
 import csv
-import difflib
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -19,8 +18,11 @@ from typing import Callable, Sequence
 import numpy as np
 import pandas as pd
 
+from mech.validation import check_file, suggest
+
 NUMERIC_COLUMNS = ("load_N", "current_A", "friction_N", "resistance_ohm")
 OPTIONAL_COLUMNS = ("run",)
+COLUMNS = NUMERIC_COLUMNS + OPTIONAL_COLUMNS
 # A per-current friction fit has one mu per current level plus gamma, and needs one
 # more point than parameters to estimate the scatter.
 EXTRA_POINTS_NEEDED = 2
@@ -68,23 +70,24 @@ def _data_lines(text: str) -> tuple[list[str], list[list[str]], list[int]]:
     return header, rows, line_numbers
 
 
-def _check_header(names: list[str], path: Path, line: int) -> None:
-    """Column names, without repeating a header that is not a tribometer header (the file
-    may be anything: a name is quoted only when the line has the shape of a CSV header)."""
-    shaped = len(names) >= len(NUMERIC_COLUMNS) - 1 and all(_NAME.fullmatch(n) for n in names)
-    allowed = NUMERIC_COLUMNS + OPTIONAL_COLUMNS
-    duplicated = sorted({c for c in names if names.count(c) > 1 and c in allowed})
+def _check_columns(names: list[str], where: str, quoted: bool = True) -> None:
+    """Column names: no tribometer column twice, none unknown (each with the did-you-mean);
+    ``quoted`` False names an unknown column by its place, not its text (the file may be
+    anything, and what is not a tribometer header is not repeated)."""
+    duplicated = sorted({c for c in names if names.count(c) > 1 and c in COLUMNS})
     if duplicated:
-        raise ValueError(f"{path}: duplicated column(s) {duplicated}")
-    unknown = [(k, c) for k, c in enumerate(names, start=1) if c not in allowed]
+        raise ValueError(f"{where}: duplicated column(s) {duplicated}")
+    unknown = [(k, c) for k, c in enumerate(names, start=1) if c not in COLUMNS]
     if unknown:
-        hints = []
-        for k, c in unknown:
-            close = difflib.get_close_matches(c, allowed, n=1)
-            label = f"{c!r}" if shaped else f"column {k}"
-            hints.append(label + (f" (did you mean {close[0]!r}?)" if close else ""))
-        raise ValueError(f"{path}: header line {line}: unknown column(s) {', '.join(hints)}; "
-                         f"allowed: {', '.join(allowed)}")
+        hints = [(repr(c) if quoted else f"column {k}") + suggest(c, COLUMNS) for k, c in unknown]
+        raise ValueError(f"{where}: unknown column(s) {', '.join(hints)}; allowed: {', '.join(COLUMNS)}")
+
+
+def _check_header(names: list[str], path: Path, line: int) -> None:
+    """The header line's column names; they are quoted only when the line has the shape of
+    a CSV header."""
+    shaped = len(names) >= len(NUMERIC_COLUMNS) - 1 and all(_NAME.fullmatch(n) for n in names)
+    _check_columns(names, f"{path}: header line {line}", quoted=shaped)
 
 
 def read_tribometer_csv(path) -> pd.DataFrame:
@@ -93,18 +96,15 @@ def read_tribometer_csv(path) -> pd.DataFrame:
     path: str or Path. Raises ValueError naming the file, column, line and value for
     missing or unknown columns, non-numeric or missing (NaN) values, loads that are
     not > 0, negative or zero friction forces and resistances, non-finite currents,
-    and too few points for a fit; FileNotFoundError for a missing file. A header that
+    and too few points for a fit; FileNotFoundError for a missing file, ValueError for a
+    folder or a device (mech.validation.check_file). A header that
     is not a tribometer header is not repeated in the message (the path may name any
     file). UTF-8 with or without a byte-order mark. The comment lines are kept in
     `df.attrs["header"]` and the path in `df.attrs["source"]`.
     """
-    path = Path(path)
+    path = check_file("tribometer CSV", path)
     try:
-        if path.is_dir():
-            raise ValueError(f"{path}: is a folder, not a tribometer CSV file")
         scan = _scan(path)
-    except FileNotFoundError:
-        raise FileNotFoundError(f"{path}: no such tribometer CSV file") from None
     except OSError as err:
         raise ValueError(f"{path}: cannot read ({err.strerror or type(err).__name__})") from None
     if not scan.ascii or scan.nul:
@@ -259,20 +259,8 @@ def validate_tribometer_frame(df: pd.DataFrame, source: str = "DataFrame",
     string or numeric columns.
     """
     columns = [str(c) for c in df.columns]
-    duplicated = sorted({c for c in columns if columns.count(c) > 1})
-    if duplicated:
-        raise ValueError(f"{source}: duplicated column(s) {duplicated}")
-    unknown = [c for c in columns if c not in NUMERIC_COLUMNS + OPTIONAL_COLUMNS]
+    _check_columns(columns, source)
     missing = [c for c in NUMERIC_COLUMNS if c not in columns]
-    if unknown:
-        hints = []
-        for c in unknown:
-            close = difflib.get_close_matches(c, NUMERIC_COLUMNS + OPTIONAL_COLUMNS, n=1)
-            hints.append(f"{c!r}" + (f" (did you mean {close[0]!r}?)" if close else ""))
-        raise ValueError(
-            f"{source}: unknown column(s) {', '.join(hints)}; "
-            f"allowed: {', '.join(NUMERIC_COLUMNS + OPTIONAL_COLUMNS)}"
-        )
     if missing:
         raise ValueError(
             f"{source}: missing column(s) {', '.join(missing)}; "

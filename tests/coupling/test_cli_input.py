@@ -3,42 +3,16 @@ traceback, nothing run. Audit reproductions, then generated (hypothesis) bad doc
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 import math
 import tempfile
 import textwrap
 from pathlib import Path
-from unittest import mock
 
 import pytest
+from cli_checks import assert_one_line_error, run_cli
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-
-import coupling.master
-from coupling.cli import main
-
-
-def no_run(*_args, **_kwargs):
-    raise AssertionError("a bad scene reached the simulation")
-
-
-def run_cli(argv) -> tuple[int, str]:
-    """main(argv) with the simulation replaced by an assertion: (exit code, stderr)."""
-    err = io.StringIO()
-    with mock.patch.object(coupling.master, "run", no_run), contextlib.redirect_stderr(err), \
-            contextlib.redirect_stdout(io.StringIO()):
-        rc = main(argv)
-    return rc, err.getvalue()
-
-
-def assert_one_line_error(rc: int, err: str) -> str:
-    lines = err.strip().splitlines()
-    assert rc == 2, err
-    assert len(lines) == 1 and lines[0].startswith("switchsim: error: "), err
-    assert "Traceback" not in err
-    return lines[0]
 
 
 # --- audit reproductions ---------------------------------------------------------------
@@ -83,6 +57,7 @@ def test_bar_modes_errors_name_the_key_the_user_wrote(tmp_path, value, words):
     scene = tmp_path / "modes.toml"
     scene.write_text(f"[bar]\nmodes = {value}\n")
     line = assert_one_line_error(*run_cli(["run", str(scene), "--out", str(tmp_path / "o")]))
+    assert line.startswith(f"switchsim: error: {scene}: ")
     for word in words:
         assert word in line
     assert "axial_modes" not in line

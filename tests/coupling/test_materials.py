@@ -103,13 +103,17 @@ def test_library_has_the_common_contact_materials_with_sources():
 
 
 @pytest.mark.parametrize("table,match", [
-    ({"law": "holm2"}, r"law = 'holm2': allowed values are 'holm', 'constant'"),
-    ({"law": "holm", "materials": ["Ag", "Pt"]}, r"unknown contact material 'Pt'; known: Ag, "),
-    ({"law": "holm", "materials": "Ag", "spots": 0}, r"spots = 0: expected a whole number >= 1"),
+    ({"law": "holm2"}, r"tribology\.resistance\.law = 'holm2': allowed values are 'holm', 'constant'"),
+    ({"law": "holm", "materials": ["Ag", "Pt"]},
+     r"tribology\.resistance\.materials: unknown contact material 'Pt'; allowed contact materials: Ag, "),
+    ({"law": "holm", "materials": ["AgNi", "Ag"]}, r"unknown contact material 'AgNi' \(did you mean 'AgNi10'\?\)"),
+    ({"law": "holm", "materials": "Ag", "spots": 0}, r"tribology\.resistance\.spots = 0: expected a whole number >= 1"),
     ({"law": "holm", "materials": "Ag", "regime": "elastic"}, r"needs radius"),
-    ({"law": "holm", "materials": "Ag", "film_resistivity": -1.0}, r"film_resistivity = -1.0"),
-    ({"law": "constant", "value": 0.0}, r"value = 0.0: expected a finite number > 0"),
-    ({"law": "constant", "value": 1e-3, "materials": "Ag"}, r"unknown key 'materials' for law = 'constant'"),
+    ({"law": "holm", "materials": "Ag", "film_resistivity": -1.0},
+     r"tribology\.resistance\.film_resistivity = -1.0: must be >= 0"),
+    ({"law": "constant", "value": 0.0}, r"tribology\.resistance\.value = 0.0: must be > 0"),
+    ({"law": "constant", "value": 1e-3, "materials": "Ag"},
+     r"tribology\.resistance \(law = 'constant'\): unknown key 'materials'; allowed keys: law, value"),
 ])
 def test_bad_resistance_tables_give_one_line_errors(table, match):
     with pytest.raises(ValueError, match=match) as err:

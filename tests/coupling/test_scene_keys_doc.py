@@ -1,11 +1,16 @@
-"""docs/scene_keys.md lists every section and key the scene validators accept (and no other)."""
+"""docs/scene_keys.md lists every section and key the scene validators accept (and no other),
+and the default it lists for a key is the value a scene that leaves the key out gets."""
 
 from __future__ import annotations
 
 import dataclasses
 import re
+import tomllib
 from pathlib import Path
 
+import pytest
+
+import circuit as ck
 from coupling import scene as cs
 from coupling.metrics import MetricSettings
 from mech.scene import ENVIRONMENT_KEYS, LIST_SECTIONS, SECTIONS
@@ -13,19 +18,25 @@ from mech.scene import ENVIRONMENT_KEYS, LIST_SECTIONS, SECTIONS
 DOC = Path(__file__).resolve().parents[2] / "docs" / "scene_keys.md"
 
 
-def _documented() -> dict[str, set[str]]:
-    out: dict[str, set[str]] = {}
+def _rows() -> dict[str, dict[str, str]]:
+    """section -> key -> the text of its default column."""
+    out: dict[str, dict[str, str]] = {}
     section = None
     for line in DOC.read_text().splitlines():
         m = re.match(r"^## \[\[?([a-z_.]+)\]\]?", line)  # [section] or [[array of tables]]
         if m:
             section = m.group(1)
-            out[section] = set()
+            out[section] = {}
             continue
         m = re.match(r"^\| `([a-z_]+)` \|", line)
         if m and section:
-            out[section].add(m.group(1))
+            cells = [c.strip() for c in re.split(r"(?<!\\)\|", line)[1:-1]]
+            out[section][m.group(1)] = cells[2]
     return out
+
+
+def _documented() -> dict[str, set[str]]:
+    return {section: set(keys) for section, keys in _rows().items()}
 
 
 def _fields(cls) -> set[str]:
@@ -44,6 +55,8 @@ def test_every_accepted_key_is_documented_and_nothing_else():
     expected["tribology"] = {"source", "fit", "data", "mu", "resistance", "feedback"}
     expected["circuit"] = set(cs.CIRCUIT_KEYS)
     expected["circuit.schedule"] = {"make", "break", "closed_resistance", "edge_time", "opening_speed"}
+    for part, cls in (("snubber", ck.Snubber), ("flyback", ck.FlybackDiode), ("arc", ck.ArcModel)):
+        expected[f"circuit.{part}"] = _fields(cls)
     expected["coupling"] = _fields(cs.CouplingOptions)
     expected["output"] = _fields(cs.OutputOptions)
     expected["metrics"] = _fields(MetricSettings)
@@ -63,3 +76,129 @@ def test_readme_relay_quick_start_scene_is_valid():
     scene = scene_from_dict(tomllib.loads(block), name="relay")
     assert scene.kind == "coupled" and scene.tribology.laws.resistance_law.materials == ("AgNi10", "Ag")
     assert scene.mech.initial.height == 0.4e-3 and scene.circuit.circuit.load.resistance == 5.0
+
+
+# --- the default column ------------------------------------------------------------------
+
+NO_VALUE = object()  # "-": no value, or the key is needed
+NETLIST = "net\nV1 a 0 24\nXCONTACT a b\nVLOAD b c 0\nR1 c 0 12\n"
+COUPLED = {"tribology": {"source": "illustrative"}, "circuit": {}}
+# entries of the arrays of tables with the keys they need (a key checked is left out)
+ENTRIES = {"force": {"magnitude": 1.0}, "spring": {"stiffness": 1e3}, "rivet": {}}
+# keys no dataclass field holds: the alternatives choosing the laws or the contact, file names
+NO_FIELD = {("tribology", k) for k in ("source", "fit", "data", "mu", "resistance")} | {
+    ("circuit", "netlist"), ("circuit", "schedule"), ("circuit.schedule", "make"), ("circuit.schedule", "break")}
+OPTION_KEYS = {f.name for f in dataclasses.fields(ck.SimulationOptions)}
+CONTEXTS = {"initial": {"held bar": {"mount": {"kind": "clamp", "position": 0.3}}}}
+
+
+def _split(cell: str) -> tuple[str, dict[str, str]]:
+    """'12 (inductive: 24; capacitive: 0.5)' -> ('12', {'inductive': '24', 'capacitive': '0.5'})."""
+    m = re.fullmatch(r"(.+?) \((.+)\)", cell)
+    if m and all(re.fullmatch(r"[a-z_ ]+: .+", part) for part in m.group(2).split("; ")):
+        return m.group(1), dict(part.split(": ", 1) for part in m.group(2).split("; "))
+    return cell, {}
+
+
+def _literal(text: str):
+    """A default as the TOML value it stands for ('-': NO_VALUE); anything else fails the test."""
+    if text == "-":
+        return NO_VALUE
+    try:
+        return tomllib.loads(f"v = {text}")["v"]
+    except tomllib.TOMLDecodeError:
+        raise AssertionError(f"default {text!r} is neither a TOML value nor '-'") from None
+
+
+def _plain(value):
+    return [_plain(v) for v in value] if isinstance(value, (list, tuple)) else value
+
+
+def _circuit_value(spec, name: str):
+    """The field a circuit scene key ('circuit.voltage', 'circuit.arc.min_voltage') sets."""
+    if name in ("circuit.template", "circuit.probes"):
+        return getattr(spec, name.split(".")[1])
+    parts = [spec.circuit, spec.options, spec.schedule] + [getattr(spec.circuit, a, None) for a in (
+        "source", "load", "wiring", "snubber", "flyback", "arc")]
+    objects = {type(o).__name__: o for o in parts if o is not None}
+    for class_field, key in cs.circuit_key_names(ck).items():
+        owner, fld = class_field.split(".")
+        if key == name and owner in objects:
+            return getattr(objects[owner], fld)
+    raise AssertionError(f"{name}: no field of the built circuit is set by it")
+
+
+def _omitted(section: str, key: str, patch: dict, folder: Path):
+    """What a scene leaving ``key`` out gets (NO_VALUE: None, or an error because it is needed)."""
+    try:
+        value = _field_without(section, key, patch, folder)
+    except ValueError:
+        return NO_VALUE
+    return NO_VALUE if value is None else value
+
+
+def _field_without(section: str, key: str, patch: dict, folder: Path):
+    if section in SECTIONS or section == "environment":
+        scene = cs.scene_from_dict(patch)
+        if section == "environment":
+            return scene.mech.gravity
+        part = getattr(scene.mech, section)
+        if key == "modes":
+            assert part.axial_modes == part.bending_modes
+            return part.axial_modes
+        return getattr(part, key)
+    if section in LIST_SECTIONS:
+        entry = {k: v for k, v in ENTRIES[section].items() if k != key}
+        scene = cs.scene_from_dict({section: [entry]})
+        return getattr(getattr(scene.mech, LIST_SECTIONS[section][0])[0], key)
+    if section == "tribology":
+        return getattr(cs.scene_from_dict(COUPLED).tribology, key)
+    if section in ("coupling", "output", "metrics"):
+        return getattr(getattr(cs.scene_from_dict(COUPLED), section), key)
+    table = {"schedule": {"make": [1e-4], "break": []}, **patch}
+    if table.get("template") == "netlist":
+        (folder / "net.cir").write_text(NETLIST)
+        table["netlist"] = "net.cir"
+    if section != "circuit":  # a sub-table: [circuit.arc], [circuit.schedule], ...
+        part = section.split(".")[1]
+        table[part] = {k: v for k, v in table.get(part, {}).items() if k != key}
+    spec = cs.scene_from_dict({"circuit": table}, base_dir=folder).circuit
+    return _circuit_value(spec, f"{section}.{key}")
+
+
+def _same(got, expected) -> bool:
+    if isinstance(got, bool) or isinstance(expected, bool):
+        return got is expected
+    return _plain(got) == _plain(expected)
+
+
+def _cases():
+    for section, rows in _rows().items():
+        for key, cell in rows.items():
+            yield pytest.param(section, key, cell, id=f"{section}.{key}")
+
+
+@pytest.mark.parametrize("section, key, cell", list(_cases()))
+def test_the_documented_default_is_what_an_omitted_key_gets(section, key, cell, tmp_path):
+    if (section, key) in NO_FIELD:
+        assert cell == "-", f"{section}.{key}: no field holds it, so it has no default"
+        return
+    base, named = _split(cell)
+    contexts = dict(CONTEXTS.get(section, {}))
+    patch: dict = {}
+    if section == "circuit" and key not in {"template", "probes"} | OPTION_KEYS:
+        # checked in every template that takes the key; the first one is the plain default
+        templates = [t for t in cs.TEMPLATES if key in cs.template_keys(t)]
+        patch = {"template": templates[0]}
+        contexts = {t: {"template": t} for t in templates[1:]}
+    elif section == "circuit.flyback":
+        patch = {"template": "inductive", "flyback": {}}
+    elif section in ("circuit.arc", "circuit.snubber"):
+        patch = {section.split(".")[1]: {"resistance": 100.0, "capacitance": 1e-7} if "snubber" in section else {}}
+    assert set(named) <= set(contexts), f"{section}.{key}: unknown context(s) {set(named) - set(contexts)}"
+    for name, extra in [(None, patch)] + [(n, {**patch, **p}) for n, p in contexts.items()]:
+        expected = _literal(named.get(name, base) if name else base)
+        got = _omitted(section, key, extra, tmp_path)
+        where = f"{section}.{key}" + (f" ({name})" if name else "")
+        same = got is expected if NO_VALUE in (got, expected) else _same(got, expected)
+        assert same, f"{where}: documented {cell!r}, a scene without it gets {got!r}"

@@ -99,7 +99,7 @@ def test_bad_csv_gives_a_clear_error_naming_file_column_line_and_value(tmp_path,
 
 
 def test_missing_file_is_a_file_not_found_error(tmp_path):
-    with pytest.raises(FileNotFoundError, match="no such tribometer CSV"):
+    with pytest.raises(FileNotFoundError, match=r"tribometer CSV: file '.*nope\.csv' not found"):
         read_tribometer_csv(tmp_path / "nope.csv")
 
 

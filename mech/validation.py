@@ -1,0 +1,181 @@
+"""The value checks of mech's parameter dataclasses, and the one did-you-mean of scene keys.
+
+Every frozen dataclass of mech (mech/parameters.py, mech/beam_fe.py) checks its fields
+with these functions, once, in ``__post_init__``; nothing downstream re-validates. Each
+check raises ``ValueError`` naming the field, the value and what is allowed, on one line,
+and returns the value in its checked form (a float, a tuple). The scene readers only add
+the structure around them: sections, key names, the file (docs/scene_keys.md, "Where
+values are checked"). coupling's own section dataclasses use these checks too, and
+``suggest`` / ``unknown`` are the did-you-mean of every scene section, key and CSV column.
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+from pathlib import Path
+
+import numpy as np
+
+
+def check_finite(name: str, value) -> float:
+    """Return ``value`` as float, or raise naming the field when it is not a finite number."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise ValueError(f"{name} = {value!r}: expected a number")
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f"{name} = {value!r}: expected a finite number")
+    return value
+
+
+def check_positive(name: str, value, *, allow_inf: bool = False) -> float:
+    """A number > 0; ``allow_inf`` accepts +inf (a bound that may be switched off)."""
+    if allow_inf and isinstance(value, (float, np.floating)) and value == math.inf:
+        return math.inf
+    try:
+        value = check_finite(name, value)
+    except ValueError:
+        if allow_inf:
+            raise ValueError(f"{name} = {value!r}: expected a number > 0 or inf") from None
+        raise
+    if value <= 0.0:
+        raise ValueError(f"{name} = {value!r}: must be > 0" + (" (inf allowed)" if allow_inf else ""))
+    return value
+
+
+def check_nonnegative(name: str, value) -> float:
+    value = check_finite(name, value)
+    if value < 0.0:
+        raise ValueError(f"{name} = {value!r}: must be >= 0")
+    return value
+
+
+def check_range(name: str, value, low: float, high: float, *, closed_low=False, closed_high=False) -> float:
+    """A number inside (low, high); ``closed_*`` makes that end inclusive."""
+    value = check_finite(name, value)
+    ok_low = value >= low if closed_low else value > low
+    ok_high = value <= high if closed_high else value < high
+    if not (ok_low and ok_high):
+        lo, hi = ("[" if closed_low else "("), ("]" if closed_high else ")")
+        raise ValueError(f"{name} = {value!r}: allowed range is {lo}{low}, {high}{hi}")
+    return value
+
+
+def check_choice(name: str, value, choices) -> str:
+    if isinstance(value, (list, dict)) or value not in choices:
+        raise ValueError(f"{name} = {value!r}: allowed values are {', '.join(map(repr, choices))}")
+    return value
+
+
+def check_bool(name: str, value) -> bool:
+    if not isinstance(value, bool):
+        raise ValueError(f"{name} = {value!r}: expected true or false")
+    return value
+
+
+def check_whole(name: str, value, low: int = 0, high: int | None = None, *, note: str = "") -> int:
+    """A whole number in [low, high] (no upper bound when ``high`` is None); ``note`` is
+    added to the message, e.g. what 0 means."""
+    if (isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low
+            or (high is not None and value > high)):
+        allowed = f">= {low}" if high is None else f"in [{low}, {high}]"
+        raise ValueError(f"{name} = {value!r}: expected a whole number {allowed}{note}")
+    return int(value)
+
+
+def check_count(name: str, value, high: int = 40, auto: bool = False):
+    """A mode count: a whole number in [0, high], or "auto" when ``auto`` (chosen from the
+    scene's contact time, mech/mode_count.py)."""
+    if auto and value == "auto":
+        return value
+    return check_whole(name, value, 0, high, note=' or "auto"' if auto else "")
+
+
+def check_vector3(name: str, value) -> tuple[float, float, float]:
+    try:
+        items = list(value)
+    except TypeError:
+        raise ValueError(f"{name} = {value!r}: expected a list of 3 numbers") from None
+    if isinstance(value, (str, dict)) or len(items) != 3:
+        raise ValueError(f"{name} = {value!r}: expected a list of 3 numbers")
+    return tuple(check_finite(f"{name}[{i}]", v) for i, v in enumerate(items))
+
+
+def check_table(name: str, times, values=None, *, width: int | None = None):
+    """A time table: times strictly increasing, finite, >= 0; values finite, one per time
+    (``width``: each value a list of that many numbers). Returns (times, values) as tuples."""
+    numbers = (int, float, np.integer, np.floating)
+    items = list(times) if hasattr(times, "__iter__") and not isinstance(times, (str, dict)) else None
+    if items is None or not all(isinstance(v, numbers) and not isinstance(v, bool) for v in items):
+        raise ValueError(f"{name}.time = {times!r}: expected a list of numbers (s)")
+    ts = [float(v) for v in items]
+    if not ts:
+        raise ValueError(f"{name}.time: the table is empty; give at least one time")
+    for k, t in enumerate(ts):
+        if not math.isfinite(t) or t < 0.0:
+            raise ValueError(f"{name}.time[{k}] = {t!r}: times must be finite and >= 0 s")
+        if k and t <= ts[k - 1]:
+            raise ValueError(f"{name}.time[{k}] = {t!r}: times must increase strictly "
+                             f"(previous {ts[k - 1]!r})")
+    if values is None:
+        return tuple(ts), None
+    try:
+        if isinstance(values, (str, dict)):
+            raise TypeError
+        vals = list(values)
+    except TypeError:
+        raise ValueError(f"{name}: expected a list of values, one per time") from None
+    if len(vals) != len(ts):
+        raise ValueError(f"{name}: {len(vals)} values for {len(ts)} times; give one value per time")
+    out = []
+    for k, v in enumerate(vals):
+        if width is None:
+            out.append(check_finite(f"{name}[{k}]", v))
+        else:
+            out.append(check_vector3(f"{name}[{k}]", v))
+    return tuple(ts), tuple(out)
+
+
+def check_position(name: str, value, length: float) -> float:
+    """A position along the bar (m from tip 0) inside [0, length]."""
+    x = check_finite(name, value)
+    if not 0.0 <= x <= length:
+        raise ValueError(f"{name} = {x!r}: must lie on the bar, in [0, {length!r}] m from tip 0")
+    return x
+
+
+def check_file(name: str, path) -> Path:
+    """A file a scene or command names, as a Path: a missing file is FileNotFoundError; a
+    folder, a device (``/dev/null``), a pipe or a socket a ValueError saying which. The
+    file's content is not read here (and never quoted)."""
+    path = Path(path)
+    if path.is_dir():
+        raise ValueError(f"{name}: {str(path)!r} is a folder, not a file")
+    if not path.exists():
+        raise FileNotFoundError(f"{name}: file {str(path)!r} not found")
+    if not path.is_file():
+        raise ValueError(f"{name}: {str(path)!r} is not a regular file (a device, pipe or socket)")
+    return path
+
+
+def suggest(word: str, allowed) -> str:
+    """The did-you-mean of every scene section, key and CSV column: ' (did you mean 'x'?)'
+    for the closest allowed name, or '' when none is close."""
+    close = difflib.get_close_matches(str(word), [str(a) for a in allowed], n=1)
+    return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+def unknown(where: str, name: str, allowed, kind: str = "key") -> ValueError:
+    """The error for an unknown ``kind`` ("key", "section"): the name, a did-you-mean and
+    the allowed names."""
+    shown = f"[{name}]" if kind == "section" else repr(name)
+    return ValueError(f"{where}: unknown {kind} {shown}{suggest(name, allowed)}; "
+                      f"allowed {kind}s: {', '.join(sorted(allowed))}")
+
+
+def check_keys(where: str, table: dict, allowed, kind: str = "key") -> dict:
+    """``table`` when every key of it is allowed, else the ``unknown`` error of the first one."""
+    for key in table:
+        if key not in allowed:
+            raise unknown(where, key, allowed, kind)
+    return table

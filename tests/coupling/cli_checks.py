@@ -1,0 +1,32 @@
+"""The command line run in-process for input tests: the simulation replaced by an assertion."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+from unittest import mock
+
+import coupling.master
+from coupling.cli import main
+
+
+def no_run(*_args, **_kwargs):
+    raise AssertionError("a bad scene reached the simulation")
+
+
+def run_cli(argv) -> tuple[int, str]:
+    """main(argv) with the simulation replaced by an assertion: (exit code, stderr)."""
+    err = io.StringIO()
+    with mock.patch.object(coupling.master, "run", no_run), contextlib.redirect_stderr(err), \
+            contextlib.redirect_stdout(io.StringIO()):
+        rc = main(argv)
+    return rc, err.getvalue()
+
+
+def assert_one_line_error(rc: int, err: str) -> str:
+    """The one error line of exit code 2 (no traceback, nothing else on stderr)."""
+    lines = err.strip().splitlines()
+    assert rc == 2, err
+    assert len(lines) == 1 and lines[0].startswith("switchsim: error: "), err
+    assert "Traceback" not in err
+    return lines[0]
