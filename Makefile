@@ -26,9 +26,11 @@ $(STAMP): pyproject.toml scripts/install-system-deps
 bench: $(STAMP)
 	for b in benchmarks/bench_*.py; do $(VENV)/bin/python $$b || exit 1; done
 
-# Regenerates docs/accuracy.md and its plots in docs/accuracy/ (~15 min on a loaded 2-core box)
+# Regenerates docs/accuracy.md and its plots in docs/accuracy/ (~15 min on a loaded 2-core box);
+# part 6 compares with Exudyn, the optional `bench` extra, installed here first (not by run or test)
 accuracy: $(STAMP)
-	for p in mech modes coupling circuit matrix; do $(VENV)/bin/python benchmarks/accuracy_$$p.py || exit 1; done
+	$(VENV)/bin/python -m pip install -q -e '.[bench]'
+	for p in mech modes coupling circuit matrix exudyn; do $(VENV)/bin/python benchmarks/accuracy_$$p.py || exit 1; done
 	$(VENV)/bin/python benchmarks/accuracy_report.py
 
 clean:

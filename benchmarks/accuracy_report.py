@@ -12,7 +12,7 @@ import platform
 
 from accuracy_common import OUT, ROOT, git_commit, load_note
 
-PARTS = ("mech", "modes", "coupling", "circuit", "matrix")
+PARTS = ("mech", "modes", "coupling", "circuit", "matrix", "exudyn")
 
 HEAD = """# Accuracy: what the numbers are worth
 
