@@ -254,13 +254,19 @@ def test_a_netlist_line_that_cannot_be_parsed_is_bad_input_before_anything_runs(
     assert not out.exists()
 
 
-LONG = textwrap.dedent("""
+# A tilted flexible bar bouncing elastically (e = 1): it never comes to rest, so the solver
+# integrates every bounce; ~7 s of work per simulated second here, t_end 10 s.
+BOUNCING = textwrap.dedent("""
+    [bar]
+    modes = 10
     [initial]
-    angle_deg = 90.0
-    resting = true
+    angle_deg = 30.0
+    height = 0.001
     velocity = [0.0, 0.0, 0.0]
+    [contact]
+    restitution = 1.0
     [solver]
-    t_end = 1.0
+    t_end = 10.0
     [output]
     plots = false
     """)
@@ -278,8 +284,8 @@ def interrupted_time(out: Path) -> float:
 @pytest.mark.slow
 def test_ctrl_c_in_a_coupled_run_writes_the_partial_result_marked_interrupted_and_exits_130(tmp_path):
     """A real SIGINT to the command, once its run loop reports progress."""
-    # A bar standing on one tip, closing the circuit, for 1 s: far longer than the test waits.
-    scene = write(tmp_path, "long.toml", LONG.replace("[output]", COUPLED[COUPLED.index("[tribology]"):
+    # The bouncing bar closing the circuit: far longer than the test waits.
+    scene = write(tmp_path, "long.toml", BOUNCING.replace("[output]", COUPLED[COUPLED.index("[tribology]"):
                                                                        COUPLED.index("[output]")] + "[output]"))
     out = tmp_path / "out"
     env = dict(os.environ, PYTHONPATH=str(ROOT))
@@ -314,7 +320,7 @@ def test_ctrl_c_in_a_mechanics_run_keeps_the_partial_result(tmp_path):
 
     warm = write(tmp_path, "drop.toml", DROP)
     assert main(["run", str(warm), "--out", str(tmp_path / "warm"), "--quiet"]) == 0  # compiled, loaded
-    scene = write(tmp_path, "long.toml", LONG)
+    scene = write(tmp_path, "long.toml", BOUNCING)
     out = tmp_path / "out"
     timer = threading.Timer(2.0, _thread.interrupt_main)  # the run takes > 20 s: well inside it
     timer.start()
