@@ -78,8 +78,8 @@ def main() -> None:
     mech_findings = findings()
     if mech_findings:
         text += ("## Findings: crashes, failures, hangs and silent errors\n\n"
-                 "Collected from the parts below (the mechanics internals are being rewritten; these are "
-                 "reported, not patched here).\n\n" + "\n".join(mech_findings) + "\n\n")
+                 "Collected from the parts below: each is a defect to fix (an empty list prints no "
+                 "section).\n\n" + "\n".join(mech_findings) + "\n\n")
     for part in PARTS:
         path = OUT / f"{part}.md"
         text += (path.read_text() if path.exists() else f"## {part}\n\n(not generated: run `make accuracy`)\n") + "\n"
