@@ -88,13 +88,17 @@ def _result_lines(summary: dict) -> None:
     if "bounce" in summary:
         b = summary["bounce"]
         peak = b.get("peak_contact_voltage")
+        settle = (f"settled closed {_ms(b['settle_time'])} after the first make" if b.get("settled")
+                  else b.get("settle_note") or f"final state {b.get('final_state')}")
         print(f"switchsim: first make {_ms(b.get('first_make'))}, last make {_ms(b.get('last_make'))}, "
-              f"{b.get('bounces')} bounce(s), final state {b.get('final_state')}, "
+              f"{b.get('bounces')} bounce(s), {settle}, "
               f"peak contact voltage {peak or 0:.3g} V, arc energy {b.get('arc_energy') or 0:.3g} J")
     if "contacts" in summary:
         residual = summary.get("energy", {}).get("relative_residual")
-        print(f"switchsim: {len(summary['contacts'])} contact(s), first restitution "
-              f"{summary.get('restitution')}, energy residual {residual if residual is None else f'{residual:.2g}'}")
+        e = summary.get("restitution") or {}
+        first = ", ".join(f"{v:.3g} ({k})" for k, v in e.items() if v is not None) or "none (no rebound)"
+        print(f"switchsim: {len(summary['contacts'])} contact(s), first restitution {first}, "
+              f"energy residual {residual if residual is None else f'{residual:.2g}'}")
     for flag in summary.get("flags", []):
         print(f"switchsim: flag: {flag}")
     for line in summary.get("warnings", []):  # coupling.diagnostics
