@@ -46,13 +46,25 @@ def test_slip_direction_blends_from_the_reference_below_the_speed_resolution():
     e = (1.0, 0.0)
     res = 1e-6
     assert slip_direction(0.0, 0.0, *e, res) == pytest.approx(e)  # from rest: along the reference
-    for v in ((3e-6, 4e-6), (-2e-6, 1e-6)):  # above the resolution: the velocity's own direction
+    for v in ((3e-6, 4e-6), (1e-6, -2e-6)):  # above the resolution on e's side: the velocity's own direction
         assert slip_direction(*v, *e, res) == pytest.approx(np.array(v) / np.hypot(*v))
     # continuous at the resolution, from below
     v = np.array([0.6, 0.8]) * res
     assert slip_direction(*(v * (1 - 1e-9)), *e, res) == pytest.approx(v / res, abs=1e-6)
-    # a slow slip past the reference by more than the dead band keeps it (the stop is an event)
-    assert slip_direction(-2 * REVERSAL_DEADBAND * res, 1e-8, *e, res) == e
+    # past the reference (trial stages beyond the slip event) the component along it is
+    # mirrored: a slip stopping and reversing, slow or fast, keeps friction along the
+    # reference (the speed goes through zero for the event to see the stop) ...
+    for s in (2 * REVERSAL_DEADBAND * res, 0.5 * res, 3 * res):
+        assert slip_direction(-s, 0.0, *e, res) == pytest.approx(e)
+    # ... and the direction is continuous across v . e = 0 for every v
+    rng = np.random.default_rng(1)
+    for _ in range(200):
+        v = rng.normal(size=2) * res * rng.choice([0.3, 1.0, 10.0])
+        n = np.array([-e[1], e[0]])
+        on = (v @ n) * n  # v moved onto the plane v . e = 0
+        eps = 1e-9 * res * np.array(e)
+        below, above = slip_direction(*(on - eps), *e, res), slip_direction(*(on + eps), *e, res)
+        assert np.allclose(below, above, atol=1e-6)
 
 
 def test_a_3d_slip_starting_from_rest_takes_ordinary_steps():
