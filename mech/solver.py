@@ -238,8 +238,14 @@ class ImpactSolver:
         else:
             fpar[F_MU_SLOPE] = (float(mu_end) - float(mu_start)) / (t_end - self.t)
 
-    def advance(self, t_target: float, mu=None) -> Segment:
-        """Integrate to ``t_target`` (s); ``mu`` = number or (mu_start, mu_end) over the step."""
+    def advance(self, t_target: float, mu=None, *, stop_at_switch: bool = False) -> Segment:
+        """Integrate to ``t_target`` (s); ``mu`` = number or (mu_start, mu_end) over the step.
+
+        stop_at_switch: return at the first contact start or end (make/break) after the
+        current time instead, the segment ending there (a co-simulation step in free flight
+        ends at the make it meets; integrating past it only to return there costs the whole
+        bounce sequence beyond).
+        """
         if not math.isfinite(t_target) or t_target < self.t:
             raise ValueError(f"t_target = {t_target!r}: must be a finite time >= the current {self.t!r} s")
         if mu is not None:
@@ -306,9 +312,13 @@ class ImpactSolver:
             if status == BUFFER_FULL:
                 continue
             if status == EVENT:
+                n_events = len(self.events)
                 self._handle_event(ev)
                 if ev % NEV_TIP == EV_CONTACT:  # a contact made or broken: not at rest
                     self._restart_rest_window()
+                    if stop_at_switch and t_new > t_start and any(
+                            e["kind"] in ("contact_start", "contact_end") for e in self.events[n_events:]):
+                        break
                 continue
             self.wall_time += time.perf_counter() - tick
             raise MechSolverError(

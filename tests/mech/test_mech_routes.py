@@ -169,3 +169,21 @@ def test_coupled_states_integrate_in_the_same_solve_as_the_mechanics():
     # the extra state enters the error norm, so the steps differ at the tolerance level
     assert_same_contacts(plain, coupled, time_rtol=1e-7, rtol=1e-5)
     assert coupled.extra_states[-1, 0] == pytest.approx(coupled.contacts.impulse.sum(), rel=1e-6)
+
+
+def test_advance_stopping_at_each_make_and_break_gives_the_result_of_one_run():
+    """stop_at_switch ends a segment at the first contact start or end: the segments end
+    exactly at the one run's contact times, and going on from there gives its contacts."""
+    scene = default_truncated(2.5e-3, 1e-10)
+    one_run = ImpactSolver(scene).run()
+    solver = ImpactSolver(scene)
+    ends = []
+    while solver.t < 2.5e-3:
+        seg = solver.advance(2.5e-3, stop_at_switch=True)
+        ends.append(seg.t_end)
+        if seg.t_end < 2.5e-3:
+            assert seg.events[-1]["kind"] in ("contact_start", "contact_end") and seg.events[-1]["time"] == seg.t_end
+    switches = sorted(one_run.contacts.t_start.tolist() + one_run.contacts.t_end.tolist())
+    np.testing.assert_allclose(ends[:-1], switches, rtol=1e-8)
+    assert ends[-1] == 2.5e-3
+    assert_same_contacts(one_run, solver.result(), time_rtol=1e-8, rtol=1e-6)
