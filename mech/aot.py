@@ -152,6 +152,9 @@ def _build(folder: Path) -> str | None:
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     _note(f"compiled in {time.perf_counter() - tick:.0f} s: {module_file(folder)}")
+    for stale in folder.parent.glob("aot-*"):  # builds of earlier sources (a loaded one stays mapped)
+        if stale.is_dir() and stale != folder and ".build-" not in stale.name:
+            shutil.rmtree(stale, ignore_errors=True)
     return None
 
 
@@ -235,7 +238,7 @@ def _merge_layouts(name: str, sigs):
             if a == b:
                 continue
             if isinstance(a, types.Array) and isinstance(b, types.Array) and (a.dtype, a.ndim) == (b.dtype, b.ndim):
-                args[i] = a.copy(layout="A", readonly=a.readonly or b.readonly)
+                args[i] = a.copy(layout="A")
             else:
                 raise RuntimeError(f"{name} was compiled for different argument types: {a} and {b}")
     return first.return_type(*args)
@@ -294,12 +297,19 @@ def argument_checks(folder: Path) -> dict:
             return check
         if kind[0] == "tuple":
             parts = [checker(k) for k in kind[1]]
+            seen = {}  # id -> tuple already checked (held, so its id is not reused): the model and
+            # work tuples, passed on every call, are checked once
 
             def check(a, where):
+                if seen.get(id(a)) is a:
+                    return
                 if not isinstance(a, tuple) or len(a) != len(parts):
                     raise TypeError(f"{where}: exported for a tuple of {len(parts)}, got {type(a).__name__}")
                 for k, (part, item) in enumerate(zip(parts, a)):
                     part(item, f"{where}[{k}]")
+                if len(seen) > 256:
+                    seen.clear()
+                seen[id(a)] = a
             return check
         return None  # numbers are converted by the wrapper
 
