@@ -1,5 +1,6 @@
-"""The `switchsim` command line: `switchsim run [SCENE.toml] [--out DIR] [--overwrite] [--quiet]`,
-`switchsim fit DATA.csv --out DIR`. Exit codes: coupling/commands.py."""
+"""The `switchsim` command line: `switchsim run [SCENE.toml] [--out DIR] [--overwrite] [--quiet] [--plots]`,
+`switchsim plot RESULT_DIR`, `switchsim fit DATA.csv --out DIR`, `switchsim sweep`. Exit codes:
+coupling/commands.py."""
 
 from __future__ import annotations
 
@@ -21,8 +22,13 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--overwrite", action="store_true",
                      help="replace a non-empty --out folder that is not a previous result of this scene")
     run.add_argument("--quiet", action="store_true", help="no progress output (the result lines stay)")
+    run.add_argument("--plots", action="store_true",
+                     help="also draw the PNG plots (as [output] plots = true; or later: switchsim plot DIR)")
     run.add_argument("--check", action="store_true",
                      help="rerun refined (modes, rtol, macro step, RELTOL) and report the error (summary.accuracy)")
+
+    plot = sub.add_parser("plot", help="draw the PNG plots of a result folder that a run wrote")
+    plot.add_argument("result", help="result folder (holds summary.json)")
 
     fit = sub.add_parser("fit", help="fit gamma, mu(I) and R_c(F_n, I) to tribometer data")
     fit.add_argument("data", help="tribometer CSV (see docs/tribology.md for its form)")
@@ -44,7 +50,12 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "run":
             from coupling.commands import run_command
 
-            return run_command(args.scene, args.out, quiet=args.quiet, overwrite=args.overwrite, check=args.check)
+            return run_command(args.scene, args.out, quiet=args.quiet, overwrite=args.overwrite, check=args.check,
+                               plots=args.plots)
+        if args.command == "plot":
+            from coupling.commands import plot_command
+
+            return plot_command(args.result)
         if args.command == "fit":
             from coupling.tribology.command import fit_command
 

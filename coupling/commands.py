@@ -23,13 +23,15 @@ def default_out(scene_path: str | None) -> str:
 
 
 def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = False,
-                overwrite: bool = False, check: bool = False) -> int:
+                overwrite: bool = False, check: bool = False, plots: bool = False) -> int:
     from .master import CoupledRunError, RunInterrupted, run
     from .output import ResultFolder, scene_identity
     from .scene import default_scene, load_scene
     from .soundness import assess
 
     scene = default_scene() if scene_path is None else load_scene(scene_path)  # validates before running
+    if plots:
+        scene = scene.set("output.plots", True)
     if out_dir is None:
         out_dir = default_out(scene_path)
     folder = ResultFolder.check(out_dir, scene_identity(scene, scene_path), overwrite=overwrite)
@@ -63,6 +65,24 @@ def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = Fa
         _say(f"unsound: {problem}")
     _say(f"status {result.status}; wrote {out}")
     return EXIT_UNSOUND if soundness["problems"] else EXIT_OK
+
+
+def plot_command(result_dir: str) -> int:
+    """Draw the PNG plots of a result folder into it (each file written whole, by rename)."""
+    from .plots import save_plots, stored_result
+
+    folder = Path(result_dir)
+    if not (folder / "summary.json").is_file():
+        _say(f"error: {result_dir!r} holds no summary.json: give a folder that `switchsim run` wrote")
+        return EXIT_INPUT
+    try:
+        paths = save_plots(stored_result(folder), folder)
+    except OSError as err:
+        _say(f"could not draw into {folder}: {err.strerror or err}")
+        return EXIT_FAILED
+    _say(f"wrote {', '.join(p.name for p in paths) or 'no plots (the folder has no waveforms or history)'} "
+         f"into {folder}")
+    return EXIT_OK
 
 
 def _write_partial(folder, partial, extra: dict, message: str, code: int) -> int:

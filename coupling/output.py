@@ -16,8 +16,10 @@
 
 from __future__ import annotations
 
+import csv
 import dataclasses
 import json
+import math
 import os
 import shutil
 import tempfile
@@ -151,7 +153,10 @@ def write_files(result, folder: Path, summary_extra: dict | None = None) -> None
         t = result.mechanics.t
         interval = opts.history_interval(float(t[-1] - t[0]) if len(t) else 0.0)
         kept = thin_history(result.mechanics, interval)
-        thin_result(result.mechanics, kept).history.to_csv(folder / "history.csv", index=False)
+        from .results import REGIME_NAMES
+
+        write_csv(folder / "history.csv", thin_result(result.mechanics, kept).history_columns,
+                  codes={"regime_0": REGIME_NAMES, "regime_1": REGIME_NAMES})
         summary["history"] = {"file": "history.csv", "resolution": interval,
                               "rows": int(len(kept)), "solver_records": int(len(t))}
     summary.update(summary_extra or {})
@@ -192,6 +197,44 @@ def thin_result(mres, kept: np.ndarray):
     return cls(model=mres.model, t=mres.t[kept], states=mres.states[kept], aux=mres.aux[kept],
                peak_force=mres.peak_force[kept], regimes=mres.regimes[kept], events=mres.events,
                stats=mres.stats, projection_energy=mres.projection_energy, extra_states=extra)
+
+
+def write_csv(path: Path, columns: dict, codes: dict | None = None) -> None:
+    """A CSV file of ``columns`` (name -> array or list, equal lengths), as pandas'
+    ``to_csv(index=False)`` writes it: floats in their shortest exact form, NaN and None
+    blank, booleans True/False; a column named in ``codes`` holds indices into its names.
+    Written from the arrays: the command line needs no pandas to write its tables."""
+    codes = codes or {}
+    names = list(columns)
+    cells = [_cells(columns[name], codes.get(name)) for name in names]
+    with open(path, "w", newline="") as fh:
+        writer = csv.writer(fh, lineterminator="\n")
+        writer.writerow(names)
+        writer.writerows(zip(*cells))
+
+
+def _cells(values, names=None) -> list:
+    """One column's CSV cells (see write_csv)."""
+    if names is not None:
+        return [names[v] for v in np.asarray(values).tolist()]
+    if isinstance(values, np.ndarray) and values.dtype.kind == "f":
+        out = list(map(float.__repr__, values.astype(float).tolist()))
+        for k in np.flatnonzero(np.isnan(values)).tolist():
+            out[k] = ""
+        return out
+    if isinstance(values, np.ndarray) and values.dtype.kind in "iub":
+        return list(map(str, values.tolist()))
+    values = values.tolist() if isinstance(values, np.ndarray) else values
+    return ["" if v is None or (isinstance(v, float) and math.isnan(v)) else
+            (float.__repr__(v) if isinstance(v, float) else v) for v in values]
+
+
+def write_parquet(path: Path, columns: dict) -> None:
+    """A Parquet file of ``columns`` (name -> numpy array) through pyarrow, without pandas."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    pq.write_table(pa.table({k: np.asarray(v) for k, v in columns.items()}), path)
 
 
 def _write_text(path: Path, text: str) -> None:

@@ -8,6 +8,9 @@ sit outside the axes.
 
 from __future__ import annotations
 
+import json
+import os
+import types
 from pathlib import Path
 
 import numpy as np
@@ -274,6 +277,53 @@ def save_plots(result, out_dir) -> list[Path]:
     paths = []
     for name, make in figures:
         fig = make(result)
-        fig.savefig(out / name, dpi=110)
+        tmp = out / f".{name}.tmp"
+        fig.savefig(tmp, dpi=110, format="png")
+        os.replace(tmp, out / name)  # a reader of the folder never sees half a picture
         paths.append(out / name)
     return paths
+
+
+def stored_result(folder) -> types.SimpleNamespace:
+    """A result folder read back with what the plots use: summary.json, waveforms.parquet
+    (or .csv), openings.csv, history.csv (its energy columns give the energy plot). The
+    mechanics curves are those of history.csv, thinned as [output] history_resolution says.
+    FileNotFoundError when the folder holds no summary.json."""
+    import pandas as pd
+
+    from .metrics import merge_intervals
+
+    folder = Path(folder)
+    summary = json.loads((folder / "summary.json").read_text())
+    bounce = summary.get("bounce") or {}
+    waves = None
+    if (folder / "waveforms.parquet").is_file():
+        waves = pd.read_parquet(folder / "waveforms.parquet")
+    elif (folder / "waveforms.csv").is_file():
+        waves = pd.read_csv(folder / "waveforms.csv")
+    mechanics = None
+    if (folder / "history.csv").is_file():
+        history = pd.read_csv(folder / "history.csv")
+        energy = [c for c in ("time", "kinetic", "elastic", "potential", "contact_stored", "normal_dissipation",
+                              "friction_dissipation", "modal_dissipation", "spring_stored", "load_dissipation",
+                              "work_in", "residual") if c in history]
+        mechanics = types.SimpleNamespace(history=history, energy_table=history[energy])
+    ends = [float(f.time.iloc[-1]) for f in (waves, mechanics and mechanics.history) if f is not None and len(f)]
+    t_end = max(ends, default=0.0)
+    if "contacts" in summary:
+        closed = merge_intervals((c["t_start"], c["t_end"] if c["t_end"] is not None else t_end)
+                                 for c in summary["contacts"])
+    else:  # a prescribed schedule: closed from the first make, between the openings
+        closed, start = [], bounce.get("first_make")
+        for op in bounce.get("openings") or []:
+            if start is not None:
+                closed.append((start, op["start"]))
+            start = op["end"] if op.get("reclosed") else None
+        if start is not None:
+            closed.append((start, t_end))
+    openings = pd.DataFrame(bounce.get("openings") or [],
+                            columns=["start", "end", "open_duration", "reclosed", "kind", "current_at_break",
+                                     "peak_voltage", "arc_duration", "arc_energy"])
+    scene = types.SimpleNamespace(name=summary.get("scene", "run"), t_end=t_end)
+    return types.SimpleNamespace(scene=scene, summary=summary, bounce=bounce, waveforms=waves, openings=openings,
+                                 mechanics=mechanics, closed_intervals=closed)

@@ -15,10 +15,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
+
+from mech.results import REGIME_NAMES
 
 from .metrics import MetricSettings, merge_intervals
 from .metrics import bounce_metrics as _bounce_metrics
+
+
+OPENING_COLUMNS = ("start", "end", "open_duration", "reclosed", "kind", "current_at_break", "peak_voltage",
+                   "arc_duration", "arc_energy")
 
 
 def _num(v):
@@ -28,7 +33,7 @@ def _num(v):
     return v if math.isfinite(v) else None
 
 
-def bounce_metrics(intervals, t_end: float, waveforms: pd.DataFrame | None, closed_at_end: bool,
+def bounce_metrics(intervals, t_end: float, waveforms, closed_at_end: bool,
                    settings: MetricSettings | None = None) -> dict:
     """The bounce summary (coupling.metrics.bounce_metrics) from closed intervals and a waveform frame."""
     if waveforms is None or not len(waveforms):
@@ -49,7 +54,7 @@ class CoupledResult:
 
     scene: object
     mechanics: object | None
-    waveforms: pd.DataFrame | None
+    waveforms: object | None  # pandas DataFrame
     stats: dict
     status: str = "ok"
     accuracy: dict | None = None  # summary.accuracy of run(scene, check=True) (coupling/accuracy.py)
@@ -59,8 +64,8 @@ class CoupledResult:
     def closed_intervals(self) -> list[tuple[float, float]]:
         """Intervals (s) during which the contact is closed."""
         if self.mechanics is not None:
-            c = self.mechanics.contacts
-            return merge_intervals(zip(c.t_start, c.t_end))
+            c = self.mechanics.contact_columns
+            return merge_intervals(zip(c["t_start"], c["t_end"]))
         sched = self.scene.circuit.schedule
         return [(a, min(b, self.scene.t_end)) for a, b in sched.intervals if a < self.scene.t_end]
 
@@ -69,8 +74,7 @@ class CoupledResult:
         if self.scene.circuit is None:
             return {}
         if self.mechanics is not None:
-            c = self.mechanics.contacts
-            closed_at_end = bool((~c.complete).any()) if len(c) else False
+            closed_at_end = bool((~self.mechanics.contact_columns["complete"]).any())
         else:
             closed_at_end = self.scene.circuit.schedule.is_closed(self.scene.t_end)
         key = "bounce"
@@ -80,12 +84,18 @@ class CoupledResult:
         return self._cache[key]
 
     @property
-    def openings(self) -> pd.DataFrame:
-        """The per-opening table of ``bounce`` (openings.csv): start, end, open_duration, reclosed,
-        kind, current_at_break, peak_voltage, arc_duration, arc_energy (SI)."""
-        columns = ["start", "end", "open_duration", "reclosed", "kind", "current_at_break", "peak_voltage",
-                   "arc_duration", "arc_energy"]
-        return pd.DataFrame(self.bounce.get("openings", []), columns=columns)
+    def opening_columns(self) -> dict:
+        """The per-opening table of ``bounce`` (openings.csv) as lists: start, end, open_duration,
+        reclosed, kind, current_at_break, peak_voltage, arc_duration, arc_energy (SI)."""
+        rows = self.bounce.get("openings", [])
+        return {k: [r.get(k) for r in rows] for k in OPENING_COLUMNS}
+
+    @property
+    def openings(self):
+        """pandas DataFrame of ``opening_columns``."""
+        import pandas as pd
+
+        return pd.DataFrame(self.bounce.get("openings", []), columns=list(OPENING_COLUMNS))
 
     @property
     def warnings(self) -> list[str]:
@@ -122,6 +132,8 @@ class CoupledResult:
     def save(self, out_dir) -> Path:
         """Write summary.json, the waveforms (CSV, parquet, the interactive waveforms.html),
         openings.csv, the mechanics tables and PNG plots, as the scene's [output] asks."""
+        from .output import write_csv, write_parquet
+
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         opts = self.scene.output
@@ -134,23 +146,32 @@ class CoupledResult:
             summary["waveforms_html"] = "waveforms.html" if html == "written" else html
         (out / "summary.json").write_text(json.dumps(summary, indent=2))
         if self.waveforms is not None:
+            waves = {k: self.waveforms[k].to_numpy() for k in self.waveforms.columns}
             if opts.csv:
-                self.waveforms.to_csv(out / "waveforms.csv", index=False)
+                write_csv(out / "waveforms.csv", waves)
             if opts.parquet:
-                self.waveforms.to_parquet(out / "waveforms.parquet", index=False)
+                write_parquet(out / "waveforms.parquet", waves)
             if self.scene.circuit is not None:
-                self.openings.to_csv(out / "openings.csv", index=False)
-        if self.mechanics is not None:
+                write_csv(out / "openings.csv", self.opening_columns)
+        m = self.mechanics
+        if m is not None:
             if opts.history:
-                self.mechanics.history.to_csv(out / "history.csv", index=False)
-            self.mechanics.contacts.to_csv(out / "contacts.csv", index=False)
-            self.mechanics.phases.to_csv(out / "phases.csv", index=False)
-            self.mechanics.event_table.to_csv(out / "events.csv", index=False)
+                write_csv(out / "history.csv", m.history_columns, codes={"regime_0": REGIME_NAMES,
+                                                                         "regime_1": REGIME_NAMES})
+            write_csv(out / "contacts.csv", m.contact_columns)
+            write_csv(out / "phases.csv", m.phase_columns)
+            write_csv(out / "events.csv", event_columns(m.events))
         if opts.plots:
             from .plots import save_plots
 
             save_plots(self, out)
         return out
+
+
+def event_columns(events: list[dict]) -> dict:
+    """events.csv's columns: every key any event has, in order of first appearance (blank where an event lacks it)."""
+    keys = list(dict.fromkeys(k for ev in events for k in ev))
+    return {k: [ev.get(k) for ev in events] for k in keys}
 
 
 def jacobi_step_flag(result) -> str | None:
@@ -161,11 +182,11 @@ def jacobi_step_flag(result) -> str | None:
     scene = result.scene
     if scene.kind != "coupled" or scene.coupling.scheme != "jacobi" or result.mechanics is None:
         return None
-    c = result.mechanics.contacts
-    c = c[c.complete]
-    if not len(c):
+    c = result.mechanics.contact_columns
+    done = c["complete"]
+    if not done.any():
         return None
-    shortest = float((c.t_end - c.t_start).min())
+    shortest = float((c["t_end"][done] - c["t_start"][done]).min())
     h = scene.coupling.macro_step
     if shortest >= 2.0 * h:
         return None

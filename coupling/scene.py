@@ -118,7 +118,7 @@ class OutputOptions:
 
     csv: bool = True
     parquet: bool = True
-    plots: bool = True
+    plots: bool = False  # PNGs on request (`switchsim run --plots`, `switchsim plot DIR`): drawing them costs more than a run
     history: bool = True
     html: bool = True
     history_resolution: float = 1e-6

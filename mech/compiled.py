@@ -1,17 +1,66 @@
 """The compiled mechanics as the Python side calls it: the one place that loads it.
 
-The solver, the results and the scipy backend take every compiled function from here,
-never from mech.kernel or mech.integrator directly, and read the kernel's indices from
-mech.kernel_layout; so how the compiled code is obtained (numba's just-in-time functions
-with their on-disk cache, mech.compiled_cache) is decided in this module alone.
+The solver, the results, the scipy backend and the damping calibration take every
+compiled function from here, never from mech.kernel or mech.integrator directly, and read
+the kernel's indices from mech.kernel_layout; so how the compiled code is obtained is
+decided in this module alone:
+- ``ROUTE == "aot"``: the extension module built ahead of time by numba.pycc from the
+  same sources (mech.aot: built on first use, cached by a hash of the sources); numba is
+  not imported. Its functions read their arguments as the warm-up's types, unchecked, so
+  each call is checked here first (a few microseconds); an argument of another type
+  (a new call the warm-up does not make) goes to the JIT function instead, with a
+  RuntimeWarning that names it (an error in the test suite);
+- ``ROUTE == "jit"``: numba's just-in-time functions with their on-disk cache
+  (mech.compiled_cache), when the module cannot be built or ``SWITCHSIM_JIT=1``.
 """
 
 from __future__ import annotations
 
-from .integrator import dense_contact, dense_eval, dense_tip_forces, events_from_aux, integrate
-from .kernel import dynamics, energies, energy_table, make_work, project_to_stick
+import importlib
+import warnings
 
-__all__ = [
-    "dense_contact", "dense_eval", "dense_tip_forces", "dynamics", "energies", "energy_table",
-    "events_from_aux", "integrate", "make_work", "project_to_stick",
-]
+from . import aot
+
+# every compiled function the Python side calls (mech.aot exports exactly these), and the
+# module of its numba source
+ENTRY_POINTS = {
+    "dense_contact": "integrator", "dense_eval": "integrator", "dense_tip_forces": "integrator",
+    "events_from_aux": "integrator", "integrate": "integrator", "dynamics": "kernel", "energies": "kernel",
+    "energy_table": "kernel", "make_work": "kernel", "project_to_stick": "kernel", "scaled_rebound": "kernel",
+}
+
+
+class CompiledArgumentWarning(RuntimeWarning):
+    """An ahead-of-time function was called with arguments it was not built for."""
+
+
+def _jit(name: str):
+    return getattr(importlib.import_module(f".{ENTRY_POINTS[name]}", __package__), name)
+
+
+def _checked(name: str, fn, check):
+    def call(*args):
+        try:
+            check(args)
+        except TypeError as err:
+            warnings.warn(f"{err}: calling numba's just-in-time {name} instead (add the call to mech.aot.warm_up)",
+                          CompiledArgumentWarning, stacklevel=2)
+            return _jit(name)(*args)
+        return fn(*args)
+
+    call.__name__ = call.__qualname__ = name
+    call.__doc__ = f"{name} from the ahead-of-time module, its arguments checked first"
+    return call
+
+
+_loaded = aot.load()
+if _loaded is not None:
+    ROUTE = "aot"
+    _module, _folder = _loaded
+    _checks = aot.argument_checks(_folder)
+    globals().update({name: _checked(name, getattr(_module, name), _checks[name]) for name in ENTRY_POINTS})
+else:
+    ROUTE = "jit"
+    globals().update({name: _jit(name) for name in ENTRY_POINTS})
+
+__all__ = list(ENTRY_POINTS) + ["ROUTE"]

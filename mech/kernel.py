@@ -47,6 +47,7 @@ normal_force = njit(cache=True)(_contact_laws.normal_force)
 friction_limit = njit(cache=True)(_friction.friction_limit)
 regularized_scale = njit(cache=True)(_friction.regularized_scale)
 slip_direction = njit(cache=True)(_friction.slip_direction)
+scaled_rebound = njit(cache=True)(_contact_laws.scaled_rebound)  # the damping calibration's impact
 
 
 quat_to_matrix = njit(cache=True)(_rotations.quat_to_matrix)

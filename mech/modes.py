@@ -17,13 +17,40 @@ import numpy as np
 
 
 def free_free_roots(count: int) -> np.ndarray:
-    """beta_n L of the first ``count`` elastic free-free bending modes (4.730041, 7.853205, ...)."""
-    from scipy.optimize import brentq
+    """beta_n L of the first ``count`` elastic free-free bending modes (4.730041, 7.853205, ...).
 
+    Newton's method on f(b) = cos b - 1/cosh b from (n + 1/2) pi, kept inside the bracket
+    [guess - 0.5, guess + 0.5] that holds the n-th root alone (a step leaving it bisects),
+    then the nearby float with the smallest residual.
+    """
     roots = []
     for n in range(1, count + 1):
-        guess = (n + 0.5) * math.pi
-        roots.append(brentq(lambda b: math.cos(b) - 1.0 / math.cosh(b), guess - 0.5, guess + 0.5, xtol=1e-15))
+        lo = (n + 0.5) * math.pi - 0.5
+        hi = lo + 1.0
+        f_lo = math.cos(lo) - 1.0 / math.cosh(lo)
+        b = lo + 0.5
+        for _ in range(100):
+            f = math.cos(b) - 1.0 / math.cosh(b)
+            if f == 0.0:
+                break
+            if (f < 0.0) == (f_lo < 0.0):
+                lo, f_lo = b, f
+            else:
+                hi = b
+            slope = -math.sin(b) + math.tanh(b) / math.cosh(b)
+            nxt = b - f / slope if slope != 0.0 else 0.5 * (lo + hi)
+            if not lo < nxt < hi:
+                nxt = 0.5 * (lo + hi)
+            if abs(nxt - b) <= 4e-16 * b:
+                b = nxt
+                break
+            b = nxt
+        # of the floats within 4 spacings of b (1.4e-14 at b ~ 90), the smallest residual
+        near = [b]
+        for _ in range(4):
+            near = [math.nextafter(near[0], 0.0)] + near + [math.nextafter(near[-1], math.inf)]
+        b = min(near, key=lambda c: abs(math.cos(c) - 1.0 / math.cosh(c)))
+        roots.append(b)
     return np.array(roots)
 
 

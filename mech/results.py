@@ -1,4 +1,9 @@
-"""Results of an impact run: pandas history, contact intervals, phases, restitution, energy audit.
+"""Results of an impact run: history, contact intervals, phases, restitution, energy audit.
+
+Every table exists as columns of numpy arrays (``*_columns``: what the summary, the
+soundness checks and the command line's CSV files use) and as a pandas DataFrame built
+from them on first access (``history``, ``contacts``, ``phases``, ``energy_table``,
+``event_table``): a run that only writes its summary and CSV files never imports pandas.
 
 All quantities SI; the history is in the world frame (z up) for planar and 3D runs alike.
 Energy audit (paper eqs. 21-23 with elastic strain energy added):
@@ -15,7 +20,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
 from .compiled import energy_table
 from .kernel_layout import (
@@ -26,6 +30,18 @@ from .model import BarModel
 from .rotations import matrix_to_quaternion, rotation_y, rotation_z
 
 REGIME_NAMES = ("free", "slip", "stick")
+CONTACT_COLUMNS = ("tip", "t_start", "t_end", "peak_force", "impulse", "normal_speed_in", "normal_speed_out",
+                   "kinematic_restitution", "energetic_restitution", "complete")
+PHASE_COLUMNS = ("tip", "regime", "t_start", "t_end")
+
+
+def _frame(columns: dict, categorical: tuple = ()):
+    """A pandas DataFrame of ``columns`` (name -> array); columns named in ``categorical``
+    (arrays of REGIME_NAMES codes) become categoricals."""
+    import pandas as pd
+
+    data = {k: (pd.Categorical.from_codes(v, REGIME_NAMES) if k in categorical else v) for k, v in columns.items()}
+    return pd.DataFrame(data)
 
 
 @dataclass
@@ -90,13 +106,16 @@ class ImpactResult:
     # --- tables ---------------------------------------------------------------------------
 
     @property
-    def energy_table(self) -> pd.DataFrame:
-        """Per record: kinetic, elastic, potential (change), contact_stored, dissipations, residual (J)."""
-        if "energy" not in self._cache:
+    def energy_columns(self) -> dict:
+        """Per record (numpy arrays): time, kinetic, elastic, potential (change), contact_stored,
+        normal/friction/modal dissipation, spring_stored, load_dissipation, work_in, residual (J)."""
+        if "energy_columns" not in self._cache:
             m = self.model
             E = energy_table(self.states, m.arrays)
             qd = self.states[:, m.slices()["quad"]]
-            df = pd.DataFrame({
+            held = qd.shape[1] > Q_WIN  # quadratures of input work and load dissipation
+            zero = np.zeros(len(self.t))
+            c = {
                 "time": self.t,
                 "kinetic": E[:, 0],
                 "elastic": E[:, 1],
@@ -106,16 +125,22 @@ class ImpactResult:
                 "friction_dissipation": qd[:, Q_DFRICTION],
                 "modal_dissipation": qd[:, Q_DMODAL],
                 "spring_stored": E[:, 4],
-            })
-            held = qd.shape[1] > Q_WIN  # quadratures of input work and load dissipation
-            df["load_dissipation"] = qd[:, Q_DLOAD] if held else 0.0
-            df["work_in"] = qd[:, Q_WIN] if held else 0.0
+                "load_dissipation": qd[:, Q_DLOAD] if held else zero,
+                "work_in": qd[:, Q_WIN] if held else zero,
+            }
             e0 = E[0, 0] + E[0, 1] + E[0, 3] + E[0, 4]
-            total = (df.kinetic + df.elastic + df.potential + df.contact_stored + df.normal_dissipation
-                     + df.friction_dissipation + df.modal_dissipation + df.spring_stored
-                     + df.load_dissipation - df.work_in)
-            df["residual"] = e0 - total + self._projection_series()
-            self._cache["energy"] = df
+            total = (c["kinetic"] + c["elastic"] + c["potential"] + c["contact_stored"] + c["normal_dissipation"]
+                     + c["friction_dissipation"] + c["modal_dissipation"] + c["spring_stored"]
+                     + c["load_dissipation"] - c["work_in"])
+            c["residual"] = e0 - total + self._projection_series()
+            self._cache["energy_columns"] = c
+        return self._cache["energy_columns"]
+
+    @property
+    def energy_table(self):
+        """pandas DataFrame of ``energy_columns``."""
+        if "energy" not in self._cache:
+            self._cache["energy"] = _frame(self.energy_columns)
         return self._cache["energy"]
 
     def _projection_series(self) -> np.ndarray:
@@ -126,9 +151,10 @@ class ImpactResult:
         return out
 
     @property
-    def history(self) -> pd.DataFrame:
-        """Time history at every accepted step (SI, world frame)."""
-        if "history" not in self._cache:
+    def history_columns(self) -> dict:
+        """Time history at every accepted step (SI, world frame) as numpy arrays; the
+        regime_i columns hold REGIME_NAMES codes."""
+        if "history_columns" not in self._cache:
             m = self.model
             pos, quat, vel, omega = self._world()
             data = {"time": self.t,
@@ -153,20 +179,27 @@ class ImpactResult:
                 data[f"slip_vx_{i}"] = vs[:, 0]
                 data[f"slip_vy_{i}"] = vs[:, 1]
                 data[f"slip_speed_{i}"] = np.hypot(vs[:, 0], vs[:, 1])
-                data[f"regime_{i}"] = pd.Categorical.from_codes(self.regimes[:, i], REGIME_NAMES)
-            df = pd.DataFrame(data)
-            en = self.energy_table
-            for col in en.columns[1:]:
-                df[col] = en[col].to_numpy()
-            self._cache["history"] = df
+                data[f"regime_{i}"] = self.regimes[:, i]
+            en = self.energy_columns
+            for col in list(en)[1:]:
+                data[col] = en[col]
+            self._cache["history_columns"] = data
+        return self._cache["history_columns"]
+
+    @property
+    def history(self):
+        """pandas DataFrame of ``history_columns`` (regimes as categoricals)."""
+        if "history" not in self._cache:
+            self._cache["history"] = _frame(self.history_columns, ("regime_0", "regime_1"))
         return self._cache["history"]
 
     @property
-    def contacts(self) -> pd.DataFrame:
-        """One row per contact interval: tip, t_start, t_end (s), peak_force (N), impulse (N s),
-        normal speeds in/out (m/s), kinematic and energetic (Stronge) restitution."""
-        if "contacts" in self._cache:
-            return self._cache["contacts"]
+    def contact_columns(self) -> dict:
+        """One entry per contact interval (numpy arrays, by t_start): tip, t_start, t_end (s),
+        peak_force (N), impulse (N s), normal speeds in/out (m/s), kinematic and energetic
+        (Stronge) restitution, complete."""
+        if "contact_columns" in self._cache:
+            return self._cache["contact_columns"]
         rows = []
         quad0 = self.model.slices()["quad"].start
         for i in range(2):
@@ -184,11 +217,18 @@ class ImpactResult:
             if start is not None:  # still in contact at the end of the run
                 end = dict(time=self.t[-1], penetration_rate=self.aux[-1, i, A_YDOT], open=True)
                 rows.append(self._contact_row(i, start, end, quad0))
-        cols = ["tip", "t_start", "t_end", "peak_force", "impulse", "normal_speed_in", "normal_speed_out",
-                "kinematic_restitution", "energetic_restitution", "complete"]
-        df = pd.DataFrame(rows, columns=cols).sort_values("t_start", kind="stable").reset_index(drop=True)
-        self._cache["contacts"] = df
-        return df
+        rows.sort(key=lambda r: r["t_start"])  # stable: tip 0 first at equal times
+        kinds = {"tip": np.int64, "complete": bool}
+        cols = {k: np.array([r[k] for r in rows], dtype=kinds.get(k, float)) for k in CONTACT_COLUMNS}
+        self._cache["contact_columns"] = cols
+        return cols
+
+    @property
+    def contacts(self):
+        """pandas DataFrame of ``contact_columns``."""
+        if "contacts" not in self._cache:
+            self._cache["contacts"] = _frame(self.contact_columns)
+        return self._cache["contacts"]
 
     def _state_at(self, t: float) -> np.ndarray:
         k = int(np.searchsorted(self.t, t - 1e-15))
@@ -214,10 +254,10 @@ class ImpactResult:
         )
 
     @property
-    def phases(self) -> pd.DataFrame:
-        """Intervals of constant regime per tip: tip, regime, t_start, t_end (s)."""
-        if "phases" in self._cache:
-            return self._cache["phases"]
+    def phase_columns(self) -> dict:
+        """Intervals of constant regime per tip (numpy arrays): tip, regime (name), t_start, t_end (s)."""
+        if "phase_columns" in self._cache:
+            return self._cache["phase_columns"]
         rows = []
         for i in range(2):
             codes = self.regimes[:, i]
@@ -225,45 +265,54 @@ class ImpactResult:
             for k in range(1, len(codes) + 1):
                 if k == len(codes) or codes[k] != codes[start]:
                     t_start = self.t[start - 1] if start > 0 else self.t[0]
-                    rows.append(dict(tip=i, regime=REGIME_NAMES[codes[start]], t_start=float(t_start),
-                                     t_end=float(self.t[k - 1])))
+                    rows.append((i, REGIME_NAMES[codes[start]], float(t_start), float(self.t[k - 1])))
                     start = k
-        df = pd.DataFrame(rows, columns=["tip", "regime", "t_start", "t_end"])
-        self._cache["phases"] = df
-        return df
+        kinds = (np.int64, object, float, float)
+        cols = {k: np.array([r[j] for r in rows], dtype=kinds[j]) for j, k in enumerate(PHASE_COLUMNS)}
+        self._cache["phase_columns"] = cols
+        return cols
 
     @property
-    def event_table(self) -> pd.DataFrame:
+    def phases(self):
+        """pandas DataFrame of ``phase_columns``."""
+        if "phases" not in self._cache:
+            self._cache["phases"] = _frame(self.phase_columns)
+        return self._cache["phases"]
+
+    @property
+    def event_table(self):
+        """pandas DataFrame of ``events`` (one row per event)."""
+        import pandas as pd
+
         return pd.DataFrame(self.events)
 
     @property
     def restitution(self) -> dict:
         """Kinematic and energetic restitution of the first complete contact (nan if none)."""
-        c = self.contacts
-        c = c[c.complete]
-        if c.empty:
+        c = self.contact_columns
+        done = np.flatnonzero(c["complete"])
+        if not len(done):
             return {"kinematic": float("nan"), "energetic": float("nan")}
-        first = c.iloc[0]
-        return {"kinematic": float(first.kinematic_restitution), "energetic": float(first.energetic_restitution)}
+        k = done[0]
+        return {"kinematic": float(c["kinematic_restitution"][k]), "energetic": float(c["energetic_restitution"][k])}
 
     @property
     def energy(self) -> dict:
         """Energy audit at the end of the run (J), plus the largest relative residual."""
-        en = self.energy_table
-        last = en.iloc[-1]
-        e0 = float(en.kinetic.iloc[0] + en.elastic.iloc[0] + en.contact_stored.iloc[0])
+        en = self.energy_columns
+        e0 = float(en["kinetic"][0] + en["elastic"][0] + en["contact_stored"][0])
         scale = self.energy_scale
         return {
             "initial": e0,
-            "kinetic": float(last.kinetic),
-            "elastic": float(last.elastic),
-            "potential_change": float(last.potential),
-            "contact_stored": float(last.contact_stored),
-            "normal_dissipation": float(last.normal_dissipation),
-            "friction_dissipation": float(last.friction_dissipation),
-            "modal_dissipation": float(last.modal_dissipation),
-            "residual": float(last.residual),
-            "relative_residual": float(np.max(np.abs(en.residual)) / scale),
+            "kinetic": float(en["kinetic"][-1]),
+            "elastic": float(en["elastic"][-1]),
+            "potential_change": float(en["potential"][-1]),
+            "contact_stored": float(en["contact_stored"][-1]),
+            "normal_dissipation": float(en["normal_dissipation"][-1]),
+            "friction_dissipation": float(en["friction_dissipation"][-1]),
+            "modal_dissipation": float(en["modal_dissipation"][-1]),
+            "residual": float(en["residual"][-1]),
+            "relative_residual": float(np.max(np.abs(en["residual"])) / scale),
         }
 
     @property
@@ -274,17 +323,16 @@ class ImpactResult:
         its lowest resting height (lying flat on the block: the centre at the tip radius),
         m g (z_c0 - R_tip). A bar at rest still has a scale (a standing bar can fall
         over), and a run that gains energy by error does not enlarge its own yardstick."""
-        en = self.energy_table
+        en = self.energy_columns
         m = self.model
         z0 = float(self.states[0, m.slices()["pos"]][-1])  # centre height, z up (planar: x, z)
         scene = m.scene
         # a held bar cannot fall; a free one can drop its centre to the tip radius
         drop = 0.0 if scene.mount.held else max(z0 - scene.bar.tip_radius, 0.0)
-        e_in = float(en.kinetic.iloc[0] + en.elastic.iloc[0] + en.contact_stored.iloc[0]
-                     + en.spring_stored.iloc[0])
+        e_in = float(en["kinetic"][0] + en["elastic"][0] + en["contact_stored"][0] + en["spring_stored"][0])
         # actuators and a moving clamp bring energy in while the run goes on: the most they
         # had put in at any time belongs to the yardstick too
-        work = max(float(en.work_in.max()), 0.0)
+        work = max(float(en["work_in"].max()), 0.0)
         return max(e_in + work + m.basis.mass * scene.gravity * drop, 1e-300)
 
     @property
@@ -316,12 +364,12 @@ class ImpactResult:
 
     def to_summary(self) -> dict:
         """The JSON summary: contacts, restitution, energy, solver, flags."""
-        c = self.contacts
+        c = self.contact_columns
         return {
             "contacts": [
-                {k: (int(r[k]) if k == "tip" else (bool(r[k]) if k == "complete" else _num(r[k])))
-                 for k in c.columns}
-                for _, r in c.iterrows()
+                {k: (int(c[k][j]) if k == "tip" else (bool(c[k][j]) if k == "complete" else _num(c[k][j])))
+                 for k in CONTACT_COLUMNS}
+                for j in range(len(c["tip"]))
             ],
             "restitution": {k: _num(v) for k, v in self.restitution.items()},
             "energy": {k: _num(v) for k, v in self.energy.items()},

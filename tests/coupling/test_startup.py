@@ -1,9 +1,12 @@
 """The import contract of `switchsim run`: a scene imports only what it uses.
 
 Each check runs the command in a fresh interpreter and lists the heavy packages it
-loaded: scipy.integrate only for the scipy backends (and, today, for a contact
-restitution calibration, which integrates one impact with solve_ivp: these scenes give
-contact.damping), matplotlib only when plotting, PySpice only with a circuit, Dask never.
+loaded: numba never while the ahead-of-time module is there (mech.aot); scipy not for a
+run (the quadrature, the mode roots, the damping calibration and the held bars' finite
+element modes are numpy or compiled); pandas and pyarrow not for a mechanics-only run with
+its default outputs (tables written from arrays); matplotlib only when plotting; plotly's
+Python side never (waveforms.html is written directly); PySpice only with a circuit; Dask
+never.
 """
 
 from __future__ import annotations
@@ -18,7 +21,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-HEAVY = ("scipy.integrate", "scipy.stats", "matplotlib", "PySpice", "dask", "distributed")
+HEAVY = ("numba", "scipy", "pandas", "pyarrow", "matplotlib", "plotly", "PySpice", "dask", "distributed")
 
 MECH = """
 [bar]
@@ -31,7 +34,7 @@ height = 0.0001
 angle_deg = 30.0
 velocity = [0.0, 0.0, -1.0]
 [contact]
-damping = 2e5
+restitution = 0.7
 [solver]
 t_end = 0.0003
 [output]
@@ -65,19 +68,34 @@ def _loaded(tmp_path: Path, scene_text: str, *args: str) -> set[str]:
     return {name for name in HEAVY if name in modules}
 
 
-def test_mechanics_only_scene_imports_no_integrate_matplotlib_pyspice_or_dask(tmp_path):
+def _requires_aot():
+    import mech.compiled
+
+    if mech.compiled.ROUTE != "aot":
+        pytest.skip("the ahead-of-time module could not be built here: the JIT route imports numba")
+
+
+def test_mechanics_only_scene_with_its_default_outputs_imports_nothing_heavy(tmp_path):
+    """restitution given: the damping is calibrated (compiled), without scipy."""
+    _requires_aot()
     assert _loaded(tmp_path, MECH.format(plots="false")) == set()
-    assert (tmp_path / "out" / "summary.json").is_file()
+    out = tmp_path / "out"
+    assert {p.name for p in out.iterdir()} == {"summary.json", "history.csv", "contacts.csv", "phases.csv",
+                                               "events.csv"}
 
 
-def test_plots_bring_matplotlib_and_nothing_else(tmp_path):
-    assert _loaded(tmp_path, MECH.format(plots="true")) == {"matplotlib"}
+def test_plots_bring_matplotlib_and_pandas_only(tmp_path):
+    _requires_aot()
+    assert _loaded(tmp_path, MECH.format(plots="true")) - {"pyarrow"} == {"matplotlib", "pandas"}
     assert (tmp_path / "out" / "normal_force.png").stat().st_size > 0
 
 
-def test_coupled_scene_imports_pyspice_but_no_integrate_stats_or_matplotlib(tmp_path):
-    """The illustrative laws come from their stored fit: no scipy.stats, no fitting."""
-    assert _loaded(tmp_path, MECH.format(plots="false") + CIRCUIT) == {"PySpice"}
+def test_coupled_scene_imports_pyspice_but_no_numba_scipy_matplotlib_or_plotly(tmp_path):
+    """The illustrative laws come from their stored fit: no scipy.stats, no fitting. (pandas:
+    the circuit's waveforms are a DataFrame; pyarrow writes waveforms.parquet.)"""
+    _requires_aot()
+    assert _loaded(tmp_path, MECH.format(plots="false") + CIRCUIT) == {"PySpice", "pandas", "pyarrow"}
+    assert (tmp_path / "out" / "waveforms.html").stat().st_size > 1_000_000
 
 
 def test_the_stored_default_fit_is_current_and_equals_a_fresh_fit():

@@ -1,0 +1,145 @@
+"""The ahead-of-time module (mech.aot) against numba's just-in-time functions, and its build.
+
+Both routes compile the same source: a run on either gives the same trajectory, to the
+last bit, on scenes that reach every part of the kernel (3D and planar free bars, stick
+and slip, a clamped blade with a rivet under a force, a pivot on a spring). The build
+machinery is checked with a stand-in compiler: one build for concurrent callers, a
+failure remembered and said, the JIT route taken then.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mech import aot
+
+ROOT = Path(__file__).resolve().parents[2]
+
+RUN = textwrap.dedent("""
+    import json, sys
+    import numpy as np
+    import mech.compiled
+    from mech.aot import warm_up
+    from mech.scene import scene_from_dict
+    from mech.solver import ImpactSolver
+    steel = dict(youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0)
+    scenes = [
+        {"bar": dict(length=0.3, diameter=0.006, tip_radius=0.003, modes=4, **steel),
+         "initial": dict(height=5e-4, angle_deg=30.0, velocity=[0.2, 0.1, -1.0]),
+         "friction": dict(mu=0.5), "solver": dict(t_end=1.5e-3)},
+        {"bar": dict(length=0.3, diameter=0.006, tip_radius=0.003, modes=6, **steel),
+         "initial": dict(height=5e-4, angle_deg=30.0, velocity=[0.0, 0.0, -1.0]),
+         "friction": dict(mu=0.3), "solver": dict(t_end=1.5e-3)},
+        {"bar": dict(length=0.02, width=0.003, thickness=0.0003, tip_radius=0.0016,
+                     modes={"axial": 1, "bending": 4}, modal_damping=0.05, **steel),
+         "mount": dict(kind="clamp", position=0.02), "rivet": [dict(position=0.0015, offset=0.0, radius=0.0015)],
+         "force": [dict(position=0.01, time=[0.0, 0.002], value=[0.0, 3.0])],
+         "initial": dict(height=5e-5), "friction": dict(mu=0.3), "solver": dict(t_end=4e-3)},
+        {"bar": dict(length=0.05, diameter=0.005, tip_radius=0.0025, modes=0, **steel),
+         "mount": dict(kind="pivot", position=0.05, stiffness=1.0, preload_torque=0.01),
+         "initial": dict(height=2e-5), "solver": dict(t_end=2e-3)},
+    ]
+    out = {"route": mech.compiled.ROUTE}
+    for k, doc in enumerate(scenes):
+        res = ImpactSolver(scene_from_dict(doc)).run()
+        np.save(sys.argv[1] + f"/states{k}.npy", res.states)
+        np.save(sys.argv[1] + f"/energy{k}.npy", np.column_stack(list(res.energy_columns.values())))
+        out[k] = len(res.contact_columns["tip"])
+    print(json.dumps(out))
+""")
+
+
+def _run(folder: Path, jit: bool) -> dict:
+    folder.mkdir()
+    env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    env[aot.FORCE_JIT] = "1" if jit else "0"
+    done = subprocess.run([sys.executable, "-c", RUN, str(folder)], env=env, capture_output=True, text=True,
+                          timeout=1800)
+    assert done.returncode == 0, done.stderr[-3000:]
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def test_ahead_of_time_and_just_in_time_routes_give_the_same_trajectories(tmp_path):
+    jit = _run(tmp_path / "jit", jit=True)
+    ahead = _run(tmp_path / "aot", jit=False)
+    assert jit["route"] == "jit" and ahead["route"] == "aot"
+    assert all(jit[str(k)] > 0 for k in range(4))  # every scene has contacts
+    for k in range(4):
+        for what in ("states", "energy"):
+            a = np.load(tmp_path / "jit" / f"{what}{k}.npy")
+            b = np.load(tmp_path / "aot" / f"{what}{k}.npy")
+            assert a.shape == b.shape
+            np.testing.assert_array_equal(a, b, err_msg=f"scene {k}, {what}")
+
+
+def test_an_argument_of_another_type_goes_to_the_jit_function_with_a_warning():
+    import mech.compiled as compiled
+
+    if compiled.ROUTE != "aot":
+        pytest.skip("the ahead-of-time module is not in use here")
+    coef = np.arange(15.0).reshape(5, 3)
+    expected = np.empty(3)
+    compiled.dense_eval(coef, 0.3, expected)
+    got = np.empty(3)
+    with pytest.warns(compiled.CompiledArgumentWarning, match="dense_eval argument 0"):
+        compiled.dense_eval(np.asfortranarray(coef), 0.3, got)  # read wrongly by the module
+    np.testing.assert_array_equal(got, expected)
+    closed_form = coef[0] + 0.3 * (coef[1] + 0.7 * (coef[2] + 0.3 * (coef[3] + 0.7 * coef[4])))
+    np.testing.assert_allclose(expected, closed_form, rtol=1e-15)
+
+
+def _fake_build(calls, delay=0.2):
+    def build(folder: Path):
+        calls.append(folder)
+        threading.Event().wait(delay)
+        staging = folder.with_name(folder.name + ".tmp")
+        staging.mkdir()
+        aot.module_file(staging).write_bytes(b"")
+        os.rename(staging, folder)
+        return None
+    return build
+
+
+def test_concurrent_callers_build_once(tmp_path, monkeypatch):
+    calls = []
+    monkeypatch.setattr(aot, "_build", _fake_build(calls))
+    folder = tmp_path / "aot-key"
+    results = []
+    threads = [threading.Thread(target=lambda: results.append(aot._build_locked(folder))) for _ in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert results == [None] * 4 and len(calls) == 1
+    assert aot.module_file(folder).is_file()
+
+
+def test_a_failed_build_is_remembered_said_once_and_the_jit_route_taken(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    monkeypatch.delenv(aot.FORCE_JIT, raising=False)
+    monkeypatch.setattr(aot.sysconfig, "get_config_var", lambda name: "no-such-compiler-here" if name == "CC" else None)
+    assert aot.load() is None
+    err = capsys.readouterr().err
+    assert err.count("switchsim:") == 1 and "no C compiler" in err and "just-in-time" in err
+    failed = list(tmp_path.glob("aot-*.failed"))
+    assert len(failed) == 1
+    # the next process does not try again; it says why, and how to retry
+    assert aot.load() is None
+    err = capsys.readouterr().err
+    assert "failed before" in err and str(failed[0]) in err
+
+
+def test_the_environment_forces_the_jit_route(monkeypatch, tmp_path):
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    monkeypatch.setenv(aot.FORCE_JIT, "1")
+    assert aot.load() is None
+    assert not list(tmp_path.iterdir())  # nothing built, nothing written
