@@ -590,6 +590,56 @@ def _sticking_tips(regime, aux):
 
 
 @njit(cache=True)
+def symmetric_eigen(A):
+    """(eigenvalues, eigenvectors as columns) of a small symmetric matrix, by cyclic Jacobi
+    rotations. Why not np.linalg.eigh or lstsq (or a matrix product): numba reaches LAPACK
+    and BLAS through SciPy, whose import (~0.2 s) a run of a few milliseconds of work should
+    not pay; the stick matrices here are at most 4 x 4, where Jacobi converges in a few
+    sweeps to round-off."""
+    n = A.shape[0]
+    a = A.copy()
+    v = np.eye(n)
+    scale = 0.0
+    for i in range(n):
+        for j in range(n):
+            scale += a[i, j] * a[i, j]
+    for _sweep in range(50):
+        off = 0.0
+        for i in range(n):
+            for j in range(i + 1, n):
+                off += a[i, j] * a[i, j]
+        if off <= 1e-32 * scale:
+            break
+        for p in range(n):
+            for q in range(p + 1, n):
+                if a[p, q] == 0.0:
+                    continue
+                theta = (a[q, q] - a[p, p]) / (2.0 * a[p, q])
+                t = (1.0 if theta >= 0.0 else -1.0) / (abs(theta) + math.sqrt(theta * theta + 1.0))
+                c = 1.0 / math.sqrt(t * t + 1.0)
+                sn = t * c
+                for k in range(n):  # columns p, q of a
+                    akp = a[k, p]
+                    akq = a[k, q]
+                    a[k, p] = c * akp - sn * akq
+                    a[k, q] = sn * akp + c * akq
+                for k in range(n):  # rows p, q of a
+                    apk = a[p, k]
+                    aqk = a[q, k]
+                    a[p, k] = c * apk - sn * aqk
+                    a[q, k] = sn * apk + c * aqk
+                for k in range(n):
+                    vkp = v[k, p]
+                    vkq = v[k, q]
+                    v[k, p] = c * vkp - sn * vkq
+                    v[k, q] = sn * vkp + c * vkq
+    w = np.empty(n)
+    for i in range(n):
+        w[i] = a[i, i]
+    return w, v
+
+
+@njit(cache=True)
 def _min_norm_solve(W, rhs):
     """Least-squares, minimum-norm solution of W x = rhs.
 
@@ -606,7 +656,17 @@ def _min_norm_solve(W, rhs):
     events took the run nowhere (measured on the 2 deg, 1 mm, e = 0.5, mu = 0.3 drop:
     8145 steps and 363 events to rest with this cut-off).
     """
-    x, _res, _rank, _sv = np.linalg.lstsq(W, rhs, 1e-7)
+    s, U = symmetric_eigen(W)
+    cut = 1e-7 * max(np.max(np.abs(s)), 1e-300)
+    n = W.shape[0]
+    x = np.zeros(n)
+    for k in range(n):
+        if s[k] > cut:
+            c = 0.0
+            for i in range(n):
+                c += U[i, k] * rhs[i]
+            for i in range(n):
+                x[i] += (c / s[k]) * U[i, k]
     return x
 
 
@@ -632,7 +692,7 @@ def _rest_projection_solve(W, rhs, vres):
     for i in range(nc):
         if W[i, i] > 0.0:
             bound += vres * vres / W[i, i]
-    s, U = np.linalg.eigh(W)
+    s, U = symmetric_eigen(W)
     lam = np.zeros(nc)
     for k in range(nc):
         if s[k] <= 0.0:
