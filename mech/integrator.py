@@ -196,6 +196,7 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
         if h > hcap:
             h = hcap
         last = False
+        h_want = h  # the controller's step, kept across a last step clipped to t_stop
         if t + h >= t_stop:
             h = t_stop - t
             last = True
@@ -367,6 +368,11 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
         if reject:
             hnew = min(hnew, h)
             reject = False
+        if last and h < 0.5 * h_want and hnew < h_want:
+            # a step clipped well short by t_stop says little about the next: going on from a
+            # round-off sliver (a redone coupling step ending 5e-16 s before its event) with
+            # the sliver's own step failed as 'step size too small'
+            hnew = h_want
         h = hnew
 
 

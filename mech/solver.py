@@ -706,6 +706,8 @@ class ImpactSolver:
         self._resolve(triggered=ev)
         aux = self._aux
         if kind == EV_CONTACT:
+            if (old[tip] == FREE) == (self.regime[tip] == FREE):
+                return  # a round-off crossing at the surface that changed nothing (_resolve)
             name = "contact_start" if old_sign < 0 else "contact_end"
             if name == "contact_start":
                 self._check_cap(tip)
@@ -834,7 +836,16 @@ class ImpactSolver:
         for i in range(2):
             pen = aux[i, A_Y]
             if triggered == NEV_TIP * i + EV_CONTACT and abs(pen) <= tiny:
-                in_contact = self.ev_sign[triggered] < 0.0  # crossing upwards: contact starts
+                # at the surface the tip's normal speed says where it goes; only where that
+                # is a round-off too does the crossing direction decide. (A tip leaving the
+                # block at 1 cm/s re-crossed its surface by round-off 5e-16 s after its
+                # contact end: taken as a contact start, it left at once, and the steps
+                # shrank to nothing: 'step size too small'.)
+                rate = aux[i, A_YDOT]
+                if abs(rate) > 1e-9 * self.model.contact.reference_speed:
+                    in_contact = rate > 0.0
+                else:
+                    in_contact = self.ev_sign[triggered] < 0.0  # crossing upwards: contact starts
             else:
                 in_contact = pen > 0.0
             if not in_contact:
