@@ -42,13 +42,15 @@ def assert_same_contacts(a, b, time_rtol=1e-6, rtol=1e-4, energetic_rtol=1e-4):
 
 @pytest.fixture(scope="module")
 def dopri5_run():
-    return ImpactSolver(default_truncated(2.5e-3, 1e-9)).run()
+    return ImpactSolver(default_truncated(2.5e-3, 1e-10)).run()
 
 
 def test_compiled_dopri5_agrees_with_scipy_dop853_on_the_default_scene(dopri5_run):
-    # Four bounces with slip turns and force clipping (2.5 ms). Both routes at rtol 1e-9:
-    # different methods, step controls and event locators.
-    dop853 = ImpactSolver(default_truncated(2.5e-3, 1e-9), backend="scipy:DOP853").run()
+    # Four bounces with slip turns and force clipping (2.5 ms). Both routes at rtol 1e-10:
+    # different methods, step controls and event locators. (At 1e-9 a stick/slip decision
+    # is not yet resolved: the two routes' contact times differ by ~2.5e-10 s, at 1e-10 and
+    # 1e-11 by ~1.5e-12 s, measured; the end-state bound below then compared two errors.)
+    dop853 = ImpactSolver(default_truncated(2.5e-3, 1e-10), backend="scipy:DOP853").run()
     assert len(dopri5_run.contacts) == 4
     assert_same_contacts(dopri5_run, dop853)
     # the state at the end, in free flight after the bounces, to 1e-6 of the error scales
