@@ -204,7 +204,7 @@ class Scene:
         bar.diameter back, and tribology.source / fit / data (ALTERNATIVES)."""
         raw = copy.deepcopy(self.raw)
         for key, value in changes.items():
-            node, last = _walk(raw, key)
+            node, last = _walk(raw, key, self.name)
             node[last] = list(value) if isinstance(value, tuple) else value
         _drop_replaced_alternatives(raw, changes)
         return scene_from_dict(raw, base_dir=self.base_dir, name=self.name)
@@ -213,7 +213,7 @@ class Scene:
         """A new scene without these "section.key" entries (their defaults apply), validated."""
         raw = copy.deepcopy(self.raw)
         for key in keys:
-            node, last = _walk(raw, key)
+            node, last = _walk(raw, key, self.name)
             node.pop(last, None)
         return scene_from_dict(raw, base_dir=self.base_dir, name=self.name)
 
@@ -550,16 +550,20 @@ def _drop_replaced_alternatives(raw: dict, changes: dict) -> None:
                         table.pop(key, None)
 
 
-def _walk(raw: dict, key: str) -> tuple[dict, str]:
-    """The table holding "section.key" (created if missing) and the last part of the key."""
-    parts = key.split(".")
+def _walk(raw: dict, key: str, scene: str) -> tuple[dict, str]:
+    """The table holding "section.key" (created if missing) and the last part of the key;
+    errors start with the scene's name, like every other error about it."""
+    parts = key.split(".") if isinstance(key, str) else []
     if len(parts) < 2 or not all(parts):
-        raise ValueError(f"key {key!r}: expected 'section.key', e.g. 'initial.angle_deg'")
+        raise ValueError(f"{scene}: key {key!r}: expected 'section.key', e.g. 'initial.angle_deg'")
     node = raw
     for part in parts[:-1]:
         node = node.setdefault(part, {})
+        if isinstance(node, list):
+            raise ValueError(f"{scene}: key {key!r}: [[{part}]] is a list of tables, which a key cannot "
+                             f"reach into; change it in the scene file")
         if not isinstance(node, dict):
-            raise ValueError(f"key {key!r}: {part!r} is not a table")
+            raise ValueError(f"{scene}: key {key!r}: {part!r} is not a table")
     return node, parts[-1]
 
 
