@@ -705,10 +705,11 @@ class ImpactSolver:
         old_sign = self.ev_sign[ev]
         self._resolve(triggered=ev)
         aux = self._aux
+        name = None
         if kind == EV_CONTACT:
-            if (old[tip] == FREE) == (self.regime[tip] == FREE):
-                return  # a round-off crossing at the surface that changed nothing (_resolve)
-            name = "contact_start" if old_sign < 0 else "contact_end"
+            # (None: a round-off crossing at the surface that changed nothing, see _resolve)
+            if (old[tip] == FREE) != (self.regime[tip] == FREE):
+                name = "contact_start" if old_sign < 0 else "contact_end"
             if name == "contact_start":
                 self._check_cap(tip)
                 # F_n ~ y^1.5 is not smooth at y = 0: the first step's local error goes as
@@ -727,7 +728,8 @@ class ImpactSolver:
                 name = "slip_reversal"
         else:
             name = "stick_end"
-        self._log(tip, name, old[tip], aux)
+        if name is not None:
+            self._log(tip, name, old[tip], aux)
         # The other tip may have crossed at the same instant (a symmetric landing): its
         # regime changed at this restart without an event of its own.
         other = 1 - tip
