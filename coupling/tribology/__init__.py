@@ -13,6 +13,7 @@ import json
 from functools import cache
 from pathlib import Path
 
+from coupling import lazy_attributes
 from coupling.tribology.laws import ContactLaws, MuLaw, ResistanceLaw
 
 __all__ = [
@@ -27,14 +28,7 @@ _LAZY = {"read_tribometer_csv": "data", "validate_tribometer_frame": "data", "Tr
          "fit_tribometer": "fits"}
 
 
-def __getattr__(name: str):
-    if name in _LAZY:
-        import importlib
-
-        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__getattr__ = lazy_attributes(__name__, _LAZY)
 
 
 def illustrative_data_path():
