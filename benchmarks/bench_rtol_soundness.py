@@ -60,7 +60,7 @@ def main(rtols=RTOLS) -> None:
     for rtol in rtols:
         tick = time.perf_counter()
         m = mech.simulate(with_rtol(mscene, rtol))
-        res = CoupledResult(scene=wrapper, mechanics=m, waveforms=None, stats={})
+        res = CoupledResult(scene=wrapper, mechanics=m, waveform_columns=None, stats={})
         report("mechanics", rtol, res, time.perf_counter() - tick)
 
 

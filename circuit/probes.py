@@ -7,7 +7,6 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
-import pandas as pd
 
 #: Result columns, in order (SI: s, V, A, A, ohm, S, A).
 COLUMNS = (
@@ -78,8 +77,11 @@ class Probes:
                 raise KeyError(f"unknown result column {name!r}; known: {', '.join(COLUMNS)}")
         return out
 
-    def frame(self, read: Callable[[str], np.ndarray], extra: tuple[str, ...] = ()) -> pd.DataFrame:
-        """All columns plus ``extra`` raw ngspice vectors (e.g. 'load', 'vsource#branch')."""
+    def frame(self, read: Callable[[str], np.ndarray], extra: tuple[str, ...] = ()):
+        """All columns plus ``extra`` raw ngspice vectors (e.g. 'load', 'vsource#branch'), a
+        pandas DataFrame."""
+        import pandas as pd
+
         data = self.columns(read)
         for name in extra:
             data[name] = read(name.lower())

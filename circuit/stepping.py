@@ -22,6 +22,7 @@ Example::
             current = step.contact_current          # A, at t_next
             t = t_next
         waveform = stepper.results()                # pandas DataFrame, whole run
+        columns = stepper.result_columns()          # the same as numpy arrays (no pandas)
 """
 
 from __future__ import annotations
@@ -32,7 +33,6 @@ import time as _time
 from typing import Callable, Iterable, NamedTuple
 
 import numpy as np
-import pandas as pd
 
 from .contact import Conductance, checked_breakpoints, left_limited, snapped
 from .deck import CircuitLike, arc_state, build_deck, circuit_arc
@@ -65,7 +65,10 @@ class StepResult(NamedTuple):
     def arrays(self) -> dict[str, np.ndarray]:
         return {name: self.reader(name) for name in COLUMNS}
 
-    def frame(self) -> pd.DataFrame:
+    def frame(self):
+        """``arrays()`` as a pandas DataFrame."""
+        import pandas as pd
+
         return pd.DataFrame(self.arrays())
 
 
@@ -100,7 +103,7 @@ class Stepper:
         self._started = False
         self._finished = False
         self._failure: BaseException | None = None
-        self._final: pd.DataFrame | None = None
+        self._final: dict[str, np.ndarray] | None = None  # the columns kept at close
         self._steps = 0
         self._length = 0
         self._ngspice_seconds = 0.0
@@ -240,7 +243,7 @@ class Stepper:
     def _reader(self, start: int, stop: int) -> Callable[[str], np.ndarray]:
         def read(column: str) -> np.ndarray:
             if self._final is not None:
-                return self._final[column].to_numpy()[start:stop].copy()
+                return self._final[column][start:stop].copy()
             session = self._active()
             return self.probes.columns(lambda name: session.vector(name, start, stop), (column,))[column]
 
@@ -277,7 +280,8 @@ class Stepper:
 
     def _latest(self, column: str) -> float:
         if self._final is not None:
-            return float(self._final[column].iloc[-1]) if len(self._final) else math.nan
+            values = self._final[column]
+            return float(values[-1]) if len(values) else math.nan
         if not self._started:
             return math.nan
         return self._read_last(self._active())[2][column]
@@ -285,36 +289,44 @@ class Stepper:
     @property
     def stats(self) -> dict[str, float]:
         """Macro steps, accepted ngspice points, conductance and gap evaluations, seconds inside ngspice, arc state changes."""
-        points = len(self._final) if self._final is not None else (self._active().length() if self._started else 0)
+        points = len(self._final["time"]) if self._final is not None else (self._active().length() if self._started else 0)
         calls = self._session.source_calls if self._session is not None else 0
         gap_calls = self._session.gap_calls if self._session is not None else 0
         return {"steps": self._steps, "points": points, "conductance_calls": calls, "gap_calls": gap_calls,
                 "ngspice_seconds": self._ngspice_seconds, "arc_switches": self._arc.switches if self._arc else 0}
 
-    def results(self, extra: tuple[str, ...] = (), probes=()) -> pd.DataFrame:
+    def results(self, extra: tuple[str, ...] = (), probes=()):
+        """``result_columns(extra, probes)`` as a pandas DataFrame."""
+        import pandas as pd
+
+        return pd.DataFrame(self.result_columns(extra, probes))
+
+    def result_columns(self, extra: tuple[str, ...] = (), probes=()) -> dict[str, np.ndarray]:
         """The whole run so far: columns ``COLUMNS`` (SI) plus raw ngspice vectors named in ``extra``
         and the user probes (``circuit.probes.check_probes``: v(node), i(element)) as columns
-        named by their text; after ``close()`` the probes' columns are NaN (ngspice's vectors
-        are gone: ask for them before)."""
+        named by their text, name -> numpy array; after ``close()`` the probes' columns are
+        NaN (ngspice's vectors are gone: ask for them before)."""
+        names = tuple(extra) + tuple(p.text for p in probes)
         if self._session is None or (self._final is not None and not extra):
             # closed (e.g. a run that failed and is being written as it stood): the columns
             # kept at close, none if it never started; raw vectors and probes asked for
             # afterwards are gone (NaN)
             if self._final is not None:
-                frame = self._final.copy()
+                out = {k: v.copy() for k, v in self._final.items()}
             else:
-                frame = pd.DataFrame({name: np.empty(0) for name in COLUMNS})
-            for name in tuple(extra) + tuple(p.text for p in probes):
-                if name not in frame:
-                    frame[name] = np.nan
-            return frame
+                out = {name: np.empty(0) for name in COLUMNS}
+            n = len(out["time"])
+            for name in names:
+                out.setdefault(name, np.full(n, np.nan))
+            return out
         session = self._active()
         if not self._started:
-            return pd.DataFrame({name: np.empty(0) for name in COLUMNS + tuple(extra) + tuple(p.text for p in probes)})
-        frame = self.probes.frame(session.vector, tuple(extra))
-        for name, values in probe_columns(probes, lambda n: session.vector(n.lower()), self.deck).items():
-            frame[name] = values
-        return frame
+            return {name: np.empty(0) for name in COLUMNS + names}
+        out = self.probes.columns(session.vector)
+        for name in extra:
+            out[name] = session.vector(name.lower())
+        out.update(probe_columns(probes, lambda n: session.vector(n.lower()), self.deck))
+        return out
 
     def vector(self, name: str) -> np.ndarray:
         """Any raw ngspice vector of the run (node name, 'element#branch'), while open."""
@@ -341,7 +353,7 @@ class Stepper:
             if owner is self:
                 if self._started and self._final is None:
                     try:
-                        self._final = self.probes.frame(session.vector)
+                        self._final = self.probes.columns(session.vector)
                     except KeyError:
                         self._final = None
                 with session.exclusive():

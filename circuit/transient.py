@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import numbers
-from typing import Iterable, Union
+from typing import TYPE_CHECKING, Iterable, Union
 
 import numpy as np
-import pandas as pd
 
 from .contact import Conductance
 from .deck import CircuitLike, arc_state, build_deck, circuit_arc
@@ -14,6 +13,9 @@ from .ngspice import get_session
 from .options import SimulationOptions
 from .schedule import ContactSchedule
 from .stepping import Gap, Stepper
+
+if TYPE_CHECKING:  # pandas is imported by the DataFrame's maker, on use
+    import pandas
 
 
 def run_transient(
@@ -26,7 +28,7 @@ def run_transient(
     extra: tuple[str, ...] = (),
     gap: Gap | float | None = None,
     probes=(),
-) -> pd.DataFrame:
+) -> pandas.DataFrame:
     """Run 0..t_end (s) with the contact conductance from Python; returns the waveform (SI columns).
 
     contact: a ``ContactSchedule`` (its ramp corners become breakpoints), a function
@@ -71,7 +73,7 @@ def run_pwl_reference(
     resistance_step: float | None = None,
     extra: tuple[str, ...] = (),
     gap: GapVertices | None = None,
-) -> pd.DataFrame:
+) -> pandas.DataFrame:
     """The same run with the schedule written into the netlist as a PWL conductance source.
 
     No Python in ngspice's loop: the reference that the callback and stepping forms are

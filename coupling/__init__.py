@@ -19,14 +19,23 @@ _LAZY = {"CoSimulation": "master", "CoupledRunError": "master", "run": "master",
          "Scene": "scene", "builtin_scene": "scene", "default_scene": "scene", "load_scene": "scene", "scene_from_dict": "scene"}
 
 
-def __getattr__(name: str):
-    if name in _LAZY:
-        import importlib
+def lazy_attributes(package: str, table: dict[str, str]):
+    """A module ``__getattr__`` (PEP 562) for ``package``: a name in ``table`` is taken from
+    the submodule ``table[name]``, imported on first use, and kept in the package."""
+    def getattr_(name: str):
+        if name in table:
+            import importlib
+            import sys
 
-        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+            value = getattr(importlib.import_module(f".{table[name]}", package), name)
+            setattr(sys.modules[package], name, value)
+            return value
+        raise AttributeError(f"module {package!r} has no attribute {name!r}")
+
+    return getattr_
+
+
+__getattr__ = lazy_attributes(__name__, _LAZY)
 
 
 def __dir__():

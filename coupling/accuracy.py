@@ -142,7 +142,7 @@ def metrics_of(result) -> dict:
         c = result.mechanics.contacts
         out["peak_force"] = float(c.peak_force.max()) if len(c) else 0.0
         out["energy_residual"] = float(result.mechanics.energy["relative_residual"])
-    if result.waveforms is not None and result.scene.circuit is not None:
+    if result.waveform_columns is not None and result.scene.circuit is not None:
         b = result.bounce
         out["peak_contact_voltage"] = b.get("peak_contact_voltage")
         out["arc_energy"] = b.get("arc_energy")

@@ -5,6 +5,7 @@ coupling/commands.py."""
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 
@@ -45,6 +46,12 @@ def _build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    # Before numpy is imported: switchsim's dense problems (finite-element modes, a few
+    # hundred dof) are too small for BLAS threads, whose start alone cost 0.1-0.2 s of the
+    # default run's first eigenproblem on this 2-core machine, and ten times more when it
+    # is oversubscribed (docs/mechanics.md, 8.). A value the user set is kept; so are the
+    # threads of a process that imported numpy before calling main().
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     args = _build_parser().parse_args(argv)
     try:
         if args.command == "run":

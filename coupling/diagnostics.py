@@ -163,15 +163,15 @@ def run_warnings(result) -> list[str]:
     out = fit_warnings(scene)
     if result.mechanics is not None:
         out += hertz_warnings(result.mechanics)
-    w = result.waveforms
-    if w is not None and len(w):
-        t = w.time.to_numpy()
-        v = w.contact_voltage.to_numpy()
-        i_arc = w.arc_current.to_numpy() if "arc_current" in w else np.zeros_like(t)
+    w = result.waveform_columns
+    if w is not None and len(w["time"]):
+        t = w["time"]
+        v = w["contact_voltage"]
+        i_arc = w["arc_current"] if "arc_current" in w else np.zeros_like(t)
         burning = np.abs(i_arc) > ARC_BURNING_CURRENT
         gap = _gap_series(result, t)
         if gap is not None:
-            open_mask = (w.contact_conductance.to_numpy() <= 0.0) & ~burning
+            open_mask = (w["contact_conductance"] <= 0.0) & ~burning
             arc = getattr(getattr(scene.circuit, "circuit", None), "arc", None)
             advice = NO_BREAKDOWN_ADVICE if arc is not None and arc.breakdown_voltage is None else NO_ARC_ADVICE
             line = breakdown_warning(t, v, gap, open_mask, advice)
@@ -179,7 +179,7 @@ def run_warnings(result) -> list[str]:
                 out.append(line)
         limit = _current_limit(scene)
         if limit is not None:
-            line = overcurrent_warning(t, {"contact current": w.contact_current.to_numpy(),
+            line = overcurrent_warning(t, {"contact current": w["contact_current"],
                                            "arc current": i_arc}, *limit)
             if line:
                 out.append(line)
@@ -192,13 +192,13 @@ def run_warnings(result) -> list[str]:
         ranges = _law_ranges(scene)
         if ranges is not None and "normal_force" in w:
             name, force_range, current_range, note = ranges
-            f = w.normal_force.to_numpy()
+            f = w["normal_force"]
             closed = f > 0.0
             if closed.any():
                 out += range_warnings(name + ": normal force", (float(f[closed].min()), float(f[closed].max())),
                                       force_range, "N", note)
-                current = np.abs(w.load_current.to_numpy() if np.isfinite(w.load_current).all()
-                                 else w.contact_current.to_numpy())[closed]
+                current = np.abs(w["load_current"] if np.isfinite(w["load_current"]).all()
+                                 else w["contact_current"])[closed]
                 out += [line + "; the current factor is held at its edge value" for line in range_warnings(
                     name + ": current", (float(current.min()), float(current.max())), current_range, "A")]
     return out
@@ -207,9 +207,9 @@ def run_warnings(result) -> list[str]:
 def _gap_series(result, t):
     """m: the gap at the waveform's times (coupled: the mechanics' gap column; prescribed
     schedule: its gap when it has an opening speed), or None when unknown."""
-    w = result.waveforms
+    w = result.waveform_columns
     if "gap" in w:
-        return w.gap.to_numpy()
+        return w["gap"]
     spec = result.scene.circuit
     schedule = getattr(spec, "schedule", None) if spec is not None else None
     if schedule is not None and getattr(schedule, "opening_speed", None) is not None:

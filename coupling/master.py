@@ -147,7 +147,7 @@ class CoSimulation:
         except Exception as err:  # ngspice failed to start the circuit: a failed run at t = 0
             partial = None
             try:
-                partial = CoupledResult(scene=sc, mechanics=mech.result(), waveforms=None,
+                partial = CoupledResult(scene=sc, mechanics=mech.result(), waveform_columns=None,
                                         stats=dict(self.stats), status=f"failed at t = 0.0 s: {err}")
             except Exception:  # noqa: BLE001 - best effort
                 pass
@@ -313,9 +313,10 @@ class CoSimulation:
     # --- results -------------------------------------------------------------------------
 
     def _result(self, mech, stepper, status: str) -> CoupledResult:
-        waves = stepper.results(probes=self.scene.circuit.probes)
-        waves = waves[waves.time <= mech.t + 1e-15].reset_index(drop=True)
-        contact = mech.contact_series(waves.time.to_numpy())
+        waves = stepper.result_columns(probes=self.scene.circuit.probes)
+        kept = waves["time"] <= mech.t + 1e-15
+        waves = {name: values[kept] for name, values in waves.items()}
+        contact = mech.contact_series(waves["time"])
         for i in range(2):
             waves[f"normal_force_{i}"] = contact[:, i, 2]
             waves[f"penetration_{i}"] = np.maximum(contact[:, i, 0], 0.0)
@@ -323,8 +324,8 @@ class CoSimulation:
         # the arc's length as given to ngspice: the nearer tip's height, 0 while a tip touches
         waves["gap"] = np.where(waves["normal_force"] > 0.0, 0.0,
                                 np.maximum(0.0, -np.max(contact[:, :, 0], axis=1)))
-        waves["mu"] = self._mu_series(waves.time.to_numpy())
-        return CoupledResult(scene=self.scene, mechanics=mech.result(), waveforms=waves,
+        waves["mu"] = self._mu_series(waves["time"])
+        return CoupledResult(scene=self.scene, mechanics=mech.result(), waveform_columns=waves,
                              stats=dict(self.stats, circuit=stepper.stats), status=status)
 
     def _mu_series(self, times: np.ndarray) -> np.ndarray:
@@ -520,18 +521,18 @@ def run(scene: Scene, *, progress: bool = False, check: bool = False) -> Coupled
         except MechSolverError as err:
             partial = None
             if err.partial_result is not None:
-                partial = CoupledResult(scene=scene, mechanics=err.partial_result, waveforms=None,
+                partial = CoupledResult(scene=scene, mechanics=err.partial_result, waveform_columns=None,
                                         stats={}, status=f"failed at t = {float(err.t)!r} s: {err}")
             raise CoupledRunError(str(err), partial) from err
         except KeyboardInterrupt as err:
             status = f"interrupted at t = {float(solver.t)!r} s"
             try:
-                partial = CoupledResult(scene=scene, mechanics=solver.result(), waveforms=None,
+                partial = CoupledResult(scene=scene, mechanics=solver.result(), waveform_columns=None,
                                         stats=dict(wall_time=time.perf_counter() - tick), status=status)
             except Exception:  # noqa: BLE001 - best effort
                 partial = None
             raise RunInterrupted(status, partial) from err
-        return CoupledResult(scene=scene, mechanics=result, waveforms=None,
+        return CoupledResult(scene=scene, mechanics=result, waveform_columns=None,
                              stats=dict(wall_time=time.perf_counter() - tick), status="ok")
     from circuit import run_transient
 
@@ -541,13 +542,13 @@ def run(scene: Scene, *, progress: bool = False, check: bool = False) -> Coupled
         waves = run_transient(spec.circuit, spec.schedule, scene.t_end, options=spec.options,
                               probes=spec.probes)
     except KeyboardInterrupt as err:  # the one-shot transient has no partial waveforms
-        raise RunInterrupted("interrupted", CoupledResult(scene=scene, mechanics=None, waveforms=None,
+        raise RunInterrupted("interrupted", CoupledResult(scene=scene, mechanics=None, waveform_columns=None,
                                                           stats={}, status="interrupted")) from err
     except Exception as err:  # noqa: BLE001 - a failed circuit run still leaves its summary
         raise CoupledRunError(f"circuit run failed: {type(err).__name__}: {err}",
-                              CoupledResult(scene=scene, mechanics=None, waveforms=None, stats={},
+                              CoupledResult(scene=scene, mechanics=None, waveform_columns=None, stats={},
                                             status=f"failed: {err}")) from err
-    return CoupledResult(scene=scene, mechanics=None, waveforms=waves,
+    return CoupledResult(scene=scene, mechanics=None, waveform_columns={k: waves[k].to_numpy() for k in waves.columns},
                          stats=dict(wall_time=time.perf_counter() - tick), status="ok")
 
 

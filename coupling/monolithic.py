@@ -21,7 +21,6 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import pandas as pd
 from scipy.optimize import brentq
 
 from mech import CoupledStates, ImpactSolver
@@ -181,12 +180,12 @@ def run_monolithic(scene: Scene, *, method: str = "Radau", rtol: float | None = 
     g_eff = np.where(g_force > 0, g_force / np.asarray(laws.resistance_law.current_factor(i_c), dtype=float), 0.0)
     with np.errstate(divide="ignore"):
         r_eff = np.where(g_eff > 0, 1.0 / np.where(g_eff > 0, g_eff, 1.0), np.inf)
-    waves = pd.DataFrame({
+    waves = {
         "time": times, "contact_voltage": v, "contact_current": i_c, "load_current": i_loop,
         "contact_resistance": r_eff, "contact_conductance": g_eff, "arc_current": np.zeros(len(times)),
         "normal_force_0": forces[:, 0], "normal_force_1": forces[:, 1],
         "penetration_0": np.maximum(aux[:, 0, 0], 0.0), "penetration_1": np.maximum(aux[:, 1, 0], 0.0),
-        "normal_force": forces.sum(axis=1), "mu": [mu(i) for i in i_loop],
-    })
-    return CoupledResult(scene=scene, mechanics=mech_result, waveforms=waves,
+        "normal_force": forces.sum(axis=1), "mu": np.array([mu(i) for i in i_loop], dtype=float),
+    }
+    return CoupledResult(scene=scene, mechanics=mech_result, waveform_columns=waves,
                          stats=dict(wall_time=wall, method=method, rtol=tol), status="ok")

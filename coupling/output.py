@@ -230,11 +230,21 @@ def _cells(values, names=None) -> list:
 
 
 def write_parquet(path: Path, columns: dict) -> None:
-    """A Parquet file of ``columns`` (name -> numpy array) through pyarrow, without pandas."""
+    """A Parquet file of ``columns`` (name -> numpy array) through pyarrow, without pandas.
+
+    Numeric columns become Arrow arrays over their own memory: ``pa.array`` on a numpy
+    array imports pandas to ask whether it is a pandas object (0.17 s, more than the rest
+    of the file); NaN stays NaN (not null), as pa.array would keep it."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    pq.write_table(pa.table({k: np.asarray(v) for k, v in columns.items()}), path)
+    def arrow(values):
+        values = np.ascontiguousarray(values)
+        if values.ndim == 1 and values.dtype.kind in "iuf" and values.dtype.isnative:
+            return pa.Array.from_buffers(pa.from_numpy_dtype(values.dtype), len(values), [None, pa.py_buffer(values)])
+        return pa.array(values)  # booleans (bit-packed in Arrow), strings: pyarrow's own conversion
+
+    pq.write_table(pa.Table.from_arrays([arrow(v) for v in columns.values()], names=list(columns)), path)
 
 
 def _write_text(path: Path, text: str) -> None:

@@ -33,32 +33,45 @@ def _num(v):
     return v if math.isfinite(v) else None
 
 
-def bounce_metrics(intervals, t_end: float, waveforms, closed_at_end: bool,
+def bounce_metrics(intervals, t_end: float, waveforms: dict | None, closed_at_end: bool,
                    settings: MetricSettings | None = None) -> dict:
     """The bounce summary (coupling.metrics.bounce_metrics) from closed intervals and a waveform frame."""
-    if waveforms is None or not len(waveforms):
+    if waveforms is None or not len(waveforms["time"]):
         return _bounce_metrics(intervals, t_end, closed_at_end, settings=settings)
-    arc = waveforms.arc_current.to_numpy() if "arc_current" in waveforms else None
-    loop = waveforms.load_current.to_numpy() if "load_current" in waveforms else None
+    arc = waveforms.get("arc_current")
+    loop = waveforms.get("load_current")
     if loop is None or not np.all(np.isfinite(loop)):  # no load probe: metallic + arc current
-        loop = waveforms.contact_current.to_numpy() + (arc if arc is not None else 0.0)
-    return _bounce_metrics(intervals, t_end, closed_at_end, waveforms.time.to_numpy(),
-                           waveforms.contact_voltage.to_numpy(), loop, arc, settings=settings)
+        loop = waveforms["contact_current"] + (arc if arc is not None else 0.0)
+    return _bounce_metrics(intervals, t_end, closed_at_end, waveforms["time"],
+                           waveforms["contact_voltage"], loop, arc, settings=settings)
 
 
 @dataclass
 class CoupledResult:
-    """What a run produced. mechanics: mech.ImpactResult or None; waveforms: DataFrame
-    (time, contact_voltage, contact_current, load_current, contact_resistance,
-    contact_conductance, arc_current, normal_force[_i], penetration_i, mu; SI) or None."""
+    """What a run produced. mechanics: mech.ImpactResult or None; waveform_columns: name ->
+    numpy array (time, contact_voltage, contact_current, load_current, contact_resistance,
+    contact_conductance, arc_current, normal_force[_i], penetration_i, gap, mu, the
+    probes; SI, equal lengths) or None; ``waveforms`` is the same as a pandas DataFrame,
+    built on first use (writing and judging a run need no pandas)."""
 
     scene: object
     mechanics: object | None
-    waveforms: object | None  # pandas DataFrame
+    waveform_columns: dict | None
     stats: dict
     status: str = "ok"
     accuracy: dict | None = None  # summary.accuracy of run(scene, check=True) (coupling/accuracy.py)
     _cache: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def waveforms(self):
+        """pandas DataFrame of ``waveform_columns`` (None without waveforms)."""
+        if self.waveform_columns is None:
+            return None
+        if "waveforms" not in self._cache:
+            import pandas as pd
+
+            self._cache["waveforms"] = pd.DataFrame(self.waveform_columns)
+        return self._cache["waveforms"]
 
     @property
     def closed_intervals(self) -> list[tuple[float, float]]:
@@ -79,7 +92,7 @@ class CoupledResult:
             closed_at_end = self.scene.circuit.schedule.is_closed(self.scene.t_end)
         key = "bounce"
         if key not in self._cache:
-            self._cache[key] = bounce_metrics(self.closed_intervals, self.scene.t_end, self.waveforms,
+            self._cache[key] = bounce_metrics(self.closed_intervals, self.scene.t_end, self.waveform_columns,
                                               closed_at_end, getattr(self.scene, "metrics", None))
         return self._cache[key]
 
@@ -139,14 +152,14 @@ class CoupledResult:
         opts = self.scene.output
         summary = self.summary
         html = None
-        if self.waveforms is not None and getattr(opts, "html", True):
+        if self.waveform_columns is not None and getattr(opts, "html", True):
             from .waveview import write_waveform_html
 
             html = write_waveform_html(self, out / "waveforms.html")
             summary["waveforms_html"] = "waveforms.html" if html == "written" else html
         (out / "summary.json").write_text(json.dumps(summary, indent=2))
-        if self.waveforms is not None:
-            waves = {k: self.waveforms[k].to_numpy() for k in self.waveforms.columns}
+        if self.waveform_columns is not None:
+            waves = self.waveform_columns
             if opts.csv:
                 write_csv(out / "waveforms.csv", waves)
             if opts.parquet:

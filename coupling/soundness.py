@@ -180,9 +180,9 @@ def assess(result) -> dict:
                                  penetration_problem(pen, y_max, scene.bar.tip_radius)) if p]
         problems += [p for p in (hertz_problem(y, r, name) for name, y, r in contact_depths(mres)) if p]
     bound = _circuit_current_bound(result.scene)
-    waves = result.waveforms
-    if bound is not None and waves is not None and len(waves) and "load_current" in waves:
-        current = float(np.nanmax(np.abs(waves.load_current.to_numpy())))
+    waves = result.waveform_columns
+    if bound is not None and waves is not None and len(waves["time"]) and "load_current" in waves:
+        current = float(np.nanmax(np.abs(waves["load_current"])))
         out.update(max_load_current=current, load_current_bound=bound)
         problem = current_problem(current, bound)
         if problem:

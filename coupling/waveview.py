@@ -83,8 +83,7 @@ def _array(values: np.ndarray) -> dict:
 
 def waveform_page(result, max_points: int = MAX_POINTS) -> tuple[list, dict]:
     """(traces, layout) of a run's waveforms: one panel per quantity, linked time axes."""
-    w = result.waveforms
-    cols = {c: w[c].to_numpy() for c in w.columns}
+    cols = dict(result.waveform_columns)
     cols["abs_voltage"] = np.abs(cols["contact_voltage"])
     rows = _rows(cols)
     n = len(rows)
@@ -135,7 +134,7 @@ def plotly_js() -> Path | None:
 
 def write_waveform_html(result, path, max_points: int = MAX_POINTS) -> str:
     """Write the page; returns "written" or why it was skipped (plotly absent, no waveforms)."""
-    if result.waveforms is None or not len(result.waveforms):
+    if result.waveform_columns is None or not len(result.waveform_columns["time"]):
         return "skipped: no waveforms"
     js = plotly_js()
     if js is None:

@@ -13,14 +13,22 @@ import json
 from functools import cache
 from pathlib import Path
 
-from coupling.tribology.data import read_tribometer_csv, validate_tribometer_frame
-from coupling.tribology.fits import TribometerFit, fit_tribometer
+from coupling import lazy_attributes
 from coupling.tribology.laws import ContactLaws, MuLaw, ResistanceLaw
 
 __all__ = [
     "ContactLaws", "MuLaw", "ResistanceLaw", "TribometerFit",
     "default_fit", "fit_tribometer", "illustrative_data_path", "read_tribometer_csv", "validate_tribometer_frame",
 ]
+
+
+# Reading and fitting data need pandas (0.3 s to import): loaded on first use (PEP 562), so
+# a scene whose laws are given inline (the default scene) never imports it.
+_LAZY = {"read_tribometer_csv": "data", "validate_tribometer_frame": "data", "TribometerFit": "fits",
+         "fit_tribometer": "fits"}
+
+
+__getattr__ = lazy_attributes(__name__, _LAZY)
 
 
 def illustrative_data_path():
@@ -50,6 +58,9 @@ def default_fit_key() -> str:
 def default_fit() -> TribometerFit:
     """The fit of the shipped illustrative dataset, once per process: from the stored fit
     when it is current, else fitted."""
+    from coupling.tribology.data import read_tribometer_csv
+    from coupling.tribology.fits import TribometerFit, fit_tribometer
+
     try:
         doc = json.loads(DEFAULT_FIT_CACHE.read_text())
         if doc.get("key") == default_fit_key():
@@ -63,6 +74,9 @@ def default_fit() -> TribometerFit:
 def write_default_fit_cache() -> Path:
     """Fit the illustrative dataset and store the fit for default_fit (after changing the
     dataset or the fitting code)."""
+    from coupling.tribology.data import read_tribometer_csv
+    from coupling.tribology.fits import fit_tribometer
+
     fit = fit_tribometer(read_tribometer_csv(illustrative_data_path()))
     doc = fit.to_dict()
     doc["source"] = "coupling/data/" + illustrative_data_path().name  # default_fit puts the installed path back

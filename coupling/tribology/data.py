@@ -13,12 +13,14 @@ import csv
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import TYPE_CHECKING, Callable, Sequence
 
 import numpy as np
-import pandas as pd
 
 from mech.validation import check_file, suggest
+
+if TYPE_CHECKING:  # pandas (0.2-0.3 s) is imported where a table is read or checked
+    import pandas as pd
 
 NUMERIC_COLUMNS = ("load_N", "current_A", "friction_N", "resistance_ohm")
 OPTIONAL_COLUMNS = ("run",)
@@ -102,6 +104,8 @@ def read_tribometer_csv(path) -> pd.DataFrame:
     file). UTF-8 with or without a byte-order mark. The comment lines are kept in
     `df.attrs["header"]` and the path in `df.attrs["source"]`.
     """
+    import pandas as pd
+
     path = check_file("tribometer CSV", path)
     try:
         scan = _scan(path)
@@ -221,6 +225,8 @@ def _fast_frame(path: Path, names: list[str]) -> pd.DataFrame | None:
     """The table through pandas' C reader (large files, read in chunks), or None when a
     row does not parse cleanly: wrong field count or a non-numeric or empty cell (the
     exact reading then says where)."""
+    import pandas as pd
+
     dtypes = {c: np.float64 for c in NUMERIC_COLUMNS if c in names}
     options = dict(skipinitialspace=True, skip_blank_lines=True, comment="#", encoding="utf-8-sig", engine="c")
     df = None
@@ -258,6 +264,8 @@ def validate_tribometer_frame(df: pd.DataFrame, source: str = "DataFrame",
     the row position) say where a bad value sits (default: "row <index>"). Accepts
     string or numeric columns.
     """
+    import pandas as pd
+
     columns = [str(c) for c in df.columns]
     _check_columns(columns, source)
     missing = [c for c in NUMERIC_COLUMNS if c not in columns]

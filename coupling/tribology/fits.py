@@ -27,14 +27,16 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 import numpy as np
-import pandas as pd
 
 from coupling.tribology.data import validate_tribometer_frame
 from coupling.tribology.laws import ContactLaws, MuLaw, ResistanceLaw
 from coupling.tribology.models import CURRENT_FAMILIES, LOAD_FAMILIES, MU_FAMILIES, load_law_parameters
+
+if TYPE_CHECKING:  # pandas is imported by the fitting, not by a stored fit's reading
+    import pandas as pd
 
 CRITERION = "BIC"
 # Delta BIC below this is "not worth more than a bare mention" (Kass & Raftery 1995):
@@ -463,6 +465,8 @@ class _Response:
 
 
 def _problem_from(load: np.ndarray, current: np.ndarray) -> _Problem:
+    import pandas as pd
+
     # cells by hashing (no sort of the rows: memory and time linear in the rows)
     load_code, load_values = pd.factorize(load)
     current_code, current_values = pd.factorize(np.abs(current))

@@ -11,12 +11,15 @@ from __future__ import annotations
 import io
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from coupling.tribology.laws import ContactLaws, MuLaw, ResistanceLaw
 from coupling.tribology.models import hertz_contact_radius, holm_constriction_resistance
+
+if TYPE_CHECKING:  # pandas only to make data; the path above is read without it
+    import pandas as pd
 
 ILLUSTRATIVE_CSV = Path(__file__).resolve().parent.parent / "data" / "tribometer_illustrative.csv"
 ILLUSTRATIVE_SEED = 2024
@@ -44,6 +47,8 @@ def synthetic_tribometer_data(laws: ContactLaws, design: SyntheticDesign, rng: n
     Returns the CSV columns (load_N, current_A, friction_N, resistance_ohm, run).
     The laws must cover the design's currents in their current_range_A.
     """
+    import pandas as pd
+
     rows = [(f, i, run) for run in range(1, design.repeats + 1) for i in design.currents_A for f in design.loads_N]
     load = np.array([r[0] for r in rows])
     current = np.array([r[1] for r in rows])

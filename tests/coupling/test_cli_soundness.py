@@ -126,7 +126,7 @@ def test_a_loose_integration_is_caught_and_the_fix_the_message_names_works():
         solver = dataclasses.replace(base.solver, t_end=5e-3)
         object.__setattr__(solver, "rtol", rtol)  # past the validated range on purpose
         res = mech.simulate(dataclasses.replace(base, solver=solver))
-        return soundness.assess(CoupledResult(scene=wrapper, mechanics=res, waveforms=None, stats={}))
+        return soundness.assess(CoupledResult(scene=wrapper, mechanics=res, waveform_columns=None, stats={}))
 
     loose = judged(1e-4)
     assert len(loose["problems"]) >= 1 and "rtol" in loose["problems"][0]

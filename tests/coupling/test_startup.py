@@ -3,8 +3,9 @@
 Each check runs the command in a fresh interpreter and lists the heavy packages it
 loaded: numba never while the ahead-of-time module is there (mech.aot); scipy not for a
 run (the quadrature, the mode roots, the damping calibration and the held bars' finite
-element modes are numpy or compiled); pandas and pyarrow not for a mechanics-only run with
-its default outputs (tables written from arrays); matplotlib only when plotting; plotly's
+element modes are numpy or compiled); pandas never for a run with its default outputs
+(tables written from arrays, the waveforms kept as arrays, the tribology laws read without
+it); pyarrow only to write waveforms.parquet; matplotlib only when plotting; plotly's
 Python side never (waveforms.html is written directly); PySpice only with a circuit; Dask
 never.
 """
@@ -51,13 +52,16 @@ load_resistance = 12.0
 """
 
 
-def _loaded(tmp_path: Path, scene_text: str, *args: str) -> set[str]:
-    scene = tmp_path / "scene.toml"
-    scene.write_text(scene_text)
+def _loaded(tmp_path: Path, scene_text: str | None, *args: str) -> set[str]:
+    """The heavy packages `switchsim run` imported (scene_text None: the built-in default scene)."""
+    scene = []
+    if scene_text is not None:
+        (tmp_path / "scene.toml").write_text(scene_text)
+        scene = [str(tmp_path / "scene.toml")]
     code = textwrap.dedent(f"""
         import json, sys
         from coupling.cli import main
-        rc = main(["run", {str(scene)!r}, "--out", {str(tmp_path / 'out')!r}, "--quiet", *{list(args)!r}])
+        rc = main(["run", *{scene!r}, "--out", {str(tmp_path / 'out')!r}, "--quiet", *{list(args)!r}])
         print(json.dumps([rc, sorted(sys.modules)]))
     """)
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
@@ -90,12 +94,24 @@ def test_plots_bring_matplotlib_and_pandas_only(tmp_path):
     assert (tmp_path / "out" / "normal_force.png").stat().st_size > 0
 
 
-def test_coupled_scene_imports_pyspice_but_no_numba_scipy_matplotlib_or_plotly(tmp_path):
-    """The illustrative laws come from their stored fit: no scipy.stats, no fitting. (pandas:
-    the circuit's waveforms are a DataFrame; pyarrow writes waveforms.parquet.)"""
+def test_coupled_scene_imports_pyspice_and_pyarrow_only(tmp_path):
+    """The illustrative laws come from their stored fit: no scipy.stats, no fitting, no
+    pandas; pyarrow writes waveforms.parquet."""
     _requires_aot()
-    assert _loaded(tmp_path, MECH.format(plots="false") + CIRCUIT) == {"PySpice", "pandas", "pyarrow"}
+    assert _loaded(tmp_path, MECH.format(plots="false") + CIRCUIT) == {"PySpice", "pyarrow"}
     assert (tmp_path / "out" / "waveforms.html").stat().st_size > 1_000_000
+
+
+def test_default_scene_imports_pyspice_and_pyarrow_only_and_writes_its_documented_outputs(tmp_path):
+    """The built-in default scene (a held blade, inline laws) with its default outputs; the
+    files are the ones README.md lists for it."""
+    _requires_aot()
+    assert _loaded(tmp_path, None) == {"PySpice", "pyarrow"}
+    written = {p.name for p in (tmp_path / "out").iterdir()}
+    assert written == {"summary.json", "waveforms.csv", "waveforms.parquet", "waveforms.html", "openings.csv",
+                       "history.csv", "contacts.csv", "phases.csv", "events.csv"}
+    readme = (ROOT / "README.md").read_text()
+    assert all(f"`{name}`" in readme for name in written)
 
 
 def test_the_stored_default_fit_is_current_and_equals_a_fresh_fit():

@@ -8,7 +8,6 @@ import re
 import types
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from coupling.waveview import decimate
@@ -41,11 +40,11 @@ def test_page_is_self_contained_and_holds_the_data(tmp_path):
 
     t = np.linspace(0.0, 1e-3, 3001)
     v = np.where(t < 5e-4, 24.0, 0.01) + 3.0 * np.exp(-t / 1e-7) * np.sin(2 * np.pi * 5e7 * t)  # 50 ns ringing
-    w = pd.DataFrame(dict(time=t, contact_voltage=v, contact_current=np.where(t < 5e-4, 0.0, 2.0),
-                          load_current=np.where(t < 5e-4, 0.0, 2.0), arc_current=np.zeros_like(t),
-                          contact_resistance=np.where(t < 5e-4, np.inf, 0.005)))
+    w = dict(time=t, contact_voltage=v, contact_current=np.where(t < 5e-4, 0.0, 2.0),
+             load_current=np.where(t < 5e-4, 0.0, 2.0), arc_current=np.zeros_like(t),
+             contact_resistance=np.where(t < 5e-4, np.inf, 0.005))
     w["v(snubber)"] = 0.5 * v
-    res = types.SimpleNamespace(waveforms=w, closed_intervals=[(5e-4, 1e-3)], scene=types.SimpleNamespace(name="t"))
+    res = types.SimpleNamespace(waveform_columns=w, closed_intervals=[(5e-4, 1e-3)], scene=types.SimpleNamespace(name="t"))
     path = tmp_path / "waveforms.html"
     assert write_waveform_html(res, path) == "written"
     html = path.read_text()

@@ -143,3 +143,49 @@ def test_the_environment_forces_the_jit_route(monkeypatch, tmp_path):
     monkeypatch.setenv(aot.FORCE_JIT, "1")
     assert aot.load() is None
     assert not list(tmp_path.iterdir())  # nothing built, nothing written
+
+
+STALE = textwrap.dedent("""
+    import json, sysconfig
+    # no compiler here: a build is attempted only if no current module is found, and fails
+    # (set before mech is imported: importing it loads the compiled module)
+    sysconfig.get_config_var = lambda name: "no-such-compiler-here" if name == "CC" else None
+    from mech import aot
+    print(json.dumps([aot.load() is not None, aot.build_key(), aot.__file__]))
+""")
+
+
+def test_a_build_of_other_sources_is_never_loaded(tmp_path):
+    """A copy of mech with this tree's build in its cache loads it; the same copy with one
+    kernel line changed does not (its key differs), and builds instead (here: fails, JIT)."""
+    import shutil
+
+    import mech.compiled
+
+    if mech.compiled.ROUTE != "aot":
+        pytest.skip("the ahead-of-time module is not in use here")
+    pkg = tmp_path / "tree" / "mech"
+    pkg.mkdir(parents=True)
+    for path in (ROOT / "mech").glob("*.py"):
+        shutil.copy(path, pkg / path.name)
+    cache = tmp_path / "cache"
+    cache.mkdir()
+    shutil.copytree(aot.module_folder(), cache / aot.module_folder().name)
+    env = dict(os.environ, PYTHONPATH=str(tmp_path / "tree"), NUMBA_CACHE_DIR=str(cache))
+    env.pop(aot.FORCE_JIT, None)
+
+    def load():
+        done = subprocess.run([sys.executable, "-c", STALE], env=env, capture_output=True, text=True, timeout=600,
+                              cwd=str(tmp_path))
+        assert done.returncode == 0, done.stderr[-3000:]
+        return json.loads(done.stdout.strip().splitlines()[-1]), done.stderr
+
+    (loaded, key, where), err = load()
+    assert where == str(pkg / "aot.py")  # the copy, not this tree
+    assert loaded and key == aot.build_key() and "switchsim:" not in err
+    kernel = pkg / "kernel.py"
+    kernel.write_text(kernel.read_text().replace("\n", "\nSTALE_MARK = 1  # a change of the kernel's source\n", 1))
+    (loaded, stale_key, _), err = load()
+    assert not loaded and stale_key != key
+    assert "no C compiler" in err and "just-in-time" in err
+    assert (cache / f"aot-{stale_key}.failed").is_file() and (cache / f"aot-{key}").is_dir()
