@@ -26,7 +26,7 @@ $(STAMP): pyproject.toml scripts/install-system-deps
 bench: $(STAMP)
 	for b in benchmarks/bench_*.py; do $(VENV)/bin/python $$b || exit 1; done
 
-# Regenerates docs/accuracy.md and its plots in docs/accuracy/ (~15 min on a loaded 2-core box);
+# Regenerates docs/accuracy.md and its plots in docs/accuracy/ (parts 1-5 ~2 min on 2 cores, part 6 far longer);
 # part 6 compares with Exudyn, the optional `bench` extra, installed here first (not by run or test)
 accuracy: $(STAMP)
 	$(VENV)/bin/python -m pip install -q -e '.[bench]'
