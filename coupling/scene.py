@@ -267,7 +267,7 @@ def _tribology(table: dict, base_dir: Path) -> TribologySpec:
         mu_law = MuLaw(0.0, "constant", (("mu0", mu),), (0.0, 1e6))
         return TribologySpec(ContactLaws(mu_law, law), f"materials ({law.name}), mu = {mu:g}", feedback)
     if "mu" in rest and not fitted:
-        mu_law = MuLaw.from_dict(_table("tribology.mu", rest["mu"]))
+        mu_law = MuLaw.from_dict(_table("tribology.mu", rest["mu"]), "tribology.mu")
         return TribologySpec(ContactLaws(mu_law, law), f"materials ({law.name}), inline mu", feedback)
     if not fitted:
         raise ValueError(f"[tribology]: resistance = {{ law = {resistance['law']!r} }} gives R_c only; give mu too: "
@@ -302,7 +302,7 @@ def _tribology_fitted(table: dict, base_dir: Path, feedback: bool) -> TribologyS
         return TribologySpec(fit.laws, f"fit of {path.name}", feedback, fit)
     if "mu" not in table or "resistance" not in table:
         raise ValueError("[tribology]: inline laws need both [tribology.mu] and [tribology.resistance]")
-    laws = ContactLaws.from_dict({"mu": table["mu"], "resistance": table["resistance"]})
+    laws = ContactLaws.from_dict({"mu": table["mu"], "resistance": table["resistance"]}, "tribology")
     return TribologySpec(laws, "inline laws", feedback)
 
 

@@ -407,7 +407,7 @@ def build_model(scene: MechScene) -> BarModel:
         )
     planar = planar_ok if mode == "auto" else mode == "planar"
     if scene.mount.held and not planar:
-        raise ValueError("mount: a held bar is solved in its plane (x-z); its initial motion must stay there")
+        raise ValueError("mount.kind: a held bar is solved in its plane (x-z); its initial motion must stay there")
     arr = build_arrays(scene, planar) if needs_mechanism(scene) else None
     basis = arr.basis if arr is not None else build_modal_basis(scene.bar, planar)
     n = basis.n

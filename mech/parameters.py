@@ -55,13 +55,13 @@ class Bar:
         if self.diameter is not None:
             if self.width is not None or self.thickness is not None:
                 raise ValueError(
-                    "bar: give either diameter (round section) or width and thickness "
-                    "(rectangular section), not both"
+                    "bar.diameter and bar.width/bar.thickness: give either bar.diameter (round section) "
+                    "or bar.width and bar.thickness (rectangular section), not both"
                 )
             check_positive("bar.diameter", self.diameter)
         else:
             if self.width is None or self.thickness is None:
-                raise ValueError("bar: a section is needed: diameter, or width and thickness")
+                raise ValueError("bar.diameter: a section is needed: bar.diameter, or bar.width and bar.thickness")
             check_positive("bar.width", self.width)
             check_positive("bar.thickness", self.thickness)
         check_positive("bar.tip_radius", self.tip_radius)
@@ -183,13 +183,13 @@ class Contact:
         check_choice("contact.law", self.law, CONTACT_LAWS)
         check_choice("contact.calibration", self.calibration, ("exact", "formula"))
         if self.damping is not None and self.restitution is not None:
-            raise ValueError("contact: give damping or restitution, not both")
+            raise ValueError("contact.damping and contact.restitution: give one of them, not both")
         if self.damping is not None:
             check_nonnegative("contact.damping", self.damping)
         elif self.restitution is not None:
             check_range("contact.restitution", self.restitution, 0.0, 1.0, closed_high=True)
         else:
-            raise ValueError("contact: give damping (c) or restitution (target e)")
+            raise ValueError("contact.restitution: give contact.damping (c) or contact.restitution (target e)")
         if self.reference_speed is not None:
             check_positive("contact.reference_speed", self.reference_speed)
         if self.stiffness is not None:
@@ -538,7 +538,7 @@ class MechScene:
                 raise ValueError(f"{sp.name}.anchor = {list(sp.anchor)!r}: a held bar moves in the "
                                  "x-z plane; the anchor must have y = 0")
         if len(self.rivets) > 2:
-            raise ValueError(f"rivet: {len(self.rivets)} rivets given; at most 2 contact points are "
+            raise ValueError(f"[[rivet]]: {len(self.rivets)} rivets given; at most 2 contact points are "
                              "supported (a single or a bridge contact)")
         half_t = 0.5 * (self.bar.thickness if self.bar.thickness is not None else self.bar.diameter)
         for rv in self.rivets:
@@ -551,7 +551,7 @@ class MechScene:
                                  f"(mount.position = {mnt.position!r}); it must be at least its radius away")
         if len(self.rivets) == 2 and abs(self.rivets[0].position - self.rivets[1].position) < (
                 self.rivets[0].radius + self.rivets[1].radius) and self.rivets[0].offset == self.rivets[1].offset:
-            raise ValueError("rivet: the two rivets overlap; place them at least the sum of their radii apart")
+            raise ValueError("rivet[1].position: the two rivets overlap; place them at least the sum of their radii apart")
         if mnt.held:
             if self.initial.azimuth_deg != 0.0:
                 raise ValueError(f"initial.azimuth_deg = {self.initial.azimuth_deg!r}: a held bar lies in "

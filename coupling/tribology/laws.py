@@ -14,6 +14,7 @@ and validates it once, naming the field and the allowed values.
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any, Mapping
 
@@ -58,6 +59,21 @@ def _current_range(where: str, value: Any) -> tuple[float, float]:
     if not (np.isfinite(lo) and np.isfinite(hi) and 0.0 <= lo <= hi):
         raise ValueError(f"{where}: current_range_A must satisfy 0 <= I_min <= I_max (A), got {[lo, hi]}")
     return lo, hi
+
+
+@contextmanager
+def _errors_named(default: str, where: str):
+    """Re-raise a law's TypeError/ValueError as one ValueError line that starts with `where`
+    (the key the user wrote) instead of the law's generic name."""
+    try:
+        yield
+    except (TypeError, ValueError, AttributeError) as err:
+        message = str(err)
+        if message.startswith(default):
+            message = where + message[len(default):]
+        elif not message.startswith(where):
+            message = f"{where}: {message}"
+        raise ValueError(message) from None
 
 
 def _check_keys(where: str, data: Mapping[str, Any], required: tuple[str, ...], optional: tuple[str, ...] = ()) -> None:
@@ -129,11 +145,13 @@ class MuLaw:
         }
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> "MuLaw":
-        _check_keys("mu law", data, ("gamma", "model", "params", "current_range_A"))
-        if not isinstance(data["params"], Mapping):
-            raise ValueError(f"mu law: params must be a table of name = value, got {data['params']!r}")
-        return cls(data["gamma"], data["model"], tuple(data["params"].items()), tuple(data["current_range_A"]))
+    def from_dict(cls, data: Mapping[str, Any], where: str = "mu law") -> "MuLaw":
+        """The law from its table; errors start with `where` (a scene key such as tribology.mu)."""
+        with _errors_named("mu law", where):
+            _check_keys("mu law", data, ("gamma", "model", "params", "current_range_A"))
+            if not isinstance(data["params"], Mapping):
+                raise ValueError(f"mu law: params must be a table of name = value, got {data['params']!r}")
+            return cls(data["gamma"], data["model"], tuple(data["params"].items()), tuple(data["current_range_A"]))
 
 
 @dataclass(frozen=True)
@@ -247,11 +265,14 @@ class ResistanceLaw:
         }
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> "ResistanceLaw":
-        _check_keys("resistance law", data, ("load_model", "current_model", "params", "current_range_A"))
-        if not isinstance(data["params"], Mapping):
-            raise ValueError(f"resistance law: params must be a table of name = value, got {data['params']!r}")
-        return cls(data["load_model"], data["current_model"], tuple(data["params"].items()), tuple(data["current_range_A"]))
+    def from_dict(cls, data: Mapping[str, Any], where: str = "resistance law") -> "ResistanceLaw":
+        """The law from its table; errors start with `where` (a scene key such as tribology.resistance)."""
+        with _errors_named("resistance law", where):
+            _check_keys("resistance law", data, ("load_model", "current_model", "params", "current_range_A"))
+            if not isinstance(data["params"], Mapping):
+                raise ValueError(f"resistance law: params must be a table of name = value, got {data['params']!r}")
+            return cls(data["load_model"], data["current_model"], tuple(data["params"].items()),
+                       tuple(data["current_range_A"]))
 
 
 @dataclass(frozen=True)
@@ -290,6 +311,11 @@ class ContactLaws:
         return {"mu": self.mu_law.to_dict(), "resistance": self.resistance_law.to_dict()}
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> "ContactLaws":
-        _check_keys("contact laws", data, ("mu", "resistance"))
-        return cls(MuLaw.from_dict(data["mu"]), ResistanceLaw.from_dict(data["resistance"]))
+    def from_dict(cls, data: Mapping[str, Any], where: str = "") -> "ContactLaws":
+        """Both laws from {"mu": ..., "resistance": ...}; with `where` (a scene table such as
+        tribology) errors name where.mu and where.resistance."""
+        with _errors_named("contact laws", where or "contact laws"):
+            _check_keys("contact laws", data, ("mu", "resistance"))
+        prefix = f"{where}." if where else ""
+        return cls(MuLaw.from_dict(data["mu"], f"{prefix}mu" if where else "mu law"),
+                   ResistanceLaw.from_dict(data["resistance"], f"{prefix}resistance" if where else "resistance law"))

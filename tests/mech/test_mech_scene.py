@@ -56,7 +56,7 @@ BAD = [
     ({"bar": {"modes": 41}}, ["bar.modes", "[0, 40]"]),
     ({"bar": {"modes": 2.5}}, ["bar.modes = 2.5", "whole number"]),
     ({"bar": {"modes": {"axial": 2, "bend": 1}}}, ["modes", "'bend'", "axial, bending"]),
-    ({"bar": {"width": 0.01}}, ["bar", "width and thickness"]),
+    ({"bar": {"width": 0.01}}, ["bar.width", "bar.thickness"]),
     ({"initial": {"angle_deg": 95.0}}, ["initial.angle_deg", "[-90.0, 90.0]"]),
     ({"initial": {"velocity": [1.0, 2.0]}}, ["initial.velocity", "3 numbers"]),
     ({"solver": {"rtol": 1.0}}, ["solver.rtol", "1e-05]"]),
