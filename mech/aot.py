@@ -152,10 +152,20 @@ def _build(folder: Path) -> str | None:
     finally:
         shutil.rmtree(staging, ignore_errors=True)
     _note(f"compiled in {time.perf_counter() - tick:.0f} s: {module_file(folder)}")
-    for stale in folder.parent.glob("aot-*"):  # builds of earlier sources (a loaded one stays mapped)
-        if stale.is_dir() and stale != folder and ".build-" not in stale.name:
-            shutil.rmtree(stale, ignore_errors=True)
+    remove_stale(folder)
     return None
+
+
+def remove_stale(folder: Path) -> None:
+    """Delete the builds of earlier sources beside ``folder`` (a loaded one stays mapped),
+    with their lock files and failure notes; keep ``folder``'s own and builds under way."""
+    for stale in folder.parent.glob("aot-*"):
+        if stale.name.startswith(folder.name) or ".build-" in stale.name:
+            continue
+        if stale.is_dir():
+            shutil.rmtree(stale, ignore_errors=True)
+        else:
+            stale.unlink(missing_ok=True)
 
 
 # --- the child process -----------------------------------------------------------------

@@ -128,3 +128,19 @@ def test_the_stored_default_fit_is_current_and_equals_a_fresh_fit():
     a, b = stored.laws.to_dict(), fresh.laws.to_dict()
     assert json.dumps(a, sort_keys=True) == json.dumps(b, sort_keys=True)
     assert stored.gamma == pytest.approx(fresh.gamma, rel=1e-12)
+
+
+def test_a_new_build_removes_earlier_builds_their_locks_and_failure_notes_only(tmp_path):
+    from mech.aot import remove_stale
+
+    current = tmp_path / "aot-new-np2-cp311"
+    for name in ("aot-old-np2-cp311", "aot-new-np2-cp311", "aot-old2-np2-cp311.build-x1"):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "module.so").write_bytes(b"\0")
+    for name in ("aot-old-np2-cp311.lock", "aot-old3-np2-cp311.failed", "aot-new-np2-cp311.lock",
+                 "aot-new-np2-cp311.failed", "other.txt"):
+        (tmp_path / name).write_text("x")
+    remove_stale(current)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "aot-new-np2-cp311", "aot-new-np2-cp311.failed", "aot-new-np2-cp311.lock", "aot-old2-np2-cp311.build-x1",
+        "other.txt"]
