@@ -31,7 +31,7 @@ import math
 import numpy as np
 
 from .metrics import ARC_BURNING_CURRENT, arc_toggles
-from .soundness import HERTZ_UNSOUND_ERROR, HERTZ_WARN_ERROR, contact_depths, hertz_gap_error, hertz_validity_line
+from .soundness import HERTZ_UNSOUND_ERROR, HERTZ_WARN_ERROR, hertz_gap_error, hertz_validity_line
 
 PASCHEN_A = 15.0  # 1/(cm Torr), air
 PASCHEN_B = 365.0  # V/(cm Torr), air
@@ -81,7 +81,7 @@ def breakdown_warning(t, v, gap, open_mask, advice: str = NO_ARC_ADVICE) -> str 
 def hertz_warnings(mres) -> list[str]:
     """A line per contact point whose deepest penetration stretches Hertz's law past
     HERTZ_WARN_ERROR (and not past HERTZ_UNSOUND_ERROR, which makes the run unsound)."""
-    return [hertz_validity_line(y, r, name) for name, y, r in contact_depths(mres)
+    return [hertz_validity_line(y, r, name) for name, y, r in mres.contact_depths
             if HERTZ_WARN_ERROR < hertz_gap_error(y, r) <= HERTZ_UNSOUND_ERROR]
 
 

@@ -130,24 +130,6 @@ def hertz_problem(penetration: float, radius: float, name: str) -> str | None:
     return hertz_validity_line(penetration, radius, name)
 
 
-def contact_depths(mres) -> list[tuple[str, float, float]]:
-    """(name, deepest penetration m, effective radius m) of each contact point of a
-    mechanics result: the cap's radius, against a spherical block R1 R2 / (R1 + R2)."""
-    from mech.kernel_layout import A_Y, C_ON, C_R
-
-    model = mres.model
-    block = model.scene.block
-    out = []
-    for i in range(2):
-        if model.cpar[i, C_ON] == 0.0 or not len(mres.aux):
-            continue
-        r = float(model.cpar[i, C_R])
-        if block.shape == "sphere":
-            r = r * block.radius / (r + block.radius)
-        out.append((f"contact point {i}", float(np.max(mres.aux[:, i, A_Y])), r))
-    return out
-
-
 def current_problem(max_current: float, bound: float) -> str | None:
     """None if the largest |loop current| (A) respects the circuit's bound (A)."""
     if max_current <= bound * (1.0 + BOUND_MARGIN):
@@ -178,7 +160,7 @@ def assess(result) -> dict:
         problems += [p for p in (energy_problem(residual, scale, scene.solver.energy_tolerance),
                                  kinetic_problem(kinetic, scale), speed_problem(speed, v_max),
                                  penetration_problem(pen, y_max, scene.bar.tip_radius)) if p]
-        problems += [p for p in (hertz_problem(y, r, name) for name, y, r in contact_depths(mres)) if p]
+        problems += [p for p in (hertz_problem(y, r, name) for name, y, r in mres.contact_depths) if p]
     bound = _circuit_current_bound(result.scene)
     waves = result.waveform_columns
     if bound is not None and waves is not None and len(waves["time"]) and "load_current" in waves:

@@ -24,7 +24,7 @@ import numpy as np
 from .compiled import energy_table
 from .kernel_layout import (
     A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_Y, A_YDOT, Q_DFRICTION, Q_DMODAL, Q_DNORMAL,
-    Q_DLOAD, Q_IMPULSE, Q_WCOMP, Q_WIN,
+    Q_DLOAD, Q_IMPULSE, Q_WCOMP, Q_WIN, C_ON, C_R,
 )
 from .model import BarModel
 from .rotations import matrix_to_quaternion, rotation_y, rotation_z
@@ -339,6 +339,22 @@ class ImpactResult:
     def deepest_penetration(self) -> float:
         """m: the deepest penetration of any contact point into the block over the run (0: none)."""
         return float(max(np.max(self.aux[:, :, A_Y]), 0.0)) if len(self.aux) else 0.0
+
+    @property
+    def contact_depths(self) -> list[tuple[str, float, float]]:
+        """(name, deepest penetration m, effective radius m) of each contact point that can
+        touch: the cap's radius, against a spherical block R1 R2 / (R1 + R2) (where Hertz's
+        small-deformation law is judged)."""
+        block = self.model.scene.block
+        out = []
+        for i in range(2):
+            if self.model.cpar[i, C_ON] == 0.0 or not len(self.aux):
+                continue
+            r = float(self.model.cpar[i, C_R])
+            if block.shape == "sphere":
+                r = r * block.radius / (r + block.radius)
+            out.append((f"contact point {i}", float(np.max(self.aux[:, i, A_Y])), r))
+        return out
 
     @property
     def flags(self) -> list[str]:
