@@ -97,35 +97,43 @@ def on_cluster(sweep, workers: int, tmp: Path, repeat: int) -> float:
         return best
 
 
-def _timed_runs(n: int = 4) -> list[float]:
-    """s: n runs of the 3 ms default coupled scene, each timed, in the calling process (after a warm-up)."""
+def _timed_runs(n: int = 4) -> dict:
+    """n runs of the 3 ms default coupled scene in the calling process, after a warm-up,
+    each timed (s), and the process's resident memory after them (bytes)."""
+    import psutil
+
     from coupling import run
     from coupling.scene import default_scene
 
     scene = default_scene().set("solver.t_end", 0.003)
     run(scene)
     times = []
-    for _ in range(n):
+    for k in range(n):
         tick = time.perf_counter()
-        run(scene)
+        run(scene.set("circuit.load_resistance", 6.0 + 0.5 * k))
         times.append(time.perf_counter() - tick)
-    return times
+    return dict(times=times, rss=psutil.Process().memory_info().rss)
 
 
-def profiler_cost() -> dict:
-    """The same runs timed inside one Dask worker task with the worker's statistical profiler
-    on (Dask's default) and off (local_cluster's setting), and in this process."""
+def worker_settings_cost(n: int) -> dict:
+    """The same runs timed inside one Dask worker task under Dask's default worker settings,
+    with only the profiler off, and under local_cluster's WORKER_SETTINGS; and in this process."""
     import dask
     from distributed import Client, LocalCluster
 
+    from coupling.sweep import WORKER_SETTINGS
+
     env = {"PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    routes = (("worker, Dask's defaults (profiler on, MALLOC_TRIM_THRESHOLD_ 64 KiB)", {}),
+              ("worker, profiler off", {"distributed.worker.profile.enabled": False}),
+              ("worker, local_cluster's settings (profiler off, no malloc trim)", WORKER_SETTINGS))
     out = {}
-    for label, enabled in (("worker, profiler on", True), ("worker, profiler off", False)):
-        with dask.config.set({"distributed.worker.profile.enabled": enabled}):
+    for label, settings in routes:
+        with dask.config.set(settings):
             with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None,
                               silence_logs=40, env=env) as cluster, Client(cluster) as client:
-                out[label] = client.submit(_timed_runs, pure=False).result()
-    out["this process"] = _timed_runs()
+                out[label] = client.submit(_timed_runs, n, pure=False).result()
+    out["this process"] = _timed_runs(n)
     return out
 
 
@@ -158,6 +166,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=16, help="runs of the throughput sweep")
     parser.add_argument("--repeat", type=int, default=2, help="timed repetitions per route (the best is kept)")
+    parser.add_argument("--settings-runs", type=int, default=12, help="runs timed per worker setting")
     parser.add_argument("--memory-runs", default="10,40,160", help="sweep sizes for the client memory")
     parser.add_argument("--no-write", action="store_true")
     args = parser.parse_args()
@@ -169,9 +178,10 @@ def main() -> None:
     print(f"sweep, 1 worker: {t1:.2f} s", flush=True)
     t2 = on_cluster(sweep, 2, tmp, args.repeat)
     print(f"sweep, 2 workers: {t2:.2f} s", flush=True)
-    prof = profiler_cost()
-    for label, times in prof.items():
-        print(f"{label}: {', '.join(f'{t * 1e3:.0f}' for t in times)} ms", flush=True)
+    prof = worker_settings_cost(args.settings_runs)
+    for label, m in prof.items():
+        print(f"{label}: {', '.join(f'{t * 1e3:.0f}' for t in m['times'])} ms; RSS {m['rss'] / 2**20:.0f} MiB",
+              flush=True)
     memory = []
     for n in [int(x) for x in args.memory_runs.split(",")]:
         m = client_memory(n, tmp)
@@ -195,10 +205,11 @@ def main() -> None:
              f"- 2 workers / 1 worker: **{speedup:.2f}x** (target >= 1.8x: {'met' if speedup >= 1.8 else 'not met'}).",
              f"- Overhead of the sweep machinery per run (1 worker against bare): **{100 * overhead:+.1f} %** "
              f"(target <= 10 %: {'met' if overhead <= 0.10 else 'not met'}).", "",
-             "Dask's worker profiler (the same 3 ms default coupled run, timed 4 times inside one task, "
-             "after a warm-up run):", "",
-             "| where | per run |", "|---|---|",
-             *[f"| {label} | {min(t) * 1e3:.0f}-{max(t) * 1e3:.0f} ms |" for label, t in prof.items()], "",
+             f"Worker settings (the same 3 ms default coupled run, {args.settings_runs} runs inside one Dask task "
+             "after a warm-up run; the worker's resident memory after them):", "",
+             "| where | per run (median, range) | RSS after |", "|---|---|---|",
+             *[f"| {label} | {1e3 * sorted(m['times'])[len(m['times']) // 2]:.0f} ms ({min(m['times']) * 1e3:.0f}-"
+               f"{max(m['times']) * 1e3:.0f}) | {m['rss'] / 2**20:.0f} MiB |" for label, m in prof.items()], "",
              "Client memory (a tiny coupled scene, waveforms kept, 2 workers; tracemalloc peak of the client's "
              "Python allocations during run_sweep, and its whole-process ru_maxrss):", "",
              "| runs | traced peak | ru_maxrss |", "|---|---|---|"]

@@ -574,16 +574,26 @@ def _manifest(sweep: Sweep, out: Path, resume: bool) -> None:
     os.replace(tmp, path)
 
 
+# Dask's worker settings that slow a run down and buy a sweep nothing (benchmarks/bench_sweep.py):
+# - the statistical profiler samples every thread's stack every 10 ms; with ngspice calling
+#   back into Python thousands of times per run it made each run ~2.5x slower;
+# - MALLOC_TRIM_THRESHOLD_ = 65536, set by the nanny before it starts a worker, makes glibc
+#   hand freed memory back to the system at every 64 KiB: the run allocates and frees small
+#   arrays at every macro step and was ~10 % slower, while a worker's memory after 60 runs
+#   was the same without it (87 MiB). None unsets it (Dask's documented way).
+WORKER_SETTINGS = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+}
+
+
 def local_cluster(workers: int, **kw):
     """A dask LocalCluster for sweeps: `workers` processes with one thread each (one ngspice
-    per process), no dashboard, and Dask's statistical profiler off in the workers: it
-    samples every thread's stack every 10 ms and, with ngspice calling back into Python
-    thousands of times per run, made each run ~2.5x slower (measured in a worker: 0.22-0.26 s
-    against 0.09-0.10 s for the same coupled run)."""
+    per process), no dashboard, and WORKER_SETTINGS (no profiler, no aggressive malloc trim)."""
     import dask
     from distributed import LocalCluster
 
-    with dask.config.set({"distributed.worker.profile.enabled": False}):
+    with dask.config.set(WORKER_SETTINGS):
         return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
                             silence_logs=40, **kw)
 

@@ -291,45 +291,63 @@ def _kind(t):
 
 def argument_checks(folder: Path) -> dict:
     """name -> check(args) raising TypeError for an argument the exported function would
-    misread (numba.pycc's wrappers do not check an array's dtype, rank or layout)."""
+    misread (numba.pycc's wrappers do not check an array's dtype, rank or layout).
+
+    The checks run before every compiled call (thousands per coupled run), so passing is
+    kept cheap: a test per argument with no string built unless it fails, and the model and
+    work tuples, passed unchanged on every call, checked once."""
     import numpy as np
 
+    ndarray = np.ndarray
+
     def checker(kind):
+        """ok(a) -> bool for one argument of this kind, or None for a number (converted by the wrapper)."""
         if kind[0] == "array":
             dtype, ndim, layout = np.dtype(kind[1]), kind[2], kind[3]
-
-            def check(a, where):
-                if not (isinstance(a, np.ndarray) and a.dtype == dtype and a.ndim == ndim
-                        and (layout != "C" or a.flags.c_contiguous) and (layout != "F" or a.flags.f_contiguous)):
-                    got = (f"{a.dtype} {a.ndim}-d {'C' if a.flags.c_contiguous else 'non-C'} array"
-                           if isinstance(a, np.ndarray) else type(a).__name__)
-                    raise TypeError(f"{where}: exported for a {dtype} {ndim}-d {layout} array, got {got}")
-            return check
+            if layout == "C":
+                return lambda a: (type(a) is ndarray or isinstance(a, ndarray)) and a.dtype == dtype and \
+                    a.ndim == ndim and a.flags.c_contiguous
+            if layout == "F":
+                return lambda a: isinstance(a, ndarray) and a.dtype == dtype and a.ndim == ndim and a.flags.f_contiguous
+            return lambda a: isinstance(a, ndarray) and a.dtype == dtype and a.ndim == ndim
         if kind[0] == "tuple":
             parts = [checker(k) for k in kind[1]]
-            seen = {}  # id -> tuple already checked (held, so its id is not reused): the model and
-            # work tuples, passed on every call, are checked once
+            seen = {}  # id -> tuple already checked (held, so its id is not reused)
 
-            def check(a, where):
+            def ok(a):
                 if seen.get(id(a)) is a:
-                    return
-                if not isinstance(a, tuple) or len(a) != len(parts):
-                    raise TypeError(f"{where}: exported for a tuple of {len(parts)}, got {type(a).__name__}")
-                for k, (part, item) in enumerate(zip(parts, a)):
-                    part(item, f"{where}[{k}]")
+                    return True
+                if not (isinstance(a, tuple) and len(a) == len(parts)
+                        and all(part is None or part(item) for part, item in zip(parts, a))):
+                    return False
                 if len(seen) > 256:
                     seen.clear()
                 seen[id(a)] = a
-            return check
-        return None  # numbers are converted by the wrapper
+                return True
+            return ok
+        return None
+
+    def describe(kind, a, where) -> str:
+        """Why ``a`` is not of ``kind`` (only when a check failed)."""
+        if kind[0] == "tuple":
+            if not isinstance(a, tuple) or len(a) != len(kind[1]):
+                return f"{where}: exported for a tuple of {len(kind[1])}, got {type(a).__name__}"
+            for k, (part, item) in enumerate(zip(kind[1], a)):
+                ok = checker(part)
+                if ok is not None and not ok(item):
+                    return describe(part, item, f"{where}[{k}]")
+        got = (f"{a.dtype} {a.ndim}-d {'C' if a.flags.c_contiguous else 'non-C'} array"
+               if isinstance(a, np.ndarray) else type(a).__name__)
+        return f"{where}: exported for a {np.dtype(kind[1])} {kind[2]}-d {kind[3]} array, got {got}"
 
     out = {}
     for name, kinds in json.loads((folder / SIGNATURES).read_text()).items():
-        checks = [(k, c) for k, c in enumerate(checker(kind) for kind in kinds) if c is not None]
+        checks = tuple((k, c) for k, c in enumerate(checker(kind) for kind in kinds) if c is not None)
 
-        def check_all(args, name=name, checks=checks):
-            for k, c in checks:
-                c(args[k], f"{name} argument {k}")
+        def check_all(args, name=name, checks=checks, kinds=kinds):
+            for k, ok in checks:
+                if not ok(args[k]):
+                    raise TypeError(describe(kinds[k], args[k], f"{name} argument {k}"))
         out[name] = check_all
     return out
 

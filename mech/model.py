@@ -227,12 +227,22 @@ class BarModel:
 
     @property
     def arrays(self) -> tuple:
-        """The compiled kernel's model argument (one tuple, see kernel.dynamics)."""
-        b = self.basis
-        ptr, idx, val = self.sparse
-        psi, theta, xc = self.points
-        return (self.fpar, self.ipar, b.J0, ptr, idx, val, psi, theta, xc, self.cpar,
-                self.first_moments, self.load, self.tables)
+        """The compiled kernel's model argument (one tuple, see kernel.dynamics): the same
+        tuple object on every call until a field is set, so the compiled route's argument
+        check (mech.aot) validates it once rather than at each of thousands of calls."""
+        cached = self.__dict__.get("_arrays")
+        if cached is None:
+            b = self.basis
+            ptr, idx, val = self.sparse
+            psi, theta, xc = self.points
+            cached = (self.fpar, self.ipar, b.J0, ptr, idx, val, psi, theta, xc, self.cpar,
+                      self.first_moments, self.load, self.tables)
+            self.__dict__["_arrays"] = cached
+        return cached
+
+    def __setattr__(self, name, value):
+        object.__setattr__(self, name, value)
+        self.__dict__.pop("_arrays", None)  # a field replaced: the tuple is rebuilt on next use
 
     @property
     def state_size(self) -> int:

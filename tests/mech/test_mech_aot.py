@@ -97,6 +97,30 @@ def test_an_argument_of_another_type_goes_to_the_jit_function_with_a_warning():
     np.testing.assert_allclose(expected, closed_form, rtol=1e-15)
 
 
+def test_a_wrong_array_inside_a_tuple_argument_is_named_and_goes_to_the_jit_function():
+    """The model and work tuples are checked element by element (once per tuple object):
+    a float32 scratch array in the work tuple is named by its place, and the result is the
+    same as with the right tuple."""
+    import mech.compiled as compiled
+    from mech.model import build_model
+    from mech.scene import scene_from_dict
+
+    if compiled.ROUTE != "aot":
+        pytest.skip("the ahead-of-time module is not in use here")
+    model = build_model(scene_from_dict({"bar": {"length": 0.1, "diameter": 0.006, "tip_radius": 0.003,
+                                                 "modes": 2}}))
+    y = model.initial_state()
+    work = compiled.make_work(model.n)
+    expected = np.empty(5)
+    compiled.energies(y, model.arrays, work, expected)
+    bad = tuple(a.astype(np.float32) if k == 2 else a for k, a in enumerate(work))
+    got = np.empty(5)
+    with pytest.warns(compiled.CompiledArgumentWarning, match=r"energies argument 2\[2\]: .*float32"):
+        compiled.energies(y, model.arrays, bad, got)
+    np.testing.assert_array_equal(got, expected)
+    assert expected[0] > 0.0  # the bar moves down at its initial speed: kinetic energy
+
+
 def _fake_build(calls, delay=0.2):
     def build(folder: Path):
         calls.append(folder)
