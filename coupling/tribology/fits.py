@@ -751,7 +751,10 @@ def resistance_candidates() -> list[tuple[str, str]]:
     return [(lm, cm) for lm in LOAD_FAMILIES for cm in CURRENT_FAMILIES]
 
 
-def _ln_resistance(load_model: str, current_model: str, x: np.ndarray, load: np.ndarray, current: np.ndarray) -> np.ndarray:
+def ln_resistance(load_model: str, current_model: str, x: np.ndarray, load: np.ndarray, current: np.ndarray) -> np.ndarray:
+    """ln R_c (R_c in ohm) of the law (load_model, current_model) with parameters x (load
+    law's then current law's, in their families' order) at normal loads ``load`` (N) and
+    currents ``current`` (A)."""
     nl = len(LOAD_FAMILIES[load_model].parameters)
     rf, r1, m = load_law_parameters(load_model, dict(zip(LOAD_FAMILIES[load_model].parameters, x[:nl])))
     g = CURRENT_FAMILIES[current_model].function(current, *x[nl:])
@@ -841,7 +844,7 @@ def _fit_resistance(P: _Problem, y: np.ndarray, candidates: list[tuple[str, str]
         trials.sort(key=lambda t: t[0])
 
         def residual(x, lm=load_model, cm=current_model):
-            return w * (ybar - _ln_resistance(lm, cm, x, P.load, P.current))
+            return w * (ybar - ln_resistance(lm, cm, x, P.load, P.current))
 
         lower = np.r_[lf.lower, cf.lower]
         upper = np.r_[lf.upper, cf.upper]
@@ -1050,4 +1053,4 @@ def resistance_band(fit: TribometerFit, normal_force_N, current_A: float) -> tup
     lm, cm = chosen.name.split("+")
     f = np.asarray(normal_force_N, float)
     i = np.full_like(f, abs(current_A))
-    return _log_band(chosen, lambda x: _ln_resistance(lm, cm, x, f, i))
+    return _log_band(chosen, lambda x: ln_resistance(lm, cm, x, f, i))

@@ -33,11 +33,11 @@ def test_shipped_data_has_no_outliers_and_the_cell_fit_equals_the_row_fit():
     # the fit on (load, current) cells reproduces the row-by-row residual sum of squares
     df = read_tribometer_csv(illustrative_data_path())
     chosen = fit.resistance.selection.chosen
-    from coupling.tribology.fits import _ln_resistance
+    from coupling.tribology.fits import ln_resistance
 
     lm, cm = chosen.name.split("+")
     x = np.array([p.value for p in chosen.parameters])
-    r = np.log(df["resistance_ohm"].to_numpy()) - _ln_resistance(lm, cm, x, df["load_N"].to_numpy(),
+    r = np.log(df["resistance_ohm"].to_numpy()) - ln_resistance(lm, cm, x, df["load_N"].to_numpy(),
                                                                   np.abs(df["current_A"].to_numpy()))
     assert chosen.rss_log == pytest.approx(float(r @ r), rel=1e-10)
 
