@@ -50,15 +50,14 @@ def scene(modes: int) -> MechScene:
 
 
 @njit(cache=False)
-def _time_dynamics(states, calls, fpar, ipar, J0, ptr, idx, val, psi, theta, xc, work):
+def _time_dynamics(states, calls, mdl, work):
     dy = np.empty(states.shape[1])
     aux = np.empty((2, NAUX))
     regime = np.zeros(2, np.int64)
     eref = np.array([[1.0, 0.0], [0.0, 1.0]])
     acc = 0.0
     for c in range(calls):
-        dynamics(0.0, states[c % states.shape[0]], fpar, ipar, J0, ptr, idx, val, psi, theta, xc,
-                 regime, eref, dy, aux, work)
+        dynamics(0.0, states[c % states.shape[0]], mdl, regime, eref, dy, aux, work)
         acc += dy[0]
     return acc
 
@@ -106,11 +105,11 @@ def measure(modes: int, repeat: int) -> dict:
     etas = np.ascontiguousarray(states[:, sl["eta"]])
     ws = np.ascontiguousarray(states[:, sl["omega"]])
     arrays = model.arrays
-    fpar, ipar, J0, ptr, idx, val, psi, theta, xc = arrays
+    J0, ptr, idx, val = arrays[2:6]
     work = make_work(model.n)
     calls = max(20000, 4 * len(states))
     m = model.basis.mass
-    full = per_call(lambda c: _time_dynamics(states, c, *arrays, work), calls, repeat)
+    full = per_call(lambda c: _time_dynamics(states, c, arrays, work), calls, repeat)
     new = per_call(lambda c: _time_block(0, qs, etas, ws, c, m, J0, ptr, idx, val), calls, repeat)
     old = per_call(lambda c: _time_block(1, qs, etas, ws, c, m, J0, ptr, idx, val), calls, repeat)
     return {"modes": modes, "n": model.n, "states": len(states), "full_new": full,
