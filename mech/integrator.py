@@ -123,18 +123,24 @@ def _rk_stages(t, y, h, k1, k2, k3, k4, k5, k6, k7, ytmp, ynew, mdl,
 
 
 @njit(cache=True)
-def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
-              mdl, regime, eref, ev_sign,
-              rec_t, rec_y, rec_aux, rec_fmax, dense_t0, dense_h, dense_coef, store_dense,
-              max_steps, work, stats):
-    """Advance y (in place) from t towards t_stop.
+def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, store_dense, max_steps, work, stats):
+    """Advance y (in place) from t (s) towards t_stop (s), starting with step h (s; 0: choose).
 
+    tol: (hmax s, rtol, atol per component, relmask per component: 1 where rtol applies).
+    mdl: the model arrays with the drive (model.BarModel.kernel_arrays); regime and eref:
+    the regimes and reference slip directions (read only); ev_sign: the side of each watched
+    event function, updated at each accepted step.
+    rec: (t, y, aux, fmax) buffers from the first free row (mech.recorder.Recorder.free_rows);
+    dense: (t0, h, coef) likewise, written only with store_dense.
     Returns (status, t, h_next, n_records, event_index); after an event, h_next is the
     step size in use before the step was cut at the event. Every accepted step is recorded
     (time, state, per-tip aux and the largest normal force seen at the step's ends and
     three interior points); with store_dense, also the step's dense-output coefficients.
     stats (int64[4]) accumulates: accepted steps, rejected steps, rhs evaluations, events.
     """
+    hmax, rtol, atol, relmask = tol
+    rec_t, rec_y, rec_aux, rec_fmax = rec
+    dense_t0, dense_h, dense_coef = dense
     N = y.shape[0]
     nev = 2 * NEV_TIP
     fpar = mdl[0]
@@ -339,8 +345,7 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
                 first_theta = 1.0
             dynamics(tev, ymid, mdl, regime, eref, ytmp, aux_new, work)
             stats[2] += 1
-            _record(n_rec, t, h, tev, ymid, aux_new, aux_old, coef, rec_t, rec_y, rec_aux, rec_fmax,
-                    dense_t0, dense_h, dense_coef, store_dense,
+            _record(n_rec, t, h, tev, ymid, aux_new, aux_old, coef, rec, dense, store_dense,
                     mdl, regime, eref, work, ytmp, aux_stage, first_theta)
             n_rec += 1
             for i in range(N):
@@ -348,8 +353,7 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
             stats[0] += 1
             stats[3] += 1
             return EVENT, tev, h_continue, n_rec, first_k
-        _record(n_rec, t, h, t + h, ynew, aux_new, aux_old, coef, rec_t, rec_y, rec_aux, rec_fmax,
-                dense_t0, dense_h, dense_coef, store_dense,
+        _record(n_rec, t, h, t + h, ynew, aux_new, aux_old, coef, rec, dense, store_dense,
                 mdl, regime, eref, work, ytmp, aux_stage, 1.0)
         n_rec += 1
         stats[0] += 1
@@ -377,11 +381,12 @@ def integrate(t, y, t_stop, h, hmax, rtol, atol, relmask,
 
 
 @njit(cache=True)
-def _record(n_rec, t_start, h, t_end, y_end, aux_end, aux_start, coef, rec_t, rec_y, rec_aux, rec_fmax,
-            dense_t0, dense_h, dense_coef, store_dense,
+def _record(n_rec, t_start, h, t_end, y_end, aux_end, aux_start, coef, rec, dense, store_dense,
             mdl, regime, eref, work, scratch, aux_scratch, theta_end):
-    """Store an accepted step (and its dense-output coefficients when kept); its peak normal
-    force is sampled at both ends and 3 interior points."""
+    """Store an accepted step in row n_rec of rec (and its dense-output coefficients in
+    dense when kept); its peak normal force is sampled at both ends and 3 interior points."""
+    rec_t, rec_y, rec_aux, rec_fmax = rec
+    dense_t0, dense_h, dense_coef = dense
     if store_dense:
         dense_t0[n_rec] = t_start
         dense_h[n_rec] = h

@@ -29,7 +29,7 @@ from . import contact_laws as _contact_laws, friction as _friction, rotations as
 from .jit import njit
 from .inertia import inertia_matrix, inertia_terms, inertia_terms_sparse, schur_complement
 from .kernel_layout import (  # noqa: F401  (re-exported: the kernel's own names)
-    F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MU0, F_MU_SLOPE, F_T_MU, F_MAX_RATIO, F_RTIP,
+    F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MAX_RATIO, F_RTIP, D_MU0, D_MU_SLOPE, D_T_MU,
     F_VREG, F_BAUM, F_VBOUND, F_BLOCK_Z, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN,
     N_FPAR, I_N, I_PLANAR, I_FRICTION, I_MOUNT, I_NLOAD, I_INERTIA, N_IPAR, INERTIA_GRAM,
     INERTIA_SPARSE, FRICTION_NONE, FRICTION_EXACT, FRICTION_REGULARIZED, MOUNT_FREE, MOUNT_CLAMP,
@@ -124,9 +124,9 @@ def tip_offset(i, xc, psi, modal, n, out):
 
 
 @njit(cache=True)
-def mu_at(t, fpar):
-    """N^gamma: friction coefficient, linear in time within a coupling step."""
-    mu = fpar[F_MU0] + fpar[F_MU_SLOPE] * (t - fpar[F_T_MU])
+def mu_at(t, drive):
+    """N^gamma: friction coefficient at t (s) from the drive, linear in time within a coupling step."""
+    mu = drive[D_MU0] + drive[D_MU_SLOPE] * (t - drive[D_T_MU])
     return mu if mu > 0.0 else 0.0
 
 
@@ -351,11 +351,12 @@ def _tip_accel(k, R, s_tip, psi, theta, n, Rtip, Vdot, wdot, etadot, out):
 def dynamics(t, y, mdl, regime, eref, dy, aux, work):
     """Time derivative of the state into ``dy``; per-contact-point quantities into ``aux`` (2, NAUX).
 
-    mdl: the model arrays (model.BarModel.arrays). regime: (2,) FREE/SLIP/STICK per
+    mdl: the model arrays and, last, the drive (model.BarModel.kernel_arrays: the friction
+    coefficient over time, set by the caller; the model's arrays never change). regime: (2,) FREE/SLIP/STICK per
     contact point (friction bookkeeping; the normal force always follows the
     penetration). eref: (2, 2) reference slip direction per contact point.
     """
-    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs = mdl
+    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs, drive = mdl
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
     fmodel = ipar[I_FRICTION]
@@ -406,7 +407,7 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work):
         thd = sg * w[1]
         f_r[1] += sg * (fpar[F_PIV_T0] - fpar[F_PIV_K] * th - fpar[F_PIV_C] * thd)
         d_load += fpar[F_PIV_C] * thd * thd
-    mu = mu_at(t, fpar) if fmodel != FRICTION_NONE else 0.0
+    mu = mu_at(t, drive) if fmodel != FRICTION_NONE else 0.0
     gam = fpar[F_GAMMA]
     maxr = fpar[F_MAX_RATIO]
     d_normal = 0.0
@@ -640,7 +641,7 @@ def symmetric_eigen(A):
 
 
 @njit(cache=True)
-def _min_norm_solve(W, rhs):
+def min_norm_solve(W, rhs):
     """Least-squares, minimum-norm solution of W x = rhs.
 
     Two stick points of a rigid bar along its axis constrain the same motion: W is then
@@ -777,7 +778,7 @@ def _apply_stick(fpar, n, planar, mount, R, w, eta, s_tip, sd_tip, th_tip, vP, r
         rhs[b_k * ndir] = -(a0 + baum * vP[k, 0])
         if ndir == 2:
             rhs[b_k * ndir + 1] = -(a1 + baum * vP[k, 1])
-    lam = _min_norm_solve(W, rhs)
+    lam = min_norm_solve(W, rhs)
     for col in range(ns * ndir):
         lc = lam[col]
         for a in range(3):
@@ -856,7 +857,7 @@ def energies(y, mdl, work, out):
     Kinetic energy about a frame origin that is not the centroid (held bars):
     1/2 m V.V + V . R (w x (c + L q) + L eta) + 1/2 w J w + w B eta + 1/2 m eta.eta.
     """
-    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs = mdl
+    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs, drive = mdl
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
     r, R, q, V, w, eta, Jm, B = work[0], work[1], work[2], work[3], work[4], work[5], work[6], work[7]

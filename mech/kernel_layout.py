@@ -10,9 +10,14 @@ from __future__ import annotations
 
 # fpar indices (F_K, F_C, F_RTIP: the first contact point's values, kept for the scales;
 # the kernel reads each contact point's own from cpar)
-(F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MU0, F_MU_SLOPE, F_T_MU, F_MAX_RATIO, F_RTIP, F_VREG, F_BAUM,
- F_VBOUND, F_BLOCK_Z, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN) = range(20)
-N_FPAR = 20
+(F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MAX_RATIO, F_RTIP, F_VREG, F_BAUM,
+ F_VBOUND, F_BLOCK_Z, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN) = range(17)
+N_FPAR = 17
+# the drive: what the caller changes during a run, passed beside the model's arrays (the
+# last element of the kernel's model tuple) so that the model itself never changes: the
+# friction coefficient mu (N^gamma), linear in time from D_T_MU within a coupling step
+D_MU0, D_MU_SLOPE, D_T_MU = range(3)
+N_DRIVE = 3
 # ipar indices
 I_N, I_PLANAR, I_FRICTION, I_MOUNT, I_NLOAD, I_INERTIA = range(6)
 N_IPAR = 6

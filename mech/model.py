@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -17,8 +17,8 @@ from .contact_laws import (
     calibrate_damping, damping_formula, hertz_impact, hertz_stiffness,
 )
 from .kernel_layout import (
-    F_BAUM, F_BETA, F_C, F_G, F_GAMMA, F_VBOUND, F_K, F_MASS, F_MAX_RATIO, F_MU0, F_MU_SLOPE, F_RTIP,
-    F_T_MU, F_VREG, FRICTION_EXACT, FRICTION_NONE, FRICTION_REGULARIZED, I_FRICTION, I_N,
+    D_MU0, F_BAUM, F_BETA, F_C, F_G, F_GAMMA, F_VBOUND, F_K, F_MASS, F_MAX_RATIO, F_RTIP, N_DRIVE,
+    F_VREG, FRICTION_EXACT, FRICTION_NONE, FRICTION_REGULARIZED, I_FRICTION, I_N,
     I_PLANAR, I_MOUNT, I_NLOAD, MOUNT_CLAMP, MOUNT_FREE, MOUNT_PIVOT, N_FPAR,
     F_PIV_C, F_PIV_K, F_PIV_PHI0, F_PIV_SIGN, F_PIV_T0, L_L0, I_INERTIA, INERTIA_GRAM, INERTIA_SPARSE, N_IPAR, N_LOAD, NQ, NQ_FREE, C_C, C_K, C_ON, C_R, state_sizes,
 )
@@ -162,43 +162,64 @@ def mechanism_scales(scene: MechScene, arr: MechanismArrays, n_modes: int) -> Co
     )
 
 
-def _set_up_mount(model: "BarModel", scene: MechScene) -> None:
-    """Pivot spring parameters and the springs' rest lengths from their preloads."""
-    fpar = model.fpar
+def _pivot_parameters(fpar: np.ndarray, scene: MechScene, xc: np.ndarray) -> None:
+    """The pivot's torsion spring into fpar (before the model is built from it)."""
     mnt = scene.mount
+    # the free end is the side of the first contact point; with kernel.unpack's rotation
+    # a point at body x moves by dz/dphi = -x cos(phi), so turning it down, towards the
+    # block, is -phi when it lies at body -x
+    fpar[F_PIV_SIGN] = -1.0 if xc[0, 0] < 0.0 else 1.0
+    fpar[F_PIV_K] = mnt.stiffness
+    fpar[F_PIV_C] = mnt.damping
+    fpar[F_PIV_T0] = mnt.preload_torque
+    fpar[F_PIV_PHI0] = -math.radians(scene.initial.angle_deg)
+
+
+def _spring_rest_lengths(model: "BarModel") -> np.ndarray:
+    """The load table with each spring's rest length (m) from its preload or rest_length,
+    measured on the model's initial state."""
+    scene = model.scene
+    load = model.load.copy()
     xc = model.points[2]
-    if mnt.kind == "pivot":
-        # the free end is the side of the first contact point; with kernel.unpack's
-        # rotation a point at body x moves by dz/dphi = -x cos(phi), so turning it down,
-        # towards the block, is -phi when it lies at body -x
-        fpar[F_PIV_SIGN] = -1.0 if xc[0, 0] < 0.0 else 1.0
-        fpar[F_PIV_K] = mnt.stiffness
-        fpar[F_PIV_C] = mnt.damping
-        fpar[F_PIV_T0] = mnt.preload_torque
-        fpar[F_PIV_PHI0] = -math.radians(scene.initial.angle_deg)
-    if model.mechanism.spring_points:
-        y0 = model.initial_state()
-        R0 = rotation_y(-math.radians(scene.initial.angle_deg))
-        r0 = np.array([y0[0], 0.0, y0[1]]) if model.planar else y0[0:3]
-        for row, sp in model.mechanism.spring_points:
-            p = int(model.load[row, 1])
-            x = r0 + R0 @ xc[p]
-            length = float(np.linalg.norm(x - np.array(sp.anchor)))
-            if sp.rest_length is not None:
-                rest = sp.rest_length
-            elif sp.preload is not None:
-                rest = length - sp.preload / sp.stiffness
-                if rest < 0.0:
-                    raise ValueError(f"{sp.name}.preload = {sp.preload!r}: more than the spring's stiffness times "
-                                     f"its length ({sp.stiffness * length!r} N) can give")
-            else:
-                rest = length
-            model.load[row, L_L0] = rest
+    y0 = model.initial_state()
+    R0 = rotation_y(-math.radians(scene.initial.angle_deg))
+    r0 = np.array([y0[0], 0.0, y0[1]]) if model.planar else y0[0:3]
+    for row, sp in model.mechanism.spring_points:
+        p = int(load[row, 1])
+        x = r0 + R0 @ xc[p]
+        length = float(np.linalg.norm(x - np.array(sp.anchor)))
+        if sp.rest_length is not None:
+            rest = sp.rest_length
+        elif sp.preload is not None:
+            rest = length - sp.preload / sp.stiffness
+            if rest < 0.0:
+                raise ValueError(f"{sp.name}.preload = {sp.preload!r}: more than the spring's stiffness times "
+                                 f"its length ({sp.stiffness * length!r} N) can give")
+        else:
+            rest = length
+        load[row, L_L0] = rest
+    return load
 
 
-@dataclass
+def state_slices(n: int, planar: bool, nq: int) -> dict:
+    """Named slices of the state vector for n modes and nq quadratures."""
+    if planar:
+        return {"pos": slice(0, 2), "angle": slice(2, 3), "q": slice(3, 3 + n),
+                "vel": slice(3 + n, 5 + n), "omega": slice(5 + n, 6 + n),
+                "eta": slice(6 + n, 6 + 2 * n), "quad": slice(6 + 2 * n, 6 + 2 * n + nq)}
+    return {"pos": slice(0, 3), "quat": slice(3, 7), "q": slice(7, 7 + n),
+            "vel": slice(7 + n, 10 + n), "omega": slice(10 + n, 13 + n),
+            "eta": slice(13 + n, 13 + 2 * n), "quad": slice(13 + 2 * n, 13 + 2 * n + nq)}
+
+
+@dataclass(frozen=True)
 class BarModel:
-    """The compiled model's arrays plus what Python needs to interpret the state."""
+    """The compiled model's arrays plus what Python needs to interpret the state.
+
+    Built whole by ``build_model`` and never changed afterwards (frozen; its arrays are
+    not written after the build): what changes during a run -- the friction coefficient
+    mu(t) -- is the solver's drive, passed beside the arrays (``kernel_arrays``).
+    """
 
     scene: MechScene
     planar: bool
@@ -210,39 +231,44 @@ class BarModel:
     atol: np.ndarray
     relmask: np.ndarray
     max_step: float
+    sparse: tuple  # the sparse inertia invariants (mech.modal_basis.sparse_invariants)
+    points: tuple  # (psi, theta, xc): contact caps (rows 0, 1) then load points
+    cpar: np.ndarray  # (2, 4) per contact point: k, c, cap radius, on
+    first_moments: np.ndarray  # (3, 2n + 1): c (kg m), L_j (kg), H_j (kg m), body frame
+    load: np.ndarray  # (n_loads, N_LOAD) actuator forces and springs
+    tables: np.ndarray  # (2, n) concatenated time tables of the loads
+    mechanism: MechanismArrays | None = None  # set for mechanism scenes (mech.mechanism)
+    mode_count: object = None  # ModeCount when bar.modes = "auto" chose the counts, else None
 
     @property
     def n(self) -> int:
         return self.basis.n
 
-    sparse: tuple = ()
-    mode_count: object = None  # ModeCount when bar.modes = "auto" chose the counts, else None
+    def initial_drive(self) -> np.ndarray:
+        """A new drive array (kernel_layout D_*): the scene's friction coefficient at zero
+        current, constant in time."""
+        drive = np.zeros(N_DRIVE)
+        fr = self.scene.friction
+        drive[D_MU0] = fr.mu_at(0.0) if fr.active else 0.0
+        return drive
 
-    points: tuple = ()  # (psi, theta, xc): contact caps (rows 0, 1) then load points
-    cpar: np.ndarray | None = None  # (2, 4) per contact point: k, c, cap radius, on
-    first_moments: np.ndarray | None = None  # (3, 2n + 1): c (kg m), L_j (kg), H_j (kg m), body frame
-    load: np.ndarray | None = None  # (n_loads, N_LOAD) actuator forces and springs
-    tables: np.ndarray | None = None  # (2, n) concatenated time tables of the loads
-    mechanism: MechanismArrays | None = None  # set for mechanism scenes (mech.mechanism)
-
-    @property
+    @functools.cached_property
     def arrays(self) -> tuple:
-        """The compiled kernel's model argument (one tuple, see kernel.dynamics): the same
-        tuple object on every call until a field is set, so the compiled route's argument
-        check (mech.aot) validates it once rather than at each of thousands of calls."""
-        cached = self.__dict__.get("_arrays")
-        if cached is None:
-            b = self.basis
-            ptr, idx, val = self.sparse
-            psi, theta, xc = self.points
-            cached = (self.fpar, self.ipar, b.J0, ptr, idx, val, psi, theta, xc, self.cpar,
-                      self.first_moments, self.load, self.tables)
-            self.__dict__["_arrays"] = cached
-        return cached
+        """The compiled kernel's model argument (one tuple, see kernel.dynamics) with the
+        scene's constant friction coefficient as its drive: the same tuple object on every
+        call, so the compiled route's argument check (mech.aot) validates it once rather
+        than at each of thousands of calls. A solver passes its own drive instead
+        (``kernel_arrays``)."""
+        return self.kernel_arrays(self.initial_drive())
 
-    def __setattr__(self, name, value):
-        object.__setattr__(self, name, value)
-        self.__dict__.pop("_arrays", None)  # a field replaced: the tuple is rebuilt on next use
+    def kernel_arrays(self, drive: np.ndarray) -> tuple:
+        """The kernel's model argument with ``drive`` (float64[N_DRIVE], kernel_layout D_*)
+        as the friction coefficient over time."""
+        b = self.basis
+        ptr, idx, val = self.sparse
+        psi, theta, xc = self.points
+        return (self.fpar, self.ipar, b.J0, ptr, idx, val, psi, theta, xc, self.cpar,
+                self.first_moments, self.load, self.tables, drive)
 
     @property
     def state_size(self) -> int:
@@ -336,14 +362,7 @@ class BarModel:
 
     def slices(self) -> dict:
         """Named slices of the state vector."""
-        n = self.n
-        if self.planar:
-            return {"pos": slice(0, 2), "angle": slice(2, 3), "q": slice(3, 3 + n),
-                    "vel": slice(3 + n, 5 + n), "omega": slice(5 + n, 6 + n),
-                    "eta": slice(6 + n, 6 + 2 * n), "quad": slice(6 + 2 * n, 6 + 2 * n + self.nq)}
-        return {"pos": slice(0, 3), "quat": slice(3, 7), "q": slice(7, 7 + n),
-                "vel": slice(7 + n, 10 + n), "omega": slice(10 + n, 13 + n),
-                "eta": slice(13 + n, 13 + 2 * n), "quad": slice(13 + 2 * n, 13 + 2 * n + self.nq)}
+        return state_slices(self.n, self.planar, self.nq)
 
     def _resting(self, R0: np.ndarray) -> tuple[float, np.ndarray]:
         """Centre height (m) and modal coordinates (m) of the bar resting on the block.
@@ -430,9 +449,6 @@ def build_model(scene: MechScene) -> BarModel:
     fpar[F_C] = cs.damping
     fpar[F_BETA] = cs.beta
     fpar[F_GAMMA] = fr.gamma
-    fpar[F_MU0] = fr.mu_at(0.0) if fr.active else 0.0
-    fpar[F_MU_SLOPE] = 0.0
-    fpar[F_T_MU] = 0.0
     fpar[F_MAX_RATIO] = fr.max_ratio if math.isfinite(fr.max_ratio) else 1e300
     fpar[F_RTIP] = scene.bar.tip_radius
     # the friction's speed scale: the regularized law's v_s; for the exact law the slip
@@ -467,9 +483,7 @@ def build_model(scene: MechScene) -> BarModel:
     nq = NQ if (ipar[I_MOUNT] != MOUNT_FREE or ipar[I_NLOAD] > 0) else NQ_FREE
     atol = np.empty(npos + nvel + nq)
     rel = np.zeros_like(atol)
-    sl_model = BarModel(scene, planar, basis, cs, fpar, ipar, math.radians(scene.initial.azimuth_deg),
-                        atol, rel, 0.0)
-    sl = sl_model.slices()
+    sl = state_slices(n, planar, nq)
     atol[sl["pos"]] = rtol * dstar
     atol[sl["angle" if planar else "quat"]] = rtol * dstar / L
     atol[sl["q"]] = rtol * dstar
@@ -488,31 +502,29 @@ def build_model(scene: MechScene) -> BarModel:
     max_step = 0.25 * cs.shortest_contact
     if scene.solver.max_step is not None:
         max_step = min(max_step, scene.solver.max_step)
-    sl_model.max_step = max_step
-    sl_model.sparse = sparse_invariants(basis)
     if arr is None:
         xc = np.zeros((2, 3))
         xc[:, 0] = basis.x_centre
-        sl_model.points = (basis.psi_tip, basis.theta_tip, xc)
         cpar = np.zeros((2, 4))
         cpar[:, C_K] = cs.stiffness
         cpar[:, C_C] = cs.damping
         cpar[:, C_R] = scene.bar.tip_radius
         cpar[:, C_ON] = 1.0
-        sl_model.cpar = cpar
-        sl_model.first_moments = np.zeros((3, 2 * n + 1))
-        sl_model.load = np.zeros((0, N_LOAD))
-        sl_model.tables = np.zeros((2, 1))
+        parts = dict(points=(basis.psi_tip, basis.theta_tip, xc), cpar=cpar,
+                     first_moments=np.zeros((3, 2 * n + 1)), load=np.zeros((0, N_LOAD)), tables=np.zeros((2, 1)))
     else:
-        sl_model.mechanism = arr
-        sl_model.points = arr.points
-        sl_model.cpar = contact_parameters(arr.contacts, scene.block, scene.contact.stiffness, cs.dampings)
-        sl_model.first_moments = arr.first_moments
-        sl_model.load = arr.load.copy()
-        sl_model.tables = arr.tables
-        _set_up_mount(sl_model, scene)
-    sl_model.mode_count = mode_count
-    return sl_model
+        if scene.mount.kind == "pivot":
+            _pivot_parameters(fpar, scene, arr.points[2])
+        parts = dict(points=arr.points, mechanism=arr, first_moments=arr.first_moments, load=arr.load.copy(),
+                     tables=arr.tables,
+                     cpar=contact_parameters(arr.contacts, scene.block, scene.contact.stiffness, cs.dampings))
+    model = BarModel(scene, planar, basis, cs, fpar, ipar, math.radians(scene.initial.azimuth_deg), atol, rel,
+                     max_step, sparse_invariants(basis), mode_count=mode_count, **parts)
+    if arr is not None and arr.spring_points:
+        # the springs' rest lengths are measured on the initial state, which the other
+        # arrays define: a second, complete model with them
+        model = replace(model, load=_spring_rest_lengths(model))
+    return model
 
 
 # --- bar.modes = "auto" (issue 9): counts from the contact time -----------------------

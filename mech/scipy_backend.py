@@ -1,8 +1,9 @@
 """scipy.integrate.solve_ivp as an alternative stepper for the same model and regimes.
 
 Same right-hand side, same events, same regime logic as the compiled DOPRI5 loop; only
-the stepping differs. Used as the speed baseline (Radau, benchmarks/bench_mech.py) and as
-an independent integration route in the tests (DOP853, Radau).
+the stepping differs (mech.stepping: the protocol both implement). Used as the speed
+baseline (Radau, benchmarks/bench_mech.py) and as an independent integration route in the
+tests (DOP853, Radau).
 """
 
 from __future__ import annotations
@@ -11,28 +12,43 @@ import numpy as np
 
 from .compiled import dynamics, events_from_aux
 from .kernel_layout import (
-    A_FN, A_Y, A_YDOT, DONE, EV_CLIP, EV_COMPRESSION, EV_SLIP, EV_STICK, EVENT, F_MU0, FREE, FRICTION_EXACT,
+    A_FN, A_Y, A_YDOT, D_MU0, DONE, EV_CLIP, EV_COMPRESSION, EV_SLIP, EV_STICK, EVENT, FREE, FRICTION_EXACT,
     I_FRICTION, NAUX, NEV_TIP, NOT_FINITE, SLIP, STICK,
 )
+
+from .stepping import Outcome
 
 METHODS = ("RK45", "DOP853", "Radau", "BDF", "LSODA")
 
 
+class ScipyStepper:
+    """solve_ivp with ``method`` as a stepper (mech.stepping.Stepper)."""
+
+    def __init__(self, method: str):
+        if method not in METHODS:
+            raise ValueError(f"backend method = {method!r}: allowed values are {', '.join(METHODS)}")
+        self.method = method
+
+    def segment(self, state, t_goal: float) -> Outcome:
+        return Outcome(*scipy_segment(state, t_goal, self.method))
+
+
 def scipy_segment(solver, t_target: float, method: str):
-    """Integrate ``solver`` (an ImpactSolver) from its state towards t_target with solve_ivp.
+    """Integrate the integration state ``solver`` (mech.stepping) from its time towards
+    t_target (s) with solve_ivp.
 
     Returns (status, t_new, h_next, n_records, event_index) like the compiled loop and
-    writes the accepted steps into the solver's record buffers.
+    writes the accepted steps into the recorder's rows from its ``n`` on.
     """
     from scipy.integrate import solve_ivp  # lazily: only the scipy backends import it
 
-    if method not in METHODS:
-        raise ValueError(f"backend method = {method!r}: allowed values are {', '.join(METHODS)}")
     m = solver.model
-    arrays = m.arrays
+    arrays = solver.arrays
+    drive = solver.drive
     regime = solver.regime.copy()
     eref = solver.eref.copy()
-    work = solver._work
+    work = solver.work
+    rec = solver.recorder
     aux = np.empty((2, NAUX))
     aux_mid = np.empty((2, NAUX))
     g = np.empty(2 * NEV_TIP)
@@ -44,7 +60,7 @@ def scipy_segment(solver, t_target: float, method: str):
     def fun(t, y):
         dy = np.empty(N + n_ext)
         if coupled is not None:
-            m.fpar[F_MU0] = coupled.friction_coefficient(t, y[N:])
+            drive[D_MU0] = coupled.friction_coefficient(t, y[N:])
         dynamics(t, y[:N], arrays, regime, eref, dy[:N], aux, work)
         if coupled is not None:
             dy[N:] = coupled.rhs(t, y[N:], aux[:, [A_Y, A_YDOT, A_FN]])
@@ -78,10 +94,10 @@ def scipy_segment(solver, t_target: float, method: str):
         def _value(t, y):
             dy = np.empty(N)
             if coupled is not None:
-                m.fpar[F_MU0] = coupled.friction_coefficient(t, y[N:])
+                drive[D_MU0] = coupled.friction_coefficient(t, y[N:])
             dynamics(t, y[:N], arrays, regime, eref, dy, aux, work)
             counter_events["nfev"] += 1
-            events_from_aux(aux, eref, m.arrays, g)
+            events_from_aux(aux, eref, arrays, g)
             if kind == EV_SLIP and not (fexact and regime[i] == SLIP):
                 return solver.ev_sign[k]
             if kind == EV_STICK and not (fexact and regime[i] == STICK):
@@ -143,22 +159,21 @@ def scipy_segment(solver, t_target: float, method: str):
                     first_step=min(solver.h, m.max_step, t_target - solver.t) if solver.h > 0 else None)
     solver.stats[2] += counter["nfev"]
     n_new = len(sol.t) - 1
-    while solver._n + n_new + 1 >= solver._cap:
-        solver._grow()
-    n0 = solver._n
+    rec.reserve(n_new + 1)
+    n0 = rec.n
     for k in range(1, len(sol.t)):
         y = sol.y[:N, k]
         dy = np.empty(N)
         if coupled is not None:
-            m.fpar[F_MU0] = coupled.friction_coefficient(sol.t[k], sol.y[N:, k])
-            solver._rec_ext[n0 + k - 1] = sol.y[N:, k]
+            drive[D_MU0] = coupled.friction_coefficient(sol.t[k], sol.y[N:, k])
+            rec.ext[n0 + k - 1] = sol.y[N:, k]
         dynamics(sol.t[k], y, arrays, regime, eref, dy, aux, work)
         r = n0 + k - 1
-        solver._rec_t[r] = sol.t[k]
-        solver._rec_y[r] = y
-        solver._rec_aux[r] = aux
-        solver._rec_fmax[r] = aux[:, A_FN]
-        if np.any(aux[:, A_Y] > 0.0) or np.any(solver._rec_aux[r - 1, :, A_Y] > 0.0 if r > 0 else False):
+        rec.t[r] = sol.t[k]
+        rec.y[r] = y
+        rec.aux[r] = aux
+        rec.fmax[r] = aux[:, A_FN]
+        if np.any(aux[:, A_Y] > 0.0) or np.any(rec.aux[r - 1, :, A_Y] > 0.0 if r > 0 else False):
             # the peak force lies inside a step: sample the dense output as the compiled loop
             # does, then evaluate it once more at the vertex of the parabola through the
             # largest sample and its neighbours (a step that resolves the motion can still
@@ -166,7 +181,7 @@ def scipy_segment(solver, t_target: float, method: str):
             # peak by 0.7 N on DOP853's steps at rtol 1e-8)
             h = sol.t[k] - sol.t[k - 1]
             samples = np.empty((5, 2))
-            samples[0] = solver._rec_aux[r - 1, :, A_FN] if r > 0 else aux[:, A_FN]
+            samples[0] = rec.aux[r - 1, :, A_FN] if r > 0 else aux[:, A_FN]
             samples[4] = aux[:, A_FN]
             for j, f in enumerate((0.25, 0.5, 0.75), start=1):
                 dynamics(sol.t[k - 1] + f * h, sol.sol(sol.t[k - 1] + f * h)[:N], arrays, regime, eref, dy,
@@ -181,12 +196,12 @@ def scipy_segment(solver, t_target: float, method: str):
                     tm = sol.t[k - 1] + 0.25 * (j + shift) * h
                     dynamics(tm, sol.sol(tm)[:N], arrays, regime, eref, dy, aux_mid, work)
                     peak[tip] = max(peak[tip], aux_mid[tip, A_FN])
-            solver._rec_fmax[r] = np.maximum(solver._rec_fmax[r], peak)
+            rec.fmax[r] = np.maximum(rec.fmax[r], peak)
     solver.stats[0] += n_new
     solver.y[:] = sol.y[:N, -1]
     if coupled is not None:
         solver.z[:] = sol.y[N:, -1]
-        m.fpar[F_MU0] = coupled.friction_coefficient(sol.t[-1], solver.z)
+        drive[D_MU0] = coupled.friction_coefficient(sol.t[-1], solver.z)
     if not sol.success:
         return NOT_FINITE, float(sol.t[-1]), 0.0, n_new, -1
     h_next = float(sol.t[-1] - sol.t[-2]) if len(sol.t) > 1 else solver.h

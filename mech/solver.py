@@ -27,12 +27,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .compiled import (
-    dense_contact, dense_eval, dense_tip_forces, dynamics, energies, events_from_aux, integrate, make_work,
+    dense_contact, dense_eval, dense_tip_forces, dynamics, energies, events_from_aux, make_work,
     project_to_stick,
 )
 from .kernel_layout import (
     A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, BUFFER_FULL, DONE, EV_CLIP, EV_COMPRESSION,
-    EV_CONTACT, EV_SLIP, EV_STICK, EVENT, F_MASS, F_MU0, F_MU_SLOPE, F_T_MU, FREE, FRICTION_EXACT,
+    D_MU0, D_MU_SLOPE, D_T_MU, EV_CONTACT, EV_SLIP, EV_STICK, EVENT, F_MASS, FREE, FRICTION_EXACT,
     I_FRICTION, NAUX, NEV_TIP, Q_WIN, SLIP, STATUS_TEXT, STICK, state_sizes,
 )
 from .contact_laws import hertz_impact
@@ -40,7 +40,9 @@ from .friction import REVERSAL_DEADBAND
 from .mechanism import base_velocity_jumps
 from .model import BarModel, build_model
 from .parameters import MechScene
-from .scipy_backend import METHODS as SCIPY_METHODS, scipy_segment
+from .recorder import Recorder
+from .scipy_backend import METHODS as SCIPY_METHODS, ScipyStepper
+from .stepping import CompiledStepper, Stepper
 
 REGIME_NAMES = ("free", "slip", "stick")
 EVENT_KINDS = ("contact", "clip", "slip", "stick", "compression")
@@ -98,6 +100,7 @@ class Segment:
     _start_state: np.ndarray
     _regime: np.ndarray
     _eref: np.ndarray
+    _arrays: tuple = field(repr=False, default=None)  # the kernel's arguments with the drive of the segment
     _work: tuple = field(repr=False, default=None)
     _out: np.ndarray = field(repr=False, default_factory=lambda: np.empty(5))
     _last_t: float = field(repr=False, default=float("nan"))
@@ -125,7 +128,7 @@ class Segment:
         k = int(np.searchsorted(self._t_valid, t)) if len(self._t_valid) else 0
         k = min(k, max(len(self._regime) - 1, 0))
         regime = self._regime[k] if len(self._regime) else np.zeros(2, np.int64)
-        dynamics(t, y, self._model.arrays, regime, self._eref, dy, aux, self._work)
+        dynamics(t, y, self._arrays, regime, self._eref, dy, aux, self._work)
         return aux[:, [A_Y, A_YDOT, A_FN]].copy()
 
     def normal_force(self, t: float) -> float:
@@ -147,7 +150,7 @@ class Segment:
             forces = (float(c[0, 2]), float(c[1, 2]), float(max(0.0, -np.max(c[:, 0]))),
                       float(c[0, 0]), float(c[1, 0]))
         else:
-            dense_tip_forces(t, self._t_valid, self._t0, self._h, self._coef, m.arrays, self._out)
+            dense_tip_forces(t, self._t_valid, self._t0, self._h, self._coef, self._arrays, self._out)
             forces = tuple(float(v) for v in self._out)
         self._last_t, self._last_forces = t, forces
         return forces
@@ -187,24 +190,17 @@ class ImpactSolver:
         self._chatter = 0
         self.wall_time = 0.0
         self.projection_energy = 0.0
-        self._work = make_work(m.n)
+        self.work = make_work(m.n)  # the compiled kernel's scratch arrays
         self._aux = np.empty((2, NAUX))
         self._dy = np.empty(m.state_size)
-        N = m.state_size
-        self._cap = capacity
-        self._n = 0
-        self._rec_t = np.empty(capacity)
-        self._rec_y = np.empty((capacity, N))
-        self._rec_aux = np.empty((capacity, 2, NAUX))
-        self._rec_fmax = np.empty((capacity, 2))
-        self._rec_regime = np.empty((capacity, 2), dtype=np.int64)
-        self._rec_ext = np.empty((capacity, len(self.z)))
+        # what changes during the run besides the state: the friction coefficient over time
+        # (kernel_layout D_*), passed to the kernel beside the model's arrays
+        self.drive = m.initial_drive()
         if coupled is not None:
-            self.model.fpar[F_MU0] = coupled.friction_coefficient(0.0, self.z)
-        dcap = capacity if keep_dense else 1
-        self._dense_t0 = np.empty(dcap)
-        self._dense_h = np.empty(dcap)
-        self._dense_coef = np.empty((dcap, 5, N))
+            self.drive[D_MU0] = coupled.friction_coefficient(0.0, self.z)
+        self.arrays = m.kernel_arrays(self.drive)
+        self.recorder = Recorder(m.state_size, len(self.z), capacity, keep_dense)
+        self.stepper: Stepper = CompiledStepper() if backend == "dopri5" else ScipyStepper(backend[6:])
         self._jumps = base_velocity_jumps(scene)
         self._jump_index = 0
         self._hold_until = -math.inf
@@ -230,13 +226,13 @@ class ImpactSolver:
     def set_friction_coefficient(self, mu_start: float, mu_end: float | None = None,
                                  t_end: float | None = None) -> None:
         """Friction coefficient (N^gamma) from now on: constant, or linear to ``mu_end`` at ``t_end``."""
-        fpar = self.model.fpar
-        fpar[F_MU0] = max(float(mu_start), 0.0)
-        fpar[F_T_MU] = self.t
+        drive = self.drive
+        drive[D_MU0] = max(float(mu_start), 0.0)
+        drive[D_T_MU] = self.t
         if mu_end is None or t_end is None or t_end <= self.t:
-            fpar[F_MU_SLOPE] = 0.0
+            drive[D_MU_SLOPE] = 0.0
         else:
-            fpar[F_MU_SLOPE] = (float(mu_end) - float(mu_start)) / (t_end - self.t)
+            drive[D_MU_SLOPE] = (float(mu_end) - float(mu_start)) / (t_end - self.t)
 
     def advance(self, t_target: float, mu=None, *, stop_at_switch: bool = False) -> Segment:
         """Integrate to ``t_target`` (s); ``mu`` = number or (mu_start, mu_end) over the step.
@@ -249,15 +245,16 @@ class ImpactSolver:
         if not math.isfinite(t_target) or t_target < self.t:
             raise ValueError(f"t_target = {t_target!r}: must be a finite time >= the current {self.t!r} s")
         if mu is not None:
-            fpar = self.model.fpar
-            mu_now = fpar[F_MU0] + fpar[F_MU_SLOPE] * (self.t - fpar[F_T_MU])
+            drive = self.drive
+            mu_now = drive[D_MU0] + drive[D_MU_SLOPE] * (self.t - drive[D_T_MU])
             if np.ndim(mu) == 0:
                 self.set_friction_coefficient(float(mu))
             else:
                 self.set_friction_coefficient(float(mu[0]), float(mu[1]), t_target)
-            if self.model.ipar[I_FRICTION] == FRICTION_EXACT and fpar[F_MU0] != max(mu_now, 0.0):
+            if self.model.ipar[I_FRICTION] == FRICTION_EXACT and drive[D_MU0] != max(mu_now, 0.0):
                 self._resolve(triggered=None)  # a new mu may change what can stick
-        n_first = self._n
+        rec = self.recorder
+        n_first = rec.n
         ev_first = len(self.events)
         start_state = self.y.copy()
         t_start = self.t
@@ -266,9 +263,7 @@ class ImpactSolver:
         if self._hold_until > self.t and np.any(self.regime != self._hold_regime):
             self._release_hold()  # the new mu no longer holds a contact at rest
         while self.t < t_target:
-            if self._n >= self._cap - 1:
-                self._grow()
-            n0 = self._n
+            rec.reserve(1)
             goal = t_target
             jump_due = self._jump_index < len(self._jumps) and self._jumps[self._jump_index][0] <= t_target
             if jump_due:
@@ -285,20 +280,20 @@ class ImpactSolver:
             # watched for rest in windows only while a contact is closed (a bar in flight
             # is never at rest, and its steps stay as they were)
             window_end = self._rest_t0 + self.model.rest_window
-            closed = bool(np.any(self._rec_aux[self._n - 1, :, A_Y] > 0.0))
+            closed = bool(np.any(rec.last_aux[:, A_Y] > 0.0))
             if not closed:
                 self._restart_rest_window()
             elif window_end < goal:
                 goal = window_end
                 jump_due = False
             try:
-                status, t_new, h, n_rec, ev = self._segment(goal, n0)
+                n0 = rec.n
+                status, t_new, h, n_rec, ev = self.stepper.segment(self, goal)
             except np.linalg.LinAlgError as err:
                 self.wall_time += time.perf_counter() - tick
                 raise MechSolverError(f"mechanics integration failed at t = {self.t!r} s: {err}",
                                       self.t, self.named_state(), partial=self.result()) from err
-            self._rec_regime[n0:n0 + n_rec] = self.regime
-            self._n += n_rec
+            rec.commit(n_rec, self.regime)
             self.t = t_new
             self.h = h
             if status == DONE:
@@ -327,32 +322,16 @@ class ImpactSolver:
                 self.t, self.named_state(), partial=self.result(),
             )
         self.wall_time += time.perf_counter() - tick
-        n_last = self._n
+        n_last = rec.n
         if self.keep_dense:
-            t0 = self._dense_t0[n_first:n_last].copy()
-            hh = self._dense_h[n_first:n_last].copy()
-            coef = self._dense_coef[n_first:n_last].copy()
+            t0, hh, coef = rec.dense(n_first, n_last)
         else:
             t0 = hh = np.empty(0)
             coef = np.empty((0, 5, m.state_size))
         return Segment(t_start, self.t, self.events[ev_first:], m, t0, hh,
-                       self._rec_t[n_first:n_last].copy(), coef, start_state,
-                       self._rec_regime[n_first:n_last].copy(), self.eref.copy())
-
-    def _segment(self, t_target: float, n0: int):
-        """One call of the stepper backend from the current state towards t_target."""
-        if self.backend != "dopri5":
-            return scipy_segment(self, t_target, self.backend[6:])
-        m = self.model
-        return integrate(
-            self.t, self.y, t_target, self.h, m.max_step, self.scene.solver.rtol, m.atol, m.relmask,
-            m.arrays, self.regime, self.eref, self.ev_sign,
-            self._rec_t[n0:], self._rec_y[n0:], self._rec_aux[n0:], self._rec_fmax[n0:],
-            self._dense_t0[n0:] if self.keep_dense else self._dense_t0,
-            self._dense_h[n0:] if self.keep_dense else self._dense_h,
-            self._dense_coef[n0:] if self.keep_dense else self._dense_coef,
-            self.keep_dense, self.scene.solver.max_steps, self._work, self.stats,
-        )
+                       rec.t[n_first:n_last].copy(), coef, start_state,
+                       rec.regime[n_first:n_last].copy(), self.eref.copy(),
+                       _arrays=m.kernel_arrays(self.drive.copy()))
 
     def run(self):
         """Integrate to ``solver.t_end`` and return the ``ImpactResult``."""
@@ -362,20 +341,14 @@ class ImpactSolver:
     def result(self):
         from .results import ImpactResult
 
-        n = self._n
         return ImpactResult(
             model=self.model,
-            t=self._rec_t[:n].copy(),
-            states=self._rec_y[:n].copy(),
-            aux=self._rec_aux[:n].copy(),
-            peak_force=self._rec_fmax[:n].copy(),
-            regimes=self._rec_regime[:n].copy(),
+            **self.recorder.columns(),
             events=list(self.events),
             stats=dict(steps=int(self.stats[0]), rejected_steps=int(self.stats[1]),
                        rhs_evals=int(self.stats[2]), events=int(self.stats[3]),
                        wall_time=self.wall_time),
             projection_energy=self.projection_energy,
-            extra_states=self._rec_ext[:n].copy(),
         )
 
     def set_modal_state(self, q=None, eta=None) -> None:
@@ -391,7 +364,7 @@ class ImpactSolver:
         ``model.slices()`` except "quad" (pos, angle or quat, q, vel, omega, eta; SI, the
         solver's frame). For what a scene cannot say: a modal initial condition, a start
         already in contact. The run's first record and the regimes are redone."""
-        if self.t != 0.0 or self._n != 1:
+        if self.t != 0.0 or self.recorder.n != 1:
             raise ValueError("start_from: only before the first advance")
         sl = self.model.slices()
         for name, value in parts.items():
@@ -404,7 +377,7 @@ class ImpactSolver:
                 raise ValueError(f"{name}: expected {size} finite number(s), got {value!r}")
             self.y[sl[name]] = arr
         self._initial_state = self.y.copy()
-        self._n = 0
+        self.recorder.truncate(0)
         self._resolve(triggered=None)
         self._record_point()
 
@@ -412,8 +385,8 @@ class ImpactSolver:
         """Everything needed to return to this instant with ``restore`` (records after it are dropped)."""
         return dict(t=self.t, y=self.y.copy(), z=self.z.copy(), h=self.h, regime=self.regime.copy(),
                     eref=self.eref.copy(), ev_sign=self.ev_sign.copy(), stats=self.stats.copy(),
-                    n=self._n, n_events=len(self.events), projection_energy=self.projection_energy,
-                    fpar=self.model.fpar.copy(), jump_index=self._jump_index,
+                    n=self.recorder.n, n_events=len(self.events), projection_energy=self.projection_energy,
+                    drive=self.drive.copy(), jump_index=self._jump_index,
                     rest=(self._hold_until, self._hold_regime.copy(), self._rest_t0, self._rest_ke,
                           [list(h) for h in self.holds]))
 
@@ -426,10 +399,10 @@ class ImpactSolver:
         self.eref[:] = cp["eref"]
         self.ev_sign[:] = cp["ev_sign"]
         self.stats[:] = cp["stats"]
-        self._n = cp["n"]
+        self.recorder.truncate(cp["n"])
         del self.events[cp["n_events"]:]
         self.projection_energy = cp["projection_energy"]
-        self.model.fpar[:] = cp["fpar"]
+        self.drive[:] = cp["drive"]
         self._jump_index = cp["jump_index"]
         self._hold_until, hold_regime, self._rest_t0, self._rest_ke, holds = cp["rest"]
         self._hold_regime = hold_regime.copy()
@@ -442,13 +415,13 @@ class ImpactSolver:
             raise ValueError("contact_series needs the dense output: build the solver with keep_dense=True")
         times = np.asarray(times, dtype=float)
         order = np.argsort(times, kind="stable")
-        n = self._n
-        if len(times) and (times[order[0]] < self._rec_t[0] - 1e-15 or times[order[-1]] > self.t + 1e-15):
-            raise ValueError(f"times must lie in [{self._rec_t[0]!r}, {self.t!r}] s")
+        rec = self.recorder
+        n = rec.n
+        if len(times) and (times[order[0]] < rec.t[0] - 1e-15 or times[order[-1]] > self.t + 1e-15):
+            raise ValueError(f"times must lie in [{rec.t[0]!r}, {self.t!r}] s")
         out = np.empty((len(times), 2, 3))
-        dense_contact(times[order], self._rec_t[:n], self._dense_t0[:n], self._dense_h[:n],
-                      self._dense_coef[:n], self._rec_regime[:n], self.model.arrays, self.eref,
-                      self._work, out)
+        dense_contact(times[order], rec.t[:n], rec.dense_t0[:n], rec.dense_h[:n], rec.dense_coef[:n],
+                      rec.regime[:n], self.arrays, self.eref, self.work, out)
         result = np.empty_like(out)
         result[order] = out
         return result
@@ -481,7 +454,7 @@ class ImpactSolver:
     # --- internals ------------------------------------------------------------------
 
     def _evaluate(self) -> np.ndarray:
-        dynamics(self.t, self.y, self.model.arrays, self.regime, self.eref, self._dy, self._aux, self._work)
+        dynamics(self.t, self.y, self.arrays, self.regime, self.eref, self._dy, self._aux, self.work)
         return self._aux
 
     # --- contacts at rest ------------------------------------------------------------
@@ -517,17 +490,18 @@ class ImpactSolver:
         """
         if self.model.rest_window <= 0.0:
             return
+        rec = self.recorder
         e = self._rest_e
         for k in range(n0, n0 + n_rec):
-            energies(self._rec_y[k], self.model.arrays, self._work, e)
+            energies(rec.y[k], self.arrays, self.work, e)
             if e[0] > self._rest_ke:
                 self._rest_ke = e[0]
         if self.t - self._rest_t0 < self.model.rest_window * (1.0 - 1e-12):
             return
         # closed throughout: a window that began in flight (a segment ending at touchdown
         # is watched before its event is handled) says nothing about rest
-        first = int(np.searchsorted(self._rec_t[:self._n], self._rest_t0, side="right"))
-        if not np.all(np.any(self._rec_aux[first:self._n, :, A_Y] > 0.0, axis=1)):
+        first = int(np.searchsorted(rec.t[:rec.n], self._rest_t0, side="right"))
+        if not np.all(np.any(rec.aux[first:rec.n, :, A_Y] > 0.0, axis=1)):
             self._restart_rest_window()
             return
         tol = self.scene.solver.stick_velocity_tol
@@ -553,17 +527,18 @@ class ImpactSolver:
         Returns False, and leaves the state as it was, if no equilibrium is found or a
         contact would then change its regime."""
         m = self.model
-        n = self._n
-        first = int(np.searchsorted(self._rec_t[:n], self._rest_t0, side="left"))
-        t = self._rec_t[first:n]
+        rec = self.recorder
+        n = rec.n
+        first = int(np.searchsorted(rec.t[:n], self._rest_t0, side="left"))
+        t = rec.t[first:n]
         if len(t) < 2 or t[-1] <= t[0]:
             return False
         npos, nvel = state_sizes(m.n, m.planar)
         saved = (self.y.copy(), self.regime.copy(), self.eref.copy(), self.ev_sign.copy(), self.projection_energy)
         e = self._rest_e
-        energies(self.y, m.arrays, self._work, e)
+        energies(self.y, self.arrays, self.work, e)
         before = float(e.sum())
-        self.y[:npos] = np.trapezoid(self._rec_y[first:n, :npos], t, axis=0) / (t[-1] - t[0])
+        self.y[:npos] = np.trapezoid(rec.y[first:n, :npos], t, axis=0) / (t[-1] - t[0])
         self.y[npos:npos + nvel] = 0.0
         self._normalize_attitude()
         regime = self.regime.copy()
@@ -576,7 +551,7 @@ class ImpactSolver:
                 or np.any((regime == STICK) & (self.regime == SLIP))):
             self.y[:], self.regime[:], self.eref[:], self.ev_sign[:], self.projection_energy = saved
             return False
-        energies(self.y, m.arrays, self._work, e)
+        energies(self.y, self.arrays, self.work, e)
         self.projection_energy += float(e.sum()) - before
         return True
 
@@ -640,50 +615,20 @@ class ImpactSolver:
         sl = m.slices()
         n = m.n
         e = np.empty(5)
-        energies(self.y, m.arrays, self._work, e)
+        energies(self.y, self.arrays, self.work, e)
         ke_before = e[0]
         R = m.rotation(self.y)
         self.y[sl["vel"]] += (dv[0], dv[2]) if m.planar else dv
         L = m.first_moments[:, 1:n + 1]
         self.y[sl["eta"]] -= (L.T @ (R.T @ dv)) / m.fpar[F_MASS]
-        energies(self.y, m.arrays, self._work, e)
+        energies(self.y, self.arrays, self.work, e)
         if resolve:  # (a jump at t = 0 comes before the first record: the audit starts after it)
             self.y[sl["quad"].start + Q_WIN] += e[0] - ke_before
             self._resolve(triggered=None)
 
-    def _grow(self) -> None:
-        cap = 2 * self._cap
-        def grown(a):
-            b = np.empty((cap,) + a.shape[1:], dtype=a.dtype)
-            b[: self._n] = a[: self._n]
-            return b
-        self._rec_t, self._rec_y = grown(self._rec_t), grown(self._rec_y)
-        self._rec_aux, self._rec_fmax = grown(self._rec_aux), grown(self._rec_fmax)
-        self._rec_regime = grown(self._rec_regime)
-        self._rec_ext = grown(self._rec_ext)
-        if self.keep_dense:
-            self._dense_t0, self._dense_h = grown(self._dense_t0), grown(self._dense_h)
-            self._dense_coef = grown(self._dense_coef)
-        self._cap = cap
-
     def _record_point(self) -> None:
-        """Record the current state as a history row (start of the run)."""
-        if self._n >= self._cap - 1:
-            self._grow()
-        aux = self._evaluate()
-        k = self._n
-        self._rec_t[k] = self.t
-        self._rec_y[k] = self.y
-        self._rec_aux[k] = aux
-        self._rec_fmax[k] = aux[:, A_FN]
-        self._rec_regime[k] = self.regime
-        self._rec_ext[k] = self.z
-        if self.keep_dense:  # a zero-length step: evaluates to the state itself
-            self._dense_t0[k] = self.t
-            self._dense_h[k] = 1.0
-            self._dense_coef[k] = 0.0
-            self._dense_coef[k, 0] = self.y
-        self._n += 1
+        """Record the current state as a history row (the start, a hold at rest)."""
+        self.recorder.append(self.t, self.y, self._evaluate(), self.regime, self.z)
 
     def _handle_event(self, ev: int) -> None:
         tip, kind = divmod(ev, NEV_TIP)
@@ -809,7 +754,7 @@ class ImpactSolver:
                 rest[i] = SLIP  # (not at rest: left out of the projection)
         if any_rest:
             self.projection_energy += project_to_stick(
-                self.t, self.y, self.model.arrays, rest, self.eref, self._aux, self._work)
+                self.t, self.y, self.arrays, rest, self.eref, self._aux, self.work)
 
     def _slip_reference(self, i: int, aux: np.ndarray, resisted: np.ndarray) -> np.ndarray:
         """Reference direction of a slip that starts at tip i from (near) rest: the direction
@@ -899,7 +844,7 @@ class ImpactSolver:
         self.regime[:] = new
         aux = self._evaluate()
         g = np.empty(2 * NEV_TIP)
-        events_from_aux(aux, self.eref, self.model.arrays, g)
+        events_from_aux(aux, self.eref, self.arrays, g)
         for i in range(2):
             b = NEV_TIP * i
             self.ev_sign[b + EV_CONTACT] = -1.0 if new[i] == FREE else 1.0

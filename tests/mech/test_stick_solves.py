@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mech.kernel import _min_norm_solve, symmetric_eigen
+from mech.kernel import min_norm_solve, symmetric_eigen
 
 
 def psd_matrices(rng, n, count=200):
@@ -36,6 +36,6 @@ def test_min_norm_solve_is_least_squares_with_a_relative_cut_off_of_1e_7(n):
     rng = np.random.default_rng(10 + n)
     for A in psd_matrices(rng, n):
         rhs = rng.normal(size=n)
-        x = _min_norm_solve(A, rhs)
+        x = min_norm_solve(A, rhs)
         ref = np.linalg.lstsq(A, rhs, rcond=1e-7)[0]
         np.testing.assert_allclose(x, ref, rtol=1e-8, atol=1e-10 * np.max(np.abs(ref)))
