@@ -562,7 +562,7 @@ def resolve_auto_modes(scene: MechScene, safety: float | None = None):
     if bar.axial_modes != "auto" and bar.bending_modes != "auto":
         return scene, None
     if needs_mechanism(scene):
-        axial, bend, t_c, speed = _mechanism_auto_inputs(scene, CAP)
+        axial, bend, t_c, speed = _mechanism_auto_inputs(scene, CAP, SAFETY if safety is None else safety)
         cs = None
     else:
         cs = contact_scales(scene, 0)
@@ -579,23 +579,53 @@ def resolve_auto_modes(scene: MechScene, safety: float | None = None):
     return dataclasses.replace(scene, bar=bar), choice
 
 
-def _mechanism_auto_inputs(scene: MechScene, cap: int):
+def _mechanism_auto_inputs(scene: MechScene, cap: int, safety: float):
     """(axial Hz, bending Hz, contact time s, impact speed m/s) for "auto" on a mechanism
     scene: the frequencies of the bar as held (finite-element modes, rivets' masses on
-    it; bending in its more flexible plane) and the Hertz time of the first contact
-    point's impact on its effective mass (mechanism_scales, from a small basis)."""
+    it; bending in its more flexible plane), every one below f_cut = safety / t_c at least,
+    and the Hertz time t_c of the first contact point's impact on its effective mass
+    (mechanism_scales, from a small basis)."""
     import dataclasses
 
-    from .beam_fe import beam_modes
     from .mechanism import fe_beam
 
     bar = scene.bar
-    beam = fe_beam(scene)
-    axial = beam_modes(beam, "axial", cap).frequencies
-    i22, i33 = bar.second_moments
-    bend = beam_modes(beam, "bend3" if i22 <= i33 else "bend2", cap).frequencies
     small = dataclasses.replace(scene, bar=dataclasses.replace(bar, axial_modes=1, bending_modes=3))
     arr = build_arrays(small, True)
     cs = mechanism_scales(small, arr, arr.basis.n)
     t_c = hertz_impact(cs.reference_mass, cs.stiffness, cs.reference_speed).contact_time
+    beam = fe_beam(scene)
+    i22, i33 = bar.second_moments
+    cutoff = safety / t_c
+    axial = frequencies_below(beam, "axial", cutoff, cap)
+    bend = frequencies_below(beam, "bend3" if i22 <= i33 else "bend2", cutoff, cap)
     return axial, bend, t_c, cs.reference_speed
+
+
+def frequencies_below(beam, family: str, cutoff: float, cap: int, first: int = 8) -> np.ndarray:
+    """Frequencies (Hz, ascending) of the lowest modes of ``family`` of a held bar (a
+    mech.beam_fe.FEBeam), enough of them that the last lies at or above ``cutoff`` (Hz),
+    or ``cap`` of them.
+
+    Solved on the mesh the count needs (beam_fe.default_elements), not on the mesh of
+    ``cap`` modes: a first solve of ``first`` modes, then, if needed, the count the
+    family's growth of frequency with mode number (bending ~ (n + 1/2)^2, axial ~ n)
+    predicts for the cutoff, with a fifth more. The highest mode of a solve is within
+    about 4e-5 of its converged frequency (default_elements), so a count of modes below
+    the cutoff differs from the finest mesh's only for a mode that close to the cutoff;
+    the cap's mesh (255 elements, ~0.3 s of eigen-solves for a blade's two families)
+    was most of the start of a held bar's run.
+    """
+    from .beam_fe import beam_modes
+
+    count = max(1, min(first, cap))
+    while True:
+        f = beam_modes(beam, family, count).frequencies
+        if count >= cap or f[-1] >= cutoff:
+            return f
+        top = f[-1]
+        if family == "axial":
+            needed = count * cutoff / top
+        else:
+            needed = (count + 0.5) * math.sqrt(cutoff / top) - 0.5
+        count = min(cap, max(count + 1, math.ceil(1.2 * needed) + 1))

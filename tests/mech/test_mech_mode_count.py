@@ -126,3 +126,32 @@ def test_scene_files_take_auto_counts_and_name_a_bad_value():
     assert scene_from_dict({"bar": {"modes": "auto"}}).bar.axial_modes == "auto"
     with pytest.raises(ValueError, match=r"bar\.modes = 'many'.*\"auto\""):  # the key the user wrote
         scene_from_dict({"bar": {"modes": "many"}})
+
+
+@pytest.mark.parametrize("length, thickness, clamp", [(0.015, 3e-4, True), (0.04, 2e-4, True), (0.01, 8e-4, False)])
+def test_held_frequencies_below_a_cutoff_equal_those_of_the_finest_mesh(length, thickness, clamp):
+    """"auto" on a held bar solves the finite-element modes on the mesh the count below the
+    cutoff needs; the same frequencies (within the FE error of the coarser mesh's highest
+    mode, 4e-5) and so the same count as on the cap's mesh, for cutoffs across the spectrum."""
+    import numpy as np
+
+    from mech.beam_fe import beam_modes
+    from mech.mechanism import fe_beam
+    from mech.mode_count import count_below
+    from mech.model import frequencies_below
+    from mech.parameters import Mount, Rivet
+
+    bar = Bar(length=length, diameter=None, width=3e-3, thickness=thickness, tip_radius=1.6e-3, youngs_modulus=128e9,
+              density=8250.0)
+    mount = Mount(kind="clamp" if clamp else "pivot", position=length)
+    scene = MechScene(bar=bar, mount=mount, rivets=(Rivet(position=0.1 * length, radius=1.5e-3, mass=2e-5),),
+                      initial=Initial(height=1e-4, velocity=(0.0, 0.0, 0.0)))
+    beam = fe_beam(scene)
+    for family in ("axial", "bend3"):
+        finest = beam_modes(beam, family, CAP).frequencies
+        for cutoff in np.geomspace(0.5 * finest[0], 1.2 * finest[-1], 12):
+            got = frequencies_below(beam, family, cutoff, CAP)
+            below = count_below(got, cutoff)
+            assert below == count_below(finest, cutoff)
+            assert below < len(got) or len(got) == CAP  # the first mode above the cutoff was reached
+            np.testing.assert_allclose(got[:below], finest[:below], rtol=4e-5)
