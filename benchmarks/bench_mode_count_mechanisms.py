@@ -1,0 +1,96 @@
+"""Benchmark: what modes = "auto" holds for on switch mechanisms, coupled, over a whole closure.
+
+Run: .venv/bin/python benchmarks/bench_mode_count_mechanisms.py [--no-write]
+
+bench_mode_count.py checks the rule on free bars over their first impacts (1.2 ms). A switch
+closure is more: a held blade or lever, an actuator, a bounce sequence of 5-10 contacts
+ending in micro-bounces, an arc at each opening. For the built-in default relay (clamped
+CuBe blade) and the pushbutton example (pivoted steel lever), each run coupled as shipped,
+this runs the auto count and a ladder of explicit counts (modes per family, axial and
+bending) and reports, per count, the metrics of `switchsim run --check` against the finest
+count of the ladder: contact-state mismatch time, contacts, bounces, last make, total
+bounce time, peak contact force, first contact's kinematic restitution, arc energy; and
+the run's wall time. Writes the block between the mode-count-mechanisms markers of
+docs/accuracy-modes.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from coupling import builtin_scene, run  # noqa: E402
+from coupling.accuracy import metrics_of, mismatch_time, mode_counts, tip_intervals  # noqa: E402
+from coupling.scene import load_scene  # noqa: E402
+
+DOC = ROOT / "docs" / "accuracy-modes.md"
+BEGIN, END = "<!-- mode-count-mechanisms:begin -->", "<!-- mode-count-mechanisms:end -->"
+CASES = {
+    "default relay (clamped CuBe blade, 24 V / 10 ohm, arc)": lambda: builtin_scene("default"),
+    "pushbutton (pivoted steel lever, 5 V / 1 kohm)": lambda: load_scene(ROOT / "examples" / "pushbutton.toml"),
+}
+LADDER = [(1, 3), (1, 6), (3, 5), (3, 8), (3, 12), (3, 16), (5, 20)]
+
+
+def one(scene) -> tuple[dict, dict, float, dict]:
+    t0 = time.perf_counter()
+    res = run(scene)
+    wall = time.perf_counter() - t0
+    m = metrics_of(res)
+    c = res.mechanics.contacts
+    m["restitution"] = float(c.kinematic_restitution.iloc[0]) if len(c) else float("nan")
+    return m, tip_intervals(res), wall, mode_counts(res)
+
+
+def table(name: str, base) -> tuple[list[str], dict]:
+    rows = [("auto", base)] + [(f"{a}, {b}", base.update({"bar.modes": {"axial": a, "bending": b}}))
+                               for a, b in LADDER]
+    results = [(label, *one(sc)) for label, sc in rows]
+    ref_m, ref_iv = results[-1][1], results[-1][2]
+    lines = [f"**{name}**, against the finest count ({results[-1][0]}):", "",
+             "| modes (axial, bending) | mismatch (us) | contacts | bounces | last make (ms) | total bounce time (ms) "
+             "| peak force (N) | first restitution | arc energy (mJ) | wall (s) |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for label, m, iv, wall, counts in results:
+        mism = sum(mismatch_time(iv.get(k, []), ref_iv.get(k, [])) for k in set(iv) | set(ref_iv))
+        shown = label if label != "auto" else f"auto ({counts['axial']}, {counts['bending']})"
+        arc = m.get("arc_energy")
+        lines.append(
+            f"| {shown} | {mism * 1e6:.0f} | {m['contacts']} | {m['bounces']} | {m['last_make'] * 1e3:.3f} | "
+            f"{m['total_bounce_time'] * 1e3:.3f} | {m['peak_force']:.2f} | {m['restitution']:.3f} | "
+            f"{'-' if arc is None else f'{arc * 1e3:.2f}'} | {wall:.2f} |")
+        print(lines[-1], flush=True)
+    return lines + [""], dict(ref=ref_m)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--no-write", action="store_true")
+    args = ap.parse_args()
+    lines = []
+    for name, make in CASES.items():
+        part, _ = table(name, make())
+        lines += part
+    text = "\n".join([f"`.venv/bin/python benchmarks/bench_mode_count_mechanisms.py`; rows in modes per family "
+                      f"(axial, bending); mismatch: contact-state mismatch time against the last row.", ""] + lines
+                     + [f"Load average at the end of the run: {os.getloadavg()[0]:.1f} (2 cores)."])
+    if not args.no_write:
+        doc = DOC.read_text()
+        block = f"{BEGIN}\n{text}\n{END}"
+        if BEGIN in doc:
+            doc = re.sub(re.escape(BEGIN) + r".*?" + re.escape(END), lambda _: block, doc, flags=re.S)
+        else:
+            doc = doc.rstrip("\n") + "\n\n" + block + "\n"
+        DOC.write_text(doc)
+        print(f"written to {DOC.relative_to(ROOT)}")
+
+
+if __name__ == "__main__":
+    main()
