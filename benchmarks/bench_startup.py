@@ -93,6 +93,8 @@ PHASES = textwrap.dedent("""
     folder.write(result, {"soundness": soundness})
     mark("write the default outputs")
     stats = result.stats
+    import gc
+    gc.freeze()  # as coupling.cli.main does when the process's own command line returns
     phases = [(b[0], b[1] - a[1]) for a, b in zip(marks, marks[1:])]
     print(json.dumps(dict(phases=phases, wall_time=stats.get("wall_time", 0.0),
                           mech=stats.get("mech_seconds"), circuit=stats.get("circuit_seconds"),
