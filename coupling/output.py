@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import itertools
 import json
 import math
 import os
@@ -228,9 +229,9 @@ def write_csv(path: Path, columns: dict, codes: dict | None = None) -> None:
             writer.writerows(zip(*cells))
             return
         fh.write(",".join(names) + "\n")
-        if cells and cells[0]:
-            fh.write("\n".join(map(",".join, zip(*cells))))
-            fh.write("\n")
+        rows = zip(*cells)
+        while chunk := list(itertools.islice(rows, 200)):  # in pieces: the whole text is never held (peak RSS as with csv.writer)
+            fh.write("\n".join(map(",".join, chunk)) + "\n")
 
 
 # what makes csv.writer (QUOTE_MINIMAL, "," and '"', "\n" line ends) quote a field
