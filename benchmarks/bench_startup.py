@@ -116,6 +116,19 @@ def phases(scene: str, out: str) -> dict:
     return doc
 
 
+def _bytecode_note() -> str:
+    """Whether the children run switchsim from compiled bytecode: with PYTHONDONTWRITEBYTECODE
+    set and no cache of this tree, every start compiles switchsim's ~50 modules from source
+    (~0.05-0.09 s of the import and scene phases here)."""
+    import importlib.util
+
+    cached = os.path.exists(importlib.util.cache_from_source(str(ROOT / "coupling" / "cli.py")))
+    if not sys.flags.dont_write_bytecode:
+        return "bytecode caches on"
+    return "PYTHONDONTWRITEBYTECODE set, " + ("bytecode caches present" if cached else
+                                              "no bytecode cache: each start compiles switchsim's modules from source")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=5)
@@ -160,7 +173,7 @@ def main() -> None:
 
     lines = [f"`.venv/bin/python benchmarks/bench_startup.py --repeat {args.repeat}` "
              f"(load average {load:.1f} at the end; median of {args.repeat}, whole process, "
-             f"peak RSS from wait4)", "",
+             f"peak RSS from wait4); {_bytecode_note()}", "",
              "| command | wall | best | / `import numpy` | peak RSS |", "|---|---|---|---|---|"]
     for label, med, best, rss in rows:
         lines.append(f"| {label} | {med:.3f} s | {best:.3f} s | {med / base:.1f}x | {rss:.0f} MiB |")
