@@ -93,6 +93,8 @@ PHASES = textwrap.dedent("""
     folder.write(result, {"soundness": soundness})
     mark("write the default outputs")
     stats = result.stats
+    import gc
+    gc.freeze()  # as coupling.cli.main does when the process's own command line returns
     phases = [(b[0], b[1] - a[1]) for a, b in zip(marks, marks[1:])]
     print(json.dumps(dict(phases=phases, wall_time=stats.get("wall_time", 0.0),
                           mech=stats.get("mech_seconds"), circuit=stats.get("circuit_seconds"),
@@ -112,6 +114,19 @@ def phases(scene: str, out: str) -> dict:
                      + [("exit (interpreter teardown)", end - doc["wall1"])])
     doc["whole"] = end - spawn
     return doc
+
+
+def _bytecode_note() -> str:
+    """Whether the children run switchsim from compiled bytecode: with PYTHONDONTWRITEBYTECODE
+    set and no cache of this tree, every start compiles switchsim's ~50 modules from source
+    (~0.05-0.09 s of the import and scene phases here)."""
+    import importlib.util
+
+    cached = os.path.exists(importlib.util.cache_from_source(str(ROOT / "coupling" / "cli.py")))
+    if not sys.flags.dont_write_bytecode:
+        return "bytecode caches on"
+    return "PYTHONDONTWRITEBYTECODE set, " + ("bytecode caches present" if cached else
+                                              "no bytecode cache: each start compiles switchsim's modules from source")
 
 
 def main() -> None:
@@ -158,7 +173,7 @@ def main() -> None:
 
     lines = [f"`.venv/bin/python benchmarks/bench_startup.py --repeat {args.repeat}` "
              f"(load average {load:.1f} at the end; median of {args.repeat}, whole process, "
-             f"peak RSS from wait4)", "",
+             f"peak RSS from wait4); {_bytecode_note()}", "",
              "| command | wall | best | / `import numpy` | peak RSS |", "|---|---|---|---|---|"]
     for label, med, best, rss in rows:
         lines.append(f"| {label} | {med:.3f} s | {best:.3f} s | {med / base:.1f}x | {rss:.0f} MiB |")
