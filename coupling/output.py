@@ -149,8 +149,7 @@ def write_files(result, folder: Path, summary_extra: dict | None = None) -> None
     # the result writes its own tables and plots; the history is written thinned, here
     view = dataclasses.replace(result, scene=dataclasses.replace(
         scene, output=dataclasses.replace(opts, history=False)))
-    view.save(folder)
-    summary = result.summary
+    summary = view.write_tables(folder)
     if result.mechanics is not None and opts.history:
         t = result.mechanics.t
         interval = opts.history_interval(float(t[-1] - t[0]) if len(t) else 0.0)

@@ -143,21 +143,26 @@ class CoupledResult:
         return out
 
     def save(self, out_dir) -> Path:
-        """Write summary.json, the waveforms (CSV, parquet, the interactive waveforms.html),
-        openings.csv, the mechanics tables and PNG plots, as the scene's [output] asks."""
+        """Write the waveforms (CSV, parquet, the interactive waveforms.html), openings.csv,
+        the mechanics tables and PNG plots, as the scene's [output] asks, then summary.json."""
+        out = Path(out_dir)
+        summary = self.write_tables(out)
+        (out / "summary.json").write_text(json.dumps(summary, indent=2))
+        return out
+
+    def write_tables(self, out: Path) -> dict:
+        """Every file of ``save`` but summary.json, into the folder ``out`` (made if missing);
+        returns the summary with what the writing found (``waveforms_html``)."""
         from .output import write_csv, write_parquet
 
-        out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
         opts = self.scene.output
         summary = self.summary
-        html = None
         if self.waveform_columns is not None and getattr(opts, "html", True):
             from .waveview import write_waveform_html
 
             html = write_waveform_html(self, out / "waveforms.html")
             summary["waveforms_html"] = "waveforms.html" if html == "written" else html
-        (out / "summary.json").write_text(json.dumps(summary, indent=2))
         if self.waveform_columns is not None:
             waves = self.waveform_columns
             if opts.csv:
@@ -178,7 +183,7 @@ class CoupledResult:
             from .plots import save_plots
 
             save_plots(self, out)
-        return out
+        return summary
 
 
 def event_columns(events: list[dict]) -> dict:

@@ -100,6 +100,8 @@ def test_coupled_scene_imports_pyspice_and_pyarrow_only(tmp_path):
     _requires_aot()
     assert _loaded(tmp_path, MECH.format(plots="false") + CIRCUIT) == {"PySpice", "pyarrow"}
     assert (tmp_path / "out" / "waveforms.html").stat().st_size > 1_000_000
+    # the summary, written last, records the page as docs/coupling.md says
+    assert json.loads((tmp_path / "out" / "summary.json").read_text())["waveforms_html"] == "waveforms.html"
 
 
 def test_default_scene_imports_pyspice_and_pyarrow_only_and_writes_its_documented_outputs(tmp_path):
