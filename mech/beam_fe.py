@@ -515,7 +515,9 @@ def _solve(beam: FEBeam, system: FESystem, cond: str, count: int):
     """
     K, M = system.stiffness, system.mass
     ndof = K.shape[0]
-    keep = np.setdiff1d(np.arange(ndof), system.constrained)
+    free = np.ones(ndof, dtype=bool)  # (np.setdiff1d would import numpy.ma, ~10 ms of a run's start)
+    free[system.constrained] = False
+    keep = np.flatnonzero(free)
     x_ref = beam.centroid if cond == "free" else float(beam.support_position)
     rigid = _rigid_shapes(system, cond, x_ref)
     r = len(rigid)
@@ -672,7 +674,8 @@ def point_shapes(modes: Sequence[BeamModes], x, offset=0.0, offset2=0.0):
 
 def _quadrature_points(modes: Sequence[BeamModes], L: float):
     """Gauss points (4 per interval of the union of all meshes): exact for the FE shapes."""
-    nodes = np.unique(np.concatenate([m.nodes for m in modes] + [np.array([0.0, L])]))
+    # sorted; repeated nodes go with the coincident ones below (np.unique would import numpy.ma)
+    nodes = np.sort(np.concatenate([m.nodes for m in modes] + [np.array([0.0, L])]))
     keep = np.concatenate([[True], np.diff(nodes) > _COINCIDENT * L])
     nodes = nodes[keep]
     nodes[-1] = L

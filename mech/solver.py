@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .compiled import (
-    dense_contact, dense_eval, dense_tip_forces, dynamics, energies, events_from_aux, make_work,
+    dense_contact, dense_eval, dense_tip_forces, dynamics, energies, energy_table, events_from_aux, make_work,
     project_to_stick,
 )
 from .kernel_layout import (
@@ -491,11 +491,8 @@ class ImpactSolver:
         if self.model.rest_window <= 0.0:
             return
         rec = self.recorder
-        e = self._rest_e
-        for k in range(n0, n0 + n_rec):
-            energies(rec.y[k], self.arrays, self.work, e)
-            if e[0] > self._rest_ke:
-                self._rest_ke = e[0]
+        if n_rec:  # the largest kinetic energy of the new records, in one compiled call
+            self._rest_ke = max(self._rest_ke, float(energy_table(rec.y[n0:n0 + n_rec], self.arrays)[:, 0].max()))
         if self.t - self._rest_t0 < self.model.rest_window * (1.0 - 1e-12):
             return
         # closed throughout: a window that began in flight (a segment ending at touchdown
