@@ -345,16 +345,14 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
                 first_theta = 1.0
             dynamics(tev, ymid, mdl, regime, eref, ytmp, aux_new, work)
             stats[2] += 1
-            _record(n_rec, t, h, tev, ymid, aux_new, aux_old, coef, rec, dense, store_dense,
-                    mdl, regime, eref, work, ytmp, aux_stage, first_theta)
+            _record(n_rec, t, h, tev, ymid, aux_new, aux_old, coef, rec, dense, store_dense, mdl, first_theta)
             n_rec += 1
             for i in range(N):
                 y[i] = ymid[i]
             stats[0] += 1
             stats[3] += 1
             return EVENT, tev, h_continue, n_rec, first_k
-        _record(n_rec, t, h, t + h, ynew, aux_new, aux_old, coef, rec, dense, store_dense,
-                mdl, regime, eref, work, ytmp, aux_stage, 1.0)
+        _record(n_rec, t, h, t + h, ynew, aux_new, aux_old, coef, rec, dense, store_dense, mdl, 1.0)
         n_rec += 1
         stats[0] += 1
         for k in range(nev):
@@ -381,8 +379,7 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
 
 
 @njit(cache=True)
-def _record(n_rec, t_start, h, t_end, y_end, aux_end, aux_start, coef, rec, dense, store_dense,
-            mdl, regime, eref, work, scratch, aux_scratch, theta_end):
+def _record(n_rec, t_start, h, t_end, y_end, aux_end, aux_start, coef, rec, dense, store_dense, mdl, theta_end):
     """Store an accepted step in row n_rec of rec (and its dense-output coefficients in
     dense when kept); its peak normal force is sampled at both ends and 3 interior points."""
     rec_t, rec_y, rec_aux, rec_fmax = rec
@@ -403,12 +400,13 @@ def _record(n_rec, t_start, h, t_end, y_end, aux_end, aux_start, coef, rec, dens
         rec_fmax[n_rec, i] = max(aux_end[i, A_FN], aux_start[i, A_FN])
     if aux_end[0, A_Y] > 0.0 or aux_end[1, A_Y] > 0.0 or aux_start[0, A_Y] > 0.0 or aux_start[1, A_Y] > 0.0:
         ymid = np.empty(N)
+        forces = np.empty(5)
         for f in (0.25, 0.5, 0.75):
             dense_eval(coef, f * theta_end, ymid)
-            dynamics(0.0, ymid, mdl, regime, eref, scratch, aux_scratch, work)
+            tip_forces(ymid, mdl, forces)  # the normal forces alone: no right-hand side
             for i in range(2):
-                if aux_scratch[i, A_FN] > rec_fmax[n_rec, i]:
-                    rec_fmax[n_rec, i] = aux_scratch[i, A_FN]
+                if forces[i] > rec_fmax[n_rec, i]:
+                    rec_fmax[n_rec, i] = forces[i]
 
 
 @njit(cache=True)
@@ -453,6 +451,15 @@ def dense_tip_forces(t, t_valid, dense_t0, dense_h, dense_coef, mdl, out):
     N = dense_coef.shape[2]
     y = np.empty(N)
     dense_eval(dense_coef[k], (t - dense_t0[k]) / dense_h[k], y)
+    tip_forces(y, mdl, out)
+
+
+@njit(cache=True)
+def tip_forces(y, mdl, out):
+    """out = (F_0, F_1, gap, y_0, y_1) of state y: each contact point's normal force (N),
+    the nearer one's gap (m, 0 when touching) and each one's penetration (m), from the
+    kinematics alone (the normal force follows the penetration and its rate; no
+    accelerations, so a fraction of a right-hand side's cost)."""
     fpar, ipar, psi, xc, cpar = mdl[0], mdl[1], mdl[6], mdl[8], mdl[9]
     n = ipar[I_N]
     planar = ipar[I_PLANAR]

@@ -331,3 +331,36 @@ def test_the_compiled_cache_folder_follows_the_mechanics_sources(tmp_path):
     changed = source_key(tmp_path)
     (tmp_path / "kernel.py").write_text("x = 1\n")
     assert changed != before and source_key(tmp_path) == before
+
+
+@pytest.mark.parametrize("name", ["free_drop", "default", "pushbutton"])
+def test_normal_forces_from_the_kinematics_equal_the_right_hand_sides(name):
+    """The peak-force samples inside a step and the circuit's force callback evaluate only
+    the contact kinematics (integrator.tip_forces); at every recorded state of a run (a free
+    3D bar with friction, the relay blade on a spherical rivet, the pivoted lever) they give
+    the normal forces and penetrations of the full right-hand side."""
+    from pathlib import Path
+
+    from coupling.scene import builtin_scene, load_scene
+    from mech import ImpactSolver
+    from mech.compiled import dense_tip_forces, dynamics, make_work
+    from mech.kernel_layout import A_FN, A_Y, NAUX
+
+    root = Path(__file__).resolve().parents[2]
+    scene = load_scene(root / "examples" / "pushbutton.toml") if name == "pushbutton" else builtin_scene(name)
+    solver = ImpactSolver(scene.mech)
+    res = solver.run()
+    arrays, work = solver.arrays, make_work(solver.model.n)
+    aux, dy, out = np.empty((2, NAUX)), np.empty(res.states.shape[1]), np.empty(5)
+    touched = 0
+    for k in np.linspace(0, len(res.t) - 1, 300).astype(int):
+        y = np.ascontiguousarray(res.states[k])
+        dynamics(res.t[k], y, arrays, res.regimes[k], solver.eref, dy, aux, work)
+        coef = np.zeros((1, 5, len(y)))
+        coef[0, 0] = y  # a one-point dense output: the state itself
+        dense_tip_forces(res.t[k], np.array([res.t[k]]), np.array([res.t[k]]), np.ones(1), coef, arrays, out)
+        np.testing.assert_allclose(out[:2], aux[:, A_FN], rtol=1e-12, atol=1e-12 * max(1.0, aux[:, A_FN].max()))
+        on = solver.model.cpar[:, 3] > 0.0
+        np.testing.assert_allclose(out[3:][on], aux[on, A_Y], rtol=1e-12, atol=1e-15)
+        touched += int(aux[:, A_FN].max() > 0.0)
+    assert touched > 10  # the check saw contacts carrying force
