@@ -26,7 +26,7 @@ def main() -> None:
     tick = time.perf_counter()
     ref_res = run(base.update({"circuit.reltol": REFERENCE["reltol"], "coupling.macro_step": REFERENCE["macro_step"]}))
     ref = coupled_metrics(ref_res)
-    sec.add(f"The default coupled scene (24 V, 12 ohm, 1 uH wiring, arc; 3 modes), 20 um above the block, 2 ms, "
+    sec.add(f"The free-drop scene (`builtin_scene('free_drop')`: 24 V, 12 ohm, 1 uH wiring, arc; 3 modes), 20 um above the block, 2 ms, "
             f"against RELTOL {REFERENCE['reltol']:g} with a {REFERENCE['macro_step'] * 1e6:g} us macro step "
             f"({time.perf_counter() - tick:.1f} s; {ref['bounces']} bounces, peak contact voltage "
             f"{ref['peak_contact_voltage']:.4g} V, closed-contact voltage {ref['closed_voltage'] * 1e3:.4g} mV "

@@ -184,7 +184,7 @@ def git_commit() -> str:
 # --- coupled runs -----------------------------------------------------------------------
 
 def short_default_scene():
-    """The built-in default coupled scene (24 V, 12 ohm, arc, 3 modes), released 20 um above
+    """The built-in free-drop scene (builtin_scene("free_drop"): 24 V, 12 ohm, arc, 3 modes), released 20 um above
     the block (first make at 20 us), 2 ms, no files."""
     from coupling import builtin_scene
 

@@ -74,7 +74,7 @@ def main() -> None:
         print(f"arc reference {scheme}: {time.perf_counter() - tick:.1f} s", file=sys.stderr, flush=True)
     aref = refs["mechanics_first"]
     cross = coupled_errors(refs["jacobi"], aref)
-    sec.add("", f"**(b) The arc**: the built-in default scene (24 V, 12 ohm, arc, 3 modes), released 20 um above the "
+    sec.add("", f"**(b) The arc**: the built-in free-drop scene (24 V, 12 ohm, arc, 3 modes), released 20 um above the "
             f"block, 2 ms, against itself with mechanics_first at a macro step of {ARC_REFERENCE_STEP * 1e6:g} us "
             f"({aref['contacts']} contacts, {aref['bounces']} bounces, arc energy {aref['arc_energy'] * 1e3:.4g} mJ, "
             f"peak contact voltage {aref['peak_contact_voltage']:.4g} V). Jacobi at the same step differs from it by: "

@@ -37,7 +37,7 @@ def mech(changes: dict, checks: dict | None = None) -> dict:
 
 
 def coupled(changes: dict, checks: dict | None = None) -> dict:
-    """The built-in default coupled scene (arc, 24 V, 12 ohm), 20 um above the block, 2 ms."""
+    """The built-in free-drop scene (arc, 24 V, 12 ohm), 20 um above the block, 2 ms."""
     import tomllib
 
     from coupling.scene import builtin_scene_text
@@ -151,7 +151,7 @@ def main() -> None:
             f"{TIMEOUT:g} s: a hang is recorded as such), {args.jobs} at a time. Mechanics cases start from the "
             "default bar (10 mm steel, 0.3 m, 5 mm tips, 3 modes per family) 10 um above a steel block at 30 deg, "
             "1 m/s down, restitution 0.8, rtol 1e-6, 1 ms, and change what the case names; circuit cases start "
-            "from the built-in default coupled scene (24 V, 12 ohm, arc) 20 um above the block, 2 ms. "
+            "from the built-in free-drop scene (24 V, 12 ohm, arc) 20 um above the block, 2 ms. "
             "Status: ok / ok, flagged (the result carries a flag or a warning) / unsound (a soundness bound "
             "fails: switchsim run's exit 3) / rejected (a clear error before the run) / "
             "failed (a run error with a message) / crash (an unexpected exception) / timeout. "
