@@ -162,7 +162,7 @@ def test_a_fresh_process_prints_nothing():
     assert done.stderr == ""
 
 
-def test_ctrl_c_interrupts_a_run():
+def test_ctrl_c_interrupts_a_run(sigint_raises):
     """ngspice swaps in its own SIGINT handler while it runs (it pauses); either way Python sees KeyboardInterrupt."""
     import signal
 

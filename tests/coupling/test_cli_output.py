@@ -315,7 +315,7 @@ def test_ctrl_c_in_a_coupled_run_writes_the_partial_result_marked_interrupted_an
     assert staging_left(tmp_path) == []
 
 
-def test_ctrl_c_in_a_mechanics_run_keeps_the_partial_result(tmp_path):
+def test_ctrl_c_in_a_mechanics_run_keeps_the_partial_result(tmp_path, sigint_raises):
     """The same for the mechanics alone (KeyboardInterrupt delivered as SIGINT would, in-process)."""
     import _thread
     import threading

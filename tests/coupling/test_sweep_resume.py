@@ -72,7 +72,8 @@ def _start(sweep: Path, out: Path, *extra: str) -> subprocess.Popen:
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
     return subprocess.Popen([sys.executable, "-m", "coupling.cli", "sweep", str(sweep), "--out", str(out),
                              "--quiet", *extra],
-                            env=env, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                            env=env, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # see tests/conftest.py
 
 
 def _wait_rows(out: Path, proc: subprocess.Popen, at_least: int, timeout: float = 120.0) -> int:
