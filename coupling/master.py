@@ -159,6 +159,7 @@ class CoSimulation:
         # a current not known yet, so the first step is a short one, as after a make
         jump_since_prev = bool(np.any(mech.contact_now()[:, 0] > 0.0))
         rate, scale = 0.0, math.inf  # dI/dt of the loop current at t (A/s) and its time scale (s)
+        quiet = 0.0  # s: the last step's length if the contact stayed closed and the current steady
         try:
             with stepper, _deferred_interrupt() as interrupted:
                 while t < t_end * (1.0 - 1e-14):
@@ -169,7 +170,7 @@ class CoSimulation:
                     resting = mech.at_rest and not jump_since_prev
                     touching = not resting and (jump_since_prev or bool(np.any(mech.friction_engaged())) or bool(
                         np.any(mech.contact_now()[:, 0] > 0.0)))
-                    t_next = policy.base_end(t, t_end, touching)
+                    t_next = policy.base_end(t, t_end, touching, previous=quiet)
                     if resting and mech.hold_until < t_next:
                         t_next = mech.hold_until
                     if opts.scheme == "jacobi":
@@ -179,6 +180,8 @@ class CoSimulation:
                                                     current=i_now, rate=rate, scale=scale)
                         t_new, current, jumped, (rate, scale) = self._mechanics_first_step(
                             mech, stepper, rl, t, t_next, i_now, slope, scale)
+                        quiet = t_new - t if (touching and not jumped and not jump_since_prev and policy.steady(
+                            current, rate, 2.0 * (t_new - t))) else 0.0
                         i_now, t = current, t_new
                         jump_since_prev = jumped
                     self.stats["macro_steps"] += 1
@@ -384,6 +387,7 @@ PROBE_TIME = 1e-4  # s: the step right after a current jump is H^2 / PROBE_TIME 
 TIME_SCALE_FRACTION = 0.5
 CHANGE_FRACTION = 1e-3  # the time-scale rule applies only where a step would change the current by more
 CURRENT_FLOOR = 1e-3  # A: floor of |I| in the cautious time scale |I|/|dI/dt|
+GROWTH_CAP = 4.0  # macro steps: the longest step in a closed contact with a steady current
 TAIL_POINTS = 8  # circuit points kept across macro steps for the slope and its curvature
 
 
@@ -393,7 +397,15 @@ class StepPolicy:
     and how the loop current is extrapolated over it. Times in s, currents in A.
 
     - ``base_end``: a macro step while a tip touches (or right after a jump), the longer
-      ``free_step`` while both are free; no sliver step (< 1e-3 H) left before t_end.
+      ``free_step`` while both are free; no sliver step (< 1e-3 H) left before t_end. While
+      a contact stays closed and the current steady (``previous``: the last step's length
+      when it made or broke nothing and the current moved less than the change rule of
+      ``plan`` allows), the step doubles per step up to ``growth_cap`` macro steps: the
+      mechanics find a make or break inside a long step and the step is cut there
+      (``aligned_end``), ngspice reads the mechanics' conductance at its own points, and
+      every step stays proportional to H, so the coupling keeps its order. A settled
+      contact under a slow force (the default relay after its bounces) then takes a
+      quarter of the macro steps.
     - ``plan`` (scheme mechanics_first): right after a make/break the current has jumped
       and is known only at the jump, so a short probe step H^2 / probe_time with the current
       held (zero-order hold: O(H^2) error, still second order); otherwise a Taylor step
@@ -413,9 +425,10 @@ class StepPolicy:
     time_scale_fraction: float = TIME_SCALE_FRACTION
     change_fraction: float = CHANGE_FRACTION
     current_floor: float = CURRENT_FLOOR
+    growth_cap: float = GROWTH_CAP
 
     def __post_init__(self):
-        for name in ("macro_step", "free_step", "probe_time", "time_scale_fraction", "current_floor"):
+        for name in ("macro_step", "free_step", "probe_time", "time_scale_fraction", "current_floor", "growth_cap"):
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise ValueError(f"StepPolicy.{name} = {value!r}: must be a finite number > 0")
@@ -434,9 +447,16 @@ class StepPolicy:
         """s: the short step that fetches the current right after a make/break (H^2 / probe_time)."""
         return self.macro_step ** 2 / self.probe_time
 
-    def base_end(self, t: float, t_end: float, touching: bool) -> float:
-        """s: the end of the next step before the current is looked at."""
-        t_next = min(t + (self.macro_step if touching else self.free_step), t_end)
+    def base_end(self, t: float, t_end: float, touching: bool, previous: float = 0.0) -> float:
+        """s: the end of the next step before the current is looked at; ``previous``: the
+        length (s) of the step before when the contact stayed closed over it with a steady
+        current (0: it did not, see ``steady``)."""
+        step = self.free_step
+        if touching:
+            step = self.macro_step
+            if previous > 0.0:
+                step = min(self.free_step, self.growth_cap * self.macro_step, max(self.macro_step, 2.0 * previous))
+        t_next = min(t + step, t_end)
         if t_end - t_next < 1e-3 * self.macro_step:
             t_next = t_end  # no sliver step at the end
         return t_next
@@ -447,9 +467,14 @@ class StepPolicy:
         proposed to end at t_next, given the current (A), its rate dI/dt (A/s) and time scale (s)."""
         if jumped:
             return min(t + self.probe, t_end), 0.0
-        if touching and abs(rate) * (t_next - t) > self.change_fraction * (abs(current) + self.current_floor):
+        if touching and not self.steady(current, rate, t_next - t):
             t_next = min(t_next, t + max(self.probe, self.time_scale_fraction * scale))
         return t_next, rate
+
+    def steady(self, current: float, rate: float, span: float) -> bool:
+        """True if the current (A) at rate dI/dt (A/s) moves by no more than the change rule
+        of ``plan`` allows over ``span`` (s)."""
+        return abs(rate) * span <= self.change_fraction * (abs(current) + self.current_floor)
 
     @staticmethod
     def extrapolate(current: float, slope: float, elapsed: float, horizon: float = math.inf) -> float:

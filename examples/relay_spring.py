@@ -121,8 +121,11 @@ def closing_metrics(result, release: float) -> dict:
     w = result.waveforms
     t_hold = min(release, sc.t_end)
     sel = (w.time >= t_hold - HOLD_WINDOW) & (w.time <= t_hold)
-    fn = w.normal_force[sel].to_numpy()
-    out.update(held_force=float(np.mean(fn)), held_force_min=float(np.min(fn)), held_force_max=float(np.max(fn)))
+    fn, tw = w.normal_force[sel].to_numpy(), w.time[sel].to_numpy()
+    # the time average (the circuit's points are not evenly spaced: a plain mean of them
+    # weights where ngspice stepped finely)
+    held = float(np.trapezoid(fn, tw) / (tw[-1] - tw[0])) if len(tw) > 1 else float(fn.mean())
+    out.update(held_force=held, held_force_min=float(np.min(fn)), held_force_max=float(np.max(fn)))
     return out
 
 

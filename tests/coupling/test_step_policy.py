@@ -181,3 +181,46 @@ def test_one_cosimulation_runs_again_with_the_same_result_and_leaves_ngspice_fre
     assert second.summary["bounce"] == first.summary["bounce"]
     np.testing.assert_array_equal(second.waveforms.contact_voltage.to_numpy(),
                                   first.waveforms.contact_voltage.to_numpy())
+
+
+def test_steps_grow_while_a_contact_stays_closed_and_restart_after_a_jump():
+    p = policy()
+    assert p.base_end(0.0, 1.0, touching=True, previous=H) == pytest.approx(2 * H)
+    assert p.base_end(0.0, 1.0, touching=True, previous=3 * H) == pytest.approx(p.growth_cap * H)  # capped
+    assert p.base_end(0.0, 1.0, touching=True, previous=p.probe) == H  # after a probe: the macro step
+    assert p.base_end(0.0, 1.0, touching=True, previous=0.0) == H  # the last step made or broke a contact
+    assert p.base_end(0.0, 1.0, touching=False, previous=H) == 1e-3  # free flight: the free step as before
+    # steady: the change rule of plan() over the span
+    assert p.steady(current=1.0, rate=1.0, span=1e-4)
+    assert not p.steady(current=1.0, rate=1e3, span=1e-4)
+
+
+def test_growing_steps_in_a_closed_contact_change_no_checked_metric():
+    """The default relay over 3 ms (bounces, then 1.5 ms closed with the blade ringing
+    under the rising armature force): steps that grow while the contact stays closed agree
+    with steps held at the macro step within run --check's tolerances on every metric and
+    on the waveforms, in a fraction of the macro steps."""
+    import dataclasses
+
+    from coupling import CoSimulation, builtin_scene
+    from coupling.accuracy import compare, metrics_of, tip_intervals
+
+    scene = builtin_scene("default").update({"solver.t_end": 0.003})
+    runs = {}
+    for cap in (1.0, 4.0):
+        sim = CoSimulation(scene)
+        sim.policy = dataclasses.replace(sim.policy, growth_cap=cap)
+        runs[cap] = sim.run()
+    held, grown = runs[1.0], runs[4.0]
+    diff = compare(metrics_of(held), metrics_of(grown), tip_intervals(held), tip_intervals(grown))
+    assert diff["moved"] == [], diff
+    assert grown.stats["macro_steps"] < 0.6 * held.stats["macro_steps"]
+    t = np.linspace(0.0, 0.003, 3001)
+    for name, scale in (("contact_voltage", 24.0), ("load_current", 2.4)):
+        a = np.interp(t, held.waveform_columns["time"], held.waveform_columns[name])
+        b = np.interp(t, grown.waveform_columns["time"], grown.waveform_columns[name])
+        assert np.sqrt(np.mean((a - b) ** 2)) < 1e-3 * scale, name
+    # the motion: the contact force from the mechanics' own records (steps of ~1 us)
+    ha, hb = held.mechanics.history, grown.mechanics.history
+    a, b = np.interp(t, ha.time, ha.normal_force_0), np.interp(t, hb.time, hb.normal_force_0)
+    assert np.sqrt(np.mean((a - b) ** 2)) < 1e-3 * 1.5
