@@ -17,10 +17,11 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
-import re
 import sys
 import time
 from pathlib import Path
+
+from doc_block import write_block
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -78,12 +79,7 @@ def main() -> None:
     text = "\n".join(lines)
     print(text)
     if not args.no_write:
-        doc_path = ROOT / "docs" / "benchmarks.md"
-        doc = doc_path.read_text()
-        begin, end = "<!-- auto-cost:begin -->", "<!-- auto-cost:end -->"
-        block = f"{begin}\n{text}\n{end}"
-        doc = re.sub(re.escape(begin) + r".*?" + re.escape(end), lambda _: block, doc, flags=re.S)
-        doc_path.write_text(doc)
+        write_block(ROOT / "docs" / "benchmarks.md", "<!-- auto-cost:begin -->", "<!-- auto-cost:end -->", text)
         print("written to docs/benchmarks.md")
 
 

@@ -46,6 +46,8 @@ import sys
 import time
 from pathlib import Path
 
+from doc_block import write_block
+
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # before numpy: no BLAS threads on a shared box
 
 import numpy as np  # noqa: E402
@@ -385,16 +387,10 @@ def render(a: dict, b: dict, c: dict, d: list, base: float, load: tuple, repeat:
     return "\n".join(L)
 
 
-def write_block(block: str) -> None:
-    text = DOC.read_text()
-    if BEGIN in text and END in text:
-        head, rest = text.split(BEGIN, 1)
-        text = head + BEGIN + "\n" + block + "\n" + END + rest.split(END, 1)[1]
-    else:
-        text = text.rstrip() + ("\n\n## Switch mechanisms: held bars, the hold at rest, the coupled relay (issue 8)\n"
-                                "Written by benchmarks/bench_mechanisms.py (what each part measures: its "
-                                "docstring).\n\n" + BEGIN + "\n" + block + "\n" + END + "\n")
-    DOC.write_text(text)
+def write_doc(block: str) -> None:
+    write_block(DOC, BEGIN, END, block,
+                heading="## Switch mechanisms: held bars, the hold at rest, the coupled relay (issue 8)\n"
+                        "Written by benchmarks/bench_mechanisms.py (what each part measures: its docstring).\n\n")
     print(f"wrote {DOC}")
 
 
@@ -420,7 +416,7 @@ def main() -> None:
     print()
     print(block)
     if not args.no_write:
-        write_block(block)
+        write_doc(block)
 
 
 if __name__ == "__main__":

@@ -18,10 +18,11 @@ from __future__ import annotations
 
 import argparse
 import os
-import re
 import sys
 import time
 from pathlib import Path
+
+from doc_block import write_block
 
 import numpy as np
 
@@ -169,13 +170,7 @@ def main() -> None:
         + [f"Load average at the end of the run: {os.getloadavg()[0]:.1f} (2 cores)."])
     print("\n".join(summary))
     if not args.no_write:
-        doc = DOC.read_text() if DOC.exists() else ""
-        block = f"{BEGIN}\n{text}\n{END}"
-        if BEGIN in doc:
-            doc = re.sub(re.escape(BEGIN) + r".*?" + re.escape(END), lambda _: block, doc, flags=re.S)
-        else:
-            doc = doc.rstrip("\n") + ("\n\n" if doc else "") + block + "\n"
-        DOC.write_text(doc)
+        write_block(DOC, BEGIN, END, text)
         print(f"written to {DOC.relative_to(ROOT)}")
 
 

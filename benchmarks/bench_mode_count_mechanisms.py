@@ -18,10 +18,11 @@ from __future__ import annotations
 
 import argparse
 import os
-import re
 import sys
 import time
 from pathlib import Path
+
+from doc_block import write_block
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -82,13 +83,7 @@ def main() -> None:
                       f"(axial, bending); mismatch: contact-state mismatch time against the last row.", ""] + lines
                      + [f"Load average at the end of the run: {os.getloadavg()[0]:.1f} (2 cores)."])
     if not args.no_write:
-        doc = DOC.read_text()
-        block = f"{BEGIN}\n{text}\n{END}"
-        if BEGIN in doc:
-            doc = re.sub(re.escape(BEGIN) + r".*?" + re.escape(END), lambda _: block, doc, flags=re.S)
-        else:
-            doc = doc.rstrip("\n") + "\n\n" + block + "\n"
-        DOC.write_text(doc)
+        write_block(DOC, BEGIN, END, text)
         print(f"written to {DOC.relative_to(ROOT)}")
 
 

@@ -29,6 +29,8 @@ import textwrap
 import time
 from pathlib import Path
 
+from doc_block import write_block
+
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "benchmarks.md"
 BEGIN, END = "<!-- bench_startup:begin -->", "<!-- bench_startup:end -->"
@@ -202,14 +204,8 @@ def main() -> None:
     block = "\n".join(lines)
     print("\n" + block)
     if not args.no_write:
-        text = DOC.read_text()
-        if BEGIN in text and END in text:
-            head, rest = text.split(BEGIN, 1)
-            text = head + BEGIN + "\n" + block + "\n" + END + rest.split(END, 1)[1]
-        else:
-            text = text.rstrip() + ("\n\n## Start-up: whole-process `switchsim run` (issue 12)\n"
-                                    "Written by benchmarks/bench_startup.py.\n\n" + BEGIN + "\n" + block + "\n" + END + "\n")
-        DOC.write_text(text)
+        write_block(DOC, BEGIN, END, block, heading="## Start-up: whole-process `switchsim run` (issue 12)\n"
+                                                     "Written by benchmarks/bench_startup.py.\n\n")
         print(f"\nwrote {DOC}")
 
 
