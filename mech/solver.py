@@ -100,7 +100,7 @@ class Segment:
     _start_state: np.ndarray
     _regime: np.ndarray
     _eref: np.ndarray
-    _arrays: tuple = field(repr=False, default=None)  # the kernel's arguments with the drive of the segment
+    _arrays: tuple = field(repr=False)  # the kernel's arguments with the drive of the segment
     _work: tuple = field(repr=False, default=None)
     _out: np.ndarray = field(repr=False, default_factory=lambda: np.empty(5))
     _last_t: float = field(repr=False, default=float("nan"))
@@ -491,6 +491,11 @@ class ImpactSolver:
         if self.model.rest_window <= 0.0:
             return
         rec = self.recorder
+        if n_rec and not np.any(rec.last_aux[:, A_Y] > 0.0):
+            # the segment ends in flight: the window restarts (as the next segment would
+            # otherwise do first), so the kinetic energy of its records is not needed
+            self._restart_rest_window()
+            return
         if n_rec:  # the largest kinetic energy of the new records, in one compiled call
             self._rest_ke = max(self._rest_ke, float(energy_table(rec.y[n0:n0 + n_rec], self.arrays)[:, 0].max()))
         if self.t - self._rest_t0 < self.model.rest_window * (1.0 - 1e-12):

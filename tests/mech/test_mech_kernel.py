@@ -344,7 +344,7 @@ def test_normal_forces_from_the_kinematics_equal_the_right_hand_sides(name):
     from coupling.scene import builtin_scene, load_scene
     from mech import ImpactSolver
     from mech.compiled import dense_tip_forces, dynamics, make_work
-    from mech.kernel_layout import A_FN, A_Y, NAUX
+    from mech.kernel_layout import A_FN, A_Y, C_ON, NAUX
 
     root = Path(__file__).resolve().parents[2]
     scene = load_scene(root / "examples" / "pushbutton.toml") if name == "pushbutton" else builtin_scene(name)
@@ -360,7 +360,7 @@ def test_normal_forces_from_the_kinematics_equal_the_right_hand_sides(name):
         coef[0, 0] = y  # a one-point dense output: the state itself
         dense_tip_forces(res.t[k], np.array([res.t[k]]), np.array([res.t[k]]), np.ones(1), coef, arrays, out)
         np.testing.assert_allclose(out[:2], aux[:, A_FN], rtol=1e-12, atol=1e-12 * max(1.0, aux[:, A_FN].max()))
-        on = solver.model.cpar[:, 3] > 0.0
+        on = solver.model.cpar[:, C_ON] > 0.0
         np.testing.assert_allclose(out[3:][on], aux[on, A_Y], rtol=1e-12, atol=1e-15)
         touched += int(aux[:, A_FN].max() > 0.0)
     assert touched > 10  # the check saw contacts carrying force
