@@ -22,14 +22,31 @@ Metrics (pure functions of the per-tip contact intervals and the waveforms, SI):
     peak_contact_voltage V, largest |contact voltage| after the first make (coupled)
     arc_energy           J (coupled)
 
+The switching window of a run: from its first make to its last switching instant (the
+last make when the run ends closed, the last break when it ends open), without the held
+closures (closures at least [metrics] settle_window long). Relative tolerances are taken
+on it, so holding a contact longer does not loosen them.
+
 TOLERANCES (a refinement "did not move" the result when all hold):
-    mismatch_time       <= 2 % of the base run's total contact time (both tips)
+    mismatch_time       <= max(1 us, 2 % of the base run's contact time in its switching
+                        window, both tips)
     contacts, bounces   equal
-    first/last make, total bounce time   within max(1 us, 1 % of the contact span: first
-                        make to last break)
+    first/last make, total bounce time   within max(1 us, 1 % of the switching window)
     peak_force          within 2 %
     peak_contact_voltage within 2 % + 10 mV
     arc_energy          within 5 % + 1 uJ
+
+Sensitivity: the check also reruns the scene with the contact gap (initial.height)
+changed by -1, -0.5, +0.5 and +1 % (SENSITIVITY_GAP), each perturbed contact sequence
+shifted onto the base run's first make (a longer travel delays the whole sequence; the
+pattern after the first make is what is compared). A metric that so small a change of
+the gap moves beyond its tolerance is ill-conditioned: no numerical setting makes it
+more certain than that, and its range over the five runs is reported. Late micro-bounces
+of a switch closure are typically so (a grazing opening comes and goes); four samples
+give a lower bound of the spread. The status is "converged" when no refinement moves a
+metric; "within sensitivity" when every metric a refinement moves, it moves no more than
+the gap perturbation does (the numerical error is not what limits it); else "not
+converged".
 """
 
 from __future__ import annotations
@@ -37,10 +54,15 @@ from __future__ import annotations
 import math
 import time
 
+from .metrics import DEFAULT_SETTLE_WINDOW
 from .results import merge_intervals
 
 TOLERANCES = dict(mismatch_fraction=0.02, time_floor=1e-6, time_fraction=0.01, peak_force=0.02,
                   voltage_rel=0.02, voltage_abs=0.01, arc_rel=0.05, arc_abs=1e-6)
+SENSITIVITY_GAP = (-0.01, -0.005, 0.005, 0.01)  # relative changes of initial.height, one rerun each
+COUNT_KEYS = ("contacts", "bounces")
+TIME_KEYS = ("first_make", "last_make", "total_bounce_time")
+VALUE_KEYS = ("peak_force", "peak_contact_voltage", "arc_energy")
 MAX_MODES = 40  # the largest count a family may have (mech.parameters)
 MIN_RTOL = 1e-13
 MIN_RELTOL = 1e-9
@@ -75,34 +97,93 @@ def mismatch_time(a, b) -> float:
     return max(0.0, measure(a) + measure(b) - 2.0 * measure(intersection(a, b)))
 
 
-def contact_metrics(tip_intervals) -> dict:
-    """The contact metrics of per-tip interval lists {tip: [(t_start, t_end), ...]} (s)."""
+def contact_metrics(tip_intervals, closed_at_end: bool = False,
+                    settle_window: float = DEFAULT_SETTLE_WINDOW) -> dict:
+    """The contact metrics of per-tip interval lists {tip: [(t_start, t_end), ...]} (s).
+
+    closed_at_end: the contact is closed when the run ends (its last interval is the
+    final closure, not a contact that broke). settle_window: s, a closure at least this
+    long is a held contact (coupling.metrics). Besides the metrics of the module
+    docstring: contact_time (s, both tips, whole run), span (s, first make to the last
+    interval's end), window (s, s: first make to the last switching instant, the last make
+    when closed at the end, else the last break), active (the window without held
+    closures: [(s, s), ...]), window_length (s, its length) and window_contact_time (s,
+    both tips' contact time in it).
+    """
     all_iv = [iv for ivs in tip_intervals.values() for iv in ivs]
     union = merge_intervals(all_iv)
     out = dict(contacts=len(all_iv), bounces=max(len(union) - 1, 0), first_make=None, last_make=None,
                total_bounce_time=0.0, contact_time=float(sum(measure(v) for v in tip_intervals.values())),
-               span=0.0)
+               span=0.0, window=None, active=[], window_length=0.0, window_contact_time=0.0)
     if union:
+        end = union[-1][0] if closed_at_end else union[-1][1]
+        window = (union[0][0], end)
+        active = active_window(union, window, settle_window)
         out.update(first_make=union[0][0], last_make=union[-1][0], total_bounce_time=union[-1][0] - union[0][0],
-                   span=union[-1][1] - union[0][0])
+                   span=union[-1][1] - union[0][0], window=window, active=active, window_length=measure(active),
+                   window_contact_time=float(sum(measure(intersection(v, active)) for v in tip_intervals.values())))
     return out
+
+
+def active_window(union, window, settle_window: float) -> list[tuple[float, float]]:
+    """The switching window (s, s) without the held closures (union intervals at least
+    settle_window long): the stretches where the contact makes, bounces or breaks."""
+    out, t = [], window[0]
+    for a, b in union:
+        if b - a >= settle_window and a < window[1]:
+            if a > t:
+                out.append((t, a))
+            t = max(t, b)
+    if window[1] > t:
+        out.append((t, window[1]))
+    return out
+
+
+def time_tolerance(base: dict, tol: dict = TOLERANCES) -> float:
+    """s: how far an instant or duration may move: max(1 us, 1 % of the switching window
+    without its held closures)."""
+    return max(tol["time_floor"], tol["time_fraction"] * base["window_length"])
+
+
+def mismatch_allowance(base: dict, tol: dict = TOLERANCES) -> float:
+    """s: the contact-state mismatch allowed: max(1 us, 2 % of the contact time in the
+    switching window without its held closures)."""
+    return max(tol["time_floor"], tol["mismatch_fraction"] * base["window_contact_time"])
+
+
+def agreeing_contacts(a, b, time_tol: float) -> int:
+    """How many of the first closed intervals of two runs (unions of the tips' contacts, s)
+    agree, in order, make and break each within time_tol."""
+    a, b = merge_intervals(a), merge_intervals(b)
+    k = 0
+    for (a0, a1), (b0, b1) in zip(a, b):
+        if abs(a0 - b0) > time_tol or abs(a1 - b1) > time_tol:
+            break
+        k += 1
+    return k
+
+
+def shifted(tips: dict, dt: float) -> dict:
+    """Per-tip intervals moved by dt (s)."""
+    return {k: [(a + dt, b + dt) for a, b in v] for k, v in tips.items()}
 
 
 def compare(base: dict, refined: dict, base_tips: dict, refined_tips: dict, tol: dict = TOLERANCES) -> dict:
     """Per metric {base, refined, change, within} and the mismatch time, for two runs'
     metric dicts (see ``metrics_of``) and per-tip intervals; ``moved`` lists the metrics
-    outside the tolerances."""
+    outside the tolerances; ``agreeing_contacts``: how many of the base run's first
+    closures the refined run reproduces within the time tolerance (of ``contacts_total``)."""
     out: dict = {}
     mism = sum(mismatch_time(base_tips.get(k, []), refined_tips.get(k, []))
                for k in set(base_tips) | set(refined_tips))
-    allowed = tol["mismatch_fraction"] * base["contact_time"]
+    allowed = mismatch_allowance(base, tol)
     out["mismatch_time"] = dict(base=0.0, refined=mism, change=mism, within=mism <= allowed + 1e-15,
                                 allowed=allowed)
-    for key in ("contacts", "bounces"):
+    for key in COUNT_KEYS:
         out[key] = dict(base=base[key], refined=refined[key], change=refined[key] - base[key],
                         within=refined[key] == base[key])
-    time_tol = max(tol["time_floor"], tol["time_fraction"] * base["span"])
-    for key in ("first_make", "last_make", "total_bounce_time"):
+    time_tol = time_tolerance(base, tol)
+    for key in TIME_KEYS:
         a, b = base.get(key), refined.get(key)
         if a is None and b is None:
             continue
@@ -119,7 +200,38 @@ def compare(base: dict, refined: dict, base_tips: dict, refined_tips: dict, tol:
         bound = rel * abs(a or 0.0) + absolute
         out[key] = dict(base=a, refined=b, change=change, within=change is not None and abs(change) <= bound,
                         allowed=bound)
-    return dict(metrics=out, moved=[k for k, v in out.items() if not v["within"]])
+    union_a = [iv for v in base_tips.values() for iv in v]
+    union_b = [iv for v in refined_tips.values() for iv in v]
+    return dict(metrics=out, moved=[k for k, v in out.items() if not v["within"]],
+                agreeing_contacts=agreeing_contacts(union_a, union_b, time_tol),
+                contacts_total=len(merge_intervals(union_a)))
+
+
+def within_sensitivity(moved: dict, spread: dict) -> bool:
+    """Whether a refinement's moved metrics {key: entry} each moved no more than the
+    sensitivity reruns moved them: spread {key: largest |change| (mismatch: the mismatch
+    time itself) under the gap perturbation}; first_make never (the perturbed runs are
+    aligned on it), a metric without a spread never."""
+    for key, v in moved.items():
+        if key == "first_make" or v.get("change") is None or key not in spread:
+            return False
+        if abs(v["change"]) > spread[key] * (1 + 1e-12):
+            return False
+    return True
+
+
+def sensitivity_spread(entries: list[dict]) -> dict:
+    """{metric: largest |change|} over the sensitivity reruns that ran (mismatch_time: the
+    largest mismatch), counting only changes outside the tolerances."""
+    spread: dict = {}
+    for e in entries:
+        if e.get("status") != "ok":
+            continue
+        for key in e["moved"]:
+            v = e["metrics"][key]
+            if v.get("change") is not None:
+                spread[key] = max(spread.get(key, 0.0), abs(v["change"]))
+    return spread
 
 
 # ---------------------------------------------------------------------------------------
@@ -137,7 +249,7 @@ def tip_intervals(result) -> dict:
 
 def metrics_of(result) -> dict:
     """The metrics (module docstring) of a CoupledResult."""
-    out = contact_metrics(tip_intervals(result))
+    out = contact_metrics(tip_intervals(result), result.closed_at_end, _settle_window(result))
     if result.mechanics is not None:
         c = result.mechanics.contacts
         out["peak_force"] = float(c.peak_force.max()) if len(c) else 0.0
@@ -147,6 +259,11 @@ def metrics_of(result) -> dict:
         out["peak_contact_voltage"] = b.get("peak_contact_voltage")
         out["arc_energy"] = b.get("arc_energy")
     return out
+
+
+def _settle_window(result) -> float:
+    settings = getattr(result.scene, "metrics", None)
+    return settings.settle_window if settings is not None else DEFAULT_SETTLE_WINDOW
 
 
 # ---------------------------------------------------------------------------------------
@@ -201,25 +318,95 @@ def refinements(scene, base_result) -> list[tuple[str, str, object]]:
     return out
 
 
-def verdict(entries: list[dict]) -> tuple[bool, str]:
-    """(converged, one line) from the per-refinement entries of ``check``."""
+def perturbations(scene) -> list[tuple[str, str, object]]:
+    """The sensitivity reruns: [(name, description, perturbed scene or None: the reason as
+    description)], the contact gap (initial.height) changed by each of SENSITIVITY_GAP."""
+    if scene.mech is None:
+        return [("gap", "not applicable: no mechanics (prescribed contact schedule)", None)]
+    ini = scene.mech.initial
+    if ini.resting or not ini.height > 0.0:
+        return [("gap", "not applicable: the contact starts closed (no gap)", None)]
+    out = []
+    for rel in SENSITIVITY_GAP:
+        h = ini.height * (1.0 + rel)
+        out.append((f"gap {rel:+.1%}", f"contact gap {ini.height * 1e6:.4g} -> {h * 1e6:.4g} um",
+                    scene.set("initial.height", h)))
+    return out
+
+
+def sensitivity_ranges(entries: list[dict]) -> dict:
+    """{metric: (lowest, highest)} over the base run and the sensitivity reruns that ran,
+    for every metric one of them moved beyond its tolerance (mismatch_time: (0, largest))."""
+    ran = [e for e in entries if e.get("status") == "ok"]
+    keys = [k for e in ran for k in e["moved"]]
+    out: dict = {}
+    for key in dict.fromkeys(keys):
+        values = [e["metrics"][key]["refined"] for e in ran if key in e["metrics"]]
+        values += [ran[0]["metrics"][key]["base"]]
+        values = [v for v in values if v is not None]
+        if values:
+            out[key] = (min(values), max(values))
+    return out
+
+
+def status_of(entries: list[dict], sensitivity: list[dict] | None = None) -> str:
+    """"converged", "within sensitivity" or "not converged" (module docstring)."""
+    moved = [e for e in entries if e["status"] == "ok" and e["moved"]]
+    failed = [e for e in entries if e["status"] not in ("ok", "not applicable")]
+    if failed:
+        return "not converged"
+    if not moved:
+        return "converged"
+    spread = sensitivity_spread(sensitivity or [])
+    if all(within_sensitivity({k: e["metrics"][k] for k in e["moved"]}, spread) for e in moved):
+        return "within sensitivity"
+    return "not converged"
+
+
+def verdict(entries: list[dict], sensitivity: list[dict] | None = None) -> tuple[str, str]:
+    """(status, one line) from the per-refinement entries of ``check`` and its sensitivity
+    reruns (module docstring)."""
+    sensitivity = sensitivity or []
+    status = status_of(entries, sensitivity)
     moved = [e for e in entries if e["status"] == "ok" and e["moved"]]
     failed = [e for e in entries if e["status"] not in ("ok", "not applicable")]
     done = [e["name"] for e in entries if e["status"] == "ok"]
-    if not moved and not failed:
-        return True, ("converged within the documented tolerances: "
-                      + (", ".join(done) if done else "no refinement applies") + " did not move the result")
-    parts = []
-    for e in moved:
-        m = e["metrics"]
-        what = []
-        for key in e["moved"]:
-            v = m[key]
-            what.append(_describe(key, v))
-        parts.append(f"{e['name']} ({e['refinement']}) moved {'; '.join(what)}")
-    for e in failed:
-        parts.append(f"{e['name']} refinement {e['status']}")
-    return False, "NOT converged: " + "; ".join(parts)
+    parts = [f"{e['name']} ({e['refinement']}) moved {'; '.join(_describe(k, e['metrics'][k]) for k in e['moved'])}"
+             for e in moved]
+    parts += [f"{e['name']} refinement {e['status']}" for e in failed]
+    ranges = sensitivity_ranges(sensitivity)
+    band = f"+-{max(abs(r) for r in SENSITIVITY_GAP):.0%} change of the contact gap"
+    spans = "; ".join(_describe_range(k, lo, hi) for k, (lo, hi) in ranges.items())
+    if status == "converged":
+        line = ("converged within the documented tolerances: "
+                + (", ".join(done) if done else "no refinement applies") + " did not move the result")
+        if spans:
+            line += f"; ill-conditioned over a {band}: {spans}"
+    elif status == "within sensitivity":
+        line = ("within sensitivity: " + "; ".join(parts)
+                + f"; no more than a {band} does ({spans}): quote these with that range")
+    else:
+        line = "NOT converged: " + "; ".join(parts)
+        if spans:
+            line += f"; for scale, over a {band}: {spans}"
+    runs = [e for e in entries + sensitivity if e.get("status") == "ok" and "agreeing_contacts" in e]
+    if runs and any(e["moved"] for e in runs):
+        k = min(e["agreeing_contacts"] for e in runs)
+        line += f"; the first {k} of {runs[0]['contacts_total']} closures agree in every rerun"
+    return status, line
+
+
+_UNITS = {"first_make": ("ms", 1e3), "last_make": ("ms", 1e3), "total_bounce_time": ("ms", 1e3),
+          "peak_force": ("N", 1.0), "peak_contact_voltage": ("V", 1.0), "arc_energy": ("mJ", 1e3)}
+
+
+def _describe_range(key: str, lo, hi) -> str:
+    if key == "mismatch_time":
+        return f"contact-state mismatch up to {hi * 1e6:.3g} us"
+    if key in COUNT_KEYS:
+        return f"{key} {lo}-{hi}"
+    unit, scale = _UNITS[key]
+    return f"{key} {lo * scale:.4g}-{hi * scale:.4g} {unit}"
 
 
 def _describe(key: str, v: dict) -> str:
@@ -227,8 +414,7 @@ def _describe(key: str, v: dict) -> str:
         return f"contact-state mismatch {v['refined'] * 1e6:.3g} us (allowed {v['allowed'] * 1e6:.3g} us)"
     if key in ("contacts", "bounces"):
         return f"{key} {v['base']} -> {v['refined']}"
-    unit, scale = {"first_make": ("ms", 1e3), "last_make": ("ms", 1e3), "total_bounce_time": ("ms", 1e3),
-                   "peak_force": ("N", 1.0), "peak_contact_voltage": ("V", 1.0), "arc_energy": ("mJ", 1e3)}[key]
+    unit, scale = _UNITS[key]
 
     def f(x):
         return "none" if x is None else f"{x * scale:.4g}"
@@ -236,33 +422,53 @@ def _describe(key: str, v: dict) -> str:
     return f"{key} {f(v['base'])} -> {f(v['refined'])} {unit}"
 
 
-def check(scene, base_result, *, run_fn=None) -> dict:
-    """summary.accuracy for ``base_result`` of ``scene`` (reruns the refined scenes)."""
-    from .master import CoupledRunError, run
+def _rerun(name: str, description: str, scene, run_fn, compare_fn) -> dict:
+    """One rerun's entry: status, wall_time and, when it ran, compare_fn(result)."""
+    from .master import CoupledRunError
+
+    entry: dict = dict(name=name, refinement=description)
+    if scene is None:
+        entry.update(status="not applicable", moved=[])
+        return entry
+    tick = time.perf_counter()
+    try:
+        res = run_fn(scene)
+    except CoupledRunError as err:
+        entry.update(status=f"failed: {err}", moved=[], wall_time=time.perf_counter() - tick)
+        return entry
+    entry.update(status="ok", wall_time=time.perf_counter() - tick)
+    entry.update(compare_fn(res))
+    return entry
+
+
+def check(scene, base_result, *, run_fn=None, sensitivity: bool = True) -> dict:
+    """summary.accuracy for ``base_result`` of ``scene``: reruns the refined scenes and,
+    unless sensitivity is False, the gap-perturbed ones (module docstring)."""
+    from .master import run
 
     run_fn = run_fn or run
     base = metrics_of(base_result)
     base_tips = tip_intervals(base_result)
-    entries = []
-    for name, description, refined_scene in refinements(scene, base_result):
-        entry: dict = dict(name=name, refinement=description)
-        if refined_scene is None:
-            entry.update(status="not applicable", moved=[])
-            entries.append(entry)
-            continue
-        tick = time.perf_counter()
-        try:
-            ref = run_fn(refined_scene)
-        except CoupledRunError as err:
-            entry.update(status=f"failed: {err}", moved=[], wall_time=time.perf_counter() - tick)
-            entries.append(entry)
-            continue
-        entry["wall_time"] = time.perf_counter() - tick
-        entry["status"] = "ok"
-        entry.update(compare(base, metrics_of(ref), base_tips, tip_intervals(ref)))
-        entries.append(entry)
-    converged, line = verdict(entries)
-    return dict(converged=converged, verdict=line, tolerances=dict(TOLERANCES), refinements=entries)
+
+    def refined(res):
+        return compare(base, metrics_of(res), base_tips, tip_intervals(res))
+
+    def aligned(res):  # the perturbed sequence moved onto the base run's first make
+        m = metrics_of(res)
+        dt = (base["first_make"] - m["first_make"]) if (base["first_make"] is not None
+                                                         and m["first_make"] is not None) else 0.0
+        tips = shifted(tip_intervals(res), dt)
+        m.update(contact_metrics(tips, res.closed_at_end, _settle_window(res)))
+        out = compare(base, m, base_tips, tips)
+        out["shift"] = dt
+        return out
+
+    entries = [_rerun(n, d, sc, run_fn, refined) for n, d, sc in refinements(scene, base_result)]
+    sens = ([_rerun(n, d, sc, run_fn, aligned) for n, d, sc in perturbations(scene)] if sensitivity else [])
+    status, line = verdict(entries, sens)
+    return dict(converged=status == "converged", status=status, verdict=line, tolerances=dict(TOLERANCES),
+                sensitivity_gap=list(SENSITIVITY_GAP), refinements=entries, sensitivity=sens,
+                sensitivity_ranges={k: list(v) for k, v in sensitivity_ranges(sens).items()})
 
 
 def run_checked(scene, *, progress: bool = False):

@@ -83,17 +83,20 @@ class CoupledResult:
         return [(a, min(b, self.scene.t_end)) for a, b in sched.intervals if a < self.scene.t_end]
 
     @property
+    def closed_at_end(self) -> bool:
+        """Whether the contact is closed when the run ends (a contact still going on)."""
+        if self.mechanics is not None:
+            return bool((~self.mechanics.contact_columns["complete"]).any())
+        return bool(self.scene.circuit.schedule.is_closed(self.scene.t_end))
+
+    @property
     def bounce(self) -> dict:
         if self.scene.circuit is None:
             return {}
-        if self.mechanics is not None:
-            closed_at_end = bool((~self.mechanics.contact_columns["complete"]).any())
-        else:
-            closed_at_end = self.scene.circuit.schedule.is_closed(self.scene.t_end)
         key = "bounce"
         if key not in self._cache:
             self._cache[key] = bounce_metrics(self.closed_intervals, self.scene.t_end, self.waveform_columns,
-                                              closed_at_end, getattr(self.scene, "metrics", None))
+                                              self.closed_at_end, getattr(self.scene, "metrics", None))
         return self._cache[key]
 
     @property

@@ -5,13 +5,15 @@ measured mode non-convergence of a slender bar."""
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pytest
 
 from coupling import run, scene_from_dict
 from coupling.accuracy import (
-    TOLERANCES, compare, contact_metrics, intersection, measure, mismatch_time, refined_count, verdict,
+    SENSITIVITY_GAP, TOLERANCES, agreeing_contacts, compare, contact_metrics, intersection, measure,
+    mismatch_allowance, mismatch_time, refined_count, status_of, time_tolerance, verdict,
 )
 
 
@@ -87,13 +89,67 @@ def test_refined_count_and_verdict_names_the_refinement():
     ok = dict(name="rtol", refinement="rtol 1e-06 -> 1e-07", status="ok", moved=[], metrics={})
     bad = dict(name="modes", refinement="3 -> 5", status="ok", moved=["bounces"],
                metrics={"bounces": dict(base=1, refined=3, change=2, within=False)})
-    converged, line = verdict([ok])
-    assert converged and "rtol" in line
-    converged, line = verdict([ok, bad])
-    assert not converged and line.startswith("NOT converged: modes") and "bounces 1 -> 3" in line
+    status, line = verdict([ok])
+    assert status == "converged" and "rtol" in line
+    status, line = verdict([ok, bad])
+    assert status == "not converged" and line.startswith("NOT converged: modes") and "bounces 1 -> 3" in line
     assert "rtol" not in line
-    converged, line = verdict([ok, dict(name="reltol", refinement="", status="failed: boom", moved=[])])
-    assert not converged and "reltol refinement failed" in line
+    status, line = verdict([ok, dict(name="reltol", refinement="", status="failed: boom", moved=[])])
+    assert status == "not converged" and "reltol refinement failed" in line
+
+
+def test_tolerances_come_from_the_switching_window_not_from_how_long_a_contact_is_held():
+    bounces = [(1.0e-3, 1.05e-3), (1.2e-3, 1.22e-3), (1.3e-3, 1.31e-3)]
+    settled_short = contact_metrics({0: bounces + [(1.4e-3, 3e-3)], 1: []}, closed_at_end=True)
+    settled_long = contact_metrics({0: bounces + [(1.4e-3, 0.1)], 1: []}, closed_at_end=True)
+    # the window is first make to last make; the final closure is not in it
+    assert settled_short["window_length"] == pytest.approx(0.4e-3)
+    assert settled_short["window_contact_time"] == pytest.approx(0.08e-3)
+    for f in (time_tolerance, mismatch_allowance):
+        assert f(settled_short) == f(settled_long)
+    # a make, bounces, a hold of 8 ms, a break: the hold is not in the window either
+    cycle = contact_metrics({0: bounces + [(1.4e-3, 9.4e-3)], 1: []}, closed_at_end=False)
+    assert cycle["window_length"] == pytest.approx(0.4e-3)
+    assert time_tolerance(cycle) == pytest.approx(max(TOLERANCES["time_floor"], 0.4e-3 * TOLERANCES["time_fraction"]))
+    # a run of flight and short contacts only: the window is first make to last break
+    flight = contact_metrics({0: [(0.0, 1e-4)], 1: [(2e-4, 2.5e-4)]})
+    assert flight["window_length"] == pytest.approx(2.5e-4)
+    assert mismatch_allowance(flight) == pytest.approx(max(1e-6, 0.02 * 1.5e-4))
+
+
+def test_agreeing_contacts_counts_the_common_prefix():
+    a = [(1.0, 2.0), (3.0, 4.0), (5.0, 6.0), (7.0, 8.0)]
+    assert agreeing_contacts(a, a, 0.0) == 4
+    b = [(1.0, 2.01), (3.0, 4.0), (5.3, 6.0), (7.0, 8.0)]  # the third make 0.3 late
+    assert agreeing_contacts(a, b, 0.05) == 2
+    assert agreeing_contacts(a, b, 0.5) == 4
+    assert agreeing_contacts(a, a[:2], 0.0) == 2
+
+
+def _entry(name, moved: dict):
+    metrics = {k: dict(base=b, refined=r, change=r - b, within=False) for k, (b, r) in moved.items()}
+    return dict(name=name, refinement=name, status="ok", moved=list(moved), metrics=metrics,
+                agreeing_contacts=2, contacts_total=5)
+
+
+def test_status_separates_numerical_error_from_ill_conditioning():
+    modes = _entry("modes", {"bounces": (6, 5), "last_make": (1.5e-3, 1.46e-3)})
+    quiet = [_entry("gap +1.0%", {}), _entry("gap -1.0%", {})]
+    wide = [_entry("gap +1.0%", {"bounces": (6, 8), "last_make": (1.5e-3, 1.6e-3)}), _entry("gap -1.0%", {})]
+    narrow = [_entry("gap +1.0%", {"bounces": (6, 8), "last_make": (1.5e-3, 1.52e-3)})]
+    assert status_of([_entry("rtol", {})], quiet) == "converged"
+    assert status_of([modes], quiet) == "not converged"  # the gap does not move them: a real error
+    assert status_of([modes], wide) == "within sensitivity"
+    assert status_of([modes], narrow) == "not converged"  # last make moved more than the gap moves it
+    status, line = verdict([modes], wide)
+    assert line.startswith("within sensitivity: modes") and "bounces 6-8" in line
+    assert "first 2 of 5 closures agree" in line
+    # a first make that moves is never excused: the perturbed runs are aligned on it
+    first = _entry("modes", {"first_make": (1e-3, 1.1e-3)})
+    assert status_of([first], [_entry("gap +1.0%", {"first_make": (1e-3, 1.5e-3)})]) == "not converged"
+    # a well-conditioned converged run still names what the gap moves
+    status, line = verdict([_entry("rtol", {})], wide)
+    assert status == "converged" and "ill-conditioned" in line and "bounces 6-8" in line
 
 
 # --- end to end ---------------------------------------------------------------------------
@@ -112,15 +168,25 @@ def _slender(modes):
 
 
 def test_slender_bar_with_three_modes_is_reported_unconverged_in_modes():
-    result = run(_slender(3), check=True)
+    scene = _slender(3)
+    result = run(scene, check=True)
     acc = result.summary["accuracy"]
     by_name = {e["name"]: e for e in acc["refinements"]}
     assert set(by_name) == {"modes", "rtol"}
-    assert not acc["converged"]
+    assert not acc["converged"] and acc["status"] == "not converged"
     assert acc["verdict"].startswith("NOT converged: modes")
     assert "bounces" in by_name["modes"]["moved"]
     # the integration tolerance is not what is wrong here
     assert by_name["rtol"]["moved"] == []
+    # the sensitivity reruns change the gap as stated: the first make moves by the change of
+    # the free-fall time to the block, t(h) = (sqrt(v^2 + 2 g h) - v) / g
+    v, g, h = 1.0, scene.mech.gravity, scene.mech.initial.height
+    fall = lambda height: (math.sqrt(v * v + 2 * g * height) - v) / g  # noqa: E731
+    sens = acc["sensitivity"]
+    assert [e["name"] for e in sens] == [f"gap {r:+.1%}" for r in SENSITIVITY_GAP]
+    for e, rel in zip(sens, SENSITIVITY_GAP):
+        assert e["status"] == "ok"
+        assert e["shift"] == pytest.approx(fall(h) - fall(h * (1 + rel)), rel=1e-4)
 
 
 def test_slender_bar_with_twenty_modes_is_converged():
@@ -178,3 +244,27 @@ def test_jacobi_with_a_step_longer_than_the_contacts_is_flagged():
     assert not any("jacobi scheme" in f for f in mf.summary["flags"])
     # mechanics_first, aligned on the contact events, keeps the arc at the same step
     assert mf.bounce["arc_energy"] > 1e3 * jac.bounce["arc_energy"]
+
+
+def test_relay_at_auto_is_within_its_sensitivity_and_a_coarse_count_is_not():
+    # The default relay closure: its late micro-bounces come and go with a 0.1 % change of
+    # the contact gap (docs/accuracy-modes.md), so the bounce count and the last make are
+    # ill-conditioned; the modes the automatic count leaves out move them no more than the
+    # gap does, and nothing else moves. One bending mode too few per the issue's table
+    # (1 axial + 3 bending) gets the peak force wrong, which no gap change explains.
+    from coupling import default_scene
+
+    scene = default_scene().update({"solver.t_end": 3e-3, "output.plots": False})
+    acc = run(scene, check=True).accuracy
+    entries = {e["name"]: e for e in acc["refinements"]}
+    assert acc["status"] == "within sensitivity", acc["verdict"]
+    for name in ("rtol", "macro_step", "reltol"):
+        assert entries[name]["moved"] == [], (name, entries[name]["moved"])
+    moved_by_gap = {k for e in acc["sensitivity"] for k in e["moved"]}
+    assert {"bounces", "last_make"} <= moved_by_gap
+    assert "peak_force" not in moved_by_gap and "first_make" not in moved_by_gap
+    assert min(e["agreeing_contacts"] for e in acc["refinements"] + acc["sensitivity"]) >= 1
+
+    coarse = run(scene.set("bar.modes", {"axial": 1, "bending": 3}), check=True).accuracy
+    assert coarse["status"] == "not converged", coarse["verdict"]
+    assert "peak_force" in {e["name"]: e for e in coarse["refinements"]}["modes"]["moved"]
