@@ -450,8 +450,12 @@ def check(scene, base_result, *, run_fn=None, sensitivity: bool = True) -> dict:
     base = metrics_of(base_result)
     base_tips = tip_intervals(base_result)
 
+    def closed(tips):  # the contact's closed intervals (both tips), for the plot
+        return [[a, b] for a, b in merge_intervals(iv for v in tips.values() for iv in v)]
+
     def refined(res):
-        return compare(base, metrics_of(res), base_tips, tip_intervals(res))
+        tips = tip_intervals(res)
+        return dict(compare(base, metrics_of(res), base_tips, tips), closed=closed(tips))
 
     def aligned(res):  # the perturbed sequence moved onto the base run's first make
         m = metrics_of(res)
@@ -459,14 +463,13 @@ def check(scene, base_result, *, run_fn=None, sensitivity: bool = True) -> dict:
                                                          and m["first_make"] is not None) else 0.0
         tips = shifted(tip_intervals(res), dt)
         m.update(contact_metrics(tips, res.closed_at_end, _settle_window(res)))
-        out = compare(base, m, base_tips, tips)
-        out["shift"] = dt
-        return out
+        return dict(compare(base, m, base_tips, tips), shift=dt, closed=closed(tips))
 
     entries = [_rerun(n, d, sc, run_fn, refined) for n, d, sc in refinements(scene, base_result)]
     sens = ([_rerun(n, d, sc, run_fn, aligned) for n, d, sc in perturbations(scene)] if sensitivity else [])
     status, line = verdict(entries, sens)
-    return dict(converged=status == "converged", status=status, verdict=line, tolerances=dict(TOLERANCES),
+    return dict(converged=status == "converged", status=status, verdict=line, closed=closed(base_tips),
+                tolerances=dict(TOLERANCES),
                 sensitivity_gap=list(SENSITIVITY_GAP), refinements=entries, sensitivity=sens,
                 sensitivity_ranges={k: list(v) for k, v in sensitivity_ranges(sens).items()})
 

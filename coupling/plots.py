@@ -262,6 +262,33 @@ def plot_energy(result):
     return fig
 
 
+def plot_accuracy(result):
+    """The contact's closed intervals of the run and of every rerun of ``run --check``
+    (refinements, then the gap-perturbed runs aligned on the first make), one row each,
+    over the switching window: where the sequences part is where the prediction ends."""
+    acc = result.accuracy
+    rows = [("this run", acc["closed"], "tab:green")]
+    rows += [(e["name"], e["closed"], "tab:blue") for e in acc["refinements"] if "closed" in e]
+    rows += [(e["name"] + " (aligned)", e["closed"], "tab:orange") for e in acc.get("sensitivity", []) if "closed" in e]
+    fig, ax = _subplots(figsize=(10, 0.9 + 0.42 * len(rows)))
+    starts = [iv[0][0] for _, iv, _ in rows if iv]
+    ends = [iv[-1][0] if len(iv) > 1 else iv[0][1] for _, iv, _ in rows if iv]  # the last make
+    for k, (label, intervals, color) in enumerate(rows):
+        y = len(rows) - 1 - k
+        ax.broken_barh([(a * 1e3, (b - a) * 1e3) for a, b in intervals], (y - 0.35, 0.7), color=color)
+    ax.set_yticks(range(len(rows)), [label for label, _, _ in reversed(rows)], fontsize=8)
+    if starts:
+        lo, hi = min(starts), max(ends)
+        pad = max(0.08 * (hi - lo), 50e-6)
+        ax.set_xlim((lo - pad) * 1e3, (hi + pad) * 1e3)
+    ax.set_ylim(-0.6, len(rows) - 0.4)
+    ax.set_xlabel("time (ms)")
+    ax.set_title(f"contact closed, per run of --check: {acc['status']}", fontsize=9)
+    ax.grid(alpha=0.3, axis="x")
+    fig.tight_layout()
+    return fig
+
+
 def save_plots(result, out_dir) -> list[Path]:
     """Write the plots that apply to this run's kind into out_dir; returns their paths."""
     out = Path(out_dir)
@@ -274,6 +301,8 @@ def save_plots(result, out_dir) -> list[Path]:
     if result.mechanics is not None:
         figures += [("normal_force.png", plot_normal_force), ("tip_heights.png", plot_tip_heights),
                     ("energy.png", plot_energy)]
+    if (getattr(result, "accuracy", None) or {}).get("closed") is not None:
+        figures.append(("accuracy.png", plot_accuracy))
     paths = []
     for name, make in figures:
         fig = make(result)
@@ -326,4 +355,4 @@ def stored_result(folder) -> types.SimpleNamespace:
                                      "peak_voltage", "arc_duration", "arc_energy"])
     scene = types.SimpleNamespace(name=summary.get("scene", "run"), t_end=t_end)
     return types.SimpleNamespace(scene=scene, summary=summary, bounce=bounce, waveforms=waves, openings=openings,
-                                 mechanics=mechanics, closed_intervals=closed)
+                                 mechanics=mechanics, closed_intervals=closed, accuracy=summary.get("accuracy"))

@@ -219,6 +219,10 @@ def test_short_coupled_scene_check_and_cli(tmp_path, capsys):
     assert set(entries) == {"modes", "rtol", "macro_step", "reltol"}
     assert all(e["status"] == "ok" for e in entries.values())
     assert f"switchsim: accuracy: {acc['verdict']}" in printed
+    # every rerun's closed intervals are kept, so the folder can draw them later
+    assert all("closed" in e for e in acc["refinements"] + acc["sensitivity"] if e["status"] == "ok")
+    assert main(["plot", str(tmp_path / "out")]) == 0
+    assert (tmp_path / "out" / "accuracy.png").stat().st_size > 10_000
     # The contact instants come from the mechanics' event location, which neither the
     # macro step nor ngspice's RELTOL can move beyond the friction's weak dependence on
     # the current: the contact sequence stays the same under both.
