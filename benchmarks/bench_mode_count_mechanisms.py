@@ -10,8 +10,11 @@ this runs the auto count and a ladder of explicit counts (modes per family, axia
 bending) and reports, per count, the metrics of `switchsim run --check` against the finest
 count of the ladder: contact-state mismatch time, contacts, bounces, last make, total
 bounce time, peak contact force, first contact's kinematic restitution, arc energy; and
-the run's wall time. Writes the block between the mode-count-mechanisms markers of
-docs/accuracy-modes.md.
+the run's wall time. It then runs `switchsim run --check` on the auto count (its
+refinements and its four reruns with the contact gap changed by -1 .. +1 %) and says, per
+row, whether the row's bounce count and last make lie inside the range that check
+reports: whether what auto's check tells a user brackets the converged answer. Writes the
+block between the mode-count-mechanisms markers of docs/accuracy-modes.md.
 """
 
 from __future__ import annotations
@@ -28,7 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from coupling import builtin_scene, run  # noqa: E402
-from coupling.accuracy import metrics_of, mismatch_time, mode_counts, tip_intervals  # noqa: E402
+from coupling.accuracy import check, metrics_of, mismatch_time, mode_counts, time_tolerance, tip_intervals  # noqa: E402
 from coupling.scene import load_scene  # noqa: E402
 
 DOC = ROOT / "docs" / "accuracy-modes.md"
@@ -40,14 +43,26 @@ CASES = {
 LADDER = [(1, 3), (1, 6), (3, 5), (3, 8), (3, 12), (3, 16), (5, 20)]
 
 
-def one(scene) -> tuple[dict, dict, float, dict]:
+def one(scene):
     t0 = time.perf_counter()
     res = run(scene)
     wall = time.perf_counter() - t0
     m = metrics_of(res)
     c = res.mechanics.contacts
     m["restitution"] = float(c.kinematic_restitution.iloc[0]) if len(c) else float("nan")
-    return m, tip_intervals(res), wall, mode_counts(res)
+    return m, tip_intervals(res), wall, mode_counts(res), res
+
+
+def inside(m: dict, auto: dict, ranges: dict, key: str) -> bool:
+    """Whether m[key] lies in the range auto's check reports (its sensitivity range, or
+    auto's value within the check's tolerance when the gap does not move the metric)."""
+    if key in ranges:
+        lo, hi = ranges[key]
+        tol = 0 if key == "bounces" else time_tolerance(auto)
+        return lo - tol <= m[key] <= hi + tol
+    if key == "bounces":
+        return m[key] == auto[key]
+    return abs(m[key] - auto[key]) <= time_tolerance(auto)
 
 
 def table(name: str, base) -> tuple[list[str], dict]:
@@ -55,20 +70,57 @@ def table(name: str, base) -> tuple[list[str], dict]:
                                for a, b in LADDER]
     results = [(label, *one(sc)) for label, sc in rows]
     ref_m, ref_iv = results[-1][1], results[-1][2]
+    auto_m, auto_res = results[0][1], results[0][5]
+    acc = check(base, auto_res)
+    ranges = acc["sensitivity_ranges"]
     lines = [f"**{name}**, against the finest count ({results[-1][0]}):", "",
              "| modes (axial, bending) | mismatch (us) | contacts | bounces | last make (ms) | total bounce time (ms) "
-             "| peak force (N) | first restitution | arc energy (mJ) | wall (s) |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
-    for label, m, iv, wall, counts in results:
+             "| peak force (N) | first restitution | arc energy (mJ) | bounces, last make inside auto's range | wall (s) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for label, m, iv, wall, counts, _ in results:
         mism = sum(mismatch_time(iv.get(k, []), ref_iv.get(k, [])) for k in set(iv) | set(ref_iv))
         shown = label if label != "auto" else f"auto ({counts['axial']}, {counts['bending']})"
         arc = m.get("arc_energy")
+        ins = ", ".join("yes" if inside(m, auto_m, ranges, k) else "NO" for k in ("bounces", "last_make"))
         lines.append(
             f"| {shown} | {mism * 1e6:.0f} | {m['contacts']} | {m['bounces']} | {m['last_make'] * 1e3:.3f} | "
             f"{m['total_bounce_time'] * 1e3:.3f} | {m['peak_force']:.2f} | {m['restitution']:.3f} | "
-            f"{'-' if arc is None else f'{arc * 1e3:.2f}'} | {wall:.2f} |")
+            f"{'-' if arc is None else f'{arc * 1e3:.2f}'} | {ins} | {wall:.2f} |")
         print(lines[-1], flush=True)
-    return lines + [""], dict(ref=ref_m)
+    spans = ", ".join(f"{k} {lo:.4g}-{hi:.4g}" if k in ("contacts", "bounces") else f"{k} {lo * 1e3:.4g}-{hi * 1e3:.4g} ms"
+                      for k, (lo, hi) in ranges.items() if k in ("contacts", "bounces", "last_make", "total_bounce_time"))
+    lines += ["", f"`--check` at auto: status **{acc['status']}**; over a +-1 % change of the contact gap: "
+                  f"{spans or 'nothing moves'}; {min(e['agreeing_contacts'] for e in acc['refinements'] + acc['sensitivity'] if e['status'] == 'ok')} "
+                  f"first closures agree in every rerun."]
+    print(lines[-1], flush=True)
+    return lines + [""] + scan(base, auto_m), dict(ref=ref_m)
+
+
+SCAN = [("contact gap", "initial.height", f) for f in (0.998, 0.999, 1.001, 1.002)] + [
+    ("contact restitution", "contact.restitution", f) for f in (0.99, 1.01)] + [
+    ("friction coefficient", "tribology.mu", 1.05), ("modal damping", "bar.modal_damping", 1.05)]
+
+
+def scan(base, auto_m: dict) -> list[str]:
+    """Smaller and other input changes at the auto count: how ill-conditioned the tail is."""
+    out = ["Inputs changed by less, and other inputs, at the auto count (mechanics and circuit as "
+           "shipped; first make, bounces, last make against the unchanged run):", "",
+           "| input changed | first make (ms) | bounces | last make (ms) |", "|---|---|---|---|",
+           f"| none | {auto_m['first_make'] * 1e3:.4f} | {auto_m['bounces']} | {auto_m['last_make'] * 1e3:.3f} |"]
+    for label, key, factor in SCAN:
+        value = _lookup(base, key)
+        m = one(base.set(key, value * factor))[0]
+        out.append(f"| {label} x {factor:g} | {m['first_make'] * 1e3:.4f} | {m['bounces']} | "
+                   f"{m['last_make'] * 1e3:.3f} |")
+        print(out[-1], flush=True)
+    return out + [""]
+
+
+def _lookup(scene, key: str) -> float:
+    node = scene.raw
+    for part in key.split("."):
+        node = node[part]
+    return float(node)
 
 
 def main() -> None:

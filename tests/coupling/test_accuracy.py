@@ -13,7 +13,7 @@ import pytest
 from coupling import run, scene_from_dict
 from coupling.accuracy import (
     SENSITIVITY_GAP, TOLERANCES, agreeing_contacts, compare, contact_metrics, intersection, measure,
-    mismatch_allowance, mismatch_time, refined_count, status_of, time_tolerance, verdict,
+    metrics_of, mismatch_allowance, mismatch_time, refined_count, status_of, time_tolerance, verdict,
 )
 
 
@@ -259,7 +259,8 @@ def test_relay_at_auto_is_within_its_sensitivity_and_a_coarse_count_is_not():
     from coupling import default_scene
 
     scene = default_scene().update({"solver.t_end": 3e-3, "output.plots": False})
-    acc = run(scene, check=True).accuracy
+    result = run(scene, check=True)
+    acc, base = result.accuracy, metrics_of(result)
     entries = {e["name"]: e for e in acc["refinements"]}
     assert acc["status"] == "within sensitivity", acc["verdict"]
     for name in ("rtol", "macro_step", "reltol"):
@@ -268,6 +269,13 @@ def test_relay_at_auto_is_within_its_sensitivity_and_a_coarse_count_is_not():
     assert {"bounces", "last_make"} <= moved_by_gap
     assert "peak_force" not in moved_by_gap and "first_make" not in moved_by_gap
     assert min(e["agreeing_contacts"] for e in acc["refinements"] + acc["sensitivity"]) >= 1
+    # what the check tells the user brackets the converged answer (5 + 20 modes: the
+    # finest of the study in docs/accuracy-modes.md)
+    fine = metrics_of(run(scene.set("bar.modes", {"axial": 5, "bending": 20})))
+    ranges = acc["sensitivity_ranges"]
+    assert ranges["bounces"][0] <= fine["bounces"] <= ranges["bounces"][1]
+    lo, hi = ranges["last_make"]
+    assert lo - time_tolerance(base) <= fine["last_make"] <= hi + time_tolerance(base)
 
     coarse = run(scene.set("bar.modes", {"axial": 1, "bending": 3}), check=True).accuracy
     assert coarse["status"] == "not converged", coarse["verdict"]
