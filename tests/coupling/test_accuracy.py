@@ -280,3 +280,30 @@ def test_relay_at_auto_is_within_its_sensitivity_and_a_coarse_count_is_not():
     coarse = run(scene.set("bar.modes", {"axial": 1, "bending": 3}), check=True).accuracy
     assert coarse["status"] == "not converged", coarse["verdict"]
     assert "peak_force" in {e["name"]: e for e in coarse["refinements"]}["modes"]["moved"]
+
+
+def test_pushbutton_at_auto_brackets_twice_its_mode_count():
+    # The pivoted lever of examples/pushbutton.toml: auto gives the floor, 3 modes per
+    # family; its bounce tail moves with the mode count (6 bounces at 3, 8-10 at 5-20
+    # bending modes; docs/accuracy-modes.md) as much as with a 1 % change of the gap.
+    # What the check reports must contain what twice the count gives, and the first
+    # impact must be the same in every rerun.
+    from pathlib import Path
+
+    from coupling.scene import load_scene
+
+    root = Path(__file__).resolve().parents[2]
+    scene = load_scene(root / "examples" / "pushbutton.toml").update(
+        {"solver.t_end": 6e-3, "output.plots": False, "output.csv": False})
+    result = run(scene, check=True)
+    acc, base = result.accuracy, metrics_of(result)
+    assert acc["status"] in ("converged", "within sensitivity"), acc["verdict"]
+    counts = result.summary["solver"]["modes_rule"]
+    assert counts.startswith("auto")
+    double = metrics_of(run(scene.set("bar.modes", {"axial": 6, "bending": 6})))
+    ranges = acc["sensitivity_ranges"]
+    for key in ("bounces", "last_make"):
+        slack = 0 if key == "bounces" else time_tolerance(base)
+        lo, hi = ranges.get(key, (base[key], base[key]))
+        assert lo - slack <= double[key] <= hi + slack, (key, double[key], ranges.get(key))
+    assert min(e["agreeing_contacts"] for e in acc["refinements"] + acc["sensitivity"]) >= 1
