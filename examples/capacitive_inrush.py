@@ -4,8 +4,9 @@ examples/capacitive_inrush.toml: a 47 uF input capacitor behind 5.6 ohm (plus 1 
 bleed) on 24 V. At the first make the capacitor is empty and the contact carries
 E / R_series = 4.2 A, 175 times the 24 mA steady current; the inrush decays with
 R_series C = 0.27 ms, so every bounce re-closes on a partly charged capacitor with the
-current (E - V_C) / R_series. After the first break the arc keeps charging it; once
-E - V_C is below the arc's minimum voltage U_min = 12 V the breaks no longer arc.
+current (E - V_C) / R_series. A break with E - V_C above the arc's minimum voltage
+U_min = 12 V arcs, and the arc keeps charging the capacitor; below it the breaks do not
+arc (here none does: the first contact lasts 0.34 ms, longer than R_series C).
 
 What the current does to the contact laws (the ILLUSTRATIVE tribometer fit):
 - mu(I) rises from mu(0) towards mu(4.2 A) while the inrush flows and falls back as it

@@ -51,7 +51,7 @@ DIODE_DROP_MAX = 1.5  # V: generous bound on the flyback diode's forward drop at
 
 
 def variants(fast: bool) -> dict:
-    """name -> scene. fast: 5.2 ms (just past the final extinction near 4.8 ms), looser
+    """name -> scene. fast: 5.2 ms (past the final extinction near 3.9 ms), looser
     mechanics tolerance, no extra numerics variants."""
     base = load_scene(SCENE)
     if fast:
