@@ -294,3 +294,29 @@ def test_opening_operation_against_the_closed_form_of_a_lengthening_arc():
     assert fo["arc_duration"] == pytest.approx(t_star, rel=2e-3)  # sampled at 1 us
     assert fo["arc_energy"] == pytest.approx(w, rel=2e-3)
     assert b["settled"] is False and b["settle_time"] is None
+
+
+def test_voltage_peaks_are_the_openings_not_the_closing_transient():
+    # Right after a make the contact resistance falls from infinity (Holm's law at a
+    # vanishing force): for nanoseconds the contact still shows most of the 24 V supply.
+    # Whether a sample lands there depends on RELTOL; the peaks must not.
+    import numpy as np
+
+    from coupling import builtin_scene, run
+
+    scene = builtin_scene("free_drop").update({"initial.height": 2e-5, "solver.t_end": 1.2e-3, "bar.modes": 3})
+    peaks, closing = [], []
+    for reltol in (1e-4, 1e-6):
+        res = run(scene.set("circuit.reltol", reltol))
+        b = res.bounce
+        t, v = res.waveforms.time.to_numpy(), np.abs(res.waveforms.contact_voltage.to_numpy())
+        closed = np.zeros(len(t), bool)
+        for a, e in res.closed_intervals:
+            closed |= (t > a) & (t < e)
+        closing.append(float(v[closed].max()))
+        peaks.append((b["peak_contact_voltage"], b["peak_bounce_voltage"]))
+        # every opening arcs here: its peak is the arc's voltage, far below the supply
+        assert b["peak_bounce_voltage"] == max(o["peak_voltage"] for o in b["openings"] if o["reclosed"]) < 20.0
+    assert max(closing) > 20.0  # a sample inside a closing transient exists (at the tight RELTOL)
+    for a, b in zip(*peaks):
+        assert a == pytest.approx(b, rel=0.02)
