@@ -43,20 +43,23 @@ make when the run ends closed, the last break when it ends open), without held c
 (closures at least `[metrics] settle_window` long): how long a contact is then held does
 not loosen the tolerances.
 
-**Error or ill-conditioning.** The check also reruns the scene with the contact gap
-(`initial.height`) changed by -1, -0.5, +0.5 and +1 %, each perturbed contact sequence
-shifted onto the base run's first make, and reports the range each metric spans over
-these five runs (`sensitivity_ranges`). A switch closure's late micro-bounces are often
+**Error or ill-conditioning.** The check also reruns the scene with two inputs no
+designer knows to 1 % changed by 1 % each way: the contact gap (`initial.height`) and the
+contact's dissipation (`contact.restitution`, or `contact.damping`); where one cannot be
+changed (a contact that starts closed, an elastic contact) the gap changed by 0.5 % each
+way takes its place. Each perturbed contact sequence is shifted onto the base run's first
+make, and the check reports the range each metric spans over these five runs
+(`sensitivity_ranges`). A switch closure's late micro-bounces are often
 ill-conditioned: on the default relay a 0.1 % change of the gap adds or removes a
 bounce (docs/accuracy-modes.md); no numerical setting makes such a metric more certain
 than its inputs. `status` is then one of
 
 - `converged`: no refinement moved a metric beyond its tolerance (the verdict still names
-  the metrics the gap moves, as ill-conditioned);
-- `within sensitivity`: the refinements moved some metrics, but none by more than the gap
-  perturbation moves it: quote those with their range; the numerical error is not what
+  the metrics the perturbed inputs move, as ill-conditioned);
+- `within sensitivity`: the refinements moved some metrics, but none by more than the input
+  perturbations move it: quote those with their range; the numerical error is not what
   limits them;
-- `not converged`: a refinement moved a metric more than the gap does (or moved the first
+- `not converged`: a refinement moved a metric more than the perturbed inputs do (or moved the first
   make, or a rerun failed): a numerical error to remove.
 
 The verdict also says how many first closures agree (make and break within the time

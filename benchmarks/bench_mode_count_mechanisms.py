@@ -11,7 +11,7 @@ bending) and reports, per count, the metrics of `switchsim run --check` against 
 count of the ladder: contact-state mismatch time, contacts, bounces, last make, total
 bounce time, peak contact force, first contact's kinematic restitution, arc energy; and
 the run's wall time. It then runs `switchsim run --check` on the auto count (its
-refinements and its four reruns with the contact gap changed by -1 .. +1 %) and says, per
+refinements and its four reruns with the contact gap and restitution changed by 1 %) and says, per
 row, whether the row's bounce count and last make lie inside the range that check
 reports: whether what auto's check tells a user brackets the converged answer. Writes the
 block between the mode-count-mechanisms markers of docs/accuracy-modes.md.
@@ -89,7 +89,7 @@ def table(name: str, base) -> tuple[list[str], dict]:
         print(lines[-1], flush=True)
     spans = ", ".join(f"{k} {lo:.4g}-{hi:.4g}" if k in ("contacts", "bounces") else f"{k} {lo * 1e3:.4g}-{hi * 1e3:.4g} ms"
                       for k, (lo, hi) in ranges.items() if k in ("contacts", "bounces", "last_make", "total_bounce_time"))
-    lines += ["", f"`--check` at auto: status **{acc['status']}**; over a +-1 % change of the contact gap: "
+    lines += ["", f"`--check` at auto: status **{acc['status']}**; over a 1 % change of the contact gap or restitution: "
                   f"{spans or 'nothing moves'}; {min(e['agreeing_contacts'] for e in acc['refinements'] + acc['sensitivity'] if e['status'] == 'ok')} "
                   f"first closures agree in every rerun."]
     print(lines[-1], flush=True)

@@ -36,16 +36,19 @@ TOLERANCES (a refinement "did not move" the result when all hold):
     peak_contact_voltage within 2 % + 10 mV
     arc_energy          within 5 % + 1 uJ
 
-Sensitivity: the check also reruns the scene with the contact gap (initial.height)
-changed by -1, -0.5, +0.5 and +1 % (SENSITIVITY_GAP), each perturbed contact sequence
-shifted onto the base run's first make (a longer travel delays the whole sequence; the
-pattern after the first make is what is compared). A metric that so small a change of
-the gap moves beyond its tolerance is ill-conditioned: no numerical setting makes it
-more certain than that, and its range over the five runs is reported. Late micro-bounces
-of a switch closure are typically so (a grazing opening comes and goes); four samples
-give a lower bound of the spread. The status is "converged" when no refinement moves a
+Sensitivity: the check also reruns the scene with two inputs no designer knows to 1 %
+changed by 1 % each way (SENSITIVITY): the contact gap (initial.height) and the contact's
+dissipation (contact.restitution, or contact.damping); where one cannot be changed (a
+contact that starts closed, an elastic contact, a restitution of 1 upwards) the gap by
+0.5 % each way takes its place. Each perturbed contact sequence is shifted onto the base
+run's first make (a longer travel delays the whole sequence; the pattern after the first
+make is what is compared). A metric that so small a change of an input moves beyond its
+tolerance is ill-conditioned: no numerical setting makes it more certain than that, and
+its range over the five runs is reported. Late micro-bounces of a switch closure are
+typically so (a grazing opening comes and goes); four samples give a lower bound of the
+spread. The status is "converged" when no refinement moves a
 metric; "within sensitivity" when every metric a refinement moves, it moves no more than
-the gap perturbation does (the numerical error is not what limits it); else "not
+the input perturbations do (the numerical error is not what limits it); else "not
 converged".
 """
 
@@ -59,7 +62,8 @@ from .results import merge_intervals
 
 TOLERANCES = dict(mismatch_fraction=0.02, time_floor=1e-6, time_fraction=0.01, peak_force=0.02,
                   voltage_rel=0.02, voltage_abs=0.01, arc_rel=0.05, arc_abs=1e-6)
-SENSITIVITY_GAP = (-0.01, -0.005, 0.005, 0.01)  # relative changes of initial.height, one rerun each
+SENSITIVITY = 0.01  # the relative change of an input in the sensitivity reruns
+SENSITIVITY_RERUNS = 4
 COUNT_KEYS = ("contacts", "bounces")
 TIME_KEYS = ("first_make", "last_make", "total_bounce_time")
 VALUE_KEYS = ("peak_force", "peak_contact_voltage", "arc_energy")
@@ -210,7 +214,7 @@ def compare(base: dict, refined: dict, base_tips: dict, refined_tips: dict, tol:
 def within_sensitivity(moved: dict, spread: dict) -> bool:
     """Whether a refinement's moved metrics {key: entry} each moved no more than the
     sensitivity reruns moved them: spread {key: largest |change| (mismatch: the mismatch
-    time itself) under the gap perturbation}; first_make never (the perturbed runs are
+    time itself) under the input perturbations}; first_make never (the perturbed runs are
     aligned on it), a metric without a spread never."""
     for key, v in moved.items():
         if key == "first_make" or v.get("change") is None or key not in spread:
@@ -320,17 +324,36 @@ def refinements(scene, base_result) -> list[tuple[str, str, object]]:
 
 def perturbations(scene) -> list[tuple[str, str, object]]:
     """The sensitivity reruns: [(name, description, perturbed scene or None: the reason as
-    description)], the contact gap (initial.height) changed by each of SENSITIVITY_GAP."""
+    description)] (module docstring): the gap and the contact's dissipation changed by
+    SENSITIVITY each way, the gap by half as much in place of what cannot be changed."""
     if scene.mech is None:
-        return [("gap", "not applicable: no mechanics (prescribed contact schedule)", None)]
-    ini = scene.mech.initial
-    if ini.resting or not ini.height > 0.0:
-        return [("gap", "not applicable: the contact starts closed (no gap)", None)]
+        return [("inputs", "not applicable: no mechanics (prescribed contact schedule)", None)]
+    ini, con = scene.mech.initial, scene.mech.contact
+    gap = None if (ini.resting or not ini.height > 0.0) else ini.height
+    if con.restitution is not None:
+        dissipation = ("restitution", "contact.restitution", con.restitution, 1.0)
+    elif con.damping:
+        dissipation = ("damping", "contact.damping", con.damping, math.inf)
+    else:
+        dissipation = None
     out = []
-    for rel in SENSITIVITY_GAP:
-        h = ini.height * (1.0 + rel)
-        out.append((f"gap {rel:+.1%}", f"contact gap {ini.height * 1e6:.4g} -> {h * 1e6:.4g} um",
-                    scene.set("initial.height", h)))
+
+    def add(label, key, value, rel, top, unit_scale=1.0, unit=""):
+        new = value * (1.0 + rel)
+        if new <= top:
+            out.append((f"{label} {rel:+.1%}", f"{label} {value * unit_scale:.4g} -> {new * unit_scale:.4g}{unit}",
+                        scene.set(key, new)))
+
+    for rel in (-SENSITIVITY, SENSITIVITY):
+        if gap is not None:
+            add("gap", "initial.height", gap, rel, math.inf, 1e6, " um")
+        if dissipation is not None:
+            add(dissipation[0], dissipation[1], dissipation[2], rel, dissipation[3])
+    for rel in (-0.5 * SENSITIVITY, 0.5 * SENSITIVITY):
+        if gap is not None and len(out) < SENSITIVITY_RERUNS:
+            add("gap", "initial.height", gap, rel, math.inf, 1e6, " um")
+    if not out:
+        return [("inputs", "not applicable: no contact gap and no contact dissipation to change", None)]
     return out
 
 
@@ -375,7 +398,8 @@ def verdict(entries: list[dict], sensitivity: list[dict] | None = None) -> tuple
              for e in moved]
     parts += [f"{e['name']} refinement {e['status']}" for e in failed]
     ranges = sensitivity_ranges(sensitivity)
-    band = f"+-{max(abs(r) for r in SENSITIVITY_GAP):.0%} change of the contact gap"
+    inputs = sorted({e["name"].split()[0] for e in sensitivity if e.get("status") == "ok"})
+    band = f"{SENSITIVITY:.0%} change of the {' or the '.join(inputs) or 'inputs'}"
     spans = "; ".join(_describe_range(k, lo, hi) for k, (lo, hi) in ranges.items())
     if status == "converged":
         line = ("converged within the documented tolerances: "
@@ -443,7 +467,7 @@ def _rerun(name: str, description: str, scene, run_fn, compare_fn) -> dict:
 
 def check(scene, base_result, *, run_fn=None, sensitivity: bool = True) -> dict:
     """summary.accuracy for ``base_result`` of ``scene``: reruns the refined scenes and,
-    unless sensitivity is False, the gap-perturbed ones (module docstring)."""
+    unless sensitivity is False, the input-perturbed ones (module docstring)."""
     from .master import run
 
     run_fn = run_fn or run
@@ -470,7 +494,7 @@ def check(scene, base_result, *, run_fn=None, sensitivity: bool = True) -> dict:
     status, line = verdict(entries, sens)
     return dict(converged=status == "converged", status=status, verdict=line, closed=closed(base_tips),
                 tolerances=dict(TOLERANCES),
-                sensitivity_gap=list(SENSITIVITY_GAP), refinements=entries, sensitivity=sens,
+                sensitivity_change=SENSITIVITY, refinements=entries, sensitivity=sens,
                 sensitivity_ranges={k: list(v) for k, v in sensitivity_ranges(sens).items()})
 
 

@@ -27,8 +27,8 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--plots", action="store_true",
                      help="also draw the PNG plots (as [output] plots = true; or later: switchsim plot DIR)")
     run.add_argument("--check", action="store_true",
-                     help="rerun refined (modes, rtol, macro step, RELTOL) and with the contact gap changed by "
-                          "up to +-1 %%; report the error against the sensitivity (summary.accuracy, accuracy.png)")
+                     help="rerun refined (modes, rtol, macro step, RELTOL) and with the contact gap and restitution "
+                          "changed by 1 %%; report the error against the sensitivity (summary.accuracy, accuracy.png)")
 
     plot = sub.add_parser("plot", help="draw the PNG plots of a result folder that a run wrote")
     plot.add_argument("result", help="result folder (holds summary.json)")

@@ -12,7 +12,7 @@ import pytest
 
 from coupling import run, scene_from_dict
 from coupling.accuracy import (
-    SENSITIVITY_GAP, TOLERANCES, agreeing_contacts, compare, contact_metrics, intersection, measure,
+    TOLERANCES, agreeing_contacts, compare, contact_metrics, intersection, measure,
     metrics_of, mismatch_allowance, mismatch_time, refined_count, status_of, time_tolerance, verdict,
 )
 
@@ -134,20 +134,20 @@ def _entry(name, moved: dict):
 
 def test_status_separates_numerical_error_from_ill_conditioning():
     modes = _entry("modes", {"bounces": (6, 5), "last_make": (1.5e-3, 1.46e-3)})
-    quiet = [_entry("gap +1.0%", {}), _entry("gap -1.0%", {})]
-    wide = [_entry("gap +1.0%", {"bounces": (6, 8), "last_make": (1.5e-3, 1.6e-3)}), _entry("gap -1.0%", {})]
+    quiet = [_entry("gap +1.0%", {}), _entry("restitution -1.0%", {})]
+    wide = [_entry("gap +1.0%", {"bounces": (6, 8), "last_make": (1.5e-3, 1.6e-3)}), _entry("restitution -1.0%", {})]
     narrow = [_entry("gap +1.0%", {"bounces": (6, 8), "last_make": (1.5e-3, 1.52e-3)})]
     assert status_of([_entry("rtol", {})], quiet) == "converged"
-    assert status_of([modes], quiet) == "not converged"  # the gap does not move them: a real error
+    assert status_of([modes], quiet) == "not converged"  # the inputs do not move them: a real error
     assert status_of([modes], wide) == "within sensitivity"
-    assert status_of([modes], narrow) == "not converged"  # last make moved more than the gap moves it
+    assert status_of([modes], narrow) == "not converged"  # last make moved more than the inputs move it
     status, line = verdict([modes], wide)
     assert line.startswith("within sensitivity: modes") and "bounces 6-8" in line
     assert "first 2 of 5 closures agree" in line
     # a first make that moves is never excused: the perturbed runs are aligned on it
     first = _entry("modes", {"first_make": (1e-3, 1.1e-3)})
     assert status_of([first], [_entry("gap +1.0%", {"first_make": (1e-3, 1.5e-3)})]) == "not converged"
-    # a well-conditioned converged run still names what the gap moves
+    # a well-conditioned converged run still names what the inputs move
     status, line = verdict([_entry("rtol", {})], wide)
     assert status == "converged" and "ill-conditioned" in line and "bounces 6-8" in line
 
@@ -182,11 +182,15 @@ def test_slender_bar_with_three_modes_is_reported_unconverged_in_modes():
     # the free-fall time to the block, t(h) = (sqrt(v^2 + 2 g h) - v) / g
     v, g, h = 1.0, scene.mech.gravity, scene.mech.initial.height
     fall = lambda height: (math.sqrt(v * v + 2 * g * height) - v) / g  # noqa: E731
-    sens = acc["sensitivity"]
-    assert [e["name"] for e in sens] == [f"gap {r:+.1%}" for r in SENSITIVITY_GAP]
-    for e, rel in zip(sens, SENSITIVITY_GAP):
-        assert e["status"] == "ok"
-        assert e["shift"] == pytest.approx(fall(h) - fall(h * (1 + rel)), rel=1e-4)
+    # The contact is elastic (restitution 1): the gap by 1 % each way, the restitution 1 %
+    # down (not up: above 1), and the gap by 0.5 % down in place of the missing rerun.
+    sens = {e["name"]: e for e in acc["sensitivity"]}
+    assert list(sens) == ["gap -1.0%", "restitution -1.0%", "gap +1.0%", "gap -0.5%"]
+    assert all(e["status"] == "ok" for e in sens.values())
+    for name, e in sens.items():
+        rel = float(name.split()[1].rstrip("%")) / 100 if name.startswith("gap") else 0.0
+        assert e["shift"] == pytest.approx(fall(h) - fall(h * (1 + rel)), rel=1e-4, abs=1e-15)
+    assert sens["restitution -1.0%"]["refinement"] == "restitution 1 -> 0.99"
 
 
 def test_slender_bar_with_twenty_modes_is_converged():
@@ -253,9 +257,10 @@ def test_jacobi_with_a_step_longer_than_the_contacts_is_flagged():
 def test_relay_at_auto_is_within_its_sensitivity_and_a_coarse_count_is_not():
     # The default relay closure: its late micro-bounces come and go with a 0.1 % change of
     # the contact gap (docs/accuracy-modes.md), so the bounce count and the last make are
-    # ill-conditioned; the modes the automatic count leaves out move them no more than the
-    # gap does, and nothing else moves. One bending mode too few per the table
-    # (1 axial + 3 bending) gets the peak force wrong, which no gap change explains.
+    # ill-conditioned; the modes the automatic count leaves out move them no more than a 1 %
+    # change of the gap or the restitution does, and nothing else moves. One bending mode too
+    # few per the table (1 axial + 3 bending) gets the peak force wrong, which no
+    # such change explains.
     from coupling import default_scene
 
     scene = default_scene().update({"solver.t_end": 3e-3, "output.plots": False})
@@ -265,9 +270,9 @@ def test_relay_at_auto_is_within_its_sensitivity_and_a_coarse_count_is_not():
     assert acc["status"] == "within sensitivity", acc["verdict"]
     for name in ("rtol", "macro_step", "reltol"):
         assert entries[name]["moved"] == [], (name, entries[name]["moved"])
-    moved_by_gap = {k for e in acc["sensitivity"] for k in e["moved"]}
-    assert {"bounces", "last_make"} <= moved_by_gap
-    assert "peak_force" not in moved_by_gap and "first_make" not in moved_by_gap
+    moved_by_inputs = {k for e in acc["sensitivity"] for k in e["moved"]}
+    assert {"bounces", "last_make"} <= moved_by_inputs
+    assert "peak_force" not in moved_by_inputs and "first_make" not in moved_by_inputs
     assert min(e["agreeing_contacts"] for e in acc["refinements"] + acc["sensitivity"]) >= 1
     # what the check tells the user brackets the converged answer (5 + 20 modes: the
     # finest of the study in docs/accuracy-modes.md)
@@ -285,7 +290,7 @@ def test_relay_at_auto_is_within_its_sensitivity_and_a_coarse_count_is_not():
 def test_pushbutton_at_auto_brackets_twice_its_mode_count():
     # The pivoted lever of examples/pushbutton.toml: auto gives the floor, 3 modes per
     # family; its bounce tail moves with the mode count (6 bounces at 3, 8-10 at 5-20
-    # bending modes; docs/accuracy-modes.md) as much as with a 1 % change of the gap.
+    # bending modes; docs/accuracy-modes.md) as much as with a 1 % change of the gap or the restitution.
     # What the check reports must contain what twice the count gives, and the first
     # impact must be the same in every rerun.
     from pathlib import Path
