@@ -1,6 +1,6 @@
 """Benchmark: the stepping API against the one-shot PWL run, same 2 ms five-bounce schedule.
 
-Run: .venv/bin/python benchmarks/bench_circuit_stepping.py [--repeat N]
+Run: .venv/bin/python benchmarks/bench_circuit_stepping.py [--repeat N] [--no-write]
 
 For each circuit, interleaved and repeated (best of N, the machine is shared):
 - the reference: the schedule written as a PWL conductance source (no Python in ngspice's loop);
@@ -8,16 +8,22 @@ For each circuit, interleaved and repeated (best of N, the machine is shared):
 - the stepping API at macro steps of 2 us and 10 us (G(t) and the breakpoints per step).
 Prints absolute times and the ratio to the PWL run (target <= 1.5x). With an arc model
 the PWL run has Python in its loop too: the arc state, decided at each accepted point.
+Also derived from the same times: the cost of one macro step, (t(2 us) - t(10 us)) over the
+extra macro steps. Writes its table between the bench-circuit-stepping markers of
+docs/circuit.md (section 9).
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from doc_block import command_line, write_block  # noqa: E402
 
 from circuit import (  # noqa: E402
     ArcModel,
@@ -33,6 +39,8 @@ from circuit import (  # noqa: E402
     run_transient,
 )
 
+DOC = Path(__file__).resolve().parents[1] / "docs" / "circuit.md"
+BEGIN, END = "<!-- bench-circuit-stepping:begin -->", "<!-- bench-circuit-stepping:end -->"
 T_END = 2e-3
 SCHEDULE = ContactSchedule.from_events(
     make=[0.10e-3, 0.30e-3, 0.55e-3, 0.73e-3, 0.87e-3, 0.96e-3],
@@ -76,8 +84,14 @@ def stepped(circuit, macro_step):
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--no-write", action="store_true", help="print only; leave docs/circuit.md alone")
     args = parser.parse_args()
     print(f"2 ms, 5 bounces, max_step {OPTIONS.max_step:g} s, method {OPTIONS.method}, reltol {OPTIONS.reltol:g}; best of {args.repeat}")
+    lines = [f"`{command_line()}`: 2 ms, 5 bounces, max step {OPTIONS.max_step * 1e6:g} us, {OPTIONS.method}, "
+             f"RELTOL {OPTIONS.reltol:g}; best of {args.repeat}, the routes interleaved.", "",
+             "| circuit | route | best | / PWL | points |", "|---|---|---|---|---|"]
+    ratios = {}
+    per_step = []
     for name, circuit in CIRCUITS.items():
         runs = {
             "PWL one-shot (reference)": lambda: pwl(circuit),
@@ -96,6 +110,31 @@ def main() -> int:
         print(f"\n{name}")
         for label in runs:
             print(f"  {label:26s} {best[label] * 1e3:8.1f} ms  {best[label] / reference:5.2f}x  {points[label]:6d} points")
+            lines.append(f"| {name if label.startswith('PWL') else ''} | {label} | {best[label] * 1e3:.1f} ms | {best[label] / reference:.2f}x | "
+                         f"{points[label]} |")
+            ratios.setdefault(label, []).append(best[label] / reference)
+        extra_steps = round(T_END / 2e-6) - round(T_END / 10e-6)
+        per_step.append((best["stepping, H = 2 us"] - best["stepping, H = 10 us"]) / extra_steps)
+
+    def spread(values, fmt):
+        return fmt.format(min(values)) if len(values) == 1 else f"{fmt.format(min(values))}-{fmt.format(max(values))}"
+
+    lines.append("")
+    for h in ("10", "2"):
+        r = ratios[f"stepping, H = {h} us"]
+        met = sum(x <= 1.5 for x in r)
+        lines.append(f"- Target stepping <= 1.5x the PWL run, H = {h} us: **{'met' if met == len(r) else 'not met'}** "
+                     f"({met} of {len(r)} circuits; {spread(r, '{:.2f}')}x).")
+    lines += [
+        f"- G(t) from Python by itself (callback one-shot / PWL): {spread(ratios['callback one-shot'], '{:.2f}')}x.",
+        f"- One macro step, (t(H = 2 us) - t(H = 10 us)) / {extra_steps} extra steps: "
+        f"{spread([1e6 * x for x in per_step], '{:.0f}')} us.",
+        f"- Load average at the end of the run: {os.getloadavg()[0]:.1f} (2 cores).",
+    ]
+    print("\n".join(lines))
+    if not args.no_write:
+        write_block(DOC, BEGIN, END, "\n".join(lines))
+        print(f"written to {DOC}")
     return 0
 
 

@@ -1,18 +1,20 @@
 """Benchmark: the compiled DOPRI5 against scipy solve_ivp (Radau, DOP853) on the default scene.
 
-Run: .venv/bin/python benchmarks/bench_mech.py [--repeat N] [--no-radau] [--no-compile]
+Run: .venv/bin/python benchmarks/bench_mech.py [--repeat N] [--no-radau] [--compile] [--no-write]
 
-The default mechanics scene (3D, 3 modes per family, friction gamma = 0.7, 50 ms after
-release including every re-contact) at rtol 1e-6, in one process:
-- cold: the first call (numba cache load, or a full compile with --compile in a
-  subprocess with an empty cache), measured separately;
+The default mechanics scene (mech.default_scene(): 3D, modes = "auto", friction gamma = 0.7,
+50 ms after release including every re-contact) at rtol 1e-6, in one process:
+- cold: the first call in a fresh process (with the compiled mechanics already in the
+  cache, or, with --compile, a subprocess with an empty cache that builds them), measured
+  separately;
 - DOPRI5 warm: median (and best) of N >= 5 runs after a warm-up;
 - scipy Radau (the stiff baseline the issue names) and DOP853, same right-hand side,
   events and regime logic, one run each (they are slow).
 Prints a markdown table: wall time, steps, rhs evaluations, contacts, first restitution,
 the Radau/DOPRI5 ratio (target >= 20x), whether DOPRI5 warm <= 0.1 s, and the peak memory
 of a DOPRI5 run (tracemalloc peak of Python/NumPy allocations in a separate, untimed run;
-process ru_maxrss after the DOPRI5 runs, before the scipy ones).
+process ru_maxrss after the DOPRI5 runs, before the scipy ones). It writes them between the
+bench-mech markers of docs/benchmarks.md.
 """
 
 from __future__ import annotations
@@ -28,8 +30,12 @@ import time
 import tracemalloc
 from pathlib import Path
 
+from doc_block import command_line, write_block
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+DOC = ROOT / "docs" / "benchmarks.md"
+BEGIN, END = "<!-- bench-mech:begin -->", "<!-- bench-mech:end -->"
 
 COLD_SNIPPET = """
 import time
@@ -72,6 +78,7 @@ def main() -> int:
     parser.add_argument("--no-radau", action="store_true", help="skip the (slow) Radau baseline")
     parser.add_argument("--compile", action="store_true",
                         help="also time a full numba compile in a subprocess with an empty cache")
+    parser.add_argument("--no-write", action="store_true", help="print only; leave docs/benchmarks.md alone")
     args = parser.parse_args()
     repeat = max(args.repeat, 5)
 
@@ -106,27 +113,41 @@ def main() -> int:
         rows.append((f"scipy solve_ivp {method}", wall, summary(res)))
 
     median = statistics.median(warm_times)
-    print(f"default scene: 3D, {scene.bar.axial_modes} modes per family, friction mu = {scene.friction.mu}, "
-          f"gamma = {scene.friction.gamma}, t_end = {scene.solver.t_end} s, rtol = {scene.solver.rtol:g}")
-    print()
-    print("| route | wall time | steps | rhs evals | contacts | first restitution |")
-    print("|---|---|---|---|---|---|")
+    last = warm[-1][1]
+    t_last = float(last.contacts.t_end.max()) if len(last.contacts) else 0.0
+    after = float((last.history.time > t_last).mean())
+    lines = [f"`{command_line()}`: `mech.default_scene()`, {last.solver['model']}, {last.solver.get('modes_rule') or last.solver['modes']} "
+             f"({last.solver['modes']} modal coordinates), friction mu = {scene.friction.mu}, gamma = {scene.friction.gamma}, "
+             f"t_end = {scene.solver.t_end} s, rtol = {scene.solver.rtol:g}", "",
+             "| route | wall time | steps | rhs evals | contacts | first restitution |",
+             "|---|---|---|---|---|---|"]
     for name, wall, s in rows:
-        print(f"| {name} | {wall * 1e3:.1f} ms | {s['steps']} | {s['rhs']} | {s['contacts']} | {s['restitution']:.5f} |")
-    print()
-    print(f"DOPRI5 warm: median {median * 1e3:.1f} ms, best {min(warm_times) * 1e3:.1f} ms, "
-          f"integration only {dopri['solver_wall'] * 1e3:.1f} ms; <= 0.1 s: {'yes' if median <= 0.1 else 'NO'}")
+        lines.append(f"| {name} | {wall * 1e3:.1f} ms | {s['steps']} | {s['rhs']} | {s['contacts']} | {s['restitution']:.5f} |")
+    lines.append("")
     for method, wall in baselines.items():
         ratio = wall / median
-        target = " (target >= 20x: " + ("met" if ratio >= 20 else "NOT met") + ")" if method == "Radau" else ""
-        print(f"{method} / DOPRI5 warm: {ratio:.0f}x{target}")
-    print(f"cold, fresh process with the numba cache: import mech {cold_import:.2f} s, first simulate "
-          f"{cold_first:.2f} s; first call in this process {first * 1e3:.0f} ms")
+        target = " (target >= 20x: **" + ("met" if ratio >= 20 else "NOT met") + "**)" if method == "Radau" else ""
+        lines.append(f"- {method} / DOPRI5 warm: **{ratio:.0f}x**{target}")
+    lines += [
+        f"- DOPRI5 warm: median **{median * 1e3:.1f} ms**, best {min(warm_times) * 1e3:.1f} ms, integration only "
+        f"{dopri['solver_wall'] * 1e3:.1f} ms; target <= 0.1 s: **{'met' if median <= 0.1 else 'NOT met'}**",
+        f"- Steps after the last contact (free flight from {t_last * 1e3:.2f} ms on): {100 * after:.0f} % of the "
+        f"{dopri['steps']}",
+        f"- Cold, fresh process with the compiled mechanics in the cache: import mech {cold_import:.2f} s, first "
+        f"simulate {cold_first:.2f} s; first call in this process {first * 1e3:.0f} ms",
+    ]
     if compile_times:
-        print(f"cold, empty numba cache (full compile): import mech {compile_times[0]:.2f} s, "
-              f"first simulate {compile_times[1]:.2f} s")
-    print(f"peak memory of a DOPRI5 run: tracemalloc peak {traced_peak / 2**20:.1f} MiB; "
-          f"process ru_maxrss {rss_kib / 1024:.0f} MiB (interpreter, numpy, scipy, pandas, numba included)")
+        lines.append(f"- Cold, empty cache (the compiled mechanics built first): import mech {compile_times[0]:.2f} s, "
+                     f"first simulate {compile_times[1]:.2f} s")
+    lines += [
+        f"- Peak memory of a DOPRI5 run: tracemalloc peak {traced_peak / 2**20:.1f} MiB; process ru_maxrss "
+        f"{rss_kib / 1024:.0f} MiB (the interpreter and every library this process loaded)",
+        f"- Load average at the end of the run: {os.getloadavg()[0]:.1f} (2 cores).",
+    ]
+    print("\n".join(lines))
+    if not args.no_write:
+        write_block(DOC, BEGIN, END, "\n".join(lines))
+        print(f"written to {DOC}")
     return 0
 
 

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import os
 import re
+import shlex
+import sys
 from pathlib import Path
 
 
@@ -16,3 +19,12 @@ def write_block(path: Path, begin: str, end: str, text: str, heading: str = "") 
     else:
         doc = doc.rstrip("\n") + ("\n\n" if doc else "") + heading + block + "\n"
     path.write_text(doc)
+
+
+def command_line(env: tuple[str, ...] = ()) -> str:
+    """The command that is running this script, as the docs give it:
+    ``.venv/bin/python benchmarks/NAME ARGS`` (``--no-write`` left out, since a block is only
+    written without it), preceded by those of the environment variables ``env`` that are set."""
+    prefix = [f"{name}={shlex.quote(os.environ[name])}" for name in env if name in os.environ]
+    args = [a for a in sys.argv[1:] if a != "--no-write"]
+    return " ".join([*prefix, ".venv/bin/python", f"benchmarks/{Path(sys.argv[0]).name}", *map(shlex.quote, args)])
