@@ -290,8 +290,9 @@ class Initial:
 
 
 # The loosest rtol shown to give a sound run: at 1e-5 the default coupled and mechanics
-# scenes keep their energy audit within 3e-5 and 1.2e-4 of the scene's energy; at 2e-5 the
-# mechanics default already fails it (1.9e-3), at 1e-4 by 9 % (benchmarks/bench_rtol_soundness.py).
+# scenes keep their energy audit within tolerance, at 2e-5 the mechanics default already
+# fails it (benchmarks/bench_rtol_soundness.py; its table, with the figures, in
+# docs/coupling.md, "The rtol range").
 RTOL_MAX = 1e-5
 
 
