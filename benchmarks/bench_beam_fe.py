@@ -32,7 +32,7 @@ from mech import Bar
 from mech.beam_fe import FEBeam, beam_basis, beam_invariants, beam_modes, default_elements
 from mech.modal_basis import build_modal_basis
 
-from doc_block import command_line, write_block
+from doc_block import command_line, load_line, publish
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "mechanics.md"
 BEGIN, END = "<!-- bench-beam-fe:begin -->", "<!-- bench-beam-fe:end -->"
@@ -116,11 +116,8 @@ def main() -> None:
               f"  (1/1440 = {1 / 1440:.6f}); axial {np.array2string(ea / (k_l / n) ** 6, precision=3)}")
         lines.append(f"| {n} | {', '.join(f'{x:.6f}' for x in eb / (beta_l / n) ** 4)} | "
                      f"{', '.join(f'{x:.3e}' for x in ea / (k_l / n) ** 6)} |")
-    lines += ["", f"Load average at the end of the run: {os.getloadavg()[0]:.1f} (2 cores)."]
-    print("\n".join(lines))
-    if not args.no_write:
-        write_block(DOC, BEGIN, END, "\n".join(lines))
-        print(f"written to {DOC}")
+    lines += ["", load_line(bullet=False)]
+    publish(DOC, BEGIN, END, lines, write=not args.no_write)
 
 
 if __name__ == "__main__":

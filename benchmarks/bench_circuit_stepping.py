@@ -16,14 +16,13 @@ docs/circuit.md (section 9).
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from doc_block import command_line, write_block  # noqa: E402
+from doc_block import command_line, load_line, publish  # noqa: E402
 
 from circuit import (  # noqa: E402
     ArcModel,
@@ -129,12 +128,9 @@ def main() -> int:
         f"- G(t) from Python by itself (callback one-shot / PWL): {spread(ratios['callback one-shot'], '{:.2f}')}x.",
         f"- One macro step, (t(H = 2 us) - t(H = 10 us)) / {extra_steps} extra steps: "
         f"{spread([1e6 * x for x in per_step], '{:.0f}')} us.",
-        f"- Load average at the end of the run: {os.getloadavg()[0]:.1f} (2 cores).",
+        load_line(),
     ]
-    print("\n".join(lines))
-    if not args.no_write:
-        write_block(DOC, BEGIN, END, "\n".join(lines))
-        print(f"written to {DOC}")
+    publish(DOC, BEGIN, END, lines, write=not args.no_write)
     return 0
 
 

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import argparse
 import copy
-import os
 import statistics
 import sys
 import time
@@ -18,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from doc_block import write_block
+from doc_block import load_line, publish
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -132,12 +131,9 @@ def main() -> None:
         f"- Inside the coupled run: mechanics {st['mech_seconds'] * 1e3:.1f} ms, circuit "
         f"{st['circuit_seconds'] * 1e3:.1f} ms (ngspice {st['circuit']['ngspice_seconds'] * 1e3:.1f} ms), the rest "
         "exchange and result assembly.",
-        f"- Load average at the end of the run: {os.getloadavg()[0]:.1f} (2 cores).",
+        load_line(),
     ]
-    print("\n".join(lines))
-    if not args.no_write:
-        write_block(DOC, BEGIN, END, "\n".join(lines))
-        print(f"written to {DOC.relative_to(ROOT)}")
+    publish(DOC, BEGIN, END, lines, write=not args.no_write)
 
 
 if __name__ == "__main__":

@@ -22,7 +22,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from doc_block import command_line, write_block
+from doc_block import command_line, load_line, publish
 
 REPO = Path(__file__).resolve().parents[1]
 DOC = REPO / "docs" / "tribology.md"
@@ -113,11 +113,8 @@ def main() -> None:
         f"({target[0]:.2f} s, {target[1]:.0f} MiB = {target[1] * 2**20 / 1e6:.0f} MB)")
     lines += ["", f"- Target: {TARGET_ROWS:,} rows in <= {TARGET_S:g} s and <= 300 MB = {TARGET_MIB:.0f} MiB "
               f"(whole process): {verdict}.",
-              f"- Load average at the end of the run: {os.getloadavg()[0]:.1f} (2 cores)."]
-    print("\n".join(lines))
-    if not args.no_write:
-        write_block(DOC, BEGIN, END, "\n".join(lines))
-        print(f"written to {DOC}")
+              load_line()]
+    publish(DOC, BEGIN, END, lines, write=not args.no_write)
 
 
 if __name__ == "__main__":

@@ -30,7 +30,7 @@ import time
 import tracemalloc
 from pathlib import Path
 
-from doc_block import command_line, write_block
+from doc_block import command_line, load_line, publish
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -142,12 +142,9 @@ def main() -> int:
     lines += [
         f"- Peak memory of a DOPRI5 run: tracemalloc peak {traced_peak / 2**20:.1f} MiB; process ru_maxrss "
         f"{rss_kib / 1024:.0f} MiB (the interpreter and every library this process loaded)",
-        f"- Load average at the end of the run: {os.getloadavg()[0]:.1f} (2 cores).",
+        load_line(),
     ]
-    print("\n".join(lines))
-    if not args.no_write:
-        write_block(DOC, BEGIN, END, "\n".join(lines))
-        print(f"written to {DOC}")
+    publish(DOC, BEGIN, END, lines, write=not args.no_write)
     return 0
 
 

@@ -17,12 +17,11 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import os
 import sys
 import time
 from pathlib import Path
 
-from doc_block import command_line, write_block
+from doc_block import command_line, load_line, publish
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -96,11 +95,8 @@ def main(rtols=RTOLS, write=True) -> None:
              f"residual within energy_tolerance = {mscene.solver.energy_tolerance:g} of E; bounds in parentheses.", "",
              "| run | rtol | residual / E | E (J) | max kinetic (J) | max speed (m/s) | max penetration (m) "
              "| max load current (A) | verdict | wall |", "|---|---|---|---|---|---|---|---|---|---|", *rows, "",
-             f"Load average at the end of the run: {os.getloadavg()[0]:.1f} (2 cores)."]
-    print("\n".join(lines))
-    if write:
-        write_block(DOC, BEGIN, END, "\n".join(lines))
-        print(f"written to {DOC}")
+             load_line(bullet=False)]
+    publish(DOC, BEGIN, END, lines, write=write)
 
 
 if __name__ == "__main__":

@@ -14,12 +14,11 @@ It writes its table between the bench-tribology markers of docs/benchmarks.md.
 from __future__ import annotations
 
 import argparse
-import os
 import statistics
 import time
 from pathlib import Path
 
-from doc_block import command_line, write_block
+from doc_block import command_line, load_line, publish
 
 from coupling.tribology import fit_tribometer, illustrative_data_path, read_tribometer_csv
 
@@ -65,12 +64,9 @@ def main() -> None:
         f"- Ranking the candidates costs **{full_med / base_med:.2f}x** the fit of the chosen models alone.",
         f"- Target: the full fit, which every default run does once per process at start-up, well under 1 s: "
         f"**{'met' if full_med < 1.0 else 'NOT met'}** ({full_med:.3f} s).",
-        f"- Load average at the end of the run: {os.getloadavg()[0]:.1f} (2 cores).",
+        load_line(),
     ]
-    print("\n".join(lines))
-    if not args.no_write:
-        write_block(DOC, BEGIN, END, "\n".join(lines))
-        print(f"written to {DOC}")
+    publish(DOC, BEGIN, END, lines, write=not args.no_write)
 
 
 if __name__ == "__main__":

@@ -28,3 +28,17 @@ def command_line(env: tuple[str, ...] = ()) -> str:
     prefix = [f"{name}={shlex.quote(os.environ[name])}" for name in env if name in os.environ]
     args = [a for a in sys.argv[1:] if a != "--no-write"]
     return " ".join([*prefix, ".venv/bin/python", f"benchmarks/{Path(sys.argv[0]).name}", *map(shlex.quote, args)])
+
+
+def load_line(bullet: bool = True) -> str:
+    """The load average at the end of a run, as the blocks end: this machine is shared."""
+    return f"{'- ' if bullet else ''}Load average at the end of the run: {os.getloadavg()[0]:.1f} (2 cores)."
+
+
+def publish(path: Path, begin: str, end: str, lines: list[str], write: bool = True) -> None:
+    """Print a benchmark's block and, if ``write``, put it between its markers in ``path``."""
+    text = "\n".join(lines)
+    print(text)
+    if write:
+        write_block(path, begin, end, text)
+        print(f"written to {path}")
