@@ -66,7 +66,6 @@ SENSITIVITY = 0.01  # the relative change of an input in the sensitivity reruns
 SENSITIVITY_RERUNS = 4
 COUNT_KEYS = ("contacts", "bounces")
 TIME_KEYS = ("first_make", "last_make", "total_bounce_time")
-VALUE_KEYS = ("peak_force", "peak_contact_voltage", "arc_energy")
 MAX_MODES = 40  # the largest count a family may have (mech.parameters)
 MIN_RTOL = 1e-13
 MIN_RELTOL = 1e-9
@@ -110,21 +109,20 @@ def contact_metrics(tip_intervals, closed_at_end: bool = False,
     long is a held contact (coupling.metrics). Besides the metrics of the module
     docstring: contact_time (s, both tips, whole run), span (s, first make to the last
     interval's end), window (s, s: first make to the last switching instant, the last make
-    when closed at the end, else the last break), active (the window without held
-    closures: [(s, s), ...]), window_length (s, its length) and window_contact_time (s,
-    both tips' contact time in it).
+    when closed at the end, else the last break), window_length (s, its length without
+    the held closures) and window_contact_time (s, both tips' contact time there).
     """
     all_iv = [iv for ivs in tip_intervals.values() for iv in ivs]
     union = merge_intervals(all_iv)
     out = dict(contacts=len(all_iv), bounces=max(len(union) - 1, 0), first_make=None, last_make=None,
                total_bounce_time=0.0, contact_time=float(sum(measure(v) for v in tip_intervals.values())),
-               span=0.0, window=None, active=[], window_length=0.0, window_contact_time=0.0)
+               span=0.0, window=None, window_length=0.0, window_contact_time=0.0)
     if union:
         end = union[-1][0] if closed_at_end else union[-1][1]
         window = (union[0][0], end)
         active = active_window(union, window, settle_window)
         out.update(first_make=union[0][0], last_make=union[-1][0], total_bounce_time=union[-1][0] - union[0][0],
-                   span=union[-1][1] - union[0][0], window=window, active=active, window_length=measure(active),
+                   span=union[-1][1] - union[0][0], window=window, window_length=measure(active),
                    window_contact_time=float(sum(measure(intersection(v, active)) for v in tip_intervals.values())))
     return out
 
