@@ -264,7 +264,7 @@ def plot_energy(result):
 
 def plot_accuracy(result):
     """The contact's closed intervals of the run and of every rerun of ``run --check``
-    (refinements, then the gap-perturbed runs aligned on the first make), one row each,
+    (refinements, then the input-perturbed runs aligned on the first make), one row each,
     over the switching window: where the sequences part is where the prediction ends."""
     acc = result.accuracy
     rows = [("this run", acc["closed"], "tab:green")]
