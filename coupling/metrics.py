@@ -80,12 +80,9 @@ def merge_intervals(intervals) -> list[tuple[float, float]]:
     return [(a, b) for a, b in out]
 
 
-def switching_instants(intervals, t_start: float, t_end: float, tol: float):
-    """(makes, breaks), s: interval starts after t_start and ends before t_end (tolerance tol)."""
-    iv = merge_intervals(intervals)
-    makes = [a for a, _ in iv if a > t_start + tol]
-    breaks = [b for _, b in iv if b < t_end - tol]
-    return makes, breaks
+def make_instants(intervals, t_start: float, tol: float) -> list[float]:
+    """s: the makes, interval starts after t_start (tolerance tol)."""
+    return [a for a, _ in merge_intervals(intervals) if a > t_start + tol]
 
 
 def openings_of(intervals, t_start: float, t_end: float, tol: float) -> list[tuple[float, float, bool]]:
@@ -185,7 +182,7 @@ def bounce_metrics(intervals, t_end: float, closed_at_end: bool, t=None, v=None,
     iv = merge_intervals(intervals)
     tol = guard
     starts_closed = bool(iv) and iv[0][0] <= t_start + tol
-    makes, _ = switching_instants(iv, t_start, t_end, tol)
+    makes = make_instants(iv, t_start, tol)
     openings = openings_of(iv, t_start, t_end, tol)
     if not closed_at_end and iv and iv[-1][1] >= t_end - tol:
         closed_at_end = True  # the intervals say it (a schedule closed up to t_end)
