@@ -15,6 +15,7 @@ from pathlib import Path
 
 import pytest
 from cli_checks import assert_one_line_error, run_cli
+from fit_compare import assert_same_fit
 
 from coupling.cli import main
 from coupling.scene import load_scene
@@ -115,7 +116,7 @@ def test_a_byte_order_mark_is_read_as_written(tmp_path, capsys):
     (tmp_path / "excel.csv").write_bytes(b"\xef\xbb\xbf" + SHIPPED.encode())
     assert main(["fit", str(tmp_path / "excel.csv"), "--out", str(tmp_path / "fit")]) == 0
     saved = json.loads((tmp_path / "fit" / "fit.json").read_text())
-    assert saved["laws"] == default_fit().to_dict()["laws"]
+    assert_same_fit(saved["laws"], default_fit().to_dict()["laws"])
     scene = tmp_path / "bom.toml"
     scene.write_bytes(b"\xef\xbb\xbf" + MECH.replace("t_end = 1e-4", "t_end = 1e-5").encode())
     assert main(["run", str(scene), "--out", str(tmp_path / "run"), "--quiet"]) == 0
