@@ -11,7 +11,7 @@ restitution <= 1 in every complete contact, Hertz penetration < 10 % of the tip 
 solver.energy_tolerance unless the result flags it.
 
 status: "ok" | "ok, flagged" (the result carries flags or warnings) | "unsound" (the
-soundness bounds of coupling.soundness fail: switchsim run's exit 3) | "rejected" (a clear
+soundness bounds of coupling.core.soundness fail: switchsim run's exit 3) | "rejected" (a clear
 error before the run) | "failed" (a run error with a message) | "crash" (an unexpected
 exception: a bug) ; "silent" lists physics checks that failed while the result carries
 no flag at all ("flagged_failures" those of a flagged result).
@@ -62,10 +62,10 @@ def main(arg: str) -> dict:
         except Exception as err:  # noqa: BLE001
             out.update(status="crash", message=f"summary: {type(err).__name__}: {err}")
             return out
-        # the result's flags and its warnings (coupling.diagnostics: printed by switchsim run)
+        # the result's flags and its warnings (coupling.core.diagnostics: printed by switchsim run)
         out["flags"] = list(result.summary.get("flags", summary["flags"])) + list(result.warnings)
         if out["status"] == "ok":
-            from coupling.soundness import assess
+            from coupling.core.soundness import assess
 
             problems = assess(result)["problems"]
             if problems:  # what switchsim run reports as "unsound" (exit 3)
@@ -120,7 +120,7 @@ def main(arg: str) -> dict:
     reference = checks.get("reference_changes")
     if reference is not None and w is not None and out["status"] == "ok":
         # the same scene with a fine, trusted setting: the case must agree with it
-        from coupling.accuracy import metrics_of, mismatch_time, tip_intervals
+        from coupling.app.accuracy import metrics_of, mismatch_time, tip_intervals
 
         ref = run(scene.update(reference))
         a, b = metrics_of(result), metrics_of(ref)

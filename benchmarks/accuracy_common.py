@@ -21,7 +21,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 OUT = ROOT / "docs" / "accuracy"
 
-from coupling.accuracy import contact_metrics, mismatch_time, tip_intervals  # noqa: E402
+from coupling.app.accuracy import contact_metrics, mismatch_time, tip_intervals  # noqa: E402
 
 
 def load_note() -> str:
@@ -198,7 +198,7 @@ def coupled_metrics(result) -> dict:
     breaks, V) of a CoupledResult."""
     import numpy as np
 
-    from coupling.accuracy import metrics_of
+    from coupling.app.accuracy import metrics_of
 
     m = metrics_of(result)
     m["tips"] = tip_intervals(result)

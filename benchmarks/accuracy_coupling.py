@@ -34,7 +34,7 @@ def main() -> None:
     base = load_scene(SCENE)
     ref_res, ref_wall = reference(base)
     ref = coupled_metrics(ref_res)
-    sec.add("**(a) Against the monolithic reference** (`coupling/monolithic.py`: mechanics and the series "
+    sec.add("**(a) Against the monolithic reference** (`coupling/core/monolithic.py`: mechanics and the series "
             "loop in one Radau solve, no coupling error) on tests/coupling/scenes/impact_inrush.toml "
             f"(capacitive inrush while the tip slides, mu doubling with the current; rtol "
             f"{base.mech.solver.rtol:g}, RELTOL {base.circuit.options.reltol:g}). Reference: "

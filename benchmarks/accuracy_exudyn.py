@@ -23,7 +23,7 @@ import time
 
 from accuracy_common import Section, dump, fmt, load_note, mech_scene, mech_tips, plt, run_mech
 
-from coupling.accuracy import TOLERANCES, compare, contact_metrics, mismatch_time
+from coupling.app.accuracy import TOLERANCES, compare, contact_metrics, mismatch_time
 
 # --- the scenes (SI units) --------------------------------------------------------------
 BAR = dict(length=0.3, diameter=0.01, tip_radius=0.005, youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0)
@@ -328,7 +328,7 @@ def metrics(run: dict) -> dict:
 def errors(run: dict, ref: dict) -> dict:
     """Errors of a run against a reference run: mismatch (s, both tips), count differences,
     relative peak force, end-velocity and inclination-rate differences, and `agrees`: within
-    the `run --check` tolerances (coupling.accuracy.TOLERANCES) and VELOCITY_TOL, RATE_TOL."""
+    the `run --check` tolerances (coupling.app.accuracy.TOLERANCES) and VELOCITY_TOL, RATE_TOL."""
     if run.get("status") != "ok" or ref.get("status") != "ok":
         return dict(agrees=False)
     m, r = metrics(run), metrics(ref)

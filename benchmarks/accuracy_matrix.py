@@ -40,7 +40,7 @@ def coupled(changes: dict, checks: dict | None = None) -> dict:
     """The built-in free-drop scene (arc, 24 V, 12 ohm; 3 modes per family), 20 um above the block, 2 ms."""
     import tomllib
 
-    from coupling.scene import builtin_scene_text
+    from coupling.core.scene import builtin_scene_text
 
     doc = tomllib.loads(builtin_scene_text("free_drop"))
     doc["bar"]["modes"] = 3  # the count docs/accuracy/matrix.md was measured at (the scene is "auto" now)

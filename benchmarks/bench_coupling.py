@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from coupling import builtin_scene, run  # noqa: E402
-from coupling.scene import scene_from_dict  # noqa: E402
+from coupling.core.scene import scene_from_dict  # noqa: E402
 
 DOC = ROOT / "docs" / "benchmarks.md"
 BEGIN, END = "<!-- bench-coupling:begin -->", "<!-- bench-coupling:end -->"

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from coupling import load_scene, run
-from coupling.monolithic import run_monolithic
+from coupling.core.monolithic import run_monolithic
 from doc_block import command_line, write_block
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -2,8 +2,8 @@
 
     python benchmarks/bench_fit_scale.py [--rows 10000 100000 1000000] [--keep DIR] [--no-write]
 
-Writes CSVs of the illustrative laws (coupling/tribology/illustrative.py's generator: 11
-loads x 4 currents, repeated; lognormal scatter) and runs `python -m coupling.cli fit`
+Writes CSVs of the illustrative laws (coupling/laws/tribology/illustrative.py's generator: 11
+loads x 4 currents, repeated; lognormal scatter) and runs `python -m coupling.app.cli fit`
 on each in a fresh process, measuring that process alone (os.wait4: wall time and
 peak resident memory). Also runs the imports alone, the fixed cost of any fit (IMPORTS:
 what `switchsim fit` loads, the libraries it imports lazily included). Ratios are against
@@ -30,7 +30,7 @@ BEGIN, END = "<!-- bench-fit-scale:begin -->", "<!-- bench-fit-scale:end -->"
 # every module a fit loads: the command line and the fit, and what they import lazily (pandas
 # with pyarrow, scipy.stats and scipy.optimize, matplotlib for the figures); `coupling` itself
 # imports none of them, so importing the command alone no longer measures the fixed cost
-IMPORTS = ("coupling.tribology.command, coupling.cli, coupling.tribology.plots, pandas, scipy.stats, "
+IMPORTS = ("coupling.app.fit, coupling.app.cli, coupling.app.fit_plots, pandas, scipy.stats, "
            "scipy.optimize, matplotlib.backends.backend_agg")
 TARGET_ROWS, TARGET_S, TARGET_MIB = 1_000_000, 10.0, 300e6 / 2**20
 
@@ -41,7 +41,7 @@ def write_csv(path: Path, rows: int, seed: int = 1) -> None:
     import numpy as np
 
     sys.path.insert(0, str(REPO))
-    from coupling.tribology.illustrative import ILLUSTRATIVE_LAWS, SyntheticDesign, synthetic_tribometer_data
+    from coupling.laws.tribology.illustrative import ILLUSTRATIVE_LAWS, SyntheticDesign, synthetic_tribometer_data
 
     loads = tuple(np.linspace(3.0, 8.0, 11))
     currents = (0.0, 1.0, 2.0, 5.0)
@@ -85,7 +85,7 @@ def main() -> None:
     if code0 != 0:
         raise SystemExit(f"the imports alone exited with {code0}")
     print(f"imports only: {wall0:.2f} s, {rss0:.0f} MiB peak")
-    lines = [f"`{command_line()}`: `python -m coupling.cli fit` on synthetic CSVs, each in a fresh process "
+    lines = [f"`{command_line()}`: `python -m coupling.app.cli fit` on synthetic CSVs, each in a fresh process "
              "(wall time and peak RSS of that process alone, from wait4); ratios to the smallest file, same run.", "",
              f"The imports alone (`import {IMPORTS}`): {wall0:.2f} s, {rss0:.0f} MiB peak.", "",
              "| rows | MB file | wall s | peak MiB | t / t(first) | mem / mem(first) | over the imports |",
@@ -97,7 +97,7 @@ def main() -> None:
         csv = folder / f"tribometer_{rows}.csv"
         subprocess.run([sys.executable, __file__, "--write", str(csv), str(rows)], check=True)
         out = folder / f"fit_{rows}"
-        wall, rss, code = measure(["-m", "coupling.cli", "fit", str(csv), "--out", str(out)])
+        wall, rss, code = measure(["-m", "coupling.app.cli", "fit", str(csv), "--out", str(out)])
         if code != 0:
             raise SystemExit(f"switchsim fit exited with {code} on {csv}")
         base = base or (wall, rss)

@@ -31,8 +31,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from coupling import builtin_scene, run  # noqa: E402
-from coupling.accuracy import check, metrics_of, mismatch_time, mode_counts, time_tolerance, tip_intervals  # noqa: E402
-from coupling.scene import load_scene  # noqa: E402
+from coupling.app.accuracy import check, metrics_of, mismatch_time, mode_counts, time_tolerance, tip_intervals  # noqa: E402
+from coupling.core.scene import load_scene  # noqa: E402
 
 DOC = ROOT / "docs" / "accuracy-modes.md"
 BEGIN, END = "<!-- mode-count-mechanisms:begin -->", "<!-- mode-count-mechanisms:end -->"

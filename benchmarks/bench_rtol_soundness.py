@@ -3,7 +3,7 @@
 Runs the built-in default coupled scene (10 ms) and the mechanics default scene (50 ms)
 at several rtol, including values above the allowed maximum (on purpose: the options
 object is validated at 1e-6, then its rtol is replaced), and prints the soundness
-measures of coupling.soundness: the largest |energy residual| against the scene's energy
+measures of coupling.core.soundness: the largest |energy residual| against the scene's energy
 scale, the deepest penetration and the fastest centre speed against their energy bounds,
 the loop current against the circuit's bound.
 
@@ -28,9 +28,9 @@ sys.path.insert(0, str(ROOT))
 
 import mech  # noqa: E402
 from coupling import builtin_scene, run  # noqa: E402
-from coupling.master import CoupledRunError  # noqa: E402
-from coupling.results import CoupledResult  # noqa: E402
-from coupling.soundness import assess  # noqa: E402
+from coupling.core.master import CoupledRunError  # noqa: E402
+from coupling.core.results import CoupledResult  # noqa: E402
+from coupling.core.soundness import assess  # noqa: E402
 
 DOC = ROOT / "docs" / "coupling.md"
 BEGIN, END = "<!-- bench-rtol-soundness:begin -->", "<!-- bench-rtol-soundness:end -->"
@@ -91,7 +91,7 @@ def main(rtols=RTOLS, write=True) -> None:
         rule = m.solver.get("modes_rule") or f"{m.solver['modes']} modal coordinates"
     lines = [f"`{command_line()}`: coupled = `builtin_scene(\"free_drop\")` at 3 modes per family, "
              f"{coupled.t_end * 1e3:g} ms; mechanics = `mech.default_scene()` ({rule}), "
-             f"{mscene.solver.t_end * 1e3:g} ms. Sound: every bound of coupling.soundness holds, the energy "
+             f"{mscene.solver.t_end * 1e3:g} ms. Sound: every bound of coupling.core.soundness holds, the energy "
              f"residual within energy_tolerance = {mscene.solver.energy_tolerance:g} of E; bounds in parentheses.", "",
              "| run | rtol | residual / E | E (J) | max kinetic (J) | max speed (m/s) | max penetration (m) "
              "| max load current (A) | verdict | wall |", "|---|---|---|---|---|---|---|---|---|---|", *rows, "",

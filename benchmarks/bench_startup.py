@@ -79,12 +79,12 @@ PHASES = textwrap.dedent("""
     import json, os, sys
     marks = [("start", time.perf_counter())]
     def mark(name): marks.append((name, time.perf_counter()))
-    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # as coupling.cli.main sets it
-    from coupling.master import run
-    mark("import coupling.master (numpy, mech, the compiled module)")
-    from coupling.output import ResultFolder, scene_identity
-    from coupling.scene import default_scene, load_scene
-    from coupling.soundness import assess
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # as coupling.app.cli.main sets it
+    from coupling.core.master import run
+    mark("import coupling.core.master (numpy, mech, the compiled module)")
+    from coupling.app.output import ResultFolder, scene_identity
+    from coupling.core.scene import default_scene, load_scene
+    from coupling.core.soundness import assess
     scene = default_scene() if sys.argv[1] == "default" else load_scene(sys.argv[1])
     mark("scene (read, validate; circuit: PySpice, laws)")
     folder = ResultFolder.check(sys.argv[2], scene_identity(scene, None), overwrite=True)
@@ -96,7 +96,7 @@ PHASES = textwrap.dedent("""
     mark("write the default outputs")
     stats = result.stats
     import gc
-    gc.freeze()  # as coupling.cli.main does when the process's own command line returns
+    gc.freeze()  # as coupling.app.cli.main does when the process's own command line returns
     phases = [(b[0], b[1] - a[1]) for a, b in zip(marks, marks[1:])]
     print(json.dumps(dict(phases=phases, wall_time=stats.get("wall_time", 0.0),
                           mech=stats.get("mech_seconds"), circuit=stats.get("circuit_seconds"),
@@ -105,7 +105,7 @@ PHASES = textwrap.dedent("""
 
 
 def phases(scene: str, out: str) -> dict:
-    """One fresh interpreter timing the phases of `switchsim run` (coupling.commands.run_command's
+    """One fresh interpreter timing the phases of `switchsim run` (coupling.app.commands.run_command's
     steps), with the interpreter's start and exit measured from here."""
     spawn = time.time()
     done = subprocess.run([sys.executable, "-c", PHASES, scene, out], env=_env(), capture_output=True, text=True,
@@ -147,7 +147,7 @@ def main() -> None:
     default_text = (ROOT / "coupling" / "scenes" / "default.toml").read_text()
     coupled_quiet = tmp / "default_no_output.toml"
     coupled_quiet.write_text(default_text.split("[output]")[0] + NO_OUTPUT)
-    run = [py, "-m", "coupling.cli", "run"]
+    run = [py, "-m", "coupling.app.cli", "run"]
     # warm-up: the ahead-of-time module of this tree (built if missing), ngspice, the OS file cache
     for scene in (str(mech), None):
         whole_process(run + ([scene] if scene else []) + ["--out", str(tmp / "warm"), "--quiet", "--overwrite"], 1)
@@ -156,7 +156,7 @@ def main() -> None:
     for label, cmd in [
         ("`python -c pass`", [py, "-c", "pass"]),
         ("`python -c \"import numpy\"`", [py, "-c", "import numpy"]),
-        ("`import coupling.master, coupling.scene`", [py, "-c", "import coupling.master, coupling.scene"]),
+        ("`import coupling.core.master, coupling.core.scene`", [py, "-c", "import coupling.core.master, coupling.core.scene"]),
         ("mechanics-only scene, default outputs", run + [str(mech), "--out", str(tmp / "m1"), "--quiet"]),
         ("mechanics-only scene, outputs off", run + [str(mech_quiet), "--out", str(tmp / "m2"), "--quiet"]),
         ("default coupled scene, default outputs", run + ["--out", str(tmp / "c1"), "--quiet"]),

@@ -56,8 +56,8 @@ load_resistance = 12.0
 
 def coupled_sweep(runs: int):
     """The default coupled scene, 3 ms, load resistance varied over `runs` values."""
-    from coupling.scene import default_scene
-    from coupling.sweep import Sweep
+    from coupling.core.scene import default_scene
+    from coupling.app.sweep import Sweep
 
     base = default_scene().set("solver.t_end", 0.003)
     return Sweep.grid(base, {"circuit.load_resistance": [6.0 + 0.5 * k for k in range(runs)]})
@@ -83,7 +83,7 @@ def on_cluster(sweep, workers: int, tmp: Path, repeat: int) -> float:
     (the best of `repeat` sweeps)."""
     from distributed import Client
 
-    from coupling.sweep import local_cluster, run_sweep
+    from coupling.app.sweep import local_cluster, run_sweep
 
     env = {"PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
     with local_cluster(workers, env=env) as cluster, Client(cluster) as client:
@@ -103,7 +103,7 @@ def _timed_runs(n: int = 4) -> dict:
     import psutil
 
     from coupling import run
-    from coupling.scene import default_scene
+    from coupling.core.scene import default_scene
 
     scene = default_scene().set("solver.t_end", 0.003)
     run(scene)
@@ -121,7 +121,7 @@ def worker_settings_cost(n: int) -> dict:
     import dask
     from distributed import Client, LocalCluster
 
-    from coupling.sweep import WORKER_SETTINGS
+    from coupling.app.sweep import WORKER_SETTINGS
 
     env = {"PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
     routes = (("worker, Dask's defaults (profiler on, MALLOC_TRIM_THRESHOLD_ 64 KiB)", {}),
@@ -140,8 +140,8 @@ def worker_settings_cost(n: int) -> dict:
 CLIENT = textwrap.dedent("""
     import json, resource, sys, tomllib, tracemalloc
     sys.path.insert(0, sys.argv[4])
-    from coupling.scene import scene_from_dict
-    from coupling.sweep import Sweep, run_sweep
+    from coupling.core.scene import scene_from_dict
+    from coupling.app.sweep import Sweep, run_sweep
     base = scene_from_dict(tomllib.loads(open(sys.argv[1]).read()), name="tiny")
     n = int(sys.argv[2])
     sweep = Sweep.grid(base, {"initial.angle_deg": [20.0 + 50.0 * k / n for k in range(n)]}, waveforms=True)

@@ -1,6 +1,6 @@
 """Benchmark: the shipped tribometer fit, against the fit of its chosen models alone.
 
-The default scene fits the shipped dataset once per process (`coupling.tribology.default_fit`),
+The default scene fits the shipped dataset once per process (`coupling.laws.tribology.default_fit`),
 so the whole model selection (every mu(I) candidate, every R_c load law x current factor,
 with profile-likelihood intervals) is start-up cost of every default run. Target: well under
 1 s on this 2-core machine. The baseline, measured in the same run, is the fit restricted to
@@ -20,7 +20,7 @@ from pathlib import Path
 
 from doc_block import command_line, load_line, publish
 
-from coupling.tribology import fit_tribometer, illustrative_data_path, read_tribometer_csv
+from coupling.laws.tribology import fit_tribometer, illustrative_data_path, read_tribometer_csv
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "benchmarks.md"
 BEGIN, END = "<!-- bench-tribology:begin -->", "<!-- bench-tribology:end -->"

@@ -2,7 +2,7 @@
 
 The one validation module of circuit: every frozen dataclass (templates, arc, options,
 schedule, netlist) checks its fields with these, once, in ``__post_init__``. A scene
-reports the errors under its own key names (coupling.scene translates 'Class.field' into
+reports the errors under its own key names (coupling.core.scene translates 'Class.field' into
 'circuit.key'; docs/scene_keys.md, "Where values are checked").
 """
 

@@ -13,10 +13,12 @@ Scenario scripts::
 __all__ = ["CoSimulation", "CoupledResult", "CoupledRunError", "Scene", "builtin_scene", "default_scene",
            "load_scene", "run", "scene_from_dict"]
 
-# Imported on first use (PEP 562): `import coupling.scene` or the CLI's argument parsing
+# Imported on first use (PEP 562): `import coupling.core.scene` or the CLI's argument parsing
 # must not pay for the solvers, pandas or numba.
-_LAZY = {"CoSimulation": "master", "CoupledRunError": "master", "run": "master", "CoupledResult": "results",
-         "Scene": "scene", "builtin_scene": "scene", "default_scene": "scene", "load_scene": "scene", "scene_from_dict": "scene"}
+_LAZY = {"CoSimulation": "core.master", "CoupledRunError": "core.master", "run": "core.master",
+         "CoupledResult": "core.results",
+         "Scene": "core.scene", "builtin_scene": "core.scene", "default_scene": "core.scene", "load_scene": "core.scene",
+         "scene_from_dict": "core.scene"}
 
 
 def lazy_attributes(package: str, table: dict[str, str]):

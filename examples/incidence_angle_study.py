@@ -167,7 +167,7 @@ def sweep(fast: bool = False) -> tuple[dict, dict]:
         fills["FIXED"] = float(ref.mechanics.solver["damping"])
         context["fixed_damping"] = fills["FIXED"]
     if "MU1A" in needs:
-        from coupling.tribology import default_fit
+        from coupling.laws.tribology import default_fit
 
         fit = default_fit()  # the shipped ILLUSTRATIVE (not measured) dataset's fit
         fills["MU1A"], fills["GAMMA"] = float(fit.mu(1.0)), float(fit.gamma)

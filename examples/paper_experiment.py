@@ -38,7 +38,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from coupling import load_scene, run  # noqa: E402
-from coupling.tribology import illustrative_data_path, read_tribometer_csv  # noqa: E402
+from coupling.laws.tribology import illustrative_data_path, read_tribometer_csv  # noqa: E402
 
 import example_cli  # noqa: E402  (examples/example_cli.py, next to this script)
 

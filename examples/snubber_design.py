@@ -1,6 +1,6 @@
 """Snubber design: choose R and C for a 24 V / 10 ohm / 5 mH load, and map the bounce time.
 
-Two sweeps of examples/snubber_design.toml on Dask (coupling.sweep, one local cluster):
+Two sweeps of examples/snubber_design.toml on Dask (coupling.app.sweep, one local cluster):
 
 1. The opening of the coil's circuit (the bar lifted off the block at 2 m/s, 2.4 A
    flowing) for every snubber resistance R and capacitance C of a grid. The current goes
@@ -29,8 +29,8 @@ import sys
 from pathlib import Path
 
 from coupling import load_scene
-from coupling.sweep import Sweep, local_cluster, read_results, run_sweep
-from coupling.sweep_plots import plot_map, plot_metric, plot_overlay, save
+from coupling.app.sweep import Sweep, local_cluster, read_results, run_sweep
+from coupling.app.sweep_plots import plot_map, plot_metric, plot_overlay, save
 
 import example_cli  # noqa: E402  (examples/example_cli.py, next to this script)
 

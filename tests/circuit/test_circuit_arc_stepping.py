@@ -63,7 +63,7 @@ def stepped(circuit, schedule, t_end, macro_step, options=OPTIONS):
 
 
 def coupled_like(circuit, schedule, t_end, contact_step=2e-6, free_step=1e-4, tail=20e-6, options=OPTIONS):
-    """Like coupling.master: short steps in contact (and for ``tail`` after a break), long
+    """Like coupling.core.master: short steps in contact (and for ``tail`` after a break), long
     steps in free flight, each step ending exactly at the next make or break."""
     events = sorted({t for pair in schedule.intervals for t in pair})
 

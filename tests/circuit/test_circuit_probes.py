@@ -7,7 +7,7 @@ import pytest
 
 from circuit.probes import parse_probe, spice_number
 from coupling import run
-from coupling.scene import scene_from_dict
+from coupling.core.scene import scene_from_dict
 
 PROBES = ["v(snubber,contact_b)", "i(Rsnubber)", "i(Csnubber)", "i(Lload)", "v(contact_a,contact_b)"]
 

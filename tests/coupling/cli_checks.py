@@ -6,8 +6,8 @@ import contextlib
 import io
 from unittest import mock
 
-import coupling.master
-from coupling.cli import main
+import coupling.core.master
+from coupling.app.cli import main
 
 
 def no_run(*_args, **_kwargs):
@@ -17,7 +17,7 @@ def no_run(*_args, **_kwargs):
 def run_cli(argv) -> tuple[int, str]:
     """main(argv) with the simulation replaced by an assertion: (exit code, stderr)."""
     err = io.StringIO()
-    with mock.patch.object(coupling.master, "run", no_run), contextlib.redirect_stderr(err), \
+    with mock.patch.object(coupling.core.master, "run", no_run), contextlib.redirect_stderr(err), \
             contextlib.redirect_stdout(io.StringIO()):
         rc = main(argv)
     return rc, err.getvalue()

@@ -1,4 +1,4 @@
-"""The per-run accuracy check (coupling/accuracy.py): metrics on hand-built interval
+"""The per-run accuracy check (coupling/app/accuracy.py): metrics on hand-built interval
 series against brute-force sampling, the verdict, and end-to-end runs that reproduce the
 measured mode non-convergence of a slender bar."""
 
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from coupling import run, scene_from_dict
-from coupling.accuracy import (
+from coupling.app.accuracy import (
     TOLERANCES, agreeing_contacts, compare, contact_metrics, intersection, measure,
     metrics_of, mismatch_allowance, mismatch_time, refined_count, status_of, time_tolerance, verdict,
 )
@@ -207,8 +207,8 @@ def test_rigid_bar_has_no_mode_refinement():
 
 
 def test_short_coupled_scene_check_and_cli(tmp_path, capsys):
-    from coupling.cli import main
-    from coupling.scene import default_scene_text
+    from coupling.app.cli import main
+    from coupling.core.scene import default_scene_text
 
     text = default_scene_text().replace("height = 0.001", "height = 0.00002").replace(
         "t_end = 0.01", "t_end = 0.0006").replace("plots = true", "plots = false").replace(
@@ -295,7 +295,7 @@ def test_pushbutton_at_auto_brackets_twice_its_mode_count():
     # impact must be the same in every rerun.
     from pathlib import Path
 
-    from coupling.scene import load_scene
+    from coupling.core.scene import load_scene
 
     root = Path(__file__).resolve().parents[2]
     scene = load_scene(root / "examples" / "pushbutton.toml").update(

@@ -13,7 +13,7 @@ import pytest
 
 import circuit as ck
 from coupling import run
-from coupling.scene import CIRCUIT_KEYS, scene_from_dict
+from coupling.core.scene import CIRCUIT_KEYS, scene_from_dict
 
 MECH = {"bar": {"modes": 0}, "initial": {"height": 1e-3, "angle_deg": 90.0, "velocity": [0, 0, -0.5]}}
 TRIB = {"tribology": {"source": "illustrative"}}
@@ -84,7 +84,7 @@ def test_unknown_keys_list_the_allowed_ones_with_a_did_you_mean(circuit, expecte
 
 
 def test_every_circuit_key_is_listed_once_and_maps_to_a_dataclass_field():
-    from coupling.scene import circuit_key_names  # the map the errors are translated with (public)
+    from coupling.core.scene import circuit_key_names  # the map the errors are translated with (public)
 
     targets = set(circuit_key_names(ck).values())
     top = {t.split(".")[1] for t in targets if t.count(".") == 1}

@@ -17,9 +17,9 @@ import pytest
 from cli_checks import assert_one_line_error, run_cli
 from fit_compare import assert_same_fit
 
-from coupling.cli import main
-from coupling.scene import load_scene
-from coupling.tribology import default_fit, illustrative_data_path
+from coupling.app.cli import main
+from coupling.core.scene import load_scene
+from coupling.laws.tribology import default_fit, illustrative_data_path
 
 REPO = Path(__file__).resolve().parents[2]
 MECH = """\
@@ -150,7 +150,7 @@ def test_a_tiny_friction_is_an_outlier_reported_by_fit_and_by_the_scenes_using_i
     assert main(["fit", str(tmp_path / "data.csv"), "--out", str(tmp_path / "fit")]) == 0
     printed = capsys.readouterr().out
     assert f"OUTLIERS left out of the friction fit: 1 row(s): line {line_number} (friction_N = 1e-320" in printed
-    from coupling.diagnostics import fit_warnings
+    from coupling.core.diagnostics import fit_warnings
 
     for key, value in (("data", "data.csv"), ("fit", "fit/fit.json")):
         (tmp_path / "scene.toml").write_text(
@@ -184,7 +184,7 @@ def test_python_m_coupling_cli_prints_one_line_and_exits_2(tmp_path):
     for args, words in ((["run", "c.toml"], "c.toml: circuit.voltage = -1 V"),
                         (["run", "n.toml"], "n.toml: netlist net.cir line 6: resistor line"),
                         (["fit", "lat.csv"], f"lat.csv: line {LATIN1_LINE}, column 2")):
-        done = subprocess.run([sys.executable, "-m", "coupling.cli", *args, "--out", "o"], cwd=tmp_path, env=env,
+        done = subprocess.run([sys.executable, "-m", "coupling.app.cli", *args, "--out", "o"], cwd=tmp_path, env=env,
                               capture_output=True, text=True, timeout=300)
         assert done.returncode == 2 and done.stdout == "", (args, done.stdout, done.stderr)
         assert done.stderr.startswith("switchsim: error: ") and done.stderr.count("\n") == 1, done.stderr

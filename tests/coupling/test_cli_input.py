@@ -65,7 +65,7 @@ def test_bar_modes_errors_name_the_key_the_user_wrote(tmp_path, value, words):
 
 def test_a_byte_order_mark_is_accepted(tmp_path):
     """Some Windows editors start UTF-8 files with a BOM: the scene is read as written."""
-    from coupling.scene import load_scene
+    from coupling.core.scene import load_scene
 
     scene = tmp_path / "bom.toml"
     scene.write_bytes(b"\xef\xbb\xbf" + "[bar]\nmodes = 1\n".encode())
@@ -188,7 +188,7 @@ def bad_entry(draw) -> tuple[str, str, object]:
 def known_key(section: str, key: str) -> bool:
     import dataclasses
 
-    from coupling.scene import OutputOptions
+    from coupling.core.scene import OutputOptions
     from mech.scene import ENVIRONMENT_KEYS, SECTIONS
 
     if section == "environment":
@@ -244,7 +244,7 @@ def test_generated_odd_encodings_get_one_line_and_exit_2(head, tail, encoding):
 def test_generated_text_is_never_a_traceback(text):
     """Any text at all: a valid scene (then it would run: the run is replaced here, and a
     document that validates is skipped) or one line and exit 2."""
-    from coupling.scene import load_scene
+    from coupling.core.scene import load_scene
 
     with tempfile.TemporaryDirectory() as tmp:
         scene = Path(tmp) / "any.toml"

@@ -16,8 +16,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-import coupling.master
-from coupling.cli import main
+import coupling.core.master
+from coupling.app.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -76,7 +76,7 @@ def staging_left(parent: Path) -> list[str]:
 ])
 def test_unusable_destinations_are_refused_before_the_run(tmp_path, capsys, monkeypatch, out, words):
     scene = write(tmp_path, "drop.toml", DROP)
-    monkeypatch.setattr(coupling.master, "run", no_run)
+    monkeypatch.setattr(coupling.core.master, "run", no_run)
     assert main(["run", str(scene), "--out", out]) == 2
     line = one_error_line(capsys)
     for word in words:
@@ -86,7 +86,7 @@ def test_unusable_destinations_are_refused_before_the_run(tmp_path, capsys, monk
 def test_an_existing_file_as_destination_is_refused_and_left_alone(tmp_path, capsys, monkeypatch):
     scene = write(tmp_path, "drop.toml", DROP)
     target = write(tmp_path, "notes.txt", "mine")
-    monkeypatch.setattr(coupling.master, "run", no_run)
+    monkeypatch.setattr(coupling.core.master, "run", no_run)
     assert main(["run", str(scene), "--out", str(target)]) == 2
     assert "is a file" in one_error_line(capsys)
     assert target.read_text() == "mine"
@@ -98,7 +98,7 @@ def test_a_read_only_folder_is_refused(tmp_path, capsys, monkeypatch):
     locked = tmp_path / "locked"
     locked.mkdir()
     locked.chmod(0o555)
-    monkeypatch.setattr(coupling.master, "run", no_run)
+    monkeypatch.setattr(coupling.core.master, "run", no_run)
     try:
         assert main(["run", str(scene), "--out", str(locked / "out")]) == 2
     finally:
@@ -123,7 +123,7 @@ def test_overwrite_never_deletes_a_folder_with_sub_folders(tmp_path, capsys, mon
     scene = write(tmp_path, "drop.toml", DROP)
     out = tmp_path / "project"
     (out / "src").mkdir(parents=True)
-    monkeypatch.setattr(coupling.master, "run", no_run)
+    monkeypatch.setattr(coupling.core.master, "run", no_run)
     assert main(["run", str(scene), "--out", str(out), "--overwrite"]) == 2
     assert "sub-folders" in one_error_line(capsys)
     assert (out / "src").is_dir()
@@ -132,7 +132,7 @@ def test_overwrite_never_deletes_a_folder_with_sub_folders(tmp_path, capsys, mon
 def test_the_current_folder_is_never_a_destination(tmp_path, capsys, monkeypatch):
     scene = write(tmp_path, "drop.toml", DROP)
     monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr(coupling.master, "run", no_run)
+    monkeypatch.setattr(coupling.core.master, "run", no_run)
     assert main(["run", str(scene), "--out", ".", "--overwrite"]) == 2
     assert "current folder" in one_error_line(capsys)
     assert (tmp_path / "drop.toml").exists()
@@ -187,7 +187,7 @@ def test_an_error_while_writing_leaves_the_previous_result_untouched(tmp_path, m
     def broken_history(*_args, **_kwargs):
         raise OSError(28, "No space left on device")
 
-    import coupling.output as output
+    import coupling.app.output as output
 
     monkeypatch.setattr(output, "write_csv", broken_history)
     assert main(["run", str(scene), "--out", str(out), "--quiet"]) == 1
@@ -197,7 +197,7 @@ def test_an_error_while_writing_leaves_the_previous_result_untouched(tmp_path, m
 
 
 def test_summary_is_the_last_file_written(tmp_path, monkeypatch):
-    import coupling.output as output
+    import coupling.app.output as output
 
     scene = write(tmp_path, "drop.toml", DROP)
     order = []
@@ -292,7 +292,7 @@ def test_ctrl_c_in_a_coupled_run_writes_the_partial_result_marked_interrupted_an
     out = tmp_path / "out"
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     # a non-interactive parent leaves SIGINT ignored in its children: restore the default
-    proc = subprocess.Popen([sys.executable, "-m", "coupling.cli", "run", str(scene), "--out", str(out)],
+    proc = subprocess.Popen([sys.executable, "-m", "coupling.app.cli", "run", str(scene), "--out", str(out)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
@@ -359,7 +359,7 @@ def test_quiet_keeps_the_result_lines_and_drops_the_chatter(tmp_path, capsys):
 # --- the history is thinned to its resolution ----------------------------------------
 
 def test_history_keeps_events_and_at_most_one_row_per_resolution_interval(tmp_path):
-    from coupling.output import thin_history
+    from coupling.app.output import thin_history
 
     scene = write(tmp_path, "drop.toml", DROP.replace("plots = false", "plots = false\nhistory_max_rows = 10"))
     out = tmp_path / "out"

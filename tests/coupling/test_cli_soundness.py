@@ -9,9 +9,9 @@ import textwrap
 
 import pytest
 
-from coupling import soundness
-from coupling.cli import main
-from coupling.scene import scene_from_dict
+from coupling.core import soundness
+from coupling.app.cli import main
+from coupling.core.scene import scene_from_dict
 
 
 def test_speed_bound_is_the_speed_that_carries_the_whole_energy():
@@ -117,7 +117,7 @@ def test_a_loose_integration_is_caught_and_the_fix_the_message_names_works():
     import dataclasses
 
     import mech
-    from coupling.results import CoupledResult
+    from coupling.core.results import CoupledResult
 
     base = mech.default_scene()
     wrapper = scene_from_dict({"bar": {"modes": 0}})  # a mechanics-only scene to hold the result

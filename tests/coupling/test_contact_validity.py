@@ -9,7 +9,7 @@ import math
 import pytest
 
 from coupling import builtin_scene, run, scene_from_dict
-from coupling.soundness import HERTZ_UNSOUND_ERROR, HERTZ_WARN_ERROR, assess, hertz_gap_error
+from coupling.core.soundness import HERTZ_UNSOUND_ERROR, HERTZ_WARN_ERROR, assess, hertz_gap_error
 
 
 def test_the_hertz_gap_error_is_the_paraboloid_against_the_sphere():

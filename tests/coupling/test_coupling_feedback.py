@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from coupling import builtin_scene, run
-from coupling.master import CoSimulation
+from coupling.core.master import CoSimulation
 
 
 def short(scene, t_end=2.3e-3):

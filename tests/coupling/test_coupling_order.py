@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from coupling import load_scene, run
-from coupling.monolithic import run_monolithic, series_loop
+from coupling.core.monolithic import run_monolithic, series_loop
 
 SCENE = Path(__file__).parent / "scenes" / "impact_inrush.toml"
 STEPS = (4e-5, 2e-5, 1e-5, 5e-6)

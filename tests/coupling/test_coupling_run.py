@@ -12,8 +12,8 @@ import pandas as pd
 import pytest
 
 from coupling import builtin_scene, default_scene, run
-from coupling.cli import main
-from coupling.scene import scene_from_dict
+from coupling.app.cli import main
+from coupling.core.scene import scene_from_dict
 
 SUMMARY_KEYS = {"contacts", "restitution", "energy", "solver", "bounce"}
 BOUNCE_KEYS = {"first_make", "last_make", "bounces", "total_bounce_time", "peak_contact_voltage", "arc_energy"}
@@ -22,7 +22,7 @@ WAVE_COLUMNS = {"time", "contact_voltage", "contact_current", "contact_resistanc
 
 def test_default_scene_runs_end_to_end_through_the_command(tmp_path, capsys):
     scene = tmp_path / "short_default.toml"
-    from coupling.scene import default_scene_text
+    from coupling.core.scene import default_scene_text
 
     scene.write_text(default_scene_text().replace("t_end = 0.005", "t_end = 0.003"))
     assert main(["run", str(scene), "--out", str(tmp_path / "out"), "--quiet"]) == 0
@@ -68,7 +68,7 @@ def test_mechanics_only_scene_starts_no_ngspice(tmp_path):
         """))
     code = textwrap.dedent(f"""
         import sys
-        from coupling.cli import main
+        from coupling.app.cli import main
         rc = main(["run", {str(scene)!r}, "--out", {str(tmp_path / 'out')!r}, "--quiet"])
         import circuit.ngspice as ng
         print(rc, ng._SESSION is None)
@@ -120,7 +120,7 @@ def test_planar_scene_uses_the_planar_model_and_zero_modes_the_rigid_bar():
 
 
 def test_a_failed_run_writes_what_it_has_and_says_why(tmp_path, capsys):
-    from coupling.scene import default_scene_text
+    from coupling.core.scene import default_scene_text
 
     scene = tmp_path / "fails.toml"
     scene.write_text(default_scene_text().replace("t_end = 0.005", "t_end = 0.003\nmax_steps = 300"))

@@ -7,7 +7,7 @@ import textwrap
 import pytest
 
 from coupling import builtin_scene, load_scene
-from coupling.scene import scene_from_dict
+from coupling.core.scene import scene_from_dict
 
 MECH = {"bar": {"modes": 0}, "initial": {"height": 1e-3, "angle_deg": 90.0, "velocity": [0, 0, -0.5]}}
 TRIB = {"tribology": {"source": "illustrative"}}
@@ -67,7 +67,7 @@ def test_bad_scene_gives_a_clear_error_before_running(doc, message):
 
 
 def test_scene_files_resolve_paths_next_to_them(tmp_path):
-    from coupling.tribology import default_fit
+    from coupling.laws.tribology import default_fit
 
     default_fit().to_json(tmp_path / "fit.json")
     (tmp_path / "scene.toml").write_text(textwrap.dedent("""

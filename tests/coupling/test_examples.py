@@ -19,7 +19,7 @@ import pandas as pd
 import pytest
 
 from circuit import ArcModel
-from coupling.tribology import default_fit
+from coupling.laws.tribology import default_fit
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 

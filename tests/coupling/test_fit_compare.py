@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from fit_compare import assert_same_fit
 
-from coupling.tribology import default_fit, fit_tribometer, illustrative_data_path, read_tribometer_csv
+from coupling.laws.tribology import default_fit, fit_tribometer, illustrative_data_path, read_tribometer_csv
 
 
 def test_round_off_in_the_data_passes_and_a_real_change_fails():

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from coupling.cli import main
+from coupling.app.cli import main
 
 MECH = """
 [bar]

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from coupling.materials import (
+from coupling.laws.materials import (
     MATERIALS,
     ConstantResistance,
     HolmResistance,
@@ -122,11 +122,11 @@ def test_bad_resistance_tables_give_one_line_errors(table, match):
 
 
 def _scene(tribology):
-    from coupling.scene import builtin_scene
+    from coupling.core.scene import builtin_scene
 
     base = builtin_scene("free_drop")
     raw = dict(base.raw, tribology=tribology)
-    from coupling.scene import scene_from_dict
+    from coupling.core.scene import scene_from_dict
 
     return scene_from_dict(raw)
 

@@ -7,14 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from coupling.diagnostics import (
+from coupling.core.diagnostics import (
     air_breakdown_voltage,
     breakdown_warning,
     overcurrent_warning,
     range_warnings,
     toggle_warning,
 )
-from coupling.metrics import MetricSettings, arc_toggles, bounce_metrics, make_instant_mask
+from coupling.core.metrics import MetricSettings, arc_toggles, bounce_metrics, make_instant_mask
 
 E, U_ARC, R_CLOSED = 24.0, 12.0, 0.005
 
@@ -137,7 +137,7 @@ def test_metric_settings_are_validated(key, value):
 
 
 def test_metrics_section_in_a_scene_is_validated():
-    from coupling.scene import scene_from_dict
+    from coupling.core.scene import scene_from_dict
 
     doc = {"circuit": {"schedule": {"make": [1e-4], "break": [3e-4]}}, "solver": {"t_end": 1e-3}}
     assert scene_from_dict(dict(doc, metrics={"settle_window": 2e-3})).metrics.settle_window == 2e-3
@@ -270,7 +270,7 @@ def test_opening_operation_against_the_closed_form_of_a_lengthening_arc():
     out at I_min after t* = d*/v; its energy is R_total/(E_col v) [V (i0^2 - I_min^2)/2 -
     (R_s + R_L)(i0^3 - I_min^3)/3] (the closed form of tests/circuit/test_circuit_arc_gap.py)."""
     from coupling import run
-    from coupling.scene import scene_from_dict
+    from coupling.core.scene import scene_from_dict
 
     v_s, r_s, r_l, e_col, speed, t_break = 24.0, 0.05, 12.0, 2e3, 2.0, 1e-4
     u_min, i_min, r_arc = 12.0, 0.4, 0.05

@@ -1,4 +1,4 @@
-"""The result folder's tables as written by coupling.output: the CSV cells are the float64
+"""The result folder's tables as written by coupling.app.output: the CSV cells are the float64
 values exactly (shortest repr, as numpy's own repr of the value), the file is what
 csv.writer writes for the same cells (quoting included), and waveforms.parquet holds the
 same values as waveforms.csv."""
@@ -15,7 +15,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from coupling.output import _cells, write_csv, write_parquet
+from coupling.app.output import _cells, write_csv, write_parquet
 
 SPECIAL = np.array([0.0, -0.0, 5e-324, -5e-324, 2.2250738585072014e-308, 2.225073858507201e-308, 1.7976931348623157e308,
                     -1.7976931348623157e308, 1e-4, 9.999999999999999e-05, 1e16, 9999999999999998.0, 1e-300, 1e300,

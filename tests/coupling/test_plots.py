@@ -7,7 +7,7 @@ import types
 import numpy as np
 import pandas as pd
 
-from coupling.metrics import bounce_metrics
+from coupling.core.metrics import bounce_metrics
 
 
 def _fake_result(t_end=5e-3):
@@ -36,7 +36,7 @@ def _fake_result(t_end=5e-3):
 def test_bounce_window_panels_are_scaled_to_the_bounce():
     import matplotlib.pyplot as plt
 
-    from coupling.plots import bounce_window, plot_waveforms
+    from coupling.app.plots import bounce_window, plot_waveforms
 
     res = _fake_result()
     lo, hi = bounce_window(res)
@@ -53,7 +53,7 @@ def test_bounce_window_panels_are_scaled_to_the_bounce():
 
 
 def test_all_run_plots_are_written(tmp_path):
-    from coupling.plots import save_plots
+    from coupling.app.plots import save_plots
 
     res = _fake_result()
     res.mechanics = None

@@ -11,8 +11,8 @@ from pathlib import Path
 import pytest
 
 import circuit as ck
-from coupling import scene as cs
-from coupling.metrics import MetricSettings
+from coupling.core import scene as cs
+from coupling.core.metrics import MetricSettings
 from mech.scene import ENVIRONMENT_KEYS, LIST_SECTIONS, SECTIONS
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "scene_keys.md"
@@ -69,7 +69,7 @@ def test_readme_relay_quick_start_scene_is_valid():
     """The README's "model my relay" scene validates as written (and uses the material law)."""
     import tomllib
 
-    from coupling.scene import scene_from_dict
+    from coupling.core.scene import scene_from_dict
 
     text = (DOC.parents[1] / "README.md").read_text()
     block = re.search(r"```toml\n(# relay\.toml.*?)```", text, re.S).group(1)

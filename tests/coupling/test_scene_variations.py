@@ -11,8 +11,8 @@ import re
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from coupling.scene import builtin_scene
-from coupling.sweep import Sweep
+from coupling.core.scene import builtin_scene
+from coupling.app.sweep import Sweep
 
 BASE = builtin_scene("default")  # a relay: clamped blade, rivets, force, materials' laws, circuit, arc
 

@@ -62,7 +62,7 @@ def _loaded(tmp_path: Path, scene_text: str | None, *args: str) -> set[str]:
         scene = [str(tmp_path / "scene.toml")]
     code = textwrap.dedent(f"""
         import json, sys
-        from coupling.cli import main
+        from coupling.app.cli import main
         rc = main(["run", *{scene!r}, "--out", {str(tmp_path / 'out')!r}, "--quiet", *{list(args)!r}])
         print(json.dumps([rc, sorted(sys.modules)]))
     """)
@@ -120,13 +120,13 @@ def test_default_scene_imports_pyspice_and_pyarrow_only_and_writes_its_documente
 
 def test_the_stored_default_fit_is_current_and_equals_a_fresh_fit():
     """default_fit reads the stored fit only while its key matches; the stored fit must be
-    what fitting the shipped CSV gives now (else: coupling.tribology.write_default_fit_cache())."""
-    from coupling.tribology import DEFAULT_FIT_CACHE, default_fit_key, fit_tribometer, illustrative_data_path, \
+    what fitting the shipped CSV gives now (else: coupling.laws.tribology.write_default_fit_cache())."""
+    from coupling.laws.tribology import DEFAULT_FIT_CACHE, default_fit_key, fit_tribometer, illustrative_data_path, \
         read_tribometer_csv
-    from coupling.tribology.fits import TribometerFit
+    from coupling.laws.tribology.fits import TribometerFit
 
     doc = json.loads(DEFAULT_FIT_CACHE.read_text())
-    assert doc["key"] == default_fit_key(), "stored fit is stale: run coupling.tribology.write_default_fit_cache()"
+    assert doc["key"] == default_fit_key(), "stored fit is stale: run coupling.laws.tribology.write_default_fit_cache()"
     stored = TribometerFit.from_dict(doc["fit"])
     fresh = fit_tribometer(read_tribometer_csv(illustrative_data_path()))
     # the stored fit names the dataset by its place in the package, a fresh one by this machine's path

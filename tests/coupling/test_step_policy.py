@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from coupling.master import StepPolicy, end_rate
+from coupling.core.master import StepPolicy, end_rate
 
 H = 5e-6  # s
 
@@ -120,7 +120,7 @@ def test_bad_policy_values_are_named(field, value):
 
 
 def test_policy_follows_the_scene_coupling_options():
-    from coupling.scene import CouplingOptions
+    from coupling.core.scene import CouplingOptions
 
     p = StepPolicy.from_options(CouplingOptions(macro_step=4e-6, max_macro_step=2e-4))
     assert (p.macro_step, p.free_step) == (4e-6, 2e-4)
@@ -162,7 +162,7 @@ def test_one_cosimulation_runs_again_with_the_same_result_and_leaves_ngspice_fre
 
     from circuit import get_session
     from coupling import CoSimulation, CoupledRunError
-    from coupling.scene import scene_from_dict
+    from coupling.core.scene import scene_from_dict
 
     scene = scene_from_dict(tomllib.loads(SHORT_COUPLED))
     sim = CoSimulation(scene)
@@ -203,7 +203,7 @@ def test_growing_steps_in_a_closed_contact_change_no_checked_metric():
     import dataclasses
 
     from coupling import CoSimulation, builtin_scene
-    from coupling.accuracy import compare, metrics_of, tip_intervals
+    from coupling.app.accuracy import compare, metrics_of, tip_intervals
 
     scene = builtin_scene("default").update({"solver.t_end": 0.003})
     runs = {}

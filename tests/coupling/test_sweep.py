@@ -14,8 +14,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from coupling.scene import scene_from_dict
-from coupling.sweep import Sweep, RowWriter, apply_changes, flatten_summary, load_sweep, read_results, \
+from coupling.core.scene import scene_from_dict
+from coupling.app.sweep import Sweep, RowWriter, apply_changes, flatten_summary, load_sweep, read_results, \
     run_sweep_inline
 
 TINY = """

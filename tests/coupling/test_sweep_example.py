@@ -13,7 +13,7 @@ import pytest
 
 pytest.importorskip("distributed")
 
-from coupling.sweep import read_results, read_waveforms  # noqa: E402
+from coupling.app.sweep import read_results, read_waveforms  # noqa: E402
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 

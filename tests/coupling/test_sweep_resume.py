@@ -22,7 +22,7 @@ import pytest
 pytest.importorskip("distributed")
 psutil = pytest.importorskip("psutil")
 
-from coupling.sweep import finished_run_ids, read_results  # noqa: E402
+from coupling.app.sweep import finished_run_ids, read_results  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 RUNS = 10
@@ -63,7 +63,7 @@ def scheduler():
     through --scheduler: the worker imports once. (The local-cluster path, `--workers`, is
     the same `local_cluster` the example test runs.)"""
     env = {"PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
-    from coupling.sweep import local_cluster
+    from coupling.app.sweep import local_cluster
 
     with local_cluster(1, env=env) as cluster:
         yield cluster.scheduler_address
@@ -71,7 +71,7 @@ def scheduler():
 
 def _start(sweep: Path, out: Path, *extra: str) -> subprocess.Popen:
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    return subprocess.Popen([sys.executable, "-m", "coupling.cli", "sweep", str(sweep), "--out", str(out),
+    return subprocess.Popen([sys.executable, "-m", "coupling.app.cli", "sweep", str(sweep), "--out", str(out),
                              "--quiet", *extra],
                             env=env, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # see tests/conftest.py

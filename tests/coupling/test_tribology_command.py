@@ -4,9 +4,9 @@ import json
 
 from fit_compare import assert_same_fit
 
-from coupling.cli import main
-from coupling.tribology import TribometerFit, default_fit, illustrative_data_path
-from coupling.tribology.command import fit_command
+from coupling.app.cli import main
+from coupling.laws.tribology import TribometerFit, default_fit, illustrative_data_path
+from coupling.app.fit import fit_command
 
 
 def test_fit_command_writes_fit_json_and_figures(tmp_path, capsys):

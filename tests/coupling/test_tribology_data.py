@@ -4,8 +4,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from coupling.tribology import illustrative_data_path, read_tribometer_csv, validate_tribometer_frame
-from coupling.tribology.illustrative import illustrative_csv_text
+from coupling.laws.tribology import illustrative_data_path, read_tribometer_csv, validate_tribometer_frame
+from coupling.laws.tribology.illustrative import illustrative_csv_text
 
 GOOD = "load_N,current_A,friction_N,resistance_ohm,run\n" + "".join(
     f"{f},{i},{0.2 * f**0.3:.4f},{0.02 * f ** (-1 / 3):.6f},1\n" for i in (0, 1) for f in (3, 4, 5)

@@ -12,9 +12,9 @@ right only half the time passes it < 17 % of the time.
 import numpy as np
 import pytest
 
-from coupling.tribology import ContactLaws, MuLaw, ResistanceLaw, default_fit, fit_tribometer
-from coupling.tribology.fits import fit_friction, fit_resistance
-from coupling.tribology.illustrative import ILLUSTRATIVE_DESIGN, ILLUSTRATIVE_LAWS, synthetic_tribometer_data
+from coupling.laws.tribology import ContactLaws, MuLaw, ResistanceLaw, default_fit, fit_tribometer
+from coupling.laws.tribology.fits import fit_friction, fit_resistance
+from coupling.laws.tribology.illustrative import ILLUSTRATIVE_DESIGN, ILLUSTRATIVE_LAWS, synthetic_tribometer_data
 
 DESIGN = ILLUSTRATIVE_DESIGN
 MU_TRUE = ILLUSTRATIVE_LAWS.mu_law

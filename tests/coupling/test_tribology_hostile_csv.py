@@ -8,7 +8,7 @@ from pathlib import Path
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from coupling.tribology import fit_tribometer, read_tribometer_csv
+from coupling.laws.tribology import fit_tribometer, read_tribometer_csv
 
 COLUMNS = ("load_N", "current_A", "friction_N", "resistance_ohm")
 # invalid (an error), non-physical (a gross outlier); unicode and quotes for the reader

@@ -7,11 +7,11 @@ import warnings
 import numpy as np
 import pytest
 
-from coupling.tribology import ContactLaws, MuLaw, ResistanceLaw, TribometerFit, default_fit
-from coupling.tribology.illustrative import (
+from coupling.laws.tribology import ContactLaws, MuLaw, ResistanceLaw, TribometerFit, default_fit
+from coupling.laws.tribology.illustrative import (
     EFFECTIVE_MODULUS_Pa, ILLUSTRATIVE_LAWS, PIN_RADIUS_m, R_1N_ohm, RESISTIVITY_ohm_m,
 )
-from coupling.tribology.models import (
+from coupling.laws.tribology.models import (
     constriction_film_conductance, constriction_film_resistance, generalized_friction_force,
     hertz_contact_radius, holm_constriction_resistance, plastic_contact_radius,
 )

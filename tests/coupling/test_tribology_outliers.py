@@ -7,9 +7,9 @@ import json
 import numpy as np
 import pytest
 
-from coupling.cli import main
-from coupling.tribology import TribometerFit, default_fit, fit_tribometer, illustrative_data_path, read_tribometer_csv
-from coupling.tribology.fits import GROSS_FACTOR, fit_friction, fit_resistance
+from coupling.app.cli import main
+from coupling.laws.tribology import TribometerFit, default_fit, fit_tribometer, illustrative_data_path, read_tribometer_csv
+from coupling.laws.tribology.fits import GROSS_FACTOR, fit_friction, fit_resistance
 
 SHIPPED = illustrative_data_path().read_text()
 HEADER_AT = SHIPPED.splitlines().index("load_N,current_A,friction_N,resistance_ohm,run")
@@ -33,7 +33,7 @@ def test_shipped_data_has_no_outliers_and_the_cell_fit_equals_the_row_fit():
     # the fit on (load, current) cells reproduces the row-by-row residual sum of squares
     df = read_tribometer_csv(illustrative_data_path())
     chosen = fit.resistance.selection.chosen
-    from coupling.tribology.fits import ln_resistance
+    from coupling.laws.tribology.fits import ln_resistance
 
     lm, cm = chosen.name.split("+")
     x = np.array([p.value for p in chosen.parameters])

@@ -10,7 +10,7 @@ import types
 import numpy as np
 import pytest
 
-from coupling.waveview import decimate
+from coupling.app.waveview import decimate
 
 pytest.importorskip("plotly")
 
@@ -36,7 +36,7 @@ def _decode(values):
 
 
 def test_page_is_self_contained_and_holds_the_data(tmp_path):
-    from coupling.waveview import write_waveform_html
+    from coupling.app.waveview import write_waveform_html
 
     t = np.linspace(0.0, 1e-3, 3001)
     v = np.where(t < 5e-4, 24.0, 0.01) + 3.0 * np.exp(-t / 1e-7) * np.sin(2 * np.pi * 5e7 * t)  # 50 ns ringing

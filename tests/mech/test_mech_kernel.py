@@ -341,7 +341,7 @@ def test_normal_forces_from_the_kinematics_equal_the_right_hand_sides(name):
     the normal forces and penetrations of the full right-hand side."""
     from pathlib import Path
 
-    from coupling.scene import builtin_scene, load_scene
+    from coupling.core.scene import builtin_scene, load_scene
     from mech import ImpactSolver
     from mech.compiled import dense_tip_forces, dynamics, make_work
     from mech.kernel_layout import A_FN, A_Y, C_ON, NAUX

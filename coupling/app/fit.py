@@ -5,8 +5,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from coupling.tribology.data import read_tribometer_csv
-from coupling.tribology.fits import AMBIGUOUS_DELTA, ModelFit, TribometerFit, fit_tribometer
+from coupling.laws.tribology.data import read_tribometer_csv
+from coupling.laws.tribology.fits import AMBIGUOUS_DELTA, ModelFit, TribometerFit, fit_tribometer, outlier_lines
 
 FIT_JSON = "fit.json"
 
@@ -19,17 +19,6 @@ def _params(m: ModelFit, skip: tuple[str, ...] = ()) -> str:
         ci = "" if p.ci95 is None else f" [{p.ci95[0]:.4g}, {p.ci95[1]:.4g}]"
         parts.append(f"{p.name} = {p.value:.4g}{ci}")
     return ", ".join(parts)
-
-
-def outlier_lines(fit: TribometerFit, shown: int = 5) -> list[str]:
-    """One line per fit (friction, resistance) that left rows out, naming the first ``shown``."""
-    lines = []
-    for label, part in (("friction", fit.friction), ("resistance", fit.resistance)):
-        if part.n_outliers:
-            rows = "; ".join(f"{o.where} ({o.column} = {o.value:.4g}: {o.reason})" for o in part.outliers[:shown])
-            more = f"; ... ({part.n_outliers - shown} more in fit.json)" if part.n_outliers > shown else ""
-            lines.append(f"OUTLIERS left out of the {label} fit: {part.n_outliers} row(s): {rows}{more}")
-    return lines
 
 
 def summary(fit: TribometerFit) -> str:
@@ -94,7 +83,7 @@ def fit_command(data_path: str, out_dir: str) -> int:
     fit = fit_tribometer(df)
     out.mkdir(parents=True, exist_ok=True)
     fit.to_json(out / FIT_JSON)
-    from coupling.tribology.plots import save_plots  # matplotlib only once the fit is done
+    from coupling.app.fit_plots import save_plots  # matplotlib only once the fit is done
 
     pngs = save_plots(fit, df, out)
     print(summary(fit))

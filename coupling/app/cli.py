@@ -1,6 +1,6 @@
 """The `switchsim` command line: `switchsim run [SCENE.toml] [--out DIR] [--overwrite] [--quiet] [--plots]`,
 `switchsim plot RESULT_DIR`, `switchsim fit DATA.csv --out DIR`, `switchsim sweep`. Exit codes:
-coupling/commands.py."""
+coupling/app/commands.py."""
 
 from __future__ import annotations
 
@@ -36,7 +36,7 @@ def _build_parser() -> argparse.ArgumentParser:
     fit = sub.add_parser("fit", help="fit gamma, mu(I) and R_c(F_n, I) to tribometer data")
     fit.add_argument("data", help="tribometer CSV (see docs/tribology.md for its form)")
     fit.add_argument("--out", required=True, help="output directory (created if missing)")
-    # --- sweep: coupling/sweep.py ---
+    # --- sweep: coupling/app/sweep.py ---
     sweep = sub.add_parser("sweep", help="run a design sweep of a scene on Dask (see docs/sweeps.md)")
     sweep.add_argument("sweep", help="sweep TOML file: base scene and the parameters to vary")
     sweep.add_argument("--out", required=True, help="output directory (results/ is a Parquet dataset)")
@@ -59,7 +59,7 @@ def main(argv: list[str] | None = None) -> int:
         return _command(args)
     finally:
         if argv is None:
-            # The process's own command line (the `switchsim` script, python -m coupling.cli):
+            # The process's own command line (the `switchsim` script, python -m coupling.app.cli):
             # the process ends when main returns. Its objects are moved out of the cyclic
             # collector's reach, so the interpreter's teardown does not run its full
             # collections over them (~40 ms of a default run's 45 ms exit, measured with perf:
@@ -71,20 +71,20 @@ def main(argv: list[str] | None = None) -> int:
 def _command(args) -> int:
     try:
         if args.command == "run":
-            from coupling.commands import run_command
+            from coupling.app.commands import run_command
 
             return run_command(args.scene, args.out, quiet=args.quiet, overwrite=args.overwrite, check=args.check,
                                plots=args.plots)
         if args.command == "plot":
-            from coupling.commands import plot_command
+            from coupling.app.commands import plot_command
 
             return plot_command(args.result)
         if args.command == "fit":
-            from coupling.tribology.command import fit_command
+            from coupling.app.fit import fit_command
 
             return fit_command(args.data, args.out)
         if args.command == "sweep":
-            from coupling.sweep import sweep_command
+            from coupling.app.sweep import sweep_command
 
             return sweep_command(args.sweep, args.out, workers=args.workers, scheduler=args.scheduler,
                                  resume=args.resume, quiet=args.quiet)

@@ -1,8 +1,8 @@
 """Plots of a sweep (matplotlib, Agg, no pyplot): a metric against one or two parameters,
 a metric as a map over two parameters, and overlays of the waveforms of selected runs.
 
-    from coupling.sweep import read_results
-    from coupling.sweep_plots import plot_metric, plot_map, plot_overlay
+    from coupling.app.sweep import read_results
+    from coupling.app.sweep_plots import plot_metric, plot_map, plot_overlay
     df = read_results("out/")
     plot_metric(df, "bounce.peak_contact_voltage", "circuit.snubber.capacitance",
                 by="circuit.snubber.resistance").savefig("peak.png")
@@ -94,7 +94,7 @@ def plot_overlay(out_dir, run_ids, column: str = "contact_voltage", *, label: li
     """The ``column`` waveform of each run in ``run_ids`` over time (ms), one line each, from
     the waveforms the sweep kept (sweep waveforms = true). label: parameters to name the
     lines by; window: (t0, t1) in s."""
-    from .sweep import read_results, read_waveforms
+    from coupling.app.sweep import read_results, read_waveforms
 
     rows = None
     if label:

@@ -25,9 +25,9 @@ from scipy.optimize import brentq
 
 from mech import CoupledStates, ImpactSolver
 
-from .master import conduction_onset
-from .results import CoupledResult
-from .scene import Scene
+from coupling.core.master import conduction_onset
+from coupling.core.results import CoupledResult
+from coupling.core.scene import Scene
 
 
 @dataclass(frozen=True)

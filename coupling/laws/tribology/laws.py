@@ -20,7 +20,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from coupling.tribology.models import (
+from coupling.laws.tribology.models import (
     CURRENT_FAMILIES,
     LOAD_FAMILIES,
     MU_FAMILIES,

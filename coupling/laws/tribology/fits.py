@@ -31,9 +31,9 @@ from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 import numpy as np
 
-from coupling.tribology.data import validate_tribometer_frame
-from coupling.tribology.laws import ContactLaws, MuLaw, ResistanceLaw
-from coupling.tribology.models import CURRENT_FAMILIES, LOAD_FAMILIES, MU_FAMILIES, load_law_parameters
+from coupling.laws.tribology.data import validate_tribometer_frame
+from coupling.laws.tribology.laws import ContactLaws, MuLaw, ResistanceLaw
+from coupling.laws.tribology.models import CURRENT_FAMILIES, LOAD_FAMILIES, MU_FAMILIES, load_law_parameters
 
 if TYPE_CHECKING:  # pandas is imported by the fitting, not by a stored fit's reading
     import pandas as pd
@@ -1009,7 +1009,7 @@ def _outliers(flagged: dict[int, tuple[str, str]], clean: pd.DataFrame, df: pd.D
         return ()
     where = None
     if df.attrs.get("csv") and Path(source).is_file():
-        from coupling.tribology.data import lines_of_rows
+        from coupling.laws.tribology.data import lines_of_rows
 
         where = [f"line {k}" for k in lines_of_rows(source, rows)]
     if where is None:
@@ -1054,3 +1054,14 @@ def resistance_band(fit: TribometerFit, normal_force_N, current_A: float) -> tup
     f = np.asarray(normal_force_N, float)
     i = np.full_like(f, abs(current_A))
     return _log_band(chosen, lambda x: ln_resistance(lm, cm, x, f, i))
+
+
+def outlier_lines(fit: TribometerFit, shown: int = 5) -> list[str]:
+    """One line per fit (friction, resistance) that left rows out, naming the first ``shown``."""
+    lines = []
+    for label, part in (("friction", fit.friction), ("resistance", fit.resistance)):
+        if part.n_outliers:
+            rows = "; ".join(f"{o.where} ({o.column} = {o.value:.4g}: {o.reason})" for o in part.outliers[:shown])
+            more = f"; ... ({part.n_outliers - shown} more in fit.json)" if part.n_outliers > shown else ""
+            lines.append(f"OUTLIERS left out of the {label} fit: {part.n_outliers} row(s): {rows}{more}")
+    return lines

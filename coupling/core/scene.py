@@ -24,7 +24,7 @@ A scene names only what it needs, and only that is built:
                   align_events = true, onset_penetration (m)
     [output]      csv, parquet, plots, history, html = true | false, history_resolution (s),
                   history_max_rows
-    [metrics]     settle_window (s), make_guard (s), arc_toggle_limit (coupling.metrics)
+    [metrics]     settle_window (s), make_guard (s), arc_toggle_limit (coupling.core.metrics)
 
 SI units everywhere. File paths are relative to the scene file. Every error names the
 file, the section and key as written and says what is allowed, before any solver starts.
@@ -78,7 +78,7 @@ class CouplingOptions:
     then but the contact onset, which the mechanics finds exactly); None = macro_step.
     align_events: end a macro step exactly at each contact make/break (mechanics_first).
     onset_penetration: m, penetration over which a tip's conduction ramps in smoothly
-    (coupling.master.conduction_onset): the continuum Hertz/Holm laws do not hold below
+    (coupling.core.master.conduction_onset): the continuum Hertz/Holm laws do not hold below
     the surface-roughness scale, and G ~ y^0.4 has an unbounded derivative at touchdown
     that ngspice's truncation-error control cannot follow at tight RELTOL.
     """
@@ -140,10 +140,10 @@ class OutputOptions:
 class TribologySpec:
     """The contact laws (mu(I), gamma, R_c(F_n, I)), where they came from, and the fit if any."""
 
-    laws: Any  # coupling.tribology.ContactLaws
+    laws: Any  # coupling.laws.tribology.ContactLaws
     source: str
     feedback: bool = True
-    fit: Any = None  # coupling.tribology.TribometerFit, when the laws come from a fit
+    fit: Any = None  # coupling.laws.tribology.TribometerFit, when the laws come from a fit
 
 
 @dataclass(frozen=True)
@@ -169,7 +169,7 @@ class Scene:
     coupling: CouplingOptions = field(default_factory=CouplingOptions)
     output: OutputOptions = field(default_factory=OutputOptions)
     name: str = "scene"
-    metrics: Any = None  # coupling.metrics.MetricSettings
+    metrics: Any = None  # coupling.core.metrics.MetricSettings
 
     @property
     def kind(self) -> str:
@@ -246,15 +246,15 @@ def _input_file(key: str, value, base_dir: Path) -> Path:
 
 def _tribology(table: dict, base_dir: Path) -> TribologySpec:
     """[tribology]; ``resistance = { law = "holm" | "constant", ... }`` takes R_c from
-    contact materials (coupling.materials) instead of a fit, with mu from the fit or
+    contact materials (coupling.laws.materials) instead of a fit, with mu from the fit or
     ``mu = number`` (Coulomb, gamma = 0)."""
     table = check_keys("[tribology]", _table("[tribology]", table), TRIBOLOGY_KEYS)
     feedback = check_bool("tribology.feedback", table.get("feedback", True))
     resistance = table.get("resistance")
     if not (isinstance(resistance, dict) and "law" in resistance):
         return _tribology_fitted(table, base_dir, feedback)
-    from coupling.materials import resistance_law_from_table
-    from coupling.tribology import ContactLaws, MuLaw
+    from coupling.laws.materials import resistance_law_from_table
+    from coupling.laws.tribology import ContactLaws, MuLaw
 
     law = resistance_law_from_table(resistance, "tribology.resistance")
     rest = {k: v for k, v in table.items() if k != "resistance"}
@@ -278,7 +278,7 @@ def _tribology(table: dict, base_dir: Path) -> TribologySpec:
 
 
 def _tribology_fitted(table: dict, base_dir: Path, feedback: bool) -> TribologySpec:
-    from coupling.tribology import ContactLaws, TribometerFit, default_fit, fit_tribometer, read_tribometer_csv
+    from coupling.laws.tribology import ContactLaws, TribometerFit, default_fit, fit_tribometer, read_tribometer_csv
 
     given = [k for k in ("source", "fit", "data") if k in table] + (["inline mu/resistance"] if (
         "mu" in table or "resistance" in table) else [])
@@ -512,7 +512,7 @@ def _build(doc: dict, base_dir: Path, name: str) -> Scene:
         factor = tribology.laws.resistance_law.current_factor_expression("I") if tribology is not None else None
         circuit = _circuit(circuit_table, base_dir, factor)
 
-    from .metrics import MetricSettings
+    from coupling.core.metrics import MetricSettings
 
     coupling, output, metrics = (_section(doc, section, cls) for section, cls in (
         ("coupling", CouplingOptions), ("output", OutputOptions), ("metrics", MetricSettings)))

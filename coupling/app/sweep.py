@@ -158,7 +158,7 @@ class Sweep:
 
     @classmethod
     def _of(cls, base, rows, *, waveforms=False, common: dict | None = None) -> "Sweep":
-        from .scene import Scene
+        from coupling.core.scene import Scene
 
         if isinstance(base, Scene):
             raw, base_dir, name = copy.deepcopy(base.raw), str(base.base_dir), base.name
@@ -198,7 +198,7 @@ class Sweep:
 
     def scene(self, run: Run):
         """The validated Scene of one run."""
-        from .scene import scene_from_dict
+        from coupling.core.scene import scene_from_dict
 
         return scene_from_dict(self.document(run), base_dir=self.base_dir, name=f"{self.base_name} [{run.run_id}]")
 
@@ -311,7 +311,7 @@ def load_sweep(path) -> Sweep:
     for key in ("samples", "seed"):
         if key in table and design not in ("random", "lhs"):
             raise ValueError(f"{path}: sweep.{key} is unused with sweep.design = {design!r}; remove it")
-    from .scene import default_scene, load_scene
+    from coupling.core.scene import default_scene, load_scene
 
     scene_key = table.get("scene")
     if scene_key is None:
@@ -371,8 +371,8 @@ def _cell(value):
 
 def execute(sweep_doc: dict, run_doc: dict, wave_dir: str | None) -> dict:
     """Run one scene (worker side) and return its results row; never raises for a failing run."""
-    from .master import CoupledRunError, run
-    from .scene import scene_from_dict
+    from coupling.core.master import CoupledRunError, run
+    from coupling.core.scene import scene_from_dict
 
     tick = time.perf_counter()
     row = {"run_id": run_doc["run_id"], "name": run_doc["name"]}
@@ -730,6 +730,6 @@ def sweep_command(path: str, out_dir: str, *, workers: int | None = None, schedu
         return 130
     if not quiet:
         print(f"switchsim sweep: {report.done} run(s) now, {report.skipped} already done, {report.failed} failed, "
-              f"{report.seconds:.1f} s; results in {out_dir}/results (coupling.sweep.read_results)",
+              f"{report.seconds:.1f} s; results in {out_dir}/results (coupling.app.sweep.read_results)",
               file=sys.stderr)
     return 1 if report.failed else 0

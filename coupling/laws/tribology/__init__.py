@@ -14,7 +14,7 @@ from functools import cache
 from pathlib import Path
 
 from coupling import lazy_attributes
-from coupling.tribology.laws import ContactLaws, MuLaw, ResistanceLaw
+from coupling.laws.tribology.laws import ContactLaws, MuLaw, ResistanceLaw
 
 __all__ = [
     "ContactLaws", "MuLaw", "ResistanceLaw", "TribometerFit",
@@ -33,7 +33,7 @@ __getattr__ = lazy_attributes(__name__, _LAZY)
 
 def illustrative_data_path():
     """Path of the shipped ILLUSTRATIVE (not measured) tribometer CSV."""
-    from coupling.tribology.illustrative import ILLUSTRATIVE_CSV
+    from coupling.laws.tribology.illustrative import ILLUSTRATIVE_CSV
 
     return ILLUSTRATIVE_CSV
 
@@ -58,8 +58,8 @@ def default_fit_key() -> str:
 def default_fit() -> TribometerFit:
     """The fit of the shipped illustrative dataset, once per process: from the stored fit
     when it is current, else fitted."""
-    from coupling.tribology.data import read_tribometer_csv
-    from coupling.tribology.fits import TribometerFit, fit_tribometer
+    from coupling.laws.tribology.data import read_tribometer_csv
+    from coupling.laws.tribology.fits import TribometerFit, fit_tribometer
 
     try:
         doc = json.loads(DEFAULT_FIT_CACHE.read_text())
@@ -74,11 +74,11 @@ def default_fit() -> TribometerFit:
 def write_default_fit_cache() -> Path:
     """Fit the illustrative dataset and store the fit for default_fit (after changing the
     dataset or the fitting code)."""
-    from coupling.tribology.data import read_tribometer_csv
-    from coupling.tribology.fits import fit_tribometer
+    from coupling.laws.tribology.data import read_tribometer_csv
+    from coupling.laws.tribology.fits import fit_tribometer
 
     fit = fit_tribometer(read_tribometer_csv(illustrative_data_path()))
     doc = fit.to_dict()
-    doc["source"] = "coupling/data/" + illustrative_data_path().name  # default_fit puts the installed path back
+    doc["source"] = "coupling/laws/data/" + illustrative_data_path().name  # default_fit puts the installed path back
     DEFAULT_FIT_CACHE.write_text(json.dumps({"key": default_fit_key(), "fit": doc}, indent=1) + "\n")
     return DEFAULT_FIT_CACHE

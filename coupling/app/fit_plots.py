@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from coupling.tribology.fits import TribometerFit, friction_band, mu_band, resistance_band
+from coupling.laws.tribology.fits import TribometerFit, friction_band, mu_band, resistance_band
 
 # The paper's symbols for 0, 1, 2, 5 A, then more for other levels.
 MARKERS = ("o", "^", "*", "D", "s", "v", "P", "X")

@@ -21,7 +21,7 @@ it out):
   the contact radius a = sqrt(R y) stays small against the cap radius R; the paraboloid
   is off the sphere by y / (4 R) of the gap at the contact's edge. Beyond 5 % (y > 0.2 R,
   a > 0.45 R) the result is unsound; between 1 % and 5 % (y > 0.04 R) it carries a
-  warning (coupling.diagnostics), its forces and contact times being approximate to
+  warning (coupling.core.diagnostics), its forces and contact times being approximate to
   about that fraction;
 - circuit (template circuits): the loop current through the load is at most
   2 V / (R_source + R_wiring + R_load) (A): the supply across the series loop, plus one

@@ -57,8 +57,8 @@ from __future__ import annotations
 import math
 import time
 
-from .metrics import DEFAULT_SETTLE_WINDOW
-from .results import merge_intervals
+from coupling.core.metrics import DEFAULT_SETTLE_WINDOW
+from coupling.core.results import merge_intervals
 
 TOLERANCES = dict(mismatch_fraction=0.02, time_floor=1e-6, time_fraction=0.01, peak_force=0.02,
                   voltage_rel=0.02, voltage_abs=0.01, arc_rel=0.05, arc_abs=1e-6)
@@ -106,7 +106,7 @@ def contact_metrics(tip_intervals, closed_at_end: bool = False,
 
     closed_at_end: the contact is closed when the run ends (its last interval is the
     final closure, not a contact that broke). settle_window: s, a closure at least this
-    long is a held contact (coupling.metrics). Besides the metrics of the module
+    long is a held contact (coupling.core.metrics). Besides the metrics of the module
     docstring: contact_time (s, both tips, whole run), span (s, first make to the last
     interval's end), window (s, s: first make to the last switching instant, the last make
     when closed at the end, else the last break), window_length (s, its length without
@@ -446,7 +446,7 @@ def _describe(key: str, v: dict) -> str:
 
 def _rerun(name: str, description: str, scene, run_fn, compare_fn) -> dict:
     """One rerun's entry: status, wall_time and, when it ran, compare_fn(result)."""
-    from .master import CoupledRunError
+    from coupling.core.master import CoupledRunError
 
     entry: dict = dict(name=name, refinement=description)
     if scene is None:
@@ -466,7 +466,7 @@ def _rerun(name: str, description: str, scene, run_fn, compare_fn) -> dict:
 def check(scene, base_result, *, run_fn=None, sensitivity: bool = True) -> dict:
     """summary.accuracy for ``base_result`` of ``scene``: reruns the refined scenes and,
     unless sensitivity is False, the input-perturbed ones (module docstring)."""
-    from .master import run
+    from coupling.core.master import run
 
     run_fn = run_fn or run
     base = metrics_of(base_result)
@@ -498,7 +498,7 @@ def check(scene, base_result, *, run_fn=None, sensitivity: bool = True) -> dict:
 
 def run_checked(scene, *, progress: bool = False):
     """Run ``scene`` and attach ``accuracy`` (``check``) to its CoupledResult."""
-    from .master import run
+    from coupling.core.master import run
 
     result = run(scene, progress=progress)
     result.accuracy = check(scene, result)

@@ -154,7 +154,7 @@ def write_files(result, folder: Path, summary_extra: dict | None = None) -> None
         t = result.mechanics.t
         interval = opts.history_interval(float(t[-1] - t[0]) if len(t) else 0.0)
         kept = thin_history(result.mechanics, interval)
-        from .results import REGIME_NAMES
+        from coupling.core.results import REGIME_NAMES
 
         write_csv(folder / "history.csv", thin_result(result.mechanics, kept).history_columns,
                   codes={"regime_0": REGIME_NAMES, "regime_1": REGIME_NAMES})

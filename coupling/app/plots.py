@@ -320,7 +320,7 @@ def stored_result(folder) -> types.SimpleNamespace:
     FileNotFoundError when the folder holds no summary.json."""
     import pandas as pd
 
-    from .metrics import merge_intervals
+    from coupling.core.metrics import merge_intervals
 
     folder = Path(folder)
     summary = json.loads((folder / "summary.json").read_text())

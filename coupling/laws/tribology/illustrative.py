@@ -1,7 +1,7 @@
 """The seeded generator of synthetic tribometer data, and of the shipped ILLUSTRATIVE (not measured) dataset.
 
-`python -m coupling.tribology.illustrative` rewrites
-coupling/data/tribometer_illustrative.csv byte for byte. The true laws are written into
+`python -m coupling.laws.tribology.illustrative` rewrites
+coupling/laws/data/tribometer_illustrative.csv byte for byte. The true laws are written into
 the file's header and docs/tribology.md. The tests use `synthetic_tribometer_data` with
 other laws to check that the fits recover what was put in.
 """
@@ -15,8 +15,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from coupling.tribology.laws import ContactLaws, MuLaw, ResistanceLaw
-from coupling.tribology.models import hertz_contact_radius, holm_constriction_resistance
+from coupling.laws.tribology.laws import ContactLaws, MuLaw, ResistanceLaw
+from coupling.laws.tribology.models import hertz_contact_radius, holm_constriction_resistance
 
 if TYPE_CHECKING:  # pandas only to make data; the path above is read without it
     import pandas as pd
@@ -89,7 +89,7 @@ def _header() -> list[str]:
     fmt = lambda params: ", ".join(f"{k} = {v:.6g}" for k, v in params)  # noqa: E731
     return [
         "ILLUSTRATIVE, NOT MEASURED: synthetic tribometer data made by a seeded generator",
-        "(python -m coupling.tribology.illustrative) to follow the trends reported for a burnished",
+        "(python -m coupling.laws.tribology.illustrative) to follow the trends reported for a burnished",
         "NbSe2 film (pin-on-disk, 0.5 mm/s): friction rises with load and current, gamma = 0.7,",
         "mu rises with current, contact resistance falls with load and current. Do not cite as data.",
         f"True friction law: F_t = mu(I) F_n^(1 - gamma), gamma = {mu.gamma:g},",

@@ -102,9 +102,9 @@ PROPERTIES = ("resistivity", "hardness", "youngs_modulus", "poisson_ratio")
 
 
 def load_materials(text: str | None = None) -> dict[str, Material]:
-    """The contact-material library (coupling/data/contact_materials.toml, or TOML ``text``)."""
+    """The contact-material library (coupling/laws/data/contact_materials.toml, or TOML ``text``)."""
     if text is None:
-        text = resources.files("coupling").joinpath("data/contact_materials.toml").read_text()
+        text = resources.files("coupling.laws").joinpath("data/contact_materials.toml").read_text()
     doc = tomllib.loads(text)
     out = {}
     for name, entry in doc.items():
@@ -131,7 +131,7 @@ def material(name: str, where: str = "material") -> Material:
     return MATERIALS[name]
 
 
-# --- laws the coupling calls (same interface as coupling.tribology.ResistanceLaw) -------------
+# --- laws the coupling calls (same interface as coupling.laws.tribology.ResistanceLaw) -------------
 
 
 class _ForceLaw:

@@ -1,10 +1,10 @@
 """The outcome of a run: mechanics result, circuit waveforms, bounce metrics, warnings, files and plots.
 
-Bounce metrics (``bounce`` in summary.json) are computed by coupling.metrics from the
+Bounce metrics (``bounce`` in summary.json) are computed by coupling.core.metrics from the
 closed intervals of the contact (mechanics: the union of the tips' contact intervals;
 prescribed schedule: its intervals) and the waveform; every key is defined in
 docs/coupling.md ("Bounce metrics"). Warnings (``warnings``) come from
-coupling.diagnostics.
+coupling.core.diagnostics.
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ import numpy as np
 
 from mech.results import REGIME_NAMES
 
-from .metrics import MetricSettings, merge_intervals
-from .metrics import bounce_metrics as _bounce_metrics
+from coupling.core.metrics import MetricSettings, merge_intervals
+from coupling.core.metrics import bounce_metrics as _bounce_metrics
 
 
 OPENING_COLUMNS = ("start", "end", "open_duration", "reclosed", "kind", "current_at_break", "peak_voltage",
@@ -35,7 +35,7 @@ def _num(v):
 
 def bounce_metrics(intervals, t_end: float, waveforms: dict | None, closed_at_end: bool,
                    settings: MetricSettings | None = None) -> dict:
-    """The bounce summary (coupling.metrics.bounce_metrics) from closed intervals and a waveform frame."""
+    """The bounce summary (coupling.core.metrics.bounce_metrics) from closed intervals and a waveform frame."""
     if waveforms is None or not len(waveforms["time"]):
         return _bounce_metrics(intervals, t_end, closed_at_end, settings=settings)
     arc = waveforms.get("arc_current")
@@ -59,7 +59,7 @@ class CoupledResult:
     waveform_columns: dict | None
     stats: dict
     status: str = "ok"
-    accuracy: dict | None = None  # summary.accuracy of run(scene, check=True) (coupling/accuracy.py)
+    accuracy: dict | None = None  # summary.accuracy of run(scene, check=True) (coupling/app/accuracy.py)
     _cache: dict = field(default_factory=dict, repr=False)
 
     @property
@@ -115,9 +115,9 @@ class CoupledResult:
 
     @property
     def warnings(self) -> list[str]:
-        """One-line warnings about physically doubtful states of the run (coupling.diagnostics)."""
+        """One-line warnings about physically doubtful states of the run (coupling.core.diagnostics)."""
         if "warnings" not in self._cache:
-            from .diagnostics import run_warnings
+            from coupling.core.diagnostics import run_warnings
 
             self._cache["warnings"] = run_warnings(self)
         return self._cache["warnings"]
@@ -156,13 +156,13 @@ class CoupledResult:
     def write_tables(self, out: Path) -> dict:
         """Every file of ``save`` but summary.json, into the folder ``out`` (made if missing);
         returns the summary with what the writing found (``waveforms_html``)."""
-        from .output import write_csv, write_parquet
+        from coupling.app.output import write_csv, write_parquet
 
         out.mkdir(parents=True, exist_ok=True)
         opts = self.scene.output
         summary = self.summary
         if self.waveform_columns is not None and getattr(opts, "html", True):
-            from .waveview import write_waveform_html
+            from coupling.app.waveview import write_waveform_html
 
             html = write_waveform_html(self, out / "waveforms.html")
             summary["waveforms_html"] = "waveforms.html" if html == "written" else html
@@ -183,7 +183,7 @@ class CoupledResult:
             write_csv(out / "phases.csv", m.phase_columns)
             write_csv(out / "events.csv", event_columns(m.events))
         if opts.plots:
-            from .plots import save_plots
+            from coupling.app.plots import save_plots
 
             save_plots(self, out)
         return summary

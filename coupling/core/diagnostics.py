@@ -19,7 +19,7 @@ Each is one line that says what was seen, when, and what to add to the scene. Ch
    or outside a material law's stated validity range.
 5. Hertz's law stretched: a contact point's deepest penetration y puts the paraboloid
    y / (4 R) off the sphere at the contact's edge by more than 1 % (y > 0.04 R; beyond 5 %
-   the run is unsound, coupling.soundness).
+   the run is unsound, coupling.core.soundness).
 6. The arc model on without a breakdown voltage, when an open gap's voltage passes air
    breakdown: that gap would re-ignite (item 1 names the setting to add).
 """
@@ -30,8 +30,8 @@ import math
 
 import numpy as np
 
-from .metrics import ARC_BURNING_CURRENT, arc_toggles
-from .soundness import HERTZ_UNSOUND_ERROR, HERTZ_WARN_ERROR, hertz_gap_error, hertz_validity_line
+from coupling.core.metrics import ARC_BURNING_CURRENT, arc_toggles
+from coupling.core.soundness import HERTZ_UNSOUND_ERROR, HERTZ_WARN_ERROR, hertz_gap_error, hertz_validity_line
 
 PASCHEN_A = 15.0  # 1/(cm Torr), air
 PASCHEN_B = 365.0  # V/(cm Torr), air
@@ -136,7 +136,7 @@ def _law_ranges(scene):
         return None
     law = trib.laws.resistance_law
     validity = getattr(law, "validity", None)
-    if validity is not None:  # a material law (coupling.materials)
+    if validity is not None:  # a material law (coupling.laws.materials)
         return (f"contact-resistance law {law.name}", validity.get("force_N"), validity.get("current_A"),
                 validity.get("note", ""))
     if trib.fit is not None:
@@ -152,7 +152,7 @@ def fit_warnings(scene) -> list[str]:
     trib = scene.tribology
     if trib is None or trib.fit is None or not (trib.fit.friction.n_outliers or trib.fit.resistance.n_outliers):
         return []
-    from coupling.tribology.command import outlier_lines
+    from coupling.laws.tribology.fits import outlier_lines
 
     return [f"contact laws from {trib.source}: {line}" for line in outlier_lines(trib.fit)]
 

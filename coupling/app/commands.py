@@ -24,10 +24,10 @@ def default_out(scene_path: str | None) -> str:
 
 def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = False,
                 overwrite: bool = False, check: bool = False, plots: bool = False) -> int:
-    from .master import CoupledRunError, RunInterrupted, run
-    from .output import ResultFolder, scene_identity
-    from .scene import default_scene, load_scene
-    from .soundness import assess
+    from coupling.core.master import CoupledRunError, RunInterrupted, run
+    from coupling.app.output import ResultFolder, scene_identity
+    from coupling.core.scene import default_scene, load_scene
+    from coupling.core.soundness import assess
 
     scene = default_scene() if scene_path is None else load_scene(scene_path)  # validates before running
     if plots:
@@ -69,7 +69,7 @@ def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = Fa
 
 def plot_command(result_dir: str) -> int:
     """Draw the PNG plots of a result folder into it (each file written whole, by rename)."""
-    from .plots import save_plots, stored_result
+    from coupling.app.plots import save_plots, stored_result
 
     folder = Path(result_dir)
     if not (folder / "summary.json").is_file():
@@ -121,7 +121,7 @@ def _result_lines(summary: dict) -> None:
               f"energy residual {residual if residual is None else f'{residual:.2g}'}")
     for flag in summary.get("flags", []):
         print(f"switchsim: flag: {flag}")
-    for line in summary.get("warnings", []):  # coupling.diagnostics
+    for line in summary.get("warnings", []):  # coupling.core.diagnostics
         print(f"switchsim: warning: {line}")
     if "accuracy" in summary:  # --check
         print(f"switchsim: accuracy: {summary['accuracy']['verdict']}")

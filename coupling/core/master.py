@@ -32,8 +32,8 @@ import numpy as np
 
 from mech import ImpactSolver
 
-from .results import CoupledResult
-from .scene import Scene
+from coupling.core.results import CoupledResult
+from coupling.core.scene import Scene
 
 CONTACT_EVENTS = ("contact_start", "contact_end")
 
@@ -529,9 +529,9 @@ def _coupling_current(step) -> float:
 
 def run(scene: Scene, *, progress: bool = False, check: bool = False) -> CoupledResult:
     """Run any scene: mechanics only, circuit only (prescribed schedule) or coupled.
-    check: also rerun it refined and write summary.accuracy (coupling/accuracy.py)."""
+    check: also rerun it refined and write summary.accuracy (coupling/app/accuracy.py)."""
     if check:
-        from .accuracy import run_checked
+        from coupling.app.accuracy import run_checked
 
         return run_checked(scene, progress=progress)
     if scene.kind == "coupled":
