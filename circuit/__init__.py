@@ -1,6 +1,8 @@
 """Switch circuits in real ngspice (shared library, through PySpice).
 
-The contact is a time-varying conductance driven from Python. SI units throughout.
+The contact is a time-varying conductance driven from Python. SI units throughout. A
+circuit holds one or more contacts, each a block (``ContactBlock``) with its own input
+channels (``<label>.conductance`` S, ``<label>.gap`` m) and result columns.
 
 - ``Stepper``: co-simulation stepping (advance to t_next with G(t) and breakpoints).
 - ``run_transient`` / ``run_pwl_reference``: one-shot runs.
@@ -10,6 +12,7 @@ The contact is a time-varying conductance driven from Python. SI units throughou
 """
 
 from .arc import ArcModel, add_arc
+from .blocks import ContactBlock
 from .contact import add_contact, left_limited
 from .errors import (
     ConductanceError,
@@ -49,6 +52,7 @@ __all__ = [
     "CapacitiveLoad",
     "CurrentSource",
     "ConductanceError",
+    "ContactBlock",
     "ContactSchedule",
     "ConvergenceError",
     "DCSource",

@@ -84,6 +84,7 @@ from typing import Callable, Sequence
 
 from PySpice.Spice.Netlist import Circuit
 
+from .contact import check_block_name, named
 from .validation import check_range
 
 SENSE_SOURCE = "Varc"
@@ -158,42 +159,47 @@ class ArcModel:
         return self.column_gradient > 0.0 or self.breakdown_gradient > 0.0
 
 
-def add_arc(circuit: Circuit, arc: ArcModel, node_a: str, node_b: str) -> None:
-    """Add the arc path across the contact (``node_a``, ``node_b``) of a PySpice circuit.
+def add_arc(circuit: Circuit, arc: ArcModel, node_a: str, node_b: str, name: str = "") -> None:
+    """Add the arc path across the contact ``name`` (``node_a``, ``node_b``) of a PySpice circuit.
 
     The arc current (A, positive from a to b) is the branch current of ``Varc``; the arc
     state (1 burning or armed, 0 extinguished) is the voltage of node ``arc_on``, set by
     ``ArcState`` between time points through the EXTERNAL current source ``Iarc_on``. The model is recorded on the circuit, so a run
     of a PySpice ``Circuit`` finds it. With a gap dependence (``arc.uses_gap``) the gap
     distance d(t) (m) is the voltage of node ``arc_gap``, set by the EXTERNAL source
-    ``Varc_gap`` (every run then needs a gap).
+    ``Varc_gap`` (every run then needs a gap). A named contact's arc has its elements and
+    nodes named as the contact's (``contact.named``: Varc_no, arc_no_on, Varc_no_gap, ...).
     """
+    name = check_block_name("add_arc(name=...)", name)
+    p_node, on_node, gap_node = named("arc_p", name), named(STATE_NODE, name), named(GAP_NODE, name)
     u = repr(float(arc.min_voltage))
     if arc.column_gradient > 0.0:
-        u = f"({u}+{float(arc.column_gradient)!r}*V({GAP_NODE}))"
-    v = f"V(arc_p,{node_b})"
-    circuit.V(SENSE_SOURCE[1:], node_a, "arc_p", 0)
+        u = f"({u}+{float(arc.column_gradient)!r}*V({gap_node}))"
+    v = f"V({p_node},{node_b})"
+    circuit.V(named(SENSE_SOURCE, name)[1:], node_a, p_node, 0)
     circuit.B(
-        "arc",
-        "arc_p",
+        named("Barc", name)[1:],
+        p_node,
         node_b,
         current_expression=(
-            f"V({STATE_NODE})*(uramp({v}-{u})-uramp(-{v}-{u}))/{float(arc.resistance)!r}"
+            f"V({on_node})*(uramp({v}-{u})-uramp(-{v}-{u}))/{float(arc.resistance)!r}"
             f"+{OFF_CONDUCTANCE!r}*{v}"
         ),
     )
     # No value after 'external' (a value segfaults ngspice 38-40 on V sources).
-    circuit.I(STATE_SOURCE[1:], circuit.gnd, STATE_NODE, "external")
-    circuit.R("arc_on", STATE_NODE, circuit.gnd, 1)
+    circuit.I(named(STATE_SOURCE, name)[1:], circuit.gnd, on_node, "external")
+    circuit.R(named("Rarc_on", name)[1:], on_node, circuit.gnd, 1)
     if arc.uses_gap:
         # No value after 'external' here either.
-        circuit.V(GAP_SOURCE[1:], GAP_NODE, circuit.gnd, "external")
-    setattr(circuit, _ATTRIBUTE, (arc, str(node_a), str(node_b)))
+        circuit.V(named(GAP_SOURCE, name)[1:], gap_node, circuit.gnd, "external")
+    recorded = getattr(circuit, _ATTRIBUTE, {})
+    recorded[name] = (arc, str(node_a), str(node_b))
+    setattr(circuit, _ATTRIBUTE, recorded)
 
 
-def recorded_arc(circuit: Circuit) -> ArcModel | None:
-    """The ArcModel that ``add_arc`` put on a PySpice circuit, or None."""
-    found = getattr(circuit, _ATTRIBUTE, None)
+def recorded_arc(circuit: Circuit, name: str = "") -> ArcModel | None:
+    """The ArcModel that ``add_arc`` put on a PySpice circuit's contact ``name``, or None."""
+    found = getattr(circuit, _ATTRIBUTE, {}).get(name)
     return None if found is None else found[0]
 
 
@@ -222,12 +228,15 @@ class ArcState:
     Names are ngspice vector names: ``current`` the arc current ("varc#branch"),
     ``node_a``/``node_b`` the contact nodes, ``conductance`` the node whose voltage is
     the contact conductance G(t), ``gap`` the node whose voltage is the gap distance
-    (needed only with a breakdown gradient).
+    (needed only with a breakdown gradient); ``conductance_source`` the EXTERNAL source
+    that drives G(t), when it is one.
     """
 
     def __init__(self, arc: ArcModel, current: str, node_a: str, node_b: str, conductance: str,
-                 gap: str = GAP_NODE):
+                 gap: str = GAP_NODE, conductance_source: str | None = None):
         self.arc = arc
+        # the EXTERNAL source whose last value is G at an accepted point (saves a vector read)
+        self.conductance_source = conductance_source
         self._tau = arc.formation_time / math.log(2.0)
         ground = ("0", "gnd")
         self._conductance = (conductance.lower(),)

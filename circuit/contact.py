@@ -39,6 +39,8 @@ from typing import Callable, Iterable, Sequence
 
 from PySpice.Spice.Netlist import Circuit
 
+from .names import check_block_name, named
+
 CONDUCTANCE_SOURCE = "Vcontact_g"
 CONDUCTANCE_NODE = "contact_g"
 EFFECTIVE_NODE = "contact_geff"
@@ -48,7 +50,6 @@ ELEMENT = "Bcontact"
 DEFAULT_LEAKAGE = 1e-12  # S
 
 Conductance = Callable[[float], float]
-
 
 _CURRENT_TOKEN = re.compile(r"\bI\b")
 
@@ -66,29 +67,46 @@ def check_current_factor(where: str, expression: str | None) -> str | None:
 
 
 def add_contact(circuit: Circuit, node_a: str, node_b: str, leakage_conductance: float = DEFAULT_LEAKAGE,
-                current_factor: str | None = None) -> str:
-    """Add the contact between ``node_a`` and ``node_b`` to a PySpice circuit.
+                current_factor: str | None = None, name: str = "") -> str:
+    """Add the contact ``name`` between ``node_a`` and ``node_b`` to a PySpice circuit.
 
     The contact current (A, positive from a to b) is the branch current of
-    ``Vcontact``; the prescribed conductance G(t) (S) is the voltage of node
-    ``contact_g``. With ``current_factor`` (an ngspice expression of the contact current
-    ``I``, see the module docstring) the conductance is G(t)/g(I). Returns the node
-    whose voltage is the effective conductance (S).
+    ``Vcontact`` (``Vcontact_<name>`` for a named contact); the prescribed conductance
+    G(t) (S) is the voltage of node ``contact_g`` (``contact_<name>_g``). With
+    ``current_factor`` (an ngspice expression of the contact current ``I``, see the
+    module docstring) the conductance is G(t)/g(I). Returns the node whose voltage is
+    the effective conductance (S). A PySpice circuit may hold several named contacts.
     """
-    circuit.V(SENSE_SOURCE[1:], node_a, SENSE_NODE, 0)
-    conductance = CONDUCTANCE_NODE
+    name = check_block_name("add_contact(name=...)", name)
+    sense, sense_node = named(SENSE_SOURCE, name), named(SENSE_NODE, name)
+    g_node, g_source = named(CONDUCTANCE_NODE, name), named(CONDUCTANCE_SOURCE, name)
+    circuit.V(sense[1:], node_a, sense_node, 0)
+    conductance = g_node
     if current_factor is not None:
-        g = _CURRENT_TOKEN.sub(f"i({SENSE_SOURCE})", current_factor)
-        circuit.B(EFFECTIVE_NODE, EFFECTIVE_NODE, circuit.gnd, voltage_expression=f"V({CONDUCTANCE_NODE})/({g})")
-        conductance = EFFECTIVE_NODE
+        effective = named(EFFECTIVE_NODE, name)
+        g = _CURRENT_TOKEN.sub(f"i({sense})", current_factor)
+        circuit.B(effective, effective, circuit.gnd, voltage_expression=f"V({g_node})/({g})")
+        conductance = effective
     circuit.B(
-        ELEMENT[1:],
-        SENSE_NODE,
+        named(ELEMENT, name)[1:],
+        sense_node,
         node_b,
-        current_expression=f"V({SENSE_NODE},{node_b})*(V({conductance})+{float(leakage_conductance)!r})",
+        current_expression=f"V({sense_node},{node_b})*(V({conductance})+{float(leakage_conductance)!r})",
     )
-    circuit.V(CONDUCTANCE_SOURCE[1:], CONDUCTANCE_NODE, circuit.gnd, "external")
+    circuit.V(g_source[1:], g_node, circuit.gnd, "external")
+    placed = getattr(circuit, _PLACED, {})
+    placed[name] = (str(node_a), str(node_b), float(leakage_conductance), current_factor)
+    setattr(circuit, _PLACED, placed)
     return conductance
+
+
+_PLACED = "_switchsim_contacts"  # where add_contact records the contacts it placed on a PySpice Circuit
+
+
+def placed_contacts(circuit: Circuit) -> dict[str, tuple[str, str, float, str | None]]:
+    """The contacts ``add_contact`` put on a PySpice circuit: name -> (node_a, node_b,
+    leakage conductance S, current factor or None)."""
+    return dict(getattr(circuit, _PLACED, {}))
 
 
 #: ngspice lands on a macro time when its step is within this fraction of the remaining

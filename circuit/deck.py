@@ -1,24 +1,25 @@
-"""The deck ngspice reads: circuit netlist + how the contact conductance is driven + analysis lines."""
+"""The deck ngspice reads: circuit netlist + how each input channel is driven + analysis lines."""
 
 from __future__ import annotations
 
-from typing import Union
+from typing import Mapping, Union
 
 import numpy as np
 from PySpice.Spice.Netlist import Circuit
 
-from .arc import GAP_NODE, GAP_SOURCE, STATE_SOURCE, ArcModel, ArcState, recorded_arc
-from .contact import CONDUCTANCE_NODE, CONDUCTANCE_SOURCE, SENSE_SOURCE
+from .arc import ArcState, recorded_arc
+from .blocks import ContactBlock
+from .contact import placed_contacts
 from .netlist import NetlistCircuit
 from .options import SimulationOptions
 from .probes import Probes
-from .templates import LOAD_PROBE, NODE_A, NODE_B, SwitchCircuit
+from .templates import LOAD_PROBE, SwitchCircuit
 from .validation import check_range
 
 CircuitLike = Union[SwitchCircuit, NetlistCircuit, Circuit]
 
-#: Drive of the conductance source (or of the gap source): "external" (Python callback)
-#: or PWL vertices (times s, values S or m).
+#: Drive of an input channel's source: "external" (a Python function of time, through
+#: ngspice's callback) or PWL vertices (times s, values in the channel's unit, >= 0).
 Drive = Union[str, tuple[np.ndarray, np.ndarray]]
 
 
@@ -29,86 +30,92 @@ def circuit_netlist(circuit: CircuitLike) -> tuple[str, Probes]:
     if isinstance(circuit, NetlistCircuit):
         return circuit.netlist(), circuit.probes
     if isinstance(circuit, Circuit):
-        names = {name.lower() for name in circuit.element_names}
-        if CONDUCTANCE_SOURCE.lower() not in names:
-            raise ValueError(
-                "the PySpice circuit has no contact: add it with circuit.add_contact(circuit, node_a, node_b)"
-            )
-        probes = Probes(
-            node_a=_node_of(circuit, SENSE_SOURCE, 0),
-            node_b=_node_of(circuit, "Bcontact", 1),
-            contact_current=f"{SENSE_SOURCE}#branch",
-            conductance_node=CONDUCTANCE_NODE,
-            load_current=f"{LOAD_PROBE}#branch" if LOAD_PROBE.lower() in names else None,
-            arc_current="Varc#branch" if "varc" in names else None,
-        )
-        return str(circuit), probes
+        return str(circuit), Probes(_pyspice_contacts(circuit), load_current=(
+            f"{LOAD_PROBE}#branch" if LOAD_PROBE.lower() in {n.lower() for n in circuit.element_names} else None))
     raise TypeError(
         f"expected a SwitchCircuit, a NetlistCircuit or a PySpice Circuit with a contact, got {type(circuit).__name__}"
     )
 
 
-def circuit_arc(circuit: CircuitLike) -> ArcModel | None:
-    """The circuit's ArcModel, or None without an arc path."""
-    if isinstance(circuit, (SwitchCircuit, NetlistCircuit)):
-        return circuit.arc
-    arc = recorded_arc(circuit)
-    if arc is None and "varc" in {name.lower() for name in circuit.element_names}:
-        raise ValueError("the PySpice circuit has an element Varc but no arc model: add the arc with add_arc")
-    return arc
+def _pyspice_contacts(circuit: Circuit) -> tuple[ContactBlock, ...]:
+    """The contacts ``add_contact`` placed on a PySpice circuit (with the arcs ``add_arc`` gave them)."""
+    placed = placed_contacts(circuit)
+    if not placed:
+        raise ValueError(
+            "the PySpice circuit has no contact: add it with circuit.add_contact(circuit, node_a, node_b)"
+        )
+    names = {n.lower() for n in circuit.element_names}
+    blocks = []
+    for name, (node_a, node_b, leakage, factor) in placed.items():
+        block = ContactBlock(name, node_a, node_b, leakage, factor, recorded_arc(circuit, name))
+        if block.arc is None and block.element("Varc").lower() in names:
+            raise ValueError(f"the PySpice circuit has an element {block.element('Varc')} but no arc model: "
+                             "add the arc with add_arc")
+        blocks.append(block)
+    return tuple(blocks)
 
 
-def arc_state(circuit: CircuitLike, probes: Probes) -> ArcState | None:
-    """The state machine of the circuit's arc (decided at accepted points), or None."""
-    arc = circuit_arc(circuit)
-    if arc is None:
-        return None
-    return ArcState(arc, probes.arc_current, probes.node_a, probes.node_b, CONDUCTANCE_NODE, GAP_NODE)
+def arc_states(probes: Probes) -> dict[str, ArcState]:
+    """The state machine of each contact's arc (decided at accepted points), keyed by the
+    EXTERNAL current source that carries it."""
+    return {c.state_source.lower(): ArcState(c.arc, c.arc_current_vector, c.node_a, c.node_b,
+                                             c.element("contact_g"), c.element("arc_gap"),
+                                             conductance_source=c.conductance_source)
+            for c in probes.contacts if c.arc is not None}
 
 
-def _node_of(circuit: Circuit, element: str, index: int) -> str:
-    for name in circuit.element_names:
-        if name.lower() == element.lower():
-            return str(circuit[name].nodes[index])
-    return NODE_A if index == 0 else NODE_B
+def input_sources(probes: Probes) -> dict[str, str]:
+    """Every input channel of the circuit -> the EXTERNAL source behind it."""
+    out: dict[str, str] = {}
+    for c in probes.contacts:
+        out.update(c.inputs)
+    return out
 
 
 def build_deck(
-    circuit: CircuitLike, t_end: float, options: SimulationOptions, drive: Drive = "external",
-    gap_drive: Drive = "external",
+    circuit: CircuitLike, t_end: float, options: SimulationOptions, drives: Mapping[str, Drive] | None = None,
 ) -> tuple[list[str], Probes]:
-    """Deck lines for a transient 0..t_end (s), the conductance source driven by ``drive``
-    and, with a gap-dependent arc model, the gap source by ``gap_drive``."""
+    """Deck lines for a transient 0..t_end (s), each input channel's source driven as
+    ``drives`` says (channel name -> "external" or PWL vertices; default "external")."""
     check_range("transient", "t_end", t_end, "s", 0.0, 1e3, low_open=True)
     text, probes = circuit_netlist(circuit)
+    sources = input_sources(probes)
+    drives = dict(drives or {})
+    unknown = sorted(set(drives) - set(sources))
+    if unknown:
+        raise ValueError(f"drives for {', '.join(unknown)}: the circuit's input channels are {', '.join(sources)}")
+    by_source = {source.lower(): (channel, source) for channel, source in sources.items()}
+    states = {c.state_source.lower() for c in probes.contacts if c.state_source}
     lines = [line for line in text.splitlines() if line.strip()]
-    replaced = False
+    replaced = set()
     for i, line in enumerate(lines):
         tokens = line.split()
         if not tokens or i == 0:
             continue
         head = tokens[0].lower()
-        if head == CONDUCTANCE_SOURCE.lower():
-            lines[i] = "\n".join(_source_lines(drive))
-            replaced = True
-        elif head == GAP_SOURCE.lower():
-            lines[i] = "\n".join(_source_lines(gap_drive, f"{GAP_SOURCE} {GAP_NODE} 0", "gap"))
-        elif head[0] in "vi" and head != STATE_SOURCE.lower() and "external" in (t.lower() for t in tokens[3:]):
+        if head in by_source:
+            channel, source = by_source[head]
+            # (the one unnamed contact's inputs keep their plain words in messages)
+            what = channel.split(".", 1)[1] if channel.startswith("contact.") else channel
+            lines[i] = "\n".join(_source_lines(drives.get(channel, "external"), f"{source} {tokens[1]} {tokens[2]}",
+                                               what))
+            replaced.add(head)
+        elif head[0] in "vi" and head not in states and "external" in (t.lower() for t in tokens[3:]):
             raise ValueError(
-                f"netlist line {line!r}: only the contact's conductance source (and the arc state and gap) may be EXTERNAL"
+                f"netlist line {line!r}: only a contact's conductance source (and the arc state and gap) may be EXTERNAL"
             )
         elif head == ".end":
             lines[i] = ""
-    if not replaced:
-        raise ValueError(f"the netlist has no contact conductance source {CONDUCTANCE_SOURCE}")
+    missing = sorted(channel for source, (channel, _) in by_source.items() if source not in replaced)
+    if missing:
+        raise ValueError(f"the netlist has no source for the input channel(s) {', '.join(missing)}")
     lines = [part for line in lines if line for part in line.split("\n")]
     lines += options.deck_lines(t_end)
     lines.append(".end")
     return lines, probes
 
 
-def _source_lines(drive: Drive, head: str = f"{CONDUCTANCE_SOURCE} {CONDUCTANCE_NODE} 0",
-                  what: str = "conductance") -> list[str]:
+def _source_lines(drive: Drive, head: str, what: str) -> list[str]:
     if isinstance(drive, str):
         if drive != "external":
             raise ValueError(f"drive = {drive!r}: 'external' or PWL vertices")
@@ -127,4 +134,3 @@ def _source_lines(drive: Drive, head: str = f"{CONDUCTANCE_SOURCE} {CONDUCTANCE_
     # Continuation lines keep each physical line short for ngspice's reader.
     chunks = [" ".join(pairs[i : i + 8]) for i in range(0, len(pairs), 8)]
     return [f"{head} PWL({chunks[0]}"] + [f"+ {chunk}" for chunk in chunks[1:]] + ["+ )"]
-

@@ -23,8 +23,13 @@ The netlist and the files it includes (``.include``, ``.lib FILE SECTION``, path
 relative to the including file's folder) are read and checked by switchsim before
 ngspice sees them: see ``netlist_check`` and docs/circuit.md (threat model).
 
-Reserved (do not use): elements Vcontact, Bcontact, Bcontact_geff, Vcontact_g, Varc*
-(Varc, Varc_gap), Barc*, Iarc_on, Rarc_on; nodes contact_s, contact_g, contact_geff, arc_*.
+Several contacts: name each, ``XCONTACT_<name> node_a node_b`` (a letter, then letters
+and digits: ``XCONTACT_NO``, ``XCONTACT_NC``); each becomes its own contact block with its
+own conductance, gap, arc and result columns (``contact_voltage_no``, ...). A plain
+``XCONTACT`` is the one unnamed contact and cannot be combined with named ones.
+
+Reserved (do not use): elements Vcontact*, Bcontact*, Varc*, Barc*, Iarc*, Rarc*; nodes
+contact_s, contact_g, contact_geff (and contact_<name>_s, _g, _geff), arc_*.
 """
 
 from __future__ import annotations
@@ -35,22 +40,23 @@ from pathlib import Path
 
 from PySpice.Spice.Netlist import Circuit
 
-from .arc import ArcModel, add_arc
-from .contact import (
-    CONDUCTANCE_NODE, DEFAULT_LEAKAGE, EFFECTIVE_NODE, SENSE_SOURCE, add_contact, check_current_factor,
-)
+from .arc import ArcModel
+from .blocks import ContactBlock
+from .contact import DEFAULT_LEAKAGE, check_current_factor
 from .errors import NetlistInputError
 from .netlist_check import DECK_TITLE, NetlistLine, check_lines, logical_lines, read_netlist
 from .probes import Probes
 from .validation import check_range
 
-_RESERVED_ELEMENTS = re.compile(r"^(vcontact|bcontact|bcontact_geff|vcontact_g|varc\w*|barc\w*|iarc_on|rarc_on)$", re.I)
-_RESERVED_NODES = re.compile(r"^(contact_s|contact_g|contact_geff|arc_\w+)$", re.I)
+_RESERVED_ELEMENTS = re.compile(r"^(vcontact\w*|bcontact\w*|varc\w*|barc\w*|iarc\w*|rarc\w*)$", re.I)
+_RESERVED_NODES = re.compile(r"^(contact_(\w+_)?(s|g|geff)|arc_\w+)$", re.I)
+_CONTACT_LINE = re.compile(r"^xcontact(?:_(\w+))?$", re.I)
 
 
 @dataclass(frozen=True)
 class NetlistCircuit:
-    """A user netlist (text) with one ``XCONTACT a b`` line. See the module docstring.
+    """A user netlist (text) with its contact lines (``XCONTACT a b``, or ``XCONTACT_<name> a b``
+    per contact). See the module docstring.
 
     load_probe: name of the 0 V source in series with the load, or None.
     arc: optional ArcModel across the contact.
@@ -100,9 +106,10 @@ class NetlistCircuit:
         check_lines(lines)
         return lines
 
-    def _parse(self) -> tuple[list[NetlistLine], int, str, str, bool]:
+    def _parse(self) -> tuple[list[NetlistLine], list[tuple[int, ContactBlock]], bool]:
+        """The checked lines, each contact line's row and block, and whether the load probe is there."""
         lines = self._lines()
-        contact_rows = []
+        placed: list[tuple[int, ContactBlock]] = []
         has_load_probe = False
         for i, line in enumerate(lines):
             if i == 0:
@@ -110,10 +117,19 @@ class NetlistCircuit:
             tokens = line.text.split()
             head = tokens[0]
             where = f"netlist {line.file} line {line.line}"
-            if head.lower() == "xcontact":
+            match = _CONTACT_LINE.match(head)
+            if match:
                 if len(tokens) != 3:
-                    raise NetlistInputError(f"{where}: the contact line is 'XCONTACT node_a node_b'")
-                contact_rows.append(i)
+                    raise NetlistInputError(f"{where}: the contact line is '{head} node_a node_b'")
+                name = (match.group(1) or "").lower()
+                try:
+                    block = ContactBlock(name, tokens[1], tokens[2], self.leakage_conductance,
+                                         self.contact_current_factor, self.arc)
+                except ValueError as err:
+                    raise NetlistInputError(f"{where}: {head}: {err}") from None
+                if any(b.name == name for _, b in placed):
+                    raise NetlistInputError(f"{where}: a second contact line {head}: each contact is placed once")
+                placed.append((i, block))
                 continue
             if _RESERVED_ELEMENTS.match(head):
                 raise NetlistInputError(f"{where}: element name {head} is reserved by switchsim")
@@ -121,36 +137,35 @@ class NetlistCircuit:
                 raise NetlistInputError(f"{where}: node names contact_s, contact_g, arc_* are reserved")
             if self.load_probe is not None and head.lower() == self.load_probe.lower():
                 has_load_probe = True
-        if len(contact_rows) != 1:
+        if not placed:
             raise NetlistInputError(
-                f"the netlist must contain exactly one 'XCONTACT node_a node_b' line (found {len(contact_rows)}); "
-                "the first line is the title"
+                "the netlist must contain a contact line, 'XCONTACT node_a node_b' (or one 'XCONTACT_<name> "
+                "node_a node_b' per contact; found none); the first line is the title"
             )
-        row = contact_rows[0]
-        _, node_a, node_b = lines[row].text.split()
-        return lines, row, node_a, node_b, has_load_probe
+        if len(placed) > 1 and any(not b.name for _, b in placed):
+            raise NetlistInputError("a netlist with several contacts names each one, 'XCONTACT_<name> node_a node_b' "
+                                    "(a plain XCONTACT is the one contact of a single-contact netlist)")
+        return lines, placed, has_load_probe
+
+    @property
+    def contacts(self) -> tuple[ContactBlock, ...]:
+        """The netlist's contacts, as blocks, in the order of their lines."""
+        return tuple(block for _, block in self._parse()[1])
 
     @property
     def probes(self) -> Probes:
-        _, _, node_a, node_b, has_load_probe = self._parse()
-        return Probes(
-            node_a=node_a,
-            node_b=node_b,
-            contact_current=f"{SENSE_SOURCE}#branch",
-            conductance_node=CONDUCTANCE_NODE if self.contact_current_factor is None else EFFECTIVE_NODE,
-            load_current=f"{self.load_probe}#branch" if has_load_probe else None,
-            arc_current=None if self.arc is None else "Varc#branch",
-        )
+        _, placed, has_load_probe = self._parse()
+        return Probes(tuple(block for _, block in placed),
+                      load_current=f"{self.load_probe}#branch" if has_load_probe else None)
 
     def netlist(self) -> str:
-        """The checked netlist with the XCONTACT line expanded (switchsim's own title first,
+        """The checked netlist with each contact line expanded (switchsim's own title first,
         comments dropped, no analysis, no .end)."""
-        lines, row, node_a, node_b, _ = self._parse()
-        scratch = Circuit("contact")
-        add_contact(scratch, node_a, node_b, self.leakage_conductance, self.contact_current_factor)
-        if self.arc is not None:
-            add_arc(scratch, self.arc, node_a, node_b)
-        expansion = [line for line in str(scratch).splitlines()[1:] if line.strip()]
+        lines, placed, _ = self._parse()
         texts = [line.text for line in lines]
-        expanded = [DECK_TITLE] + texts[1:row] + expansion + texts[row + 1 :]
-        return "\n".join(line for line in expanded if line.strip().lower() != ".end")
+        for row, block in placed:
+            scratch = Circuit("contact")
+            block.add_to(scratch)
+            texts[row] = "\n".join(line for line in str(scratch).splitlines()[1:] if line.strip())
+        expanded = [DECK_TITLE] + texts[1:]
+        return "\n".join(part for text in expanded for part in text.split("\n") if part.strip().lower() != ".end")

@@ -19,18 +19,15 @@ import threading
 import time
 import weakref
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Mapping
 
 import numpy as np
 from PySpice.Spice.NgSpice.Shared import NgSpiceShared, ffi
 
-from .arc import GAP_SOURCE
 from .contact import LANDING_TOLERANCE
 from .netlist_check import check_deck
 from .errors import (
-    ConductanceError,
     ConvergenceError,
-    GapError,
     LibraryNotFoundError,
     NetlistError,
     NgspiceError,
@@ -163,7 +160,7 @@ class NgspiceSession(NgSpiceShared):
       (PySpice treats "condition met", "Note: ..." and warnings as errors);
     - the background-thread and status callbacks return an int, as ngspice expects;
     - the EXTERNAL voltage source gets its value from a Python function of time set
-      with ``set_source``; the GetSyncData callback (installed once: ngspice cannot
+      with ``set_channels`` (by source name); the GetSyncData callback (installed once: ngspice cannot
       uninstall it) shortens steps to land exactly on the next macro time, and aborts
       the run on a callback failure or a wall-clock timeout.
 
@@ -174,28 +171,21 @@ class NgspiceSession(NgSpiceShared):
         self._lines: list[str] = []
         self._feed_pyspice = True
         self._exit_status: tuple[int, bool, bool] | None = None
-        self._source: Callable[[float], float] = _zero
-        self._last_t = math.nan
-        self._last_value = 0.0
-        # The gap source (arc model with a gap dependence), a second EXTERNAL voltage
-        # source told apart by its name pointer (ngspice passes the instance's own name
-        # string, so the pointer is learned once per loaded circuit).
-        self._gap: Callable[[float], float] | None = None
-        self._gap_last_t = math.nan
-        self._gap_last_value = 0.0
-        self._name_g = ffi.NULL
-        self._name_d = ffi.NULL
-        self.gap_calls = 0
+        # The input channels: each EXTERNAL voltage source of the loaded circuit gets its
+        # value from a Python function of time; ngspice passes the instance's own name
+        # string, so each source is found by its name once and by the pointer after that.
+        self._channels: dict[str, Channel] = {}
+        self._by_pointer: dict[int, Channel] = {}
         self._target = math.inf
         self._deadline = math.inf
         self._failure: BaseException | None = None
-        self._arc = None  # ArcState of the loaded circuit, or None
+        self._arcs: dict[str, object] = {}  # the ArcState of each arc, by its EXTERNAL current source
+        self._arc_by_pointer: dict[int, object] = {}
         self._arc_from = math.nan  # accepted time the arc's step bounds below apply from
         self._arc_step = math.inf
         self._arc_land = math.inf
         self._commands_sent = 0
         self._encoded: dict[str, bytes] = {}
-        self.source_calls = 0
         self.owner: weakref.ref | None = None
         self.lock = threading.Lock()
         # PySpice formats the path with the instance id; braces in a path must survive.
@@ -267,59 +257,38 @@ class NgspiceSession(NgSpiceShared):
     def _on_vsrc(self, out, t, name, ident, user):
         # Called at every Newton iteration and on rejected trial points: the value must
         # depend on t only. Repeated calls at the same t skip the Python function.
-        if self._gap is not None and name != self._name_g and (name == self._name_d or self._is_gap(name)):
-            return self._on_gap(out, t)
-        if t == self._last_t:
-            out[0] = self._last_value
+        channel = self._by_pointer.get(int(ffi.cast("uintptr_t", name)))
+        if channel is None:
+            channel = self._learn(name)
+        if t == channel.last_t or self._failure is not None:
+            out[0] = channel.last_value
             return 0
-        if self._failure is not None:
-            out[0] = self._last_value
-            return 0
-        self.source_calls += 1
+        channel.calls += 1
         try:
-            value = float(self._source(t))
+            value = float(channel.function(t))
         except BaseException as exc:  # re-raised after ngspice has stopped
             self._failure = exc
-            out[0] = self._last_value
+            out[0] = channel.last_value
             return 0
         if not (0.0 <= value < math.inf):
-            self._failure = ConductanceError(
-                f"contact conductance at t = {t!r} s is {value!r} S; it must be finite and >= 0"
-            )
-            out[0] = self._last_value
+            self._failure = channel.error(t, value)
+            out[0] = channel.last_value
             return 0
-        self._last_t = t
-        self._last_value = value
+        channel.last_t = t
+        channel.last_value = value
         out[0] = value
         return 0
 
-    def _is_gap(self, name) -> bool:
-        """Classify an EXTERNAL voltage source seen for the first time (gap or conductance)."""
-        if ffi.string(name).decode("ascii", "replace").lower() == GAP_SOURCE.lower():
-            self._name_d = name
-            return True
-        self._name_g = name
-        return False
-
-    def _on_gap(self, out, t):
-        if t == self._gap_last_t or self._failure is not None:
-            out[0] = self._gap_last_value
-            return 0
-        self.gap_calls += 1
-        try:
-            value = float(self._gap(t))
-        except BaseException as exc:  # re-raised after ngspice has stopped
-            self._failure = exc
-            out[0] = self._gap_last_value
-            return 0
-        if not (0.0 <= value < math.inf):
-            self._failure = GapError(f"contact gap at t = {t!r} s is {value!r} m; it must be finite and >= 0")
-            out[0] = self._gap_last_value
-            return 0
-        self._gap_last_t = t
-        self._gap_last_value = value
-        out[0] = value
-        return 0
+    def _learn(self, name) -> "Channel":
+        """The channel of an EXTERNAL voltage source seen for the first time (by its name)."""
+        text = ffi.string(name).decode("ascii", "replace").lower()
+        channel = self._channels.get(text)
+        if channel is None:  # not one of ours (the deck admits none): an error, reported after the run
+            channel = Channel(text, _zero)
+            if self._failure is None:
+                self._failure = NgspiceError(f"EXTERNAL source {text!r} has no input channel")
+        self._by_pointer[int(ffi.cast("uintptr_t", name))] = channel
+        return channel
 
     def _on_callback_error(self, exc_type, exc_value, traceback):
         if self._failure is None:
@@ -327,10 +296,16 @@ class NgspiceSession(NgSpiceShared):
         return None
 
     def _on_isrc(self, out, t, name, ident, user):
-        # The only EXTERNAL current source is the arc state (arc.py): constant over a
-        # step, ArcState changes it only between accepted points.
-        arc = self._arc
-        out[0] = arc.value if arc is not None else 0.0
+        # The EXTERNAL current sources are the arcs' states (arc.py): constant over a
+        # step, ArcState changes them only between accepted points.
+        arc = self._arc_by_pointer.get(int(ffi.cast("uintptr_t", name)))
+        if arc is None:
+            arc = self._arcs.get(ffi.string(name).decode("ascii", "replace").lower())
+            if arc is None:
+                out[0] = 0.0
+                return 0
+            self._arc_by_pointer[int(ffi.cast("uintptr_t", name))] = arc
+        out[0] = arc.value
         return 0
 
     def _on_sync(self, ckttime, pdelta, olddelta, redostep, ident, loc, user):
@@ -342,12 +317,17 @@ class NgspiceSession(NgSpiceShared):
             pdelta[0] = 0.0
             return 1
         target = self._target
-        if self._arc is not None:
+        if self._arcs:
             if loc == 0:
                 # loc 0: after a point was accepted (and stored), before the next step.
-                # The contact source was last evaluated at that point (if it is EXTERNAL).
-                known = self._last_value if self._last_t == ckttime else None
-                self._arc_step, self._arc_land = self._arc.accepted(ckttime, known, self._read_last)
+                # A contact's source was last evaluated at that point (if it is EXTERNAL).
+                step = land = math.inf
+                for arc in self._arcs.values():
+                    channel = self._channels.get(arc.conductance_source.lower()) if arc.conductance_source else None
+                    known = channel.last_value if channel is not None and channel.last_t == ckttime else None
+                    arc_step, arc_land = arc.accepted(ckttime, known, self._read_last)
+                    step, land = min(step, arc_step), min(land, arc_land)
+                self._arc_step, self._arc_land = step, land
                 self._arc_from = ckttime
             if ckttime == self._arc_from:  # the step (or its retry) from that accepted point
                 if pdelta[0] > self._arc_step:
@@ -402,23 +382,16 @@ class NgspiceSession(NgSpiceShared):
         self._reset_callback_state()
 
     def _reset_callback_state(self) -> None:
-        self._source = _zero
-        self._last_t = math.nan
-        self._last_value = 0.0
-        self._gap = None
-        self._gap_last_t = math.nan
-        self._gap_last_value = 0.0
-        self._name_g = ffi.NULL
-        self._name_d = ffi.NULL
-        self.gap_calls = 0
+        self._channels = {}
+        self._by_pointer = {}
         self._target = math.inf
         self._deadline = math.inf
         self._failure = None
-        self._arc = None
+        self._arcs = {}
+        self._arc_by_pointer = {}
         self._arc_from = math.nan
         self._arc_step = math.inf
         self._arc_land = math.inf
-        self.source_calls = 0
 
     def load(self, lines: list[str]) -> None:
         """Load a deck (title line first, ``.end`` last); raises NetlistError with ngspice's message.
@@ -438,17 +411,31 @@ class NgspiceSession(NgSpiceShared):
         if rc or errors:
             raise NetlistError("ngspice could not parse the netlist", _message(printed))
 
-    def set_source(self, source: Callable[[float], float], gap: Callable[[float], float] | None = None) -> None:
-        """The function of time (s) whose value ngspice reads from the EXTERNAL conductance
-        source, and the gap distance d(t) (m) for the EXTERNAL gap source (None: no gap source)."""
-        self._source = source
-        self._last_t = math.nan
-        self._gap = gap
-        self._gap_last_t = math.nan
+    def set_channels(self, functions: Mapping[str, Callable[[float], float]],
+                     errors: Mapping[str, Callable[[float, float], Exception]] | None = None) -> None:
+        """The function of time (s) behind each EXTERNAL voltage source of the loaded circuit,
+        by source name; ``errors`` (by source name) makes the error for a value that is not
+        finite and >= 0 (default: a ValueError naming the source). Channels keep their
+        call counts across calls; their last values are forgotten (a new step)."""
+        errors = errors or {}
+        for source, function in functions.items():
+            key = source.lower()
+            channel = self._channels.get(key)
+            if channel is None:
+                channel = self._channels[key] = Channel(key, function, errors.get(source))
+            channel.function = function
+            channel.last_t = math.nan
 
-    def set_arc(self, arc) -> None:
-        """The ``ArcState`` of the loaded circuit (it drives ``Iarc_on``), or None without an arc."""
-        self._arc = arc
+    @property
+    def channel_calls(self) -> dict[str, int]:
+        """Calls of each input channel's function so far (source name -> calls)."""
+        return {name: channel.calls for name, channel in self._channels.items()}
+
+    def set_arcs(self, arcs: Mapping[str, object]) -> None:
+        """The ``ArcState`` of each arc of the loaded circuit, by the EXTERNAL current source
+        that carries its state (empty: no arc)."""
+        self._arcs = {name.lower(): arc for name, arc in arcs.items()}
+        self._arc_by_pointer = {}
         self._arc_from = math.nan
         self._arc_step = math.inf
         self._arc_land = math.inf
@@ -622,6 +609,27 @@ class NgspiceSession(NgSpiceShared):
 
 def _zero(t: float) -> float:
     return 0.0
+
+
+class Channel:
+    """One input channel: the function of time behind an EXTERNAL voltage source, its last
+    value (ngspice asks again at the same time during Newton iterations) and its calls."""
+
+    __slots__ = ("name", "function", "make_error", "last_t", "last_value", "calls")
+
+    def __init__(self, name: str, function: Callable[[float], float],
+                 make_error: Callable[[float, float], Exception] | None = None):
+        self.name = name
+        self.function = function
+        self.make_error = make_error
+        self.last_t = math.nan
+        self.last_value = 0.0
+        self.calls = 0
+
+    def error(self, t: float, value: float) -> Exception:
+        if self.make_error is not None:
+            return self.make_error(t, value)
+        return ValueError(f"input {self.name} at t = {t!r} s is {value!r}; it must be finite and >= 0")
 
 
 def _message(printed: list[str]) -> str:

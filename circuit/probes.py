@@ -8,7 +8,9 @@ from typing import Callable
 
 import numpy as np
 
-#: Result columns, in order (SI: s, V, A, A, ohm, S, A).
+from .blocks import ContactBlock
+
+#: Result columns of a circuit with one unnamed contact, in order (SI: s, V, A, A, ohm, S, A).
 COLUMNS = (
     "time",
     "contact_voltage",
@@ -18,6 +20,8 @@ COLUMNS = (
     "contact_conductance",
     "arc_current",
 )
+#: Per contact, its columns (each with the contact's suffix: "" or "_<name>").
+CONTACT_COLUMNS = ("contact_voltage", "contact_current", "contact_resistance", "contact_conductance", "arc_current")
 
 _GROUND = ("0", "gnd")
 CLOSED_CONDUCTANCE = 1e-6  # S: above it the contact voltage is I/G (see Probes._contact_voltage)
@@ -25,26 +29,44 @@ CLOSED_CONDUCTANCE = 1e-6  # S: above it the contact voltage is I/G (see Probes.
 
 @dataclass(frozen=True)
 class Probes:
-    """Vector names (as ngspice knows them) behind each result column.
+    """Which ngspice vectors hold each result column of a circuit.
 
-    node_a, node_b: contact nodes; contact_voltage, V: I/G while the contact conducts,
-        V(node_a) - V(node_b) otherwise (see _contact_voltage).
-    contact_current: branch vector of the contact's 0 V probe (metallic conduction
-        only, A, positive from a to b); the arc and the parasitic capacitance are not in it.
-    conductance_node: node whose voltage is the prescribed conductance G(t), S.
+    contacts: the circuit's contact blocks (circuit.blocks.ContactBlock); each gives the
+        columns CONTACT_COLUMNS with its suffix ("" for the unnamed contact, "_<name>"):
+        contact_voltage, V: I/G while the contact conducts, V(node_a) - V(node_b)
+        otherwise (see _contact_voltage); contact_current: the metallic conduction only
+        (A, positive from a to b; the arc and the parasitic capacitance are not in it);
+        contact_conductance / contact_resistance: S / ohm the element conducts with
+        (inf open); arc_current: the arc path's current, A (0 without an arc).
     load_current: branch vector of the load probe, A, or None (column of NaN).
-    arc_current: branch vector of the arc path, A, or None (no arc model: column of 0).
     """
 
-    node_a: str
-    node_b: str
-    contact_current: str
-    conductance_node: str
+    contacts: tuple[ContactBlock, ...]
     load_current: str | None = None
-    arc_current: str | None = None
 
-    def columns(self, read: Callable[[str], np.ndarray], names: tuple[str, ...] = COLUMNS) -> dict[str, np.ndarray]:
-        """The requested columns, each read through ``read(vector_name) -> array``."""
+    def __post_init__(self) -> None:
+        names = [c.name for c in self.contacts]
+        if not names or len(set(names)) != len(names):
+            raise ValueError(f"Probes.contacts: one or more contacts with distinct names, got {names!r}")
+
+    @property
+    def column_names(self) -> tuple[str, ...]:
+        """Every result column, in order: COLUMNS for one unnamed contact; else time,
+        load_current, then each contact's CONTACT_COLUMNS with its suffix."""
+        if len(self.contacts) == 1 and not self.contacts[0].name:
+            return COLUMNS
+        return ("time", "load_current") + tuple(f"{name}{c.suffix}" for c in self.contacts for name in CONTACT_COLUMNS)
+
+    def contact(self, column: str) -> tuple[ContactBlock, str]:
+        """(the contact, the column's base name) of a per-contact column such as contact_voltage_no."""
+        for c in self.contacts:
+            for base in CONTACT_COLUMNS:
+                if column == base + c.suffix:
+                    return c, base
+        raise KeyError(f"unknown result column {column!r}; known: {', '.join(self.column_names)}")
+
+    def columns(self, read: Callable[[str], np.ndarray], names: tuple[str, ...] | None = None) -> dict[str, np.ndarray]:
+        """The requested columns (default: all), each read through ``read(vector_name) -> array``."""
         cache: dict[str, np.ndarray] = {}
 
         def vec(name: str) -> np.ndarray:
@@ -55,27 +77,28 @@ class Probes:
 
         time = vec("time")
         out: dict[str, np.ndarray] = {}
-        for name in names:
+        for name in (self.column_names if names is None else names):
             if name == "time":
                 out[name] = time
-            elif name == "contact_voltage":
-                out[name] = self._contact_voltage(vec, time)
-            elif name == "contact_current":
-                out[name] = vec(self.contact_current)
             elif name == "load_current":
                 out[name] = vec(self.load_current) if self.load_current else np.full_like(time, np.nan)
-            elif name in ("contact_resistance", "contact_conductance"):
-                g = vec(self.conductance_node)
-                if name == "contact_conductance":
-                    out[name] = g
-                else:
-                    with np.errstate(divide="ignore"):
-                        out[name] = np.where(g > 0.0, 1.0 / np.where(g > 0.0, g, 1.0), np.inf)
-            elif name == "arc_current":
-                out[name] = vec(self.arc_current) if self.arc_current else np.zeros_like(time)
             else:
-                raise KeyError(f"unknown result column {name!r}; known: {', '.join(COLUMNS)}")
+                c, base = self.contact(name)
+                out[name] = self._contact_column(c, base, vec, time)
         return out
+
+    def _contact_column(self, c: ContactBlock, base: str, vec, time: np.ndarray) -> np.ndarray:
+        if base == "contact_voltage":
+            return self._contact_voltage(c, vec, time)
+        if base == "contact_current":
+            return vec(c.current_vector)
+        if base == "contact_conductance":
+            return vec(c.conductance_node)
+        if base == "contact_resistance":
+            g = vec(c.conductance_node)
+            with np.errstate(divide="ignore"):
+                return np.where(g > 0.0, 1.0 / np.where(g > 0.0, g, 1.0), np.inf)
+        return vec(c.arc_current_vector) if c.arc_current_vector else np.zeros_like(time)
 
     def frame(self, read: Callable[[str], np.ndarray], extra: tuple[str, ...] = ()):
         """All columns plus ``extra`` raw ngspice vectors (e.g. 'load', 'vsource#branch'), a
@@ -87,7 +110,7 @@ class Probes:
             data[name] = read(name.lower())
         return pd.DataFrame(data)
 
-    def _contact_voltage(self, vec, time: np.ndarray) -> np.ndarray:
+    def _contact_voltage(self, c: ContactBlock, vec, time: np.ndarray) -> np.ndarray:
         """V: while the contact conducts, the element's law I/G with the branch current;
         otherwise the difference of the two node potentials.
 
@@ -98,11 +121,11 @@ class Probes:
         CLOSED_CONDUCTANCE (S) the leakage term of the element matters and the voltage is
         large, so the node difference is the accurate one there.
         """
-        nodes = self._node(vec, self.node_a, time) - self._node(vec, self.node_b, time)
-        g = vec(self.conductance_node)
+        nodes = self._node(vec, c.node_a, time) - self._node(vec, c.node_b, time)
+        g = vec(c.conductance_node)
         closed = g > CLOSED_CONDUCTANCE
         with np.errstate(divide="ignore", invalid="ignore"):
-            law = vec(self.contact_current) / np.where(closed, g, 1.0)
+            law = vec(c.current_vector) / np.where(closed, g, 1.0)
         return np.where(closed, law, nodes)
 
     @staticmethod

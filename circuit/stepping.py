@@ -30,13 +30,13 @@ from __future__ import annotations
 import math
 import numbers
 import time as _time
-from typing import Callable, Iterable, NamedTuple
+from typing import Callable, Iterable, Mapping, NamedTuple
 
 import numpy as np
 
 from .contact import Conductance, checked_breakpoints, left_limited, snapped
-from .deck import CircuitLike, arc_state, build_deck, circuit_arc
-from .errors import SessionBusyError
+from .deck import CircuitLike, arc_states, build_deck, input_sources
+from .errors import ConductanceError, GapError, SessionBusyError
 from .ngspice import NgspiceSession, get_session
 from .options import SimulationOptions
 from .probes import COLUMNS, probe_columns
@@ -46,7 +46,10 @@ Gap = Callable[[float], float]
 
 
 class StepResult(NamedTuple):
-    """One macro step. Scalars are the values at ``t_end`` (SI: s, V, A).
+    """One macro step. Scalars are the values at ``t_end`` (SI: s, V, A): those of the
+    circuit's first contact as attributes, every contact's in ``values`` (keyed by result
+    column: contact_voltage, contact_current, arc_current with the contact's suffix, and
+    load_current).
 
     ``arrays()`` / ``frame()`` give every accepted ngspice point of the closed interval
     [t_start, t_end] (the first point is the previous step's last). Immutable; a
@@ -61,9 +64,11 @@ class StepResult(NamedTuple):
     arc_current: float
     points: int  # accepted ngspice points in (t_start, t_end]
     reader: Callable[[str], np.ndarray]
+    values: dict = {}
+    columns: tuple = COLUMNS  # the circuit's result columns (Probes.column_names)
 
     def arrays(self) -> dict[str, np.ndarray]:
-        return {name: self.reader(name) for name in COLUMNS}
+        return {name: self.reader(name) for name in self.columns}
 
     def frame(self):
         """``arrays()`` as a pandas DataFrame."""
@@ -75,13 +80,15 @@ class StepResult(NamedTuple):
 class Stepper:
     """Step a switch circuit through a transient of length ``t_end`` (s).
 
-    circuit: a ``SwitchCircuit``, a ``NetlistCircuit`` or a PySpice ``Circuit`` with a
-        contact (``add_contact``).
+    circuit: a ``SwitchCircuit``, a ``NetlistCircuit`` or a PySpice ``Circuit`` with one
+        or more contacts (``add_contact``).
     options: ``SimulationOptions`` (max internal step, tolerances, wall-clock limit).
 
-    ``uses_gap``: True if the circuit's arc model depends on the gap distance
-    (``ArcModel.column_gradient`` or ``breakdown_gradient`` > 0): every ``advance`` then
-    needs ``gap``.
+    ``inputs``: the circuit's input channels, each a quantity Python gives ngspice as a
+    function of time at every step: per contact "<label>.conductance" (S) and, when its
+    arc model depends on the gap distance (``ArcModel.column_gradient`` or
+    ``breakdown_gradient`` > 0), "<label>.gap" (m); a contact's label is "contact" (the
+    unnamed one) or "contact_<name>". ``uses_gap``: True if any contact needs its gap.
 
     Holds this process's ngspice until ``close()`` (or the end of a ``with`` block);
     another Stepper or run meanwhile raises SessionBusyError.
@@ -91,11 +98,16 @@ class Stepper:
         self.options = options if options is not None else SimulationOptions()
         if not isinstance(self.options, SimulationOptions):
             raise TypeError(f"options must be a SimulationOptions, got {type(self.options).__name__}")
-        lines, self.probes = build_deck(circuit, t_end, self.options, "external")
-        self._arc = arc_state(circuit, self.probes)
-        model = circuit_arc(circuit)
-        self.uses_gap = model is not None and model.uses_gap
-        self._arc_model = model
+        lines, self.probes = build_deck(circuit, t_end, self.options)
+        self._arcs = arc_states(self.probes)
+        self.inputs = input_sources(self.probes)
+        self._errors = {}
+        for c in self.probes.contacts:
+            which = "contact" if not c.name else f"contact {c.name}"
+            self._errors[c.conductance_source] = _error(ConductanceError, f"{which} conductance", "S")
+            if c.gap_source is not None:
+                self._errors[c.gap_source] = _error(GapError, f"{which} gap", "m")
+        self.uses_gap = any(c.gap_source is not None for c in self.probes.contacts)
         self.t_end = float(t_end)
         self.deck = tuple(lines)
         self._session: NgspiceSession | None = None
@@ -107,15 +119,18 @@ class Stepper:
         self._steps = 0
         self._length = 0
         self._ngspice_seconds = 0.0
-        p = self.probes
-        names = ["time", p.contact_current, p.node_a, p.node_b, p.load_current, p.arc_current]
+        names = ["time"]
+        for c in self.probes.contacts:
+            names += [c.current_vector, c.node_a, c.node_b]
+        names.append(self.probes.load_current)
+        names += [c.arc_current_vector for c in self.probes.contacts]
         self._last_names = tuple(dict.fromkeys(n.lower() for n in names if n and n.lower() not in ("0", "gnd")))
         session = get_session()
         with session.exclusive():
             session.claim(self)
             try:
                 session.load(list(lines))
-                session.set_arc(self._arc)
+                session.set_arcs(self._arcs)
             except BaseException:
                 session.release(self)
                 raise
@@ -124,20 +139,19 @@ class Stepper:
     # -- stepping --
 
     def advance(
-        self, t_next: float, conductance: Conductance | float, breakpoints: Iterable[float] = (),
-        gap: Gap | float | None = None,
+        self, t_next: float, conductance: Conductance | float | None = None, breakpoints: Iterable[float] = (),
+        gap: Gap | float | None = None, *, inputs: Mapping[str, Conductance | float] | None = None,
     ) -> StepResult:
         """Integrate from the current time to ``t_next`` (s).
 
-        conductance: G(t) in S for t in [t_current, t_next], a function of time only
-            (ngspice calls it at Newton iterations and rejected trial points too), exactly
-            0 for an open contact; or a constant.
+        inputs: every input channel (``self.inputs``) -> its value over [t_current, t_next]:
+            a function of time only (ngspice calls it at Newton iterations and rejected
+            trial points too), or a constant. A conductance (S) is exactly 0 for an open
+            contact; a gap (m) is the distance d(t) >= 0. A circuit with one contact may
+            give ``conductance`` and ``gap`` instead.
         breakpoints: make/break instants (s) in (t_current, t_next]; ngspice lands on
-            each, and uses the left limit of G there (the pre-event state).
-        gap: the gap distance d(t) >= 0 in m on [t_current, t_next], a function of time
-            only (called like G: Newton iterations, rejected trials, left limit at the
-            breakpoints), or a constant. Required when the arc model depends on the gap
-            (``uses_gap``: ``column_gradient`` or ``breakdown_gradient`` > 0; without it
+            each, and every input is read as its left limit there (the pre-event state).
+        gap: required when the arc model depends on the gap (``uses_gap``; without it
             ValueError before anything runs); otherwise ignored (a number is still checked).
         """
         session = self._active()
@@ -157,20 +171,18 @@ class Stepper:
         final = t_next >= self.t_end - tol
         if final:
             t_next = self.t_end
-        source = _as_function(conductance)
-        gap_source = self._gap_function(gap)
+        functions = self._input_functions(conductance, gap, inputs)
         points = checked_breakpoints(breakpoints, t0, t_next)
         if not session.lock.acquire(blocking=False):
             raise SessionBusyError("ngspice is in use by another thread of this process")
         try:
-            if not self._started and self._arc is not None:
+            if not self._started:
                 # The operating point: an arc path closed at t = 0 is armed.
-                self._arc.start(float(source(0.0)) > 0.0)
+                for arc in self._arcs.values():
+                    arc.start(float(functions[arc.conductance_source](0.0)) > 0.0)
             span = t_next - t0
-            session.set_source(
-                left_limited(source, points, span, t_next),
-                None if gap_source is None else left_limited(gap_source, points, span, t_next),
-            )
+            session.set_channels({source: left_limited(f, points, span, t_next) for source, f in functions.items()},
+                                 self._errors)
             landings = snapped(points, t_next, t_next - t0)
             if self._started and landings and landings[0] - t0 <= self.options.min_break(self.t_end):
                 # ngspice drops a breakpoint within CKTminBreak after its current time
@@ -181,8 +193,8 @@ class Stepper:
                 session.set_breakpoint(session.last_time())
             for b in landings:
                 session.set_breakpoint(b)
-            if self._arc is not None:
-                self._arc.add_breakpoints(landings)
+            for arc in self._arcs.values():
+                arc.add_breakpoints(landings)
             first_index = max(self._length - 1, 0)
             clock = _time.perf_counter()
             try:
@@ -201,43 +213,65 @@ class Stepper:
         self._t = t_next
         self._finished = final
         self._steps += 1
+        first = self.probes.contacts[0].suffix
         return StepResult(
             t_start=t0,
             t_end=landed,
+            contact_voltage=scalars["contact_voltage" + first],
+            contact_current=scalars["contact_current" + first],
+            load_current=scalars["load_current"],
+            arc_current=scalars["arc_current" + first],
             points=last_index - first_index - 1,
             reader=self._reader(first_index, last_index),
-            **scalars,
+            values=scalars,
+            columns=self.probes.column_names,
         )
 
-    def _gap_function(self, gap: Gap | float | None) -> Gap | None:
-        """The gap as a function of time if the arc model uses it (None otherwise)."""
-        if gap is None:
-            if self.uses_gap:
-                arc = self._arc_model
+    def _input_functions(self, conductance, gap, inputs) -> dict[str, Conductance]:
+        """Every input channel's source -> its function of time, checked (ValueError/TypeError
+        naming the channel before anything runs)."""
+        given = dict(inputs or {})
+        single = self.probes.contacts[0]
+        if conductance is not None or gap is not None:
+            if len(self.probes.contacts) > 1:
+                raise ValueError(f"this circuit has {len(self.probes.contacts)} contacts: give each its input "
+                                 f"channels, advance(t_next, inputs={{...}}) with {', '.join(self.inputs)}")
+            if conductance is not None:
+                given.setdefault(f"{single.label}.conductance", conductance)
+            if gap is not None and single.gap_source is not None:
+                given.setdefault(f"{single.label}.gap", gap)
+        unknown = sorted(set(given) - set(self.inputs))
+        if unknown:
+            raise ValueError(f"inputs {', '.join(unknown)}: this circuit's input channels are {', '.join(self.inputs)}")
+        missing = [name for name in self.inputs if name not in given]
+        for name in missing:
+            if name.endswith(".gap"):
+                block = next(c for c in self.probes.contacts if f"{c.label}.gap" == name)
+                arc = block.arc
                 raise ValueError(
                     f"the arc model depends on the gap (column_gradient = {arc.column_gradient:g} V/m, "
                     f"breakdown_gradient = {arc.breakdown_gradient:g} V/m): pass the gap distance d(t) >= 0 "
-                    "in m, advance(t_next, conductance, breakpoints, gap=function_of_time_or_number)"
-                )
-            return None
-        function = _as_function(gap, "gap", "m")
-        return function if self.uses_gap else None
+                    f"in m, advance(t_next, conductance, breakpoints, gap=function_of_time_or_number)"
+                    + ("" if len(self.probes.contacts) == 1 else f" (input {name})"))
+            raise TypeError(f"advance() needs the input {name} (a function of time or a number)")
+        if gap is not None and not self.uses_gap:
+            _as_function(gap, "gap", "m")  # checked, then ignored: no arc uses it
+        return {self.inputs[name]: _as_function(value, *_what(name)) for name, value in given.items()}
 
     def _read_last(self, session: NgspiceSession) -> tuple[int, float, dict[str, float]]:
         """Points so far, the last time (s) and the last contact/load values (V, A)."""
         length, values = session.last_values(self._last_names)
         last = dict(zip(self._last_names, values))
-        p = self.probes
 
         def node(name: str) -> float:
             return 0.0 if name.lower() in ("0", "gnd") else last[name.lower()]
 
-        scalars = {
-            "contact_voltage": node(p.node_a) - node(p.node_b),
-            "contact_current": last[p.contact_current.lower()],
-            "load_current": last[p.load_current.lower()] if p.load_current else math.nan,
-            "arc_current": last[p.arc_current.lower()] if p.arc_current else 0.0,
-        }
+        p = self.probes
+        scalars = {"load_current": last[p.load_current.lower()] if p.load_current else math.nan}
+        for c in p.contacts:
+            scalars["contact_voltage" + c.suffix] = node(c.node_a) - node(c.node_b)
+            scalars["contact_current" + c.suffix] = last[c.current_vector.lower()]
+            scalars["arc_current" + c.suffix] = last[c.arc_current_vector.lower()] if c.arc_current_vector else 0.0
         return length, last["time"], scalars
 
     def _reader(self, start: int, stop: int) -> Callable[[str], np.ndarray]:
@@ -290,10 +324,13 @@ class Stepper:
     def stats(self) -> dict[str, float]:
         """Macro steps, accepted ngspice points, conductance and gap evaluations, seconds inside ngspice, arc state changes."""
         points = len(self._final["time"]) if self._final is not None else (self._active().length() if self._started else 0)
-        calls = self._session.source_calls if self._session is not None else 0
-        gap_calls = self._session.gap_calls if self._session is not None else 0
-        return {"steps": self._steps, "points": points, "conductance_calls": calls, "gap_calls": gap_calls,
-                "ngspice_seconds": self._ngspice_seconds, "arc_switches": self._arc.switches if self._arc else 0}
+        calls = self._session.channel_calls if self._session is not None else {}
+        gap_sources = {c.gap_source.lower() for c in self.probes.contacts if c.gap_source}
+        return {"steps": self._steps, "points": points,
+                "conductance_calls": sum(n for s, n in calls.items() if s not in gap_sources),
+                "gap_calls": sum(n for s, n in calls.items() if s in gap_sources),
+                "ngspice_seconds": self._ngspice_seconds,
+                "arc_switches": sum(arc.switches for arc in self._arcs.values())}
 
     def results(self, extra: tuple[str, ...] = (), probes=()):
         """``result_columns(extra, probes)`` as a pandas DataFrame."""
@@ -302,7 +339,7 @@ class Stepper:
         return pd.DataFrame(self.result_columns(extra, probes))
 
     def result_columns(self, extra: tuple[str, ...] = (), probes=()) -> dict[str, np.ndarray]:
-        """The whole run so far: columns ``COLUMNS`` (SI) plus raw ngspice vectors named in ``extra``
+        """The whole run so far: the circuit's columns (``probes.column_names``, SI) plus raw ngspice vectors named in ``extra``
         and the user probes (``circuit.probes.check_probes``: v(node), i(element)) as columns
         named by their text, name -> numpy array; after ``close()`` the probes' columns are
         NaN (ngspice's vectors are gone: ask for them before)."""
@@ -314,14 +351,14 @@ class Stepper:
             if self._final is not None:
                 out = {k: v.copy() for k, v in self._final.items()}
             else:
-                out = {name: np.empty(0) for name in COLUMNS}
+                out = {name: np.empty(0) for name in self.probes.column_names}
             n = len(out["time"])
             for name in names:
                 out.setdefault(name, np.full(n, np.nan))
             return out
         session = self._active()
         if not self._started:
-            return {name: np.empty(0) for name in COLUMNS + names}
+            return {name: np.empty(0) for name in self.probes.column_names + names}
         out = self.probes.columns(session.vector)
         for name in extra:
             out[name] = session.vector(name.lower())
@@ -367,6 +404,16 @@ class Stepper:
 
     def __exit__(self, *exc_info) -> None:
         self.close()
+
+
+def _error(kind: type, what: str, unit: str) -> Callable[[float, float], Exception]:
+    """The error for an input value that is not finite and >= 0."""
+    return lambda t, value: kind(f"{what} at t = {t!r} s is {value!r} {unit}; it must be finite and >= 0")
+
+
+def _what(channel: str) -> tuple[str, str]:
+    """(what an input is, its unit) for messages: ("conductance", "S") or ("gap", "m")."""
+    return ("gap", "m") if channel.endswith(".gap") else ("conductance", "S")
 
 
 def _as_function(value: Conductance | float, what: str = "conductance", unit: str = "S") -> Conductance:

@@ -30,9 +30,8 @@ from typing import Union
 from PySpice.Spice.Netlist import Circuit
 
 from .arc import ArcModel, add_arc
-from .contact import (
-    CONDUCTANCE_NODE, DEFAULT_LEAKAGE, EFFECTIVE_NODE, SENSE_SOURCE, add_contact, check_current_factor,
-)
+from .blocks import ContactBlock
+from .contact import DEFAULT_LEAKAGE, add_contact, check_current_factor
 from .probes import Probes
 from .validation import check_range
 
@@ -286,15 +285,13 @@ class SwitchCircuit:
             raise ValueError(f"{name}.title = {self.title!r}: must be a one-line string")
 
     @property
+    def contacts(self) -> tuple[ContactBlock, ...]:
+        """The circuit's one contact, as a block (unnamed: its elements keep their names)."""
+        return (ContactBlock("", NODE_A, NODE_B, self.leakage_conductance, self.contact_current_factor, self.arc),)
+
+    @property
     def probes(self) -> Probes:
-        return Probes(
-            node_a=NODE_A,
-            node_b=NODE_B,
-            contact_current=f"{SENSE_SOURCE}#branch",
-            conductance_node=CONDUCTANCE_NODE if self.contact_current_factor is None else EFFECTIVE_NODE,
-            load_current=f"{LOAD_PROBE}#branch",
-            arc_current=None if self.arc is None else "Varc#branch",
-        )
+        return Probes(self.contacts, load_current=f"{LOAD_PROBE}#branch")
 
     def build(self) -> Circuit:
         """The PySpice circuit (``print`` it for the netlist)."""

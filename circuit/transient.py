@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Iterable, Union
 import numpy as np
 
 from .contact import Conductance
-from .deck import CircuitLike, arc_state, build_deck, circuit_arc
+from .deck import CircuitLike, arc_states, build_deck, circuit_netlist
 from .ngspice import get_session
 from .options import SimulationOptions
 from .schedule import ContactSchedule
@@ -52,8 +52,17 @@ def run_transient(
         return stepper.results(extra, probes)
 
 
+def _single_contact(circuit: CircuitLike, how: str):
+    """The circuit's one contact (a block); a one-shot run drives exactly one."""
+    contacts = circuit_netlist(circuit)[1].contacts
+    if len(contacts) != 1:
+        raise ValueError(f"a one-shot run drives a circuit's one contact; this one has {len(contacts)} "
+                         f"({', '.join(c.label for c in contacts)}): step it with Stepper.advance(..., inputs={{...}})")
+    return contacts[0]
+
+
 def _require_gap(circuit: CircuitLike, gap: object, how: str) -> None:
-    arc = circuit_arc(circuit)
+    arc = _single_contact(circuit, how).arc
     if gap is None and arc is not None and arc.uses_gap:
         raise ValueError(
             f"the arc model depends on the gap (column_gradient = {arc.column_gradient:g} V/m, "
@@ -90,9 +99,13 @@ def run_pwl_reference(
     gap_drive = _gap_vertices(gap, schedule, t_end)
     _require_gap(circuit, gap_drive, "run_pwl_reference(..., gap=(times, distances)) or a schedule "
                  "with opening_speed")
-    lines, probes = build_deck(circuit, t_end, options, drive, "external" if gap_drive is None else gap_drive)
-    arc = arc_state(circuit, probes)
-    if arc is not None:
+    contact = _single_contact(circuit, "run_pwl_reference")
+    drives = {f"{contact.label}.conductance": drive}
+    if gap_drive is not None and contact.gap_source is not None:
+        drives[f"{contact.label}.gap"] = gap_drive
+    lines, probes = build_deck(circuit, t_end, options, drives)
+    arcs = arc_states(probes)
+    for arc in arcs.values():
         arc.start(float(drive[1][0]) > 0.0)
         arc.add_breakpoints(drive[0])  # ngspice lands on the PWL vertices
     session = get_session()
@@ -101,7 +114,7 @@ def run_pwl_reference(
         session.claim(owner)
         try:
             session.load(lines)
-            session.set_arc(arc)
+            session.set_arcs(arcs)
             session.transient(None, True, options.wall_timeout, t_end, options.end_tolerance(t_end))
             return probes.frame(session.vector, tuple(extra))
         finally:

@@ -110,8 +110,11 @@ def test_netlist_convention_expands_xcontact_and_reads_the_load_probe(tmp_path):
 @pytest.mark.parametrize(
     "text, message",
     [
-        ("t\nV1 a 0 1\nR1 a 0 1\n", "exactly one 'XCONTACT"),
-        ("t\nV1 a 0 1\nXCONTACT a b\nXCONTACT b 0\n", "exactly one"),
+        ("t\nV1 a 0 1\nR1 a 0 1\n", "must contain a contact line, 'XCONTACT node_a node_b'"),
+        ("t\nV1 a 0 1\nXCONTACT a b\nXCONTACT b 0\n", "a second contact line XCONTACT"),
+        ("t\nV1 a 0 1\nXCONTACT_no a b\nXCONTACT_NO b 0\n", "a second contact line XCONTACT_NO"),
+        ("t\nV1 a 0 1\nXCONTACT a b\nXCONTACT_nc b 0\n", "names each one"),
+        ("t\nV1 a 0 1\nXCONTACT_1 a b\n", "a letter followed by"),
         ("t\nV1 a 0 1\nXCONTACT a\n", "XCONTACT node_a node_b"),
         ("t\nV1 a 0 1\nXCONTACT a b\n.tran 1u 1m\n", "analysis"),
         ("t\nV1 a 0 1\nXCONTACT a b\nVarc b 0 0\n", "reserved"),
