@@ -25,7 +25,7 @@ from scipy.optimize import brentq
 
 from mech import CoupledStates, ImpactSolver
 
-from coupling.core.master import conduction_onset
+from coupling.core.exchange import conduction_onset
 from coupling.core.results import CoupledResult
 from coupling.core.scene import Scene
 

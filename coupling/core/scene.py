@@ -78,7 +78,7 @@ class CouplingOptions:
     then but the contact onset, which the mechanics finds exactly); None = macro_step.
     align_events: end a macro step exactly at each contact make/break (mechanics_first).
     onset_penetration: m, penetration over which a tip's conduction ramps in smoothly
-    (coupling.core.master.conduction_onset): the continuum Hertz/Holm laws do not hold below
+    (coupling.core.exchange.conduction_onset): the continuum Hertz/Holm laws do not hold below
     the surface-roughness scale, and G ~ y^0.4 has an unbounded derivative at touchdown
     that ngspice's truncation-error control cannot follow at tight RELTOL.
     """

@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from coupling.core.master import StepPolicy, end_rate
+from coupling.core.policy import StepPolicy, end_rate
 
 H = 5e-6  # s
 

@@ -1,0 +1,193 @@
+"""The exchange between mechanics and circuit: links that join a block of one to a block of
+the other over named channels.
+
+A link owns what crosses the seam for one pair of blocks, both ways:
+- into the circuit, as input channels (``circuit.Stepper.inputs``): functions of time
+  read from the mechanics' dense output over the macro step just integrated;
+- into the mechanics, as drives (``mech.ImpactSolver.advance``): values at the step's
+  start and end, linear in between, extrapolated from the circuit's last points;
+- the signal the step rules watch (``coupling.core.policy``) and the waveform columns it
+  adds to the result.
+
+``ContactLink``: a circuit contact (a ``circuit.ContactBlock``, by its label) fed by one or
+more contact points of the mechanics: its conductance G_F(F_n(t)) from the contact law
+(summed over the points, which touch the same fixed contact), its gap (the nearer
+point's height, for an arc that grows with it) and, back, mu(I) from the loop current.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from coupling.core.policy import TAIL_POINTS, end_rate
+
+CONTACT_EVENTS = ("contact_start", "contact_end")
+
+
+def conduction_onset(penetration: float, onset: float) -> float:
+    """Fraction (0..1) of the law's conductance a contact point carries at penetration y (m).
+
+    s = 3 x^2 - 2 x^3, x = y / onset, for 0 <= y < onset; 1 beyond; 0 out of contact. Over
+    the first `onset` metres (default 10 nm, a surface-roughness scale: 10 ns at 1 m/s) the
+    continuum Hertz and Holm laws do not hold, and G_F ~ y^0.4 has an unbounded derivative
+    at y = 0 that ngspice's truncation-error control chases below its minimum step at tight
+    RELTOL (measured: a relay with a snubber aborted at the first make at RELTOL 1e-6).
+    With the ramp G ~ y^2.4 near touchdown: twice differentiable.
+    """
+    if penetration <= 0.0:
+        return 0.0
+    if onset <= 0.0 or penetration >= onset:
+        return 1.0
+    x = penetration / onset
+    return x * x * (3.0 - 2.0 * x)
+
+
+def contact_intervals(seg, touching_at_start) -> list[list[tuple[float, float]]]:
+    """Per contact point, the contact intervals inside the segment as its events delimit them."""
+    intervals = []
+    for i in range(len(touching_at_start)):
+        start = seg.t_start if touching_at_start[i] else None
+        spans = []
+        for e in seg.events:
+            if e["tip"] != i:
+                continue
+            if e["kind"] == "contact_start":
+                start = e["time"]
+            elif e["kind"] == "contact_end" and start is not None:
+                spans.append((start, e["time"]))
+                start = None
+        if start is not None:
+            spans.append((start, seg.t_end))
+        intervals.append(spans)
+    return intervals
+
+
+class Tail:
+    """The last points of a circuit signal, kept across macro steps for its rate and time
+    scale (``end_rate``); points before a jump say nothing of the signal after it."""
+
+    def __init__(self):
+        self.t = np.zeros(0)
+        self.v = np.zeros(0)
+
+    def observe(self, t: np.ndarray, v: np.ndarray, jumped: bool) -> None:
+        self.t = np.concatenate([self.t, t])[-TAIL_POINTS:]
+        self.v = np.concatenate([self.v, v])[-TAIL_POINTS:]
+        keep = np.concatenate([[True], np.diff(self.t) > 0])
+        self.t, self.v = self.t[keep], self.v[keep]
+        if jumped:
+            self.t, self.v = self.t[-1:], self.v[-1:]
+
+    def rate(self, span: float) -> tuple[float, float]:
+        """(d/dt in units per s, time scale in s) at the last point (``end_rate``)."""
+        return end_rate(self.t, self.v, span)
+
+
+class ContactLink:
+    """A circuit contact fed by contact points of the mechanics (SI units).
+
+    label: the circuit contact's label ("contact", or "contact_<name>"); its input
+        channels are "<label>.conductance" (S) and, when its arc needs it, "<label>.gap" (m).
+    points: the mechanics' contact points that conduct into it (in parallel).
+    laws: the contact laws (``coupling.laws.tribology.ContactLaws``): R_c(F_n) and mu(I).
+    onset: m, the penetration over which a point's conduction ramps in (``conduction_onset``).
+    feedback: mu follows the current (False: mu = mu(0) throughout).
+    """
+
+    def __init__(self, label: str, points: tuple[int, ...], laws, onset: float, feedback: bool = True):
+        self.label = label
+        self.points = tuple(points)
+        self.laws = laws
+        self.onset = onset
+        self.feedback = feedback
+        self.tail = Tail()
+        self.mu_log: list[tuple[float, float, float, float]] = []
+
+    # -- into the mechanics --
+
+    def mu(self, current: float) -> float:
+        """N^gamma: the friction coefficient at the loop current (A)."""
+        return float(self.laws.mu(current)) if self.feedback else float(self.laws.mu(0.0))
+
+    # -- into the circuit --
+
+    def inputs(self, seg, touching_at_start, gap_wanted: bool) -> dict:
+        """The contact's input channels over the segment: G_F(F_n(t)) summed over its points,
+        S, and the gap, m, both from the dense output.
+
+        Each point conducts only inside its contact intervals as the mechanics' events
+        delimit them, the same instants ngspice gets as breakpoints: the interpolant may
+        show a round-off penetration just before a located make.
+        """
+        intervals = contact_intervals(seg, touching_at_start)
+        force = self.laws.resistance_law.scalar_force_conductance
+        onset = self.onset
+        points = self.points
+        lo, hi = seg.t_start, seg.t_end
+
+        def gap(s: float) -> float:
+            """m: the arc's length, the smaller point height; 0 while a point touches."""
+            s = lo if s < lo else (hi if s > hi else s)
+            if any(a <= s <= b for i in points for a, b in intervals[i]):
+                return 0.0
+            return seg.tip_forces(s)[2]
+
+        out = {}
+        if gap_wanted:
+            out[f"{self.label}.gap"] = gap
+        if not any(intervals[i] for i in points):
+            out[f"{self.label}.conductance"] = 0.0  # open throughout: no conductance callback needed
+            return out
+
+        def g(s: float) -> float:
+            s = lo if s < lo else (hi if s > hi else s)
+            total = 0.0
+            forces = None
+            for i in points:
+                if any(a <= s <= b for a, b in intervals[i]):
+                    if forces is None:
+                        forces = seg.tip_forces(s)
+                    total += force(forces[i]) * conduction_onset(forces[3 + i], onset)
+            return total
+
+        out[f"{self.label}.conductance"] = g
+        return out
+
+    def held_inputs(self, contact: np.ndarray, gap_wanted: bool) -> dict:
+        """The input channels held at the values of the contact state ``contact`` (rows: points;
+        columns: penetration m, ..., normal force N), as the Jacobi scheme takes them."""
+        force = self.laws.resistance_law.scalar_force_conductance
+        g = sum(force(contact[i, 2]) * conduction_onset(contact[i, 0], self.onset) for i in self.points)
+        out = {f"{self.label}.conductance": g}
+        if gap_wanted:
+            out[f"{self.label}.gap"] = float(max(0.0, -np.max(contact[list(self.points), 0])))
+        return out
+
+    # -- back from the circuit --
+
+    def current(self, step) -> float:
+        """A: the current that sets mu(I): the loop (load) current, a smooth state of the
+        circuit (the metallic contact current also carries the parasitic capacitance's
+        discharge spikes at each make); the contact's own current when the circuit has no
+        load probe."""
+        current = float(step.values["load_current"])
+        if np.isfinite(current):
+            return current
+        suffix = self.label[len("contact"):]
+        return float(step.values["contact_current" + suffix])
+
+    def observe(self, step, jumped: bool) -> None:
+        """Keep the circuit's last points of the current (for its rate and time scale)."""
+        self.tail.observe(step.reader("time"), step.reader("load_current"), jumped)
+
+    # -- results --
+
+    def mu_series(self, times: np.ndarray) -> np.ndarray:
+        """The friction coefficient the mechanics used (N^gamma), linear within each macro step."""
+        if not self.mu_log:
+            return np.full(len(times), self.mu(0.0))
+        log = np.array(self.mu_log)
+        k = np.clip(np.searchsorted(log[:, 1], times), 0, len(log) - 1)
+        t0, t1, m0, m1 = log[k].T
+        frac = np.where(t1 > t0, (times - t0) / np.where(t1 > t0, t1 - t0, 1.0), 0.0)
+        return m0 + (m1 - m0) * np.clip(frac, 0.0, 1.0)

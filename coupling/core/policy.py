@@ -1,0 +1,151 @@
+"""The co-simulation's step rules, pure (no solver, no ngspice): where a macro step ends and
+how an exchanged signal (the loop current behind mu(I)) is extrapolated over it.
+
+Times in s, currents in A. ``end_rate`` gives a signal's rate and time scale from the
+circuit's last points; ``StepPolicy`` turns them into the next step.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+PROBE_TIME = 1e-4  # s: the step right after a current jump is H^2 / PROBE_TIME (O(H^2): second order)
+# A step extrapolates the current over at most this fraction of its local time scale
+# |dI/dt|/|d2I/dt2|: an exponential overshoots by ~(1 - e^-x - x)... ~x^2/2 of its remaining
+# change over x time constants, ~12 % at 0.5.
+TIME_SCALE_FRACTION = 0.5
+CHANGE_FRACTION = 1e-3  # the time-scale rule applies only where a step would change the current by more
+CURRENT_FLOOR = 1e-3  # A: floor of |I| in the cautious time scale |I|/|dI/dt|
+GROWTH_CAP = 4.0  # macro steps: the longest step in a closed contact with a steady current
+TAIL_POINTS = 8  # circuit points kept across macro steps for the slope and its curvature
+
+
+@dataclass(frozen=True)
+class StepPolicy:
+    """The co-simulation's step rules, pure (no solver, no ngspice): where a macro step ends
+    and how the loop current is extrapolated over it. Times in s, currents in A.
+
+    - ``base_end``: a macro step while a tip touches (or right after a jump), the longer
+      ``free_step`` while both are free; no sliver step (< 1e-3 H) left before t_end. While
+      a contact stays closed and the current steady (``previous``: the last step's length
+      when it made or broke nothing and the current moved less than the change rule of
+      ``plan`` allows), the step doubles per step up to ``growth_cap`` macro steps: the
+      mechanics find a make or break inside a long step and the step is cut there
+      (``aligned_end``), ngspice reads the mechanics' conductance at its own points, and
+      every step stays proportional to H, so the coupling keeps its order. A settled
+      contact under a slow force (the default relay after its bounces) then takes a
+      quarter of the macro steps.
+    - ``plan`` (scheme mechanics_first): right after a make/break the current has jumped
+      and is known only at the jump, so a short probe step H^2 / probe_time with the current
+      held (zero-order hold: O(H^2) error, still second order); otherwise a Taylor step
+      with the circuit's own slope, no longer than time_scale_fraction of the current's
+      time scale where the step would change it by more than change_fraction of
+      (|I| + current_floor).
+    - ``extrapolate``: I(t + s) = I + slope min(s, horizon): linear, but not beyond the
+      current's time scale (an exponential approach extrapolated over its time constant
+      lands on its asymptote).
+    - ``aligned_end``: where a step that saw a make/break at t_e is cut: at t_e inside it,
+      at t + probe when t_e is at its start, else not cut (None).
+    """
+
+    macro_step: float
+    free_step: float
+    probe_time: float = PROBE_TIME
+    time_scale_fraction: float = TIME_SCALE_FRACTION
+    change_fraction: float = CHANGE_FRACTION
+    current_floor: float = CURRENT_FLOOR
+    growth_cap: float = GROWTH_CAP
+
+    def __post_init__(self):
+        for name in ("macro_step", "free_step", "probe_time", "time_scale_fraction", "current_floor", "growth_cap"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ValueError(f"StepPolicy.{name} = {value!r}: must be a finite number > 0")
+        if self.free_step < self.macro_step:
+            raise ValueError(f"StepPolicy.free_step = {self.free_step!r}: must be >= macro_step = {self.macro_step!r}")
+        if not (math.isfinite(self.change_fraction) and self.change_fraction >= 0):
+            raise ValueError(f"StepPolicy.change_fraction = {self.change_fraction!r}: must be a finite number >= 0")
+
+    @classmethod
+    def from_options(cls, options) -> "StepPolicy":
+        """From a scene's CouplingOptions (macro_step, free_step)."""
+        return cls(macro_step=float(options.macro_step), free_step=float(options.free_step))
+
+    @property
+    def probe(self) -> float:
+        """s: the short step that fetches the current right after a make/break (H^2 / probe_time)."""
+        return self.macro_step ** 2 / self.probe_time
+
+    def base_end(self, t: float, t_end: float, touching: bool, previous: float = 0.0) -> float:
+        """s: the end of the next step before the current is looked at; ``previous``: the
+        length (s) of the step before when the contact stayed closed over it with a steady
+        current (0: it did not, see ``steady``)."""
+        step = self.free_step
+        if touching:
+            step = self.macro_step
+            if previous > 0.0:
+                step = min(self.free_step, self.growth_cap * self.macro_step, max(self.macro_step, 2.0 * previous))
+        t_next = min(t + step, t_end)
+        if t_end - t_next < 1e-3 * self.macro_step:
+            t_next = t_end  # no sliver step at the end
+        return t_next
+
+    def plan(self, t: float, t_next: float, t_end: float, *, touching: bool, jumped: bool, current: float,
+             rate: float, scale: float) -> tuple[float, float]:
+        """(end of the step in s, slope in A/s to extrapolate the current with) for a step from t
+        proposed to end at t_next, given the current (A), its rate dI/dt (A/s) and time scale (s)."""
+        if jumped:
+            return min(t + self.probe, t_end), 0.0
+        if touching and not self.steady(current, rate, t_next - t):
+            t_next = min(t_next, t + max(self.probe, self.time_scale_fraction * scale))
+        return t_next, rate
+
+    def steady(self, current: float, rate: float, span: float) -> bool:
+        """True if the current (A) at rate dI/dt (A/s) moves by no more than the change rule
+        of ``plan`` allows over ``span`` (s)."""
+        return abs(rate) * span <= self.change_fraction * (abs(current) + self.current_floor)
+
+    @staticmethod
+    def extrapolate(current: float, slope: float, elapsed: float, horizon: float = math.inf) -> float:
+        """A: the current ``elapsed`` s after a point where it is ``current`` with ``slope``."""
+        return current + slope * min(elapsed, horizon)
+
+    def aligned_end(self, t: float, t_next: float, event: float) -> float | None:
+        """s: where to end a step [t, t_next] in which the first make/break is at ``event``; None: keep it."""
+        guard = 1e-9 * self.macro_step
+        if t + guard < event < t_next - guard:
+            return event
+        if event <= t + guard and t_next - t > self.probe * (1.0 + 1e-9):
+            return t + self.probe  # it happened at the step start: only a short step past it
+        return None
+
+
+def end_rate(t: np.ndarray, i: np.ndarray, span: float) -> tuple[float, float]:
+    """(dI/dt in A/s, its time scale |dI/dt| / |d2I/dt2| in s) of the loop current at the last
+    of the circuit points (t, i) (several steps' worth: a short step may hold only one or
+    two), with differences over at least 1e-3 of ``span`` (s) so a sliver landing step does
+    not dominate; (0, inf) without enough points. For an exponential approach the time
+    scale is its time constant wherever the current is on it; for a ramp it is infinite."""
+    if len(t) < 2 or not np.all(np.isfinite(i[-3:])):
+        return 0.0, math.inf
+    k = len(t) - 2
+    while k > 0 and t[-1] - t[k] < 1e-3 * span:
+        k -= 1
+    dt = t[-1] - t[k]
+    if dt <= 0:
+        return 0.0, math.inf
+    rate = float((i[-1] - i[k]) / dt)
+    j = k - 1
+    while j > 0 and t[k] - t[j] < 1e-3 * span:
+        j -= 1
+    if j < 0 or t[k] <= t[j]:
+        # too few points for a curvature: the cautious scale |I|/|dI/dt|
+        return rate, (abs(float(i[-1])) + CURRENT_FLOOR) / abs(rate) if rate != 0.0 else math.inf
+    previous = (i[k] - i[j]) / (t[k] - t[j])
+    curvature = 2.0 * (rate - previous) / (t[-1] - t[j])
+    if curvature == 0.0:
+        return rate, math.inf
+    return rate, float(abs(rate / curvature))
