@@ -1,4 +1,4 @@
-"""Circuit blocks: a contact (with its arc), placed in a circuit any number of times.
+"""Circuit blocks: a contact (with its arc) and a coil, each placed in a circuit any number of times.
 
 A block knows its name, its nodes and its constants, places its elements on a PySpice
 circuit, and names its input channels (the EXTERNAL sources Python drives) and its
@@ -8,6 +8,7 @@ their blocks; the deck, the stepper and the probes work from that list.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 from PySpice.Spice.Netlist import Circuit
@@ -115,3 +116,115 @@ class ContactBlock:
             add_arc(circuit, self.arc, self.node_a, self.node_b, self.name)
 
 
+
+
+#: The coil's elements and nodes (the unnamed coil's; a named one carries its name).
+# (an "x" in every name, as in the netlist's XCOIL line: a user's own Rcoil or Lcoil keeps its name)
+COIL_SENSE = "Vxcoil"
+COIL_PSI_NODE = "xcoil_psi"
+COIL_GAP_SOURCE = "Vxcoil_gap"
+COIL_GAP_NODE = "xcoil_gap"
+COILS_PLACED = "_switchsim_coils"  # where CoilBlock.add_to records itself on a PySpice Circuit
+COIL_PSI_LEAK = 1e12  # ohm across the flux node: a DC path for the operating point (decay time 1e12 s)
+_PSI_TOKEN = re.compile(r"\bPSI\b")
+_GAP_TOKEN = re.compile(r"\bGAP\b")
+
+
+def check_coil_current(where: str, expression) -> str:
+    """A coil's current law: a one-line ngspice expression of PSI (Wb) and GAP (m)."""
+    if not isinstance(expression, str) or not expression.strip() or "\n" in expression:
+        raise ValueError(f"{where} = {expression!r}: must be a one-line ngspice expression of the flux linkage PSI "
+                         "(Wb) and the working air gap GAP (m), e.g. 'PSI*GAP/(4e-7*pi*1000^2*1e-4)'")
+    if expression.count("(") != expression.count(")"):
+        raise ValueError(f"{where} = {expression!r}: unbalanced parentheses")
+    if not _PSI_TOKEN.search(expression):
+        raise ValueError(f"{where} = {expression!r}: the coil current must depend on the flux linkage PSI")
+    return expression
+
+
+@dataclass(frozen=True)
+class CoilBlock:
+    """The coil of an electromagnet, in flux form (SI units).
+
+    The flux linkage psi (Wb) is a circuit state: node ``xcoil_psi`` carries it as a
+    voltage across 1 F, charged by the coil's inductive voltage v_L = d(psi)/dt; the
+    coil current is an explicit function i(psi, g) of the flux linkage and the magnet's
+    working air gap g (m), which Python gives as the input channel "<label>.gap"::
+
+        Vxcoil     p xcoil_s 0                        (0 V: coil current probe, A from p to n)
+        Rxcoil     xcoil_s xcoil_e R                  (copper)
+        Bxcoil     xcoil_e n  I=i(V(xcoil_psi), V(xcoil_gap))
+        Bxcoil_psi 0 xcoil_psi I=V(xcoil_e,n)         (d psi/dt = v_L)
+        Cxcoil_psi xcoil_psi 0 1
+        Rxcoil_psi xcoil_psi 0 1e12                   (a DC path: the operating point)
+        Vxcoil_gap xcoil_gap 0 external               (g(t) in volts = metres)
+
+    So the coil voltage is R i + d(psi)/dt, the back-EMF of a moving armature included
+    (d(psi)/dt = (d psi/d i) di/dt + (d psi/d g) dg/dt), and the magnet's energy balance
+    is the circuit's own. The magnet (coupling.laws.magnet) gives the expression.
+
+    name: "" for a circuit's one coil, else letters and digits (elements Vxcoil_<name>, ...).
+    node_p, node_n: the coil's terminals; its voltage is V(node_p) - V(node_n).
+    resistance: ohm, the winding's copper resistance.
+    current: the current law, an ngspice expression of PSI (Wb) and GAP (m), in A.
+    """
+
+    name: str
+    node_p: str
+    node_n: str
+    resistance: float
+    current: str
+
+    def __post_init__(self) -> None:
+        check_block_name("CoilBlock.name", self.name)
+        for node in ("node_p", "node_n"):
+            value = getattr(self, node)
+            if not (isinstance(value, str) and value and value.split() == [value]):
+                raise ValueError(f"CoilBlock.{node} = {value!r}: a node name (one word)")
+        check_range("CoilBlock", "resistance", self.resistance, "ohm", 0.0, 1e7, low_open=True)
+        check_coil_current("CoilBlock.current", self.current)
+
+    @property
+    def suffix(self) -> str:
+        """What this coil's result columns carry after their name ("" or "_<name>")."""
+        return f"_{self.name}" if self.name else ""
+
+    @property
+    def label(self) -> str:
+        """The coil as its channels name it: "coil" or "coil_<name>"."""
+        return "coil" + self.suffix
+
+    def element(self, base: str) -> str:
+        return named(base, self.name)
+
+    @property
+    def current_vector(self) -> str:
+        return f"{self.element(COIL_SENSE)}#branch"
+
+    @property
+    def flux_node(self) -> str:
+        return self.element(COIL_PSI_NODE)
+
+    @property
+    def gap_source(self) -> str:
+        return self.element(COIL_GAP_SOURCE)
+
+    @property
+    def inputs(self) -> dict[str, str]:
+        """Input channel -> source: "<label>.gap" (m), the magnet's working air gap."""
+        return {f"{self.label}.gap": self.gap_source}
+
+    def add_to(self, circuit: Circuit) -> None:
+        """Place the coil on a PySpice circuit."""
+        e = self.element
+        sense_node, inner, psi, gap = e("xcoil_s"), e("xcoil_e"), e(COIL_PSI_NODE), e(COIL_GAP_NODE)
+        law = _GAP_TOKEN.sub(f"V({gap})", _PSI_TOKEN.sub(f"V({psi})", self.current))
+        circuit.V(e(COIL_SENSE)[1:], self.node_p, sense_node, 0)
+        circuit.R(e("Rxcoil")[1:], sense_node, inner, float(self.resistance))
+        circuit.B(e("Bxcoil")[1:], inner, self.node_n, current_expression=law)
+        circuit.B(e("Bxcoil_psi")[1:], circuit.gnd, psi, current_expression=f"V({inner},{self.node_n})")
+        circuit.C(e("Cxcoil_psi")[1:], psi, circuit.gnd, 1)
+        circuit.R(e("Rxcoil_psi")[1:], psi, circuit.gnd, COIL_PSI_LEAK)
+        # No value after 'external' (a value segfaults ngspice 38-40 on V sources).
+        circuit.V(e(COIL_GAP_SOURCE)[1:], gap, circuit.gnd, "external")
+        setattr(circuit, COILS_PLACED, getattr(circuit, COILS_PLACED, ()) + (self,))

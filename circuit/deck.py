@@ -8,7 +8,7 @@ import numpy as np
 from PySpice.Spice.Netlist import Circuit
 
 from .arc import ArcState, recorded_arc
-from .blocks import ContactBlock
+from .blocks import COILS_PLACED, ContactBlock
 from .contact import placed_contacts
 from .netlist import NetlistCircuit
 from .options import SimulationOptions
@@ -31,7 +31,8 @@ def circuit_netlist(circuit: CircuitLike) -> tuple[str, Probes]:
         return circuit.netlist(), circuit.probes
     if isinstance(circuit, Circuit):
         return str(circuit), Probes(_pyspice_contacts(circuit), load_current=(
-            f"{LOAD_PROBE}#branch" if LOAD_PROBE.lower() in {n.lower() for n in circuit.element_names} else None))
+            f"{LOAD_PROBE}#branch" if LOAD_PROBE.lower() in {n.lower() for n in circuit.element_names} else None),
+            coils=tuple(getattr(circuit, COILS_PLACED, ())))
     raise TypeError(
         f"expected a SwitchCircuit, a NetlistCircuit or a PySpice Circuit with a contact, got {type(circuit).__name__}"
     )
@@ -67,8 +68,8 @@ def arc_states(probes: Probes) -> dict[str, ArcState]:
 def input_sources(probes: Probes) -> dict[str, str]:
     """Every input channel of the circuit -> the EXTERNAL source behind it."""
     out: dict[str, str] = {}
-    for c in probes.contacts:
-        out.update(c.inputs)
+    for block in probes.contacts + probes.coils:
+        out.update(block.inputs)
     return out
 
 
@@ -102,7 +103,8 @@ def build_deck(
             replaced.add(head)
         elif head[0] in "vi" and head not in states and "external" in (t.lower() for t in tokens[3:]):
             raise ValueError(
-                f"netlist line {line!r}: only a contact's conductance source (and the arc state and gap) may be EXTERNAL"
+                f"netlist line {line!r}: only a contact's conductance source (and the arc state and gap) and a coil's "
+                "gap may be EXTERNAL"
             )
         elif head == ".end":
             lines[i] = ""

@@ -28,8 +28,13 @@ and digits: ``XCONTACT_NO``, ``XCONTACT_NC``); each becomes its own contact bloc
 own conductance, gap, arc and result columns (``contact_voltage_no``, ...). A plain
 ``XCONTACT`` is the one unnamed contact and cannot be combined with named ones.
 
-Reserved (do not use): elements Vcontact*, Bcontact*, Varc*, Barc*, Iarc*, Rarc*; nodes
-contact_s, contact_g, contact_geff (and contact_<name>_s, _g, _geff), arc_*.
+The relay's own coil (with ``coil_resistance`` and ``coil_current``, the magnet's current
+law): one line ``XCOIL node_p node_n`` in the coil's drive circuit, replaced by the coil
+block (circuit.blocks.CoilBlock: flux form, its gap an input channel ``coil.gap``).
+
+Reserved (do not use): elements Vcontact*, Bcontact*, Varc*, Barc*, Iarc*, Rarc*, Vxcoil*,
+Rxcoil*, Bxcoil*, Cxcoil*; nodes contact_s, contact_g, contact_geff (and contact_<name>_s, _g,
+_geff), arc_*, xcoil_*.
 """
 
 from __future__ import annotations
@@ -41,16 +46,18 @@ from pathlib import Path
 from PySpice.Spice.Netlist import Circuit
 
 from .arc import ArcModel
-from .blocks import ContactBlock
+from .blocks import CoilBlock, ContactBlock
 from .contact import DEFAULT_LEAKAGE, check_current_factor
 from .errors import NetlistInputError
 from .netlist_check import DECK_TITLE, NetlistLine, check_lines, logical_lines, read_netlist
 from .probes import Probes
 from .validation import check_range
 
-_RESERVED_ELEMENTS = re.compile(r"^(vcontact\w*|bcontact\w*|varc\w*|barc\w*|iarc\w*|rarc\w*)$", re.I)
-_RESERVED_NODES = re.compile(r"^(contact_(\w+_)?(s|g|geff)|arc_\w+)$", re.I)
+_RESERVED_ELEMENTS = re.compile(
+    r"^(vcontact\w*|bcontact\w*|varc\w*|barc\w*|iarc\w*|rarc\w*|[vrbc]xcoil\w*)$", re.I)
+_RESERVED_NODES = re.compile(r"^(contact_(\w+_)?(s|g|geff)|arc_\w+|xcoil_\w+)$", re.I)
 _CONTACT_LINE = re.compile(r"^xcontact(?:_(\w+))?$", re.I)
+_COIL_LINE = re.compile(r"^xcoil$", re.I)
 
 
 @dataclass(frozen=True)
@@ -63,6 +70,9 @@ class NetlistCircuit:
     leakage_conductance: open-contact conductance, S.
     contact_current_factor: optional ngspice expression g(I) of the contact current I (A);
         the contact conductance is then G(t)/g(I) (see contact.py).
+    coil_resistance, coil_current: the relay coil's copper resistance (ohm) and current law
+        (an ngspice expression of PSI, Wb, and GAP, m: circuit.blocks.CoilBlock) for an
+        ``XCOIL p n`` line; both or neither.
     origins: (file, line) where each line of ``text`` starts, for messages (set by
         ``from_file``; ``text`` is then the inlined netlist).
     """
@@ -73,6 +83,8 @@ class NetlistCircuit:
     leakage_conductance: float = DEFAULT_LEAKAGE
     contact_current_factor: str | None = None
     origins: tuple[tuple[str, int], ...] | None = field(default=None, compare=False, repr=False)
+    coil_resistance: float | None = None
+    coil_current: str | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.text, str) or not self.text.strip():
@@ -85,6 +97,9 @@ class NetlistCircuit:
                              "(letters, digits, _) or None")
         check_range("NetlistCircuit", "leakage_conductance", self.leakage_conductance, "S", 0.0, 1e-3)
         check_current_factor("NetlistCircuit", self.contact_current_factor)
+        if (self.coil_resistance is None) != (self.coil_current is None):
+            raise ValueError("NetlistCircuit.coil_resistance and NetlistCircuit.coil_current: give both (a coil) "
+                             "or neither")
         self._parse()  # fail early, before anything runs
 
     @classmethod
@@ -106,10 +121,12 @@ class NetlistCircuit:
         check_lines(lines)
         return lines
 
-    def _parse(self) -> tuple[list[NetlistLine], list[tuple[int, ContactBlock]], bool]:
-        """The checked lines, each contact line's row and block, and whether the load probe is there."""
+    def _parse(self) -> tuple[list[NetlistLine], list[tuple[int, ContactBlock]], list[tuple[int, CoilBlock]], bool]:
+        """The checked lines, each contact line's and coil line's row and block, and whether the
+        load probe is there."""
         lines = self._lines()
         placed: list[tuple[int, ContactBlock]] = []
+        coils: list[tuple[int, CoilBlock]] = []
         has_load_probe = False
         for i, line in enumerate(lines):
             if i == 0:
@@ -131,10 +148,23 @@ class NetlistCircuit:
                     raise NetlistInputError(f"{where}: a second contact line {head}: each contact is placed once")
                 placed.append((i, block))
                 continue
+            if _COIL_LINE.match(head):
+                if len(tokens) != 3:
+                    raise NetlistInputError(f"{where}: the coil line is 'XCOIL node_p node_n'")
+                if self.coil_current is None:
+                    raise NetlistInputError(f"{where}: an XCOIL line, but no coil is given (the scene's [coil] and "
+                                            "[magnet] sections make it)")
+                if coils:
+                    raise NetlistInputError(f"{where}: a second XCOIL line: the netlist holds one coil")
+                try:
+                    coils.append((i, CoilBlock("", tokens[1], tokens[2], self.coil_resistance, self.coil_current)))
+                except ValueError as err:
+                    raise NetlistInputError(f"{where}: XCOIL: {err}") from None
+                continue
             if _RESERVED_ELEMENTS.match(head):
                 raise NetlistInputError(f"{where}: element name {head} is reserved by switchsim")
             if head[0].isalpha() and any(_RESERVED_NODES.match(t) for t in tokens[1:3]):
-                raise NetlistInputError(f"{where}: node names contact_s, contact_g, arc_* are reserved")
+                raise NetlistInputError(f"{where}: node names contact_s, contact_g, arc_*, xcoil_* are reserved")
             if self.load_probe is not None and head.lower() == self.load_probe.lower():
                 has_load_probe = True
         if not placed:
@@ -142,10 +172,13 @@ class NetlistCircuit:
                 "the netlist must contain a contact line, 'XCONTACT node_a node_b' (or one 'XCONTACT_<name> "
                 "node_a node_b' per contact; found none); the first line is the title"
             )
+        if self.coil_current is not None and not coils:
+            raise NetlistInputError("a coil is given (the scene's [coil] and [magnet]) but the netlist has no "
+                                    "'XCOIL node_p node_n' line to place it")
         if len(placed) > 1 and any(not b.name for _, b in placed):
             raise NetlistInputError("a netlist with several contacts names each one, 'XCONTACT_<name> node_a node_b' "
                                     "(a plain XCONTACT is the one contact of a single-contact netlist)")
-        return lines, placed, has_load_probe
+        return lines, placed, coils, has_load_probe
 
     @property
     def contacts(self) -> tuple[ContactBlock, ...]:
@@ -153,17 +186,23 @@ class NetlistCircuit:
         return tuple(block for _, block in self._parse()[1])
 
     @property
+    def coils(self) -> tuple[CoilBlock, ...]:
+        """The netlist's coil (a block), if it places one."""
+        return tuple(block for _, block in self._parse()[2])
+
+    @property
     def probes(self) -> Probes:
-        _, placed, has_load_probe = self._parse()
+        _, placed, coils, has_load_probe = self._parse()
         return Probes(tuple(block for _, block in placed),
-                      load_current=f"{self.load_probe}#branch" if has_load_probe else None)
+                      load_current=f"{self.load_probe}#branch" if has_load_probe else None,
+                      coils=tuple(block for _, block in coils))
 
     def netlist(self) -> str:
         """The checked netlist with each contact line expanded (switchsim's own title first,
         comments dropped, no analysis, no .end)."""
-        lines, placed, _ = self._parse()
+        lines, placed, coils, _ = self._parse()
         texts = [line.text for line in lines]
-        for row, block in placed:
+        for row, block in placed + coils:
             scratch = Circuit("contact")
             block.add_to(scratch)
             texts[row] = "\n".join(line for line in str(scratch).splitlines()[1:] if line.strip())

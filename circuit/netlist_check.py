@@ -383,8 +383,8 @@ def check_lines(lines: list[NetlistLine]) -> None:
             raise NetlistInputError(f"{where}: the element name is an ngspice command; rename the element")
         if not re.fullmatch(r"[a-z0-9_.+\-#]+", head):
             raise NetlistInputError(f"{where}: an element name may hold letters, digits and _ . + - # only")
-        if re.fullmatch(r"xcontact(_\w*)?", head):
-            continue  # a contact block's line: NetlistCircuit checks its form and names
+        if re.fullmatch(r"x(contact|coil)(_\w*)?", head):
+            continue  # a contact's or a coil's block line: NetlistCircuit checks its form and names
         if (scope, head) in seen:
             raise NetlistInputError(f"{where}: an element of this name is already defined (names must be unique)")
         seen.add((scope, head))

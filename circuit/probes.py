@@ -8,7 +8,7 @@ from typing import Callable
 
 import numpy as np
 
-from .blocks import ContactBlock
+from .blocks import CoilBlock, ContactBlock
 
 #: Result columns of a circuit with one unnamed contact, in order (SI: s, V, A, A, ohm, S, A).
 COLUMNS = (
@@ -22,6 +22,8 @@ COLUMNS = (
 )
 #: Per contact, its columns (each with the contact's suffix: "" or "_<name>").
 CONTACT_COLUMNS = ("contact_voltage", "contact_current", "contact_resistance", "contact_conductance", "arc_current")
+#: Per coil, its columns (SI: A, V, Wb; each with the coil's suffix).
+COIL_COLUMNS = ("coil_current", "coil_voltage", "coil_flux_linkage")
 
 _GROUND = ("0", "gnd")
 CLOSED_CONDUCTANCE = 1e-6  # S: above it the contact voltage is I/G (see Probes._contact_voltage)
@@ -39,10 +41,14 @@ class Probes:
         contact_conductance / contact_resistance: S / ohm the element conducts with
         (inf open); arc_current: the arc path's current, A (0 without an arc).
     load_current: branch vector of the load probe, A, or None (column of NaN).
+    coils: the circuit's coil blocks (circuit.blocks.CoilBlock); each gives COIL_COLUMNS
+        with its suffix: coil_current (A, into its first terminal), coil_voltage (V, across
+        it), coil_flux_linkage (Wb).
     """
 
     contacts: tuple[ContactBlock, ...]
     load_current: str | None = None
+    coils: tuple[CoilBlock, ...] = ()
 
     def __post_init__(self) -> None:
         names = [c.name for c in self.contacts]
@@ -53,9 +59,11 @@ class Probes:
     def column_names(self) -> tuple[str, ...]:
         """Every result column, in order: COLUMNS for one unnamed contact; else time,
         load_current, then each contact's CONTACT_COLUMNS with its suffix."""
+        coils = tuple(f"{name}{c.suffix}" for c in self.coils for name in COIL_COLUMNS)
         if len(self.contacts) == 1 and not self.contacts[0].name:
-            return COLUMNS
-        return ("time", "load_current") + tuple(f"{name}{c.suffix}" for c in self.contacts for name in CONTACT_COLUMNS)
+            return COLUMNS + coils
+        return ("time", "load_current") + tuple(
+            f"{name}{c.suffix}" for c in self.contacts for name in CONTACT_COLUMNS) + coils
 
     def contact(self, column: str) -> tuple[ContactBlock, str]:
         """(the contact, the column's base name) of a per-contact column such as contact_voltage_no."""
@@ -82,6 +90,8 @@ class Probes:
                 out[name] = time
             elif name == "load_current":
                 out[name] = vec(self.load_current) if self.load_current else np.full_like(time, np.nan)
+            elif name.startswith("coil_"):
+                out[name] = self._coil_column(name, vec, time)
             else:
                 c, base = self.contact(name)
                 out[name] = self._contact_column(c, base, vec, time)
@@ -99,6 +109,16 @@ class Probes:
             with np.errstate(divide="ignore"):
                 return np.where(g > 0.0, 1.0 / np.where(g > 0.0, g, 1.0), np.inf)
         return vec(c.arc_current_vector) if c.arc_current_vector else np.zeros_like(time)
+
+    def _coil_column(self, name: str, vec, time: np.ndarray) -> np.ndarray:
+        for c in self.coils:
+            if name == "coil_current" + c.suffix:
+                return vec(c.current_vector)
+            if name == "coil_voltage" + c.suffix:
+                return self._node(vec, c.node_p, time) - self._node(vec, c.node_n, time)
+            if name == "coil_flux_linkage" + c.suffix:
+                return vec(c.flux_node)
+        raise KeyError(f"unknown result column {name!r}; known: {', '.join(self.column_names)}")
 
     def frame(self, read: Callable[[str], np.ndarray], extra: tuple[str, ...] = ()):
         """All columns plus ``extra`` raw ngspice vectors (e.g. 'load', 'vsource#branch'), a

@@ -107,6 +107,8 @@ class Stepper:
             self._errors[c.conductance_source] = _error(ConductanceError, f"{which} conductance", "S")
             if c.gap_source is not None:
                 self._errors[c.gap_source] = _error(GapError, f"{which} gap", "m")
+        for c in self.probes.coils:
+            self._errors[c.gap_source] = _error(GapError, f"{c.label} gap", "m")
         self.uses_gap = any(c.gap_source is not None for c in self.probes.contacts)
         self.t_end = float(t_end)
         self.deck = tuple(lines)
@@ -124,6 +126,8 @@ class Stepper:
             names += [c.current_vector, c.node_a, c.node_b]
         names.append(self.probes.load_current)
         names += [c.arc_current_vector for c in self.probes.contacts]
+        for c in self.probes.coils:
+            names += [c.current_vector, c.node_p, c.node_n, c.flux_node]
         self._last_names = tuple(dict.fromkeys(n.lower() for n in names if n and n.lower() not in ("0", "gnd")))
         session = get_session()
         with session.exclusive():
@@ -245,8 +249,8 @@ class Stepper:
             raise ValueError(f"inputs {', '.join(unknown)}: this circuit's input channels are {', '.join(self.inputs)}")
         missing = [name for name in self.inputs if name not in given]
         for name in missing:
-            if name.endswith(".gap"):
-                block = next(c for c in self.probes.contacts if f"{c.label}.gap" == name)
+            block = next((c for c in self.probes.contacts if f"{c.label}.gap" == name), None)
+            if block is not None:
                 arc = block.arc
                 raise ValueError(
                     f"the arc model depends on the gap (column_gradient = {arc.column_gradient:g} V/m, "
@@ -272,6 +276,10 @@ class Stepper:
             scalars["contact_voltage" + c.suffix] = node(c.node_a) - node(c.node_b)
             scalars["contact_current" + c.suffix] = last[c.current_vector.lower()]
             scalars["arc_current" + c.suffix] = last[c.arc_current_vector.lower()] if c.arc_current_vector else 0.0
+        for c in p.coils:
+            scalars["coil_current" + c.suffix] = last[c.current_vector.lower()]
+            scalars["coil_voltage" + c.suffix] = node(c.node_p) - node(c.node_n)
+            scalars["coil_flux_linkage" + c.suffix] = last[c.flux_node.lower()]
         return length, last["time"], scalars
 
     def _reader(self, start: int, stop: int) -> Callable[[str], np.ndarray]:
@@ -322,15 +330,21 @@ class Stepper:
 
     @property
     def stats(self) -> dict[str, float]:
-        """Macro steps, accepted ngspice points, conductance and gap evaluations, seconds inside ngspice, arc state changes."""
+        """Macro steps, accepted ngspice points, conductance and gap evaluations (and a coil's gap,
+        with a coil), seconds inside ngspice, arc state changes."""
         points = len(self._final["time"]) if self._final is not None else (self._active().length() if self._started else 0)
         calls = self._session.channel_calls if self._session is not None else {}
-        gap_sources = {c.gap_source.lower() for c in self.probes.contacts if c.gap_source}
-        return {"steps": self._steps, "points": points,
-                "conductance_calls": sum(n for s, n in calls.items() if s not in gap_sources),
-                "gap_calls": sum(n for s, n in calls.items() if s in gap_sources),
-                "ngspice_seconds": self._ngspice_seconds,
-                "arc_switches": sum(arc.switches for arc in self._arcs.values())}
+        conductances = {c.conductance_source.lower() for c in self.probes.contacts}
+        gaps = {c.gap_source.lower() for c in self.probes.contacts if c.gap_source}
+        coils = {c.gap_source.lower() for c in self.probes.coils}
+        out = {"steps": self._steps, "points": points,
+               "conductance_calls": sum(n for s, n in calls.items() if s in conductances),
+               "gap_calls": sum(n for s, n in calls.items() if s in gaps),
+               "ngspice_seconds": self._ngspice_seconds,
+               "arc_switches": sum(arc.switches for arc in self._arcs.values())}
+        if coils:
+            out["coil_gap_calls"] = sum(n for s, n in calls.items() if s in coils)
+        return out
 
     def results(self, extra: tuple[str, ...] = (), probes=()):
         """``result_columns(extra, probes)`` as a pandas DataFrame."""

@@ -30,7 +30,8 @@ from typing import Union
 from PySpice.Spice.Netlist import Circuit
 
 from .arc import ArcModel, add_arc
-from .blocks import ContactBlock
+from .blocks import CoilBlock, ContactBlock
+from .coil_drive import CoilDrive
 from .contact import DEFAULT_LEAKAGE, add_contact, check_current_factor
 from .probes import Probes
 from .validation import check_range
@@ -221,6 +222,8 @@ class SwitchCircuit:
     leakage_conductance: conductance of the open contact, S (insulation).
     contact_current_factor: optional ngspice expression g(I) of the contact current I
         (A): the contact conductance is then G(t)/g(I), solved by ngspice (see contact.py).
+    coil: the relay's own coil with its drive and suppression (``CoilDrive``), in the same
+        ngspice circuit as the contact's loop, or None.
 
     Example::
 
@@ -238,6 +241,7 @@ class SwitchCircuit:
     leakage_conductance: float = DEFAULT_LEAKAGE
     contact_current_factor: str | None = None
     title: str = "switchsim contact circuit"
+    coil: CoilDrive | None = None
 
     def __post_init__(self) -> None:
         name = "SwitchCircuit"
@@ -249,7 +253,7 @@ class SwitchCircuit:
             raise ValueError(
                 f"{name}.load = {self.load!r}: must be a ResistiveLoad, InductiveLoad or CapacitiveLoad"
             )
-        for attr, kind in (("snubber", Snubber), ("flyback", FlybackDiode), ("arc", ArcModel)):
+        for attr, kind in (("snubber", Snubber), ("flyback", FlybackDiode), ("arc", ArcModel), ("coil", CoilDrive)):
             value = getattr(self, attr)
             if value is not None and not isinstance(value, kind):
                 raise ValueError(f"{name}.{attr} = {value!r}: must be a {kind.__name__} or None")
@@ -290,8 +294,13 @@ class SwitchCircuit:
         return (ContactBlock("", NODE_A, NODE_B, self.leakage_conductance, self.contact_current_factor, self.arc),)
 
     @property
+    def coils(self) -> tuple[CoilBlock, ...]:
+        """The relay's own coil, when the circuit drives it (``coil``)."""
+        return () if self.coil is None else (self.coil.coil,)
+
+    @property
     def probes(self) -> Probes:
-        return Probes(self.contacts, load_current=f"{LOAD_PROBE}#branch")
+        return Probes(self.contacts, load_current=f"{LOAD_PROBE}#branch", coils=self.coils)
 
     def build(self) -> Circuit:
         """The PySpice circuit (``print`` it for the netlist)."""
@@ -356,5 +365,7 @@ class SwitchCircuit:
                 N=float(d.emission_coefficient),
                 RS=float(d.series_resistance),
             )
+        if self.coil is not None:
+            self.coil.add_to(c)
         return c
 
