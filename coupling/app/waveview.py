@@ -107,8 +107,9 @@ def _panel(panel, traces, cols, t, k, rng, max_points):
         edge = np.where(y > rng.hi, rng.hi, rng.lo)
         what = "above range (onset)" if panel.scale == "resistance" else "clipped"
         out.append({"type": "scatter", "mode": "markers", "name": f"{what} (peak {peak:.3g} {unit})",
-                    "legend": legend, "marker": {"symbol": "triangle-down" if panel.scale == "resistance"
-                                                 else "triangle-up", "size": 7, "color": colors.get(column)},
+                    "legend": legend, "marker": {"symbol": ["triangle-down" if panel.scale == "resistance" or v < rng.lo
+                                                            else "triangle-up" for v in y],
+                                                 "size": 7, "color": colors.get(column)},
                     "x": _array(t[idx]), "y": _array(edge), "customdata": _array(y),
                     "hovertemplate": "%{customdata:.4g} " + unit + "<extra></extra>",
                     "cliponaxis": False, "xaxis": f"x{suffix}", "yaxis": f"y{suffix}"})
