@@ -36,18 +36,28 @@ import numpy as np
 from coupling.app.quantities import WAVEFORM, Quantity
 
 
+SCALES = ("voltage", "spikes", "linear", "log", "resistance")
+WHEN = ("present", "finite", "nonzero")
+
+
 @dataclass(frozen=True)
 class Trace:
     """One curve of a panel: a waveform column (or a glob over columns, e.g. "v(*"; the
-    column is then the label), its legend label and colour (hex: matplotlib and plotly read it). ``when``: "present" (the
-    column exists), "finite" (every sample finite: a load current without a load probe is
-    NaN), "nonzero" (some sample not 0: an arc that burns, a contact point that touches;
-    one that never does is not drawn as if it did)."""
+    column is then the label), its legend label and colour (hex: matplotlib and plotly
+    read it). ``when``: "present" (the column exists), "finite" (every sample finite: a
+    load current without a load probe is NaN), "nonzero" (some sample not 0: an arc that
+    burns, a contact point that touches; one that never does is not drawn as if it did).
+    ``dashed``: a reference drawn behind the others (the loop current)."""
 
     column: str
     label: str = ""
     color: str | None = None
     when: str = "present"
+    dashed: bool = False
+
+    def __post_init__(self):
+        if self.when not in WHEN:
+            raise ValueError(f"Trace({self.column!r}).when = {self.when!r}: allowed {', '.join(WHEN)}")
 
 
 @dataclass(frozen=True)
@@ -62,6 +72,10 @@ class Panel:
     scale: str = "linear"
     png_unit: tuple = field(default=(None, 1.0))
 
+    def __post_init__(self):
+        if self.scale not in SCALES:
+            raise ValueError(f"Panel({self.key!r}).scale = {self.scale!r}: allowed {', '.join(SCALES)}")
+
 
 # Derived series: name -> (needed columns, function of the column mapping)
 DERIVED = {
@@ -73,7 +87,7 @@ PANELS = (
     Panel("voltage", WAVEFORM["contact_voltage"], (Trace("contact_voltage", "contact voltage", "#1f77b4"),),
           "voltage"),
     Panel("abs_voltage", WAVEFORM["abs_voltage"], (Trace("abs_voltage", "|contact voltage|", "#1f77b4"),), "log"),
-    Panel("current", WAVEFORM["current"], (Trace("load_current", "load (loop)", "#8c8c8c", "finite"),
+    Panel("current", WAVEFORM["current"], (Trace("load_current", "load (loop)", "#8c8c8c", "finite", dashed=True),
                                            Trace("contact_current", "contact (metallic)", "#d62728"),
                                            Trace("arc_current", "arc", "#ff7f0e", "nonzero")), "spikes"),
     Panel("resistance", WAVEFORM["contact_resistance"],
@@ -119,6 +133,11 @@ def panel_traces(panel: Panel, cols: dict) -> list[tuple[str, str, str | None]]:
         elif tr.column in cols and _drawn(tr, cols[tr.column]):
             out.append((tr.column, tr.label or tr.column, tr.color))
     return out
+
+
+def dashed(panel: Panel, column: str) -> bool:
+    """Whether the panel draws ``column`` as a dashed reference behind the others."""
+    return any(tr.dashed and tr.column == column for tr in panel.traces)
 
 
 def panel_of(column: str) -> Panel | None:
@@ -315,5 +334,3 @@ def axis(panel: Panel, t: np.ndarray, series: list, sel: np.ndarray, *, bounce=N
         return _log_axis(series, sel)
     return _linear_axis(series, sel)
 
-
-SCALES = ("voltage", "spikes", "linear", "log", "resistance")

@@ -92,6 +92,8 @@ def draw_panel(ax, panel, traces, cols, t_ms, rng, *, notes: bool = True, band_r
     ``notes``: label the marks in the legend (once per axis when several runs share it);
     ``band_row``: (k, n) the k-th of n rows of the open band (one per run); ``peaks``: the
     marks' legend entries give the peak (one run per axis)."""
+    from coupling.app.panels import dashed
+
     unit, factor = panel.png_unit
     unit = unit or panel.quantity.unit
     for column, label, color in traces:
@@ -102,9 +104,10 @@ def draw_panel(ax, panel, traces, cols, t_ms, rng, *, notes: bool = True, band_r
         elif rng.log:
             pos = np.isfinite(y) & (y > 0)
             ax.semilogy(t_ms[pos], y[pos], lw=0.8, color=color, label=label)
+        elif dashed(panel, column):
+            ax.plot(t_ms, y, lw=1.6, color=color, label=label, ls="--", zorder=1)
         else:
-            ax.plot(t_ms, y, lw=1.6 if column == "load_current" else 1.0, color=color, label=label,
-                    ls="--" if column == "load_current" else "-", zorder=1 if column == "load_current" else 3)
+            ax.plot(t_ms, y, lw=1.0, color=color, label=label, zorder=3)
     top = rng.hi * factor
     colors = {c: col for c, _, col in traces}
     for column, idx, peak in rng.clipped:

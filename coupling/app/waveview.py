@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from coupling.app.panels import axis, columns_of, panels_for, resistance_ticks
+from coupling.app.panels import axis, columns_of, dashed, panels_for, resistance_ticks
 from coupling.app.quantities import WAVEFORM
 
 MAX_POINTS = 200_000
@@ -99,7 +99,8 @@ def _panel(panel, traces, cols, t, k, rng, max_points):
             y = np.where((y > 0) & np.isfinite(y), y, np.nan)
         idx = decimate(t, y, max_points)
         out.append({"type": "scattergl", "mode": "lines", "name": label, "legend": legend,
-                    "line": {"width": 1, **({"color": color} if color else {})},
+                    "line": {"width": 1, **({"color": color} if color else {}),
+                             **({"dash": "dash", "width": 1.6} if dashed(panel, column) else {})},
                     "x": _array(t[idx]), "y": _array(y[idx]), "xaxis": f"x{suffix}", "yaxis": f"y{suffix}"})
     colors = {c: col for c, _, col in traces}
     for column, idx, peak in rng.clipped:
