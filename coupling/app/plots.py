@@ -57,85 +57,111 @@ def _in(t_ms, window):
     return (t_ms >= window[0]) & (t_ms <= window[1])
 
 
-def _clip_marks(ax, t_ms, y, top, color, unit):
-    """Mark samples above the axis top with a triangle at the top edge and the largest value."""
-    over = np.flatnonzero(y > top)
-    if not len(over):
-        return
-    ax.plot(t_ms[over], np.full(len(over), top), "^", color=color, ms=4, clip_on=False,
-            label=f"clipped (peak {np.max(y[over]):.3g} {unit})")
+def _open_spans(t_ms, idx):
+    """(start, end) ms of the runs of consecutive sample indices ``idx``: from a run's first
+    sample to the sample after its last (the state holds until the next sample changes it)."""
+    if not len(idx):
+        return []
+    breaks = np.flatnonzero(np.diff(idx) > 1)
+    starts = np.r_[idx[0], idx[breaks + 1]]
+    ends = np.minimum(np.r_[idx[breaks], idx[-1]] + 1, len(t_ms) - 1)
+    return [(t_ms[a], t_ms[b]) for a, b in zip(starts, ends)]
 
 
-def _robust_top(values, floor):
-    """An axis top for values that may hold a few spikes: 1.15 x their 99.5th percentile of |y|."""
-    a = np.abs(values[np.isfinite(values)])
-    return max(1.15 * float(np.percentile(a, 99.5)) if len(a) else 0.0, floor)
+def _resistance_ticks(ax, rng, factor):
+    """Numbers on the data range, "open" on the band above it (panels.resistance_ticks)."""
+    from matplotlib.ticker import NullLocator
+
+    from coupling.app.panels import resistance_ticks
+
+    ticks = resistance_ticks(rng)
+
+    def text(v):
+        e = np.log10(v)
+        return f"$10^{{{int(round(e))}}}$" if abs(e - round(e)) < 1e-9 else f"{v:g}"
+
+    ax.set_yticks([v * factor for v, _ in ticks], [s or text(v * factor) for v, s in ticks])
+    ax.yaxis.set_minor_locator(NullLocator())
+
+
+def draw_panel(ax, panel, traces, cols, t_ms, rng, *, notes: bool = True, band_row: tuple = (0, 1),
+               peaks: bool = True):
+    """One panel (coupling.app.panels) on ``ax``: its traces (column, label, colour) from
+    ``cols`` against ``t_ms``, in the panel's PNG unit; the axis ``rng`` (panels.axis):
+    limits, clipped samples marked at the edge with their peak, the open band.
+    ``notes``: label the marks in the legend (once per axis when several runs share it);
+    ``band_row``: (k, n) the k-th of n rows of the open band (one per run); ``peaks``: the
+    marks' legend entries give the peak (one run per axis)."""
+    from coupling.app.panels import dashed
+
+    unit, factor = panel.png_unit
+    unit = unit or panel.quantity.unit
+    for column, label, color in traces:
+        y = cols[column] * factor
+        if panel.scale == "resistance":
+            shown = np.isfinite(y) & (y > 0) & (y <= rng.hi * factor)
+            ax.semilogy(t_ms[shown], y[shown], ".", ms=1.5, color=color, label=label)
+        elif rng.log:
+            pos = np.isfinite(y) & (y > 0)
+            ax.semilogy(t_ms[pos], y[pos], lw=0.8, color=color, label=label)
+        elif dashed(panel, column):
+            ax.plot(t_ms, y, lw=1.6, color=color, label=label, ls="--", zorder=1)
+        else:
+            ax.plot(t_ms, y, lw=1.0, color=color, label=label, zorder=3)
+    top = rng.hi * factor
+    colors = {c: col for c, _, col in traces}
+    for column, idx, peak in rng.clipped:
+        if panel.scale == "resistance":  # inside the axis, under the open band
+            ax.plot(t_ms[idx], np.full(len(idx), top), "v", color=colors.get(column), ms=4,
+                    label=None if not notes else "above range (onset)" + (
+                        f" (peak {peak * factor:.3g} {unit})" if peaks else ""))
+            continue
+        up = cols[column][idx] > 0.0
+        edge = np.where(up, top, rng.lo * factor)
+        label = None if not notes else "clipped" + (f" (peak {peak * factor:.3g} {unit})" if peaks else "")
+        for mask, marker in ((up, "^"), (~up, "v")):
+            if mask.any():
+                ax.plot(t_ms[idx][mask], edge[mask], marker, color=colors.get(column), ms=4, clip_on=False,
+                        label=label)
+                label = None
+    if rng.band is not None:
+        b0, b1 = rng.band[0] * factor, rng.band[1] * factor
+        ax.axhspan(b0, b1, color="0.88", lw=0, zorder=0)
+        k, n = band_row
+        y = b0 * (b1 / b0) ** ((k + 0.5) / n)
+        color = "0.35" if n == 1 else traces[0][2]
+        for j, (a, b) in enumerate(_open_spans(t_ms, rng.open)):
+            ax.plot([a, b], [y, y], color=color, lw=4 if n == 1 else 2.5, solid_capstyle="butt",
+                    label="open (no conduction)" if j == 0 and notes else None)
+        _resistance_ticks(ax, rng, factor)
+        ax.set_ylim(rng.lo * factor, b1)
+    else:
+        ax.set_ylim(rng.lo * factor, rng.top * factor)
+    ax.set_ylabel(panel.quantity.label(unit))
 
 
 def plot_waveforms(result, whole_run: bool = False):
-    """Contact voltage and currents (and, in the bounce window, contact resistance with the gap,
-    and arc power) against time; closed intervals shaded."""
-    w = result.waveforms
+    """The waveform panels of coupling.app.panels (voltage, |V|, currents, contact
+    resistance, normal force per contact point, gap, arc power, probes: those the run has)
+    against time over the bounce window (or the whole run); closed intervals shaded."""
+    from coupling.app.panels import axis, columns_of, panels_for
+
     b = result.bounce
-    t = w.time.to_numpy() * 1e3
+    cols = columns_of(result)
+    t_s = cols["time"]
+    t = t_s * 1e3
     window = (0.0, result.scene.t_end * 1e3) if whole_run else bounce_window(result)
     sel = _in(t, window)
-    rows = 2 if whole_run else 4
-    fig, axes = _subplots(rows, 1, sharex=True, figsize=(10, 2.4 * rows + 1.2))
-    ax_v, ax_i = axes[0], axes[1]
-    v = w.contact_voltage.to_numpy()
-    ax_v.plot(t, v, lw=0.9, color="tab:blue", label="contact voltage")
-    if whole_run:
-        top = max(np.nanmax(np.abs(v[sel])) if sel.any() else 1.0, 1.0) * 1.08
-    else:
-        # the bounce's own peak, and the open-circuit voltage before the first make
-        peak = b.get("peak_bounce_voltage") or 0.0
-        first = b.get("first_make")
-        k = int(np.searchsorted(t, first * 1e3, side="left")) - 1 if first is not None else -1
-        top = 1.15 * max(peak, float(abs(v[k])) if k >= 0 else 0.0, 1.0)
-        _clip_marks(ax_v, t[sel], np.abs(v[sel]), top, "tab:blue", "V")
-    ax_v.set_ylim(-0.08 * top if np.nanmin(v[sel] if sel.any() else v) > -0.08 * top else -top, top)
-    ax_v.set_ylabel("contact voltage (V)")
-
-    loop = w.load_current.to_numpy() if "load_current" in w and np.all(np.isfinite(w.load_current)) else None
-    contact = w.contact_current.to_numpy()
-    arc = w.arc_current.to_numpy() if "arc_current" in w else np.zeros_like(t)
-    if loop is not None:
-        ax_i.plot(t, loop, lw=1.6, color="0.55", ls="--", label="load (loop)", zorder=1)
-    ax_i.plot(t, contact, lw=1.0, color="tab:red", label="contact (metallic)", zorder=3)
-    if np.any(arc != 0):
-        ax_i.plot(t, arc, lw=1.0, color="tab:orange", label="arc", zorder=2)
-    ref = loop if loop is not None else contact
-    itop = _robust_top(ref[sel] if sel.any() else ref, 1e-6)
-    for y, color in ((contact, "tab:red"), (arc, "tab:orange")):
-        _clip_marks(ax_i, t[sel], np.abs(y[sel]), itop, color, "A")
-    ax_i.set_ylim(-0.1 * itop, itop)
-    ax_i.set_ylabel("current (A)")
-
-    if not whole_run:
-        ax_r = axes[2]
-        r = w.contact_resistance.to_numpy()
-        finite = np.isfinite(r) & (r > 0)
-        ax_r.semilogy(t[finite], r[finite], ".", ms=1.5, color="tab:purple", label="contact resistance")
-        ax_r.set_ylabel("R_c (ohm)")
-        if "gap" in w:
-            ax_g = ax_r.twinx()
-            gap = w.gap.to_numpy() * 1e6
-            ax_g.plot(t, gap, lw=0.9, color="tab:brown", label="gap")
-            gsel = gap[sel] if sel.any() else gap
-            ax_g.set_ylim(0, max(float(np.nanmax(gsel)) * 1.1, 1e-3))
-            ax_g.set_ylabel("gap (um)")
-            ax_r.plot([], [], lw=0.9, color="tab:brown", label="gap (right axis)")
-        ax_p = axes[3]
-        power = np.abs(v * arc)
-        ax_p.plot(t, power, lw=0.9, color="tab:orange", label="arc power |V i_arc|")
-        ax_p.set_ylim(0, _robust_top(power[sel] if sel.any() else power, 1e-9))
-        _clip_marks(ax_p, t[sel], power[sel], ax_p.get_ylim()[1], "tab:orange", "W")
-        ax_p.set_ylabel("arc power (W)")
-    for ax in axes:
+    panels = panels_for(cols)
+    fig, axes = _subplots(len(panels), 1, sharex=True, figsize=(10, 1.9 * len(panels) + 1.0), squeeze=False)
+    axes = axes[:, 0]
+    for ax, (panel, traces) in zip(axes, panels):
+        rng = axis(panel, t_s, [(c, cols[c]) for c, _, _ in traces], sel, bounce=b, whole_run=whole_run,
+                   closed_intervals=result.closed_intervals)
+        draw_panel(ax, panel, traces, cols, t, rng)
         _shade(ax, result.closed_intervals, *window)
         ax.grid(alpha=0.3)
-        ax.legend(**(dict(LEGEND, bbox_to_anchor=(1.08, 1.0)) if not whole_run and ax is axes[2] else LEGEND))
+        ax.legend(**LEGEND)
     axes[-1].set_xlim(*window)
     axes[-1].set_xlabel("time (ms)")
     title = "whole run" if whole_run else "bounce window"
@@ -143,10 +169,10 @@ def plot_waveforms(result, whole_run: bool = False):
     final = b.get("peak_final_opening_voltage")
     settle = ("settled, settle time " + f"{b['settle_time'] * 1e3:.4g} ms") if b.get("settled") else (
         "not settled" + (" (ends open)" if b.get("final_state") == "open" else ""))
-    ax_v.set_title(f"{title}: {b.get('bounces', 0)} bounce(s), {settle}; "
-                   + (f"peak in bounces {peak:.3g} V" if peak is not None else "no bounce peak")
-                   + (f", final opening {final:.3g} V" if final else "")
-                   + f"; arc energy {b.get('arc_energy') or 0:.3g} J", fontsize=9)
+    axes[0].set_title(f"{title}: {b.get('bounces', 0)} bounce(s), {settle}; "
+                      + (f"peak in bounces {peak:.3g} V" if peak is not None else "no bounce peak")
+                      + (f", final opening {final:.3g} V" if final else "")
+                      + f"; arc energy {b.get('arc_energy') or 0:.3g} J", fontsize=9)
     fig.tight_layout()
     return fig
 
@@ -165,7 +191,7 @@ def plot_log_voltage(result):
     ax.set_ylim(lo / 2, max(np.nanmax(v) * 2, lo * 10))
     ax.set_xlim(0, result.scene.t_end * 1e3)
     ax.set_xlabel("time (ms)")
-    ax.set_ylabel("|V| (V)")
+    ax.set_ylabel("|contact voltage| (V)")
     ax.grid(alpha=0.3, which="both")
     ax.legend(**LEGEND)
     fig.tight_layout()
@@ -176,6 +202,11 @@ def plot_openings(result):
     """Per-opening bars: open duration, peak voltage, arc energy (bounce openings and the final one)."""
     ops = result.openings
     fig, axes = _subplots(1, 3, figsize=(11, 3.6))
+    bars = ((axes[0], "open_duration", 1e6, "open duration (us)"), (axes[1], "peak_voltage", 1.0, "peak voltage (V)"),
+            (axes[2], "arc_energy", 1e3, "arc energy (mJ)"))
+    for ax, _, _, label in bars:
+        ax.set_xlabel("opening, in order (-)")
+        ax.set_ylabel(label)
     if not len(ops):
         for ax in axes:
             ax.text(0.5, 0.5, "no openings", ha="center", va="center", transform=ax.transAxes)
@@ -183,14 +214,10 @@ def plot_openings(result):
         return fig
     x = np.arange(1, len(ops) + 1)
     colors = ["tab:blue" if k == "bounce" else "tab:red" for k in ops.kind]
-    for ax, column, scale, label in ((axes[0], "open_duration", 1e6, "open duration (us)"),
-                                     (axes[1], "peak_voltage", 1.0, "peak voltage (V)"),
-                                     (axes[2], "arc_energy", 1e3, "arc energy (mJ)")):
+    for ax, column, scale, _ in bars:
         values = ops[column].astype(float).fillna(0.0).to_numpy() * scale
         ax.bar(x, values, color=colors)
         ax.set_xticks(x)
-        ax.set_xlabel("opening")
-        ax.set_ylabel(label)
         ax.grid(alpha=0.3, axis="y")
     from matplotlib.patches import Patch
 
@@ -200,45 +227,76 @@ def plot_openings(result):
     return fig
 
 
-def _per_tip(result, column: str, scale: float, ylabel: str, window: bool):
-    """A history column of both tips against time (ms)."""
-    h = result.mechanics.history
-    fig, ax = _subplots(figsize=(10, 4))
-    for i in range(2):
-        ax.plot(h.time * 1e3, h[f"{column}_{i}"] * scale, lw=0.9, label=f"tip {i}")
-    ax.set_xlabel("time (ms)")
-    ax.set_ylabel(ylabel)
-    if window and result.waveforms is not None:
-        ax.set_xlim(*bounce_window(result))
-    ax.grid(alpha=0.3)
-    ax.legend(**LEGEND)
-    fig.tight_layout()
-    return fig, ax
+ABSENT_HEIGHT = 1e3  # m: mech's history holds this height, at every record, for a row without a contact point
+
+
+def contact_points(history) -> list[int]:
+    """The contact points a run has (0, 1). mech's history keeps two rows of contact columns
+    (``_0``, ``_1``); a row the scene has no contact point for (a single rivet, an end cap
+    inside the clamp) holds the height ABSENT_HEIGHT at every record and no force."""
+    return [i for i in range(2) if f"tip_height_{i}" in history
+            and not np.all(history[f"tip_height_{i}"].to_numpy() == ABSENT_HEIGHT)]
+
+
+def _touches(history, i: int) -> bool:
+    return bool(np.any(history[f"normal_force_{i}"].to_numpy() > 0.0))
 
 
 def plot_normal_force(result):
-    """Normal force of each tip vs time (mechanics history), over the bounce window."""
-    return _per_tip(result, "normal_force", 1.0, "normal force (N)", window=True)[0]
+    """Normal force of each contact point that touches vs time (mechanics history), over
+    the bounce window; one that never touches is named, not drawn as a zero curve."""
+    from coupling.app.quantities import WAVEFORM
+
+    h = result.mechanics.history
+    fig, ax = _subplots(figsize=(10, 4))
+    points = contact_points(h)
+    for i in points:
+        if _touches(h, i):
+            ax.plot(h.time * 1e3, h[f"normal_force_{i}"], lw=0.9, label=f"contact point {i}")
+        else:
+            ax.plot([], [], " ", label=f"contact point {i}: never touches")
+    if not any(_touches(h, i) for i in points):
+        ax.text(0.5, 0.5, "no contact", ha="center", va="center", transform=ax.transAxes)
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel(WAVEFORM["normal_force"].label())
+    if result.waveforms is not None and len(result.waveforms) > 1:
+        ax.set_xlim(*bounce_window(result))
+    ax.grid(alpha=0.3)
+    if points:
+        ax.legend(**LEGEND)
+    fig.tight_layout()
+    return fig
 
 
 def plot_tip_heights(result):
-    """Height of each tip's lowest point above the block vs time (negative: penetration),
-    scaled to the tip that strikes (the other may be off scale: its legend entry says so)."""
+    """Height of each contact point's lowest point above the block vs time (negative:
+    penetration), scaled to the one that strikes; another one off that scale has its real
+    range in its legend entry."""
+    from coupling.app.quantities import WAVEFORM
+
     h = result.mechanics.history
-    fig, ax = _per_tip(result, "tip_height", 1e3, "tip height (mm)", window=False)
+    fig, ax = _subplots(figsize=(10, 4))
+    points = contact_points(h)
+    heights = {i: h[f"tip_height_{i}"].to_numpy() * 1e3 for i in points}
     ax.axhline(0.0, color="k", lw=0.6)
-    heights = [h[f"tip_height_{i}"].to_numpy() * 1e3 for i in range(2)]
-    striking = int(np.argmin([np.min(x) for x in heights]))
-    y = heights[striking]
-    top = max(float(np.max(y)), 1e-6) * 1.1
-    bottom = min(float(np.min(y)) * 1.1, -0.02 * top)
-    ax.set_ylim(bottom, top)
-    other = heights[1 - striking]
-    if np.min(other) > top or np.max(other) < bottom:
-        handles, labels = ax.get_legend_handles_labels()
-        labels[1 - striking] += f" (off scale: {np.min(other):.3g}-{np.max(other):.3g} mm)"
-        ax.legend(handles, labels, **LEGEND)
-        fig.tight_layout()
+    if heights:
+        striking = min(heights, key=lambda i: float(np.min(heights[i])))
+        y = heights[striking]
+        top = max(float(np.max(y)), 1e-6) * 1.1
+        bottom = min(float(np.min(y)) * 1.1, -0.02 * top)
+        for i, z in heights.items():
+            label = f"contact point {i}"
+            if np.min(z) > top or np.max(z) < bottom:
+                label += f" (off scale: {np.min(z):.3g} to {np.max(z):.3g} mm)"
+            if not _touches(h, i):
+                label += ", never touches"
+            ax.plot(h.time * 1e3, z, lw=0.9, label=label)
+        ax.set_ylim(bottom, top)
+        ax.legend(**LEGEND)
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel(WAVEFORM["tip_height"].label("mm"))
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
     return fig
 
 

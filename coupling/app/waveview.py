@@ -12,6 +12,12 @@ encoding plotly.py itself uses) and a layout of stacked panels on linked time ax
 plotly's make_subplots lays them out. Importing plotly's Python side and building its
 figure objects cost ~0.5 s of every run for the same page.
 
+The panels, their units and axis ranges are those of waveforms.png: both read
+coupling.app.panels (the contact resistance over the closed contact's range with an
+"open" band above it, currents scaled to the loop with clipped spikes marked, normal force
+per contact point, ...). Each panel's legend stands at its right; the y axes say their
+quantity and unit (SI, with prefixes on the ticks).
+
 Decimation (``decimate``): a trace with more than ``max_points`` samples is cut into
 max_points / 2 buckets of equal time width, and each bucket keeps its first, last, smallest
 and largest sample (in time order). Spikes survive (each bucket's extremes are kept), and a
@@ -28,6 +34,9 @@ import json
 from pathlib import Path
 
 import numpy as np
+
+from coupling.app.panels import axis, columns_of, dashed, panels_for, resistance_ticks
+from coupling.app.quantities import WAVEFORM
 
 MAX_POINTS = 200_000
 PLOTLY_MISSING = "skipped: plotly is not installed (pip install plotly, or switchsim with its default dependencies)"
@@ -60,66 +69,110 @@ def decimate(t: np.ndarray, y: np.ndarray, max_points: int = MAX_POINTS) -> np.n
     return np.unique(np.concatenate(keep))
 
 
-def _rows(w: dict):
-    """(title, [(column, label)], log) per panel, for the columns the waveform has (w: name -> array)."""
-    rows = [("contact voltage (V)", [("contact_voltage", "contact voltage")], False),
-            ("|contact voltage| (V, log)", [("abs_voltage", "|contact voltage|")], True),
-            ("current (A)", [(c, c.replace("_", " ")) for c in ("load_current", "contact_current", "arc_current")
-                             if c in w and np.isfinite(w[c]).all()], False)]
-    if "contact_resistance" in w:
-        rows.append(("contact resistance (ohm, log)", [("contact_resistance", "R_c")], True))
-    if "gap" in w:
-        rows.append(("gap (m)", [("gap", "gap")], False))
-    probes = [c for c in w if c[:2].lower() in ("v(", "i(")]
-    if probes:
-        rows.append(("probes (V, A)", [(c, c) for c in probes], False))
-    return rows
-
-
 def _array(values: np.ndarray) -> dict:
     """plotly.js's typed-array form: little-endian float64 samples in base64 (NaN: a gap)."""
     return {"dtype": "f8", "bdata": base64.b64encode(np.ascontiguousarray(values, dtype="<f8").tobytes()).decode()}
 
 
+_SI = ((1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""), (1e-3, "m"), (1e-6, "\u00b5"), (1e-9, "n"), (1e-12, "p"))
+
+
+def _si(value: float) -> str:
+    """A tick number with an SI prefix, as plotly writes its own ("100\u00b5", "2m")."""
+    for scale, prefix in _SI:
+        if abs(value) >= scale * 0.9999:
+            return f"{value / scale:.3g}{prefix}"
+    return f"{value:.3g}"
+
+
+def _panel(panel, traces, cols, t, k, rng, max_points):
+    """The plotly traces and y axis of one panel (k: 1-based row)."""
+    suffix = "" if k == 1 else str(k)
+    legend = f"legend{suffix}"
+    unit = panel.quantity.unit
+    out = []
+    for column, label, color in traces:
+        y = cols[column]
+        if panel.scale == "resistance":  # the data range only: onsets are marked, open is drawn in the band
+            y = np.where(np.isfinite(y) & (y > 0) & (y <= rng.hi), y, np.nan)
+        elif rng.log:
+            y = np.where((y > 0) & np.isfinite(y), y, np.nan)
+        idx = decimate(t, y, max_points)
+        out.append({"type": "scattergl", "mode": "lines", "name": label, "legend": legend,
+                    "line": {"width": 1, **({"color": color} if color else {}),
+                             **({"dash": "dash", "width": 1.6} if dashed(panel, column) else {})},
+                    "x": _array(t[idx]), "y": _array(y[idx]), "xaxis": f"x{suffix}", "yaxis": f"y{suffix}"})
+    colors = {c: col for c, _, col in traces}
+    for column, idx, peak in rng.clipped:
+        y = cols[column][idx]
+        edge = np.where(y > rng.hi, rng.hi, rng.lo)
+        what = "above range (onset)" if panel.scale == "resistance" else "clipped"
+        out.append({"type": "scatter", "mode": "markers", "name": f"{what} (peak {peak:.3g} {unit})",
+                    "legend": legend, "marker": {"symbol": ["triangle-down" if panel.scale == "resistance" or v < rng.lo
+                                                            else "triangle-up" for v in y],
+                                                 "size": 7, "color": colors.get(column)},
+                    "x": _array(t[idx]), "y": _array(edge), "customdata": _array(y),
+                    "hovertemplate": "%{customdata:.4g} " + unit + "<extra></extra>",
+                    "cliponaxis": False, "xaxis": f"x{suffix}", "yaxis": f"y{suffix}"})
+    yaxis = {"title": {"text": panel.quantity.label()}, "tickformat": "~s"}
+    if rng.band is not None:
+        mid = float(np.sqrt(rng.band[0] * rng.band[1]))
+        y = np.full(len(t), np.nan)
+        y[rng.open] = mid
+        idx = decimate(t, y, max_points)
+        out.append({"type": "scattergl", "mode": "lines", "name": "open (no conduction)", "legend": legend,
+                    "line": {"width": 6, "color": "#595959"}, "x": _array(t[idx]), "y": _array(y[idx]),
+                    "hovertemplate": "open<extra></extra>", "xaxis": f"x{suffix}", "yaxis": f"y{suffix}"})
+        ticks = resistance_ticks(rng)
+        yaxis.update(tickvals=[v for v, _ in ticks], ticktext=[s or _si(v) for v, s in ticks])
+    if rng.log:
+        yaxis.update(type="log", range=[float(np.log10(rng.lo)), float(np.log10(rng.top))])
+    else:
+        yaxis.update(range=[rng.lo, rng.top])
+    return out, yaxis
+
+
 def waveform_page(result, max_points: int = MAX_POINTS) -> tuple[list, dict]:
-    """(traces, layout) of a run's waveforms: one panel per quantity, linked time axes."""
-    cols = dict(result.waveform_columns)
-    cols["abs_voltage"] = np.abs(cols["contact_voltage"])
-    rows = _rows(cols)
-    n = len(rows)
-    spacing = 0.02
+    """(traces, layout) of a run's waveforms: the panels of coupling.app.panels on linked
+    time axes, each scaled by its rule over the whole run, its legend at its right."""
+    cols = columns_of(result)
+    panels = panels_for(cols)
+    n = len(panels)
+    spacing = 0.025
     height = (1.0 - spacing * (n - 1)) / n
     t = np.asarray(cols["time"], dtype=float)
+    sel = np.ones(len(t), bool)
     traces = []
-    layout = {"annotations": [], "shapes": []}
-    for k, (title, columns, log) in enumerate(rows, start=1):
+    layout = {"shapes": []}
+    for k, (panel, drawn) in enumerate(panels, start=1):
         top = 1.0 - (k - 1) * (height + spacing)
         suffix = "" if k == 1 else str(k)
-        for column, label in columns:
-            y = np.asarray(cols[column], dtype=float)
-            if log:
-                y = np.where((y > 0) & np.isfinite(y), y, np.nan)
-            idx = decimate(t, y, max_points)
-            traces.append({"type": "scattergl", "mode": "lines", "name": label, "line": {"width": 1},
-                           "x": _array(t[idx]), "y": _array(y[idx]), "xaxis": f"x{suffix}", "yaxis": f"y{suffix}"})
-        layout[f"xaxis{suffix}"] = {"anchor": f"y{suffix}", "domain": [0.0, 1.0], "exponentformat": "SI",
+        rng = axis(panel, t, [(c, cols[c]) for c, _, _ in drawn], sel, bounce=getattr(result, "bounce", None),
+                   closed_intervals=result.closed_intervals)
+        new, yaxis = _panel(panel, drawn, cols, t, k, rng, max_points)
+        traces += new
+        layout[f"xaxis{suffix}"] = {"anchor": f"y{suffix}", "domain": [0.0, 1.0], "tickformat": "~s",
                                     "ticksuffix": "s", "showspikes": True, "spikemode": "across",
                                     **({"matches": f"x{n}", "showticklabels": False} if k < n else
-                                       {"title": {"text": "time"}})}
-        layout[f"yaxis{suffix}"] = {"anchor": f"x{suffix}", "domain": [top - height, top],
-                                    **({"type": "log"} if log else {})}
-        layout["annotations"].append({"text": title, "x": 0.5, "y": top, "xref": "paper", "yref": "paper",
-                                      "xanchor": "center", "yanchor": "bottom", "showarrow": False,
-                                      "font": {"size": 16}})
-    for a, b in result.closed_intervals:
-        layout["shapes"].append({"type": "rect", "xref": "x", "yref": "paper", "x0": float(a), "x1": float(b),
-                                 "y0": 0.0, "y1": 1.0, "fillcolor": "green", "opacity": 0.12,
-                                 "line": {"width": 0}, "layer": "below"})
+                                       {"title": {"text": WAVEFORM["time"].label()}})}
+        layout[f"yaxis{suffix}"] = {"anchor": f"x{suffix}", "domain": [top - height, top], **yaxis}
+        layout[f"legend{suffix}"] = {"x": 1.01, "xanchor": "left", "y": top, "yanchor": "top", "yref": "paper",
+                                     "font": {"size": 11}, "tracegroupgap": 2}
+        if rng.band is not None:
+            layout["shapes"].append({"type": "rect", "xref": f"x{suffix} domain", "yref": f"y{suffix}",
+                                     "x0": 0.0, "x1": 1.0, "y0": rng.band[0], "y1": rng.band[1],
+                                     "fillcolor": "#d9d9d9", "opacity": 0.7, "line": {"width": 0}, "layer": "below"})
+        for a, b in result.closed_intervals:  # shaded within each panel, not across the gaps between them
+            layout["shapes"].append({"type": "rect", "xref": f"x{suffix}", "yref": f"y{suffix} domain",
+                                     "x0": float(a), "x1": float(b), "y0": 0.0, "y1": 1.0, "fillcolor": "green",
+                                     "opacity": 0.12, "line": {"width": 0}, "layer": "below"})
     name = getattr(result.scene, "name", "run")
-    layout.update(height=230 * n + 120, title={"text": f"{name}: waveforms (drag to zoom, double-click to reset)"},
-                  hovermode="x unified", legend={"orientation": "h", "y": 1.0, "yanchor": "bottom"},
-                  margin={"l": 70, "r": 20, "t": 110, "b": 50}, template={"layout": {"plot_bgcolor": "#E5ECF6", "xaxis": {"gridcolor": "white"},
-                                                                          "yaxis": {"gridcolor": "white"}}})
+    layout.update(height=230 * n + 110,
+                  title={"text": f"{name}: waveforms (drag to zoom, double-click to reset; green: contact closed)",
+                         "x": 0.0, "xanchor": "left"},
+                  hovermode="x unified", showlegend=True, margin={"l": 80, "r": 250, "t": 60, "b": 50},
+                  template={"layout": {"plot_bgcolor": "#E5ECF6", "xaxis": {"gridcolor": "white"},
+                                       "yaxis": {"gridcolor": "white"}}})
     return traces, layout
 
 
@@ -134,7 +187,10 @@ def plotly_js() -> Path | None:
 
 def write_waveform_html(result, path, max_points: int = MAX_POINTS) -> str:
     """Write the page; returns "written" or why it was skipped (plotly absent, no waveforms)."""
-    if result.waveform_columns is None or not len(result.waveform_columns["time"]):
+    cols = getattr(result, "waveform_columns", None)
+    if cols is None and getattr(result, "waveforms", None) is not None:  # a result folder read back
+        cols = result.waveforms
+    if cols is None or not len(cols["time"]):
         return "skipped: no waveforms"
     js = plotly_js()
     if js is None:

@@ -58,4 +58,104 @@ def test_page_is_self_contained_and_holds_the_data(tmp_path):
     np.testing.assert_array_equal(_decode(by_name["contact voltage"]["x"]), t)
     np.testing.assert_array_equal(_decode(by_name["contact voltage"]["y"]), v)
     np.testing.assert_array_equal(_decode(by_name["v(snubber)"]["y"]), 0.5 * v)
-    assert set(by_name) >= {"contact voltage", "|contact voltage|", "load current", "contact current", "R_c"}
+    assert set(by_name) >= {"contact voltage", "|contact voltage|", "load (loop)", "contact (metallic)",
+                            "contact resistance"}
+
+
+# --- the page of a real run: the default relay to 2 ms (one rivet: contact point 1 does not exist) ---
+
+_PAGE = {}
+
+
+def _relay_page():
+    """(result, traces, layout) read back from the written page (run once per module)."""
+    if "page" not in _PAGE:
+        import tempfile
+        from pathlib import Path
+
+        from coupling import default_scene, run
+        from coupling.app.waveview import write_waveform_html
+
+        res = run(default_scene().set("solver.t_end", 2e-3))
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "waveforms.html"
+            assert write_waveform_html(res, path) == "written"
+            html = path.read_text()
+        m = re.search(r'Plotly\.newPlot\(\s*"[^"]+",\s*(\[.*?\])\s*,\s*(\{.*?\})\s*,\s*\{"scrollZoom"', html, re.S)
+        _PAGE["page"] = (res, json.loads(m.group(1)), json.loads(m.group(2)))
+    return _PAGE["page"]
+
+
+def _panels(layout):
+    """y axis name ("y", "y2", ...) -> its layout entry."""
+    return {("y" + k[5:]): v for k, v in layout.items() if k.startswith("yaxis")}
+
+
+def _axis_of(layout, unit):
+    (name,) = [k for k, v in _panels(layout).items() if v.get("title", {}).get("text", "").endswith(f"({unit})")]
+    return name, _panels(layout)[name]
+
+
+def test_page_resistance_axis_spans_the_closed_contact_and_draws_open_as_open():
+    """As waveforms.png (tests/coupling/test_plots.py): the axis holds the contact pressed
+    with >= 10 mN, not the 2e18 ohm onsets; the samples without conduction are a trace in
+    the band above the axis, named "open"; the R_c trace holds no sample beyond the axis."""
+    res, traces, layout = _relay_page()
+    c = res.waveform_columns
+    t, r, f = c["time"], c["contact_resistance"], c["normal_force"]
+    name, yaxis = _axis_of(layout, "ohm")
+    assert yaxis["type"] == "log"
+    lo, top = 10.0 ** np.array(yaxis["range"])
+    (band,) = [s for s in layout["shapes"] if s.get("yref") == name]
+    closed = np.zeros(len(t), bool)
+    for a, b in res.closed_intervals:
+        closed |= (t >= a) & (t <= b)
+    pressed = r[closed & (f >= 0.01) & np.isfinite(r)]
+    assert lo <= pressed.min() and pressed.max() <= band["y0"]
+    assert top < 1e-6 * np.max(r[np.isfinite(r)])
+    on_axis = [tr for tr in traces if tr["yaxis"] == name]
+    by_name = {tr["name"]: tr for tr in on_axis}
+    open_trace = by_name["open (no conduction)"]
+    y_open = _decode(open_trace["y"])
+    assert np.array_equal(np.isfinite(y_open), ~np.isfinite(r))  # exactly the samples without conduction
+    assert np.all((y_open[np.isfinite(y_open)] > band["y0"]) & (y_open[np.isfinite(y_open)] < band["y1"]))
+    y_r = _decode(by_name["contact resistance"]["y"])
+    assert np.nanmax(y_r) <= band["y0"]
+    onset = [k for k in by_name if k.startswith("above range")]
+    assert len(onset) == 1 and np.max(_decode(by_name[onset[0]]["customdata"])) == np.max(r[np.isfinite(r)])
+    ticks = dict(zip(yaxis["tickvals"], yaxis["ticktext"]))
+    assert [v for v, s in ticks.items() if v > band["y0"]] == [v for v, s in ticks.items() if s == "open"]
+
+
+def test_page_has_a_normal_force_panel_per_contact_point_that_touches():
+    res, traces, layout = _relay_page()
+    name, yaxis = _axis_of(layout, "N")
+    assert yaxis["title"]["text"] == "normal force (N)"
+    on_axis = {tr["name"]: tr for tr in traces if tr["yaxis"] == name}
+    assert set(on_axis) == {"contact point 0"}  # the relay's one rivet; row 1 has no contact point
+    np.testing.assert_array_equal(_decode(on_axis["contact point 0"]["y"]), res.waveform_columns["normal_force_0"])
+    np.testing.assert_array_equal(_decode(on_axis["contact point 0"]["x"]), res.waveform_columns["time"])
+
+
+def test_page_axes_have_units_and_legends_stand_beside_their_panels():
+    """Every y axis names its quantity and unit, the time axis its unit; each panel's
+    legend stands right of the plotting area (x > 1, left-anchored, so it covers no panel,
+    title or axis) at the top of its own panel, and holds that panel's traces only."""
+    res, traces, layout = _relay_page()
+    panels = _panels(layout)
+    assert len(panels) >= 6
+    for name, yaxis in panels.items():
+        assert re.search(r"\([^()]+\)$", yaxis["title"]["text"]), yaxis
+    bottom = [v for k, v in layout.items() if k.startswith("xaxis") and "title" in v]
+    assert [x["title"]["text"] for x in bottom] == ["time (s)"]
+    legends = {k: v for k, v in layout.items() if k.startswith("legend")}
+    assert len(legends) == len(panels)
+    for name, yaxis in panels.items():
+        legend = legends["legend" + name[1:]]
+        assert legend["x"] > 1.0 and legend["xanchor"] == "left"
+        lo, hi = yaxis["domain"]
+        assert lo < legend["y"] <= hi + 1e-12 and legend["yanchor"] == "top"
+    for tr in traces:
+        assert tr["legend"] == "legend" + tr["yaxis"][1:]
+        assert "e+06" not in tr["name"] and "tip" not in tr["name"]
+    assert not layout.get("annotations")  # no titles over the panels for a legend to cover
