@@ -241,25 +241,25 @@ AIR_SHAPES = {cls.shape: cls for cls in (AxialGap, RadialGap, QuarterCylinder, Q
 @dataclass(frozen=True)
 class FixedGap:
     """One place of the flux path where it crosses air that does not move with the
-    armature: its ``tubes`` (air tubes) in parallel. Reluctance 1 / (sum of permeances)."""
+    armature: its air tubes ``tube`` (a list) in parallel. Reluctance 1 / (sum of permeances)."""
 
-    tubes: tuple
+    tube: tuple
     name: str = "magnet.fixed_gap"
 
     def __post_init__(self):
-        tubes = tuple(self.tubes) if not isinstance(self.tubes, (str, dict)) else None
+        tubes = tuple(self.tube) if not isinstance(self.tube, (str, dict)) and hasattr(self.tube, "__iter__") else None
         if not tubes:
             raise ValueError(f"{self.name}.tube: a fixed gap needs at least one air tube "
                              f"({', '.join(AIR_SHAPES)})")
         for k, tube in enumerate(tubes):
             check_instance(f"{self.name}.tube[{k}]", tube, tuple(AIR_SHAPES.values()),
                            f"an air tube ({', '.join(cls.__name__ for cls in AIR_SHAPES.values())})")
-        object.__setattr__(self, "tubes", tubes)
+        object.__setattr__(self, "tube", tubes)
 
     @property
     def reluctance(self) -> float:
         """A/Wb."""
-        return 1.0 / sum(t.permeance for t in self.tubes)
+        return 1.0 / sum(t.permeance for t in self.tube)
 
 
 def working_gap_permeance(area: float, gap):
