@@ -132,7 +132,8 @@ def _summary(n: dict) -> str:
         lines.append(f"smallest R C with one edge: {c['pull_resistance'] / 1e3:g} kohm x "
                      f"{c['input_capacitance'] * 1e9:g} nF = {c['rc'] * 1e3:.3g} ms; from low the pin needs "
                      f"{crossing * 1e6:.0f} us to reach {n['logic_high']:g} V, longer than the longest bounce "
-                     f"opening ({needed * 1e6:.0f} us); the edge comes {c['latency'] * 1e6:.1f} us after the first make")
+                     f"opening ({needed * 1e6:.0f} us); the edge comes {c['latency'] * 1e6:.1f} us after the "
+                     "first make")
     return "\n".join(lines)
 
 

@@ -626,7 +626,8 @@ def _pin_edges(intervals, t_end: float, c: dict, r_pull: float, c_in: float) -> 
     v, level, edges, margin = vcc, True, 0, math.inf
     for k, (t0, t1) in enumerate(zip(bounds[:-1], bounds[1:])):
         closed = k % 2 == 1
-        target, tau = (0.0, c["series_resistance"] * c_in) if closed else (vcc, (r_pull + c["series_resistance"]) * c_in)
+        r_series = c["series_resistance"]
+        target, tau = (0.0, r_series * c_in) if closed else (vcc, (r_pull + r_series) * c_in)
         v_end = target + (v - target) * math.exp(-(t1 - t0) / tau)
         threshold = low if level else high
         if (level and v_end < low) or (not level and v_end > high):

@@ -206,7 +206,8 @@ BASE = {"circuit": {"template": "mcu_input", "schedule": {"make": [1e-4], "break
     ({"metrics": {"logic": {"low": 2.4, "high": 2.31}}}, "metrics.logic.low = 2.4 V must be below metrics.logic.high"),
     ({"metrics": {"logic": {"low": 1.0, "high": 1.0}}}, "metrics.logic.low = 1 V must be below"),
     ({"metrics": {"logic": {"node": "v(pim)"}}}, "metrics.logic.node: probe 'v(pim)': no node 'pim'"),
-    ({"metrics": {"logic": {"node": "i(Rpull)"}}}, "metrics.logic.node = 'i(Rpull)': a logic input reads a node voltage"),
+    ({"metrics": {"logic": {"node": "i(Rpull)"}}},
+     "metrics.logic.node = 'i(Rpull)': a logic input reads a node voltage"),
     ({"metrics": {"logic": {"node": "v(pin)", "hi": 2.0}}}, "metrics.logic: unknown key 'hi'"),
     ({"metrics": {"logic": {"high": "2.3"}}}, "metrics.logic.high = '2.3': expected a finite number of volts"),
     ({"circuit": {"logic_low": 2.5}}, "circuit.logic_low = 2.5 V must be below circuit.logic_high = 2.31 V"),
@@ -231,7 +232,8 @@ def test_logic_needs_a_circuit_and_all_three_keys_without_the_template():
     resistive = {"circuit": {"template": "resistive", "schedule": {"make": [1e-4], "break": []}}}
     with pytest.raises(ValueError, match=r"^s: metrics.logic needs low, high \("):
         scene_from_dict({**resistive, "metrics": {"logic": {"node": "v(load)"}}}, name="s")
-    with pytest.raises(ValueError, match=r"^s: metrics.logic reads a node voltage of the circuit: it needs a \[circuit\]"):
+    with pytest.raises(ValueError, match=r"^s: metrics.logic reads a node voltage of the circuit: it needs a "
+                                         r"\[circuit\]"):
         scene_from_dict({"metrics": {"logic": {"node": "v(pin)", "low": 1.0, "high": 2.0}}}, name="s")
     scene = scene_from_dict({**resistive, "metrics": {"logic": {"node": "v(load)", "low": 1.0, "high": 2.0}}})
     assert scene.metrics.logic == LogicInput("v(load)", 1.0, 2.0)
