@@ -7,7 +7,8 @@ channels (``<label>.conductance`` S, ``<label>.gap`` m) and result columns.
 - ``Stepper``: co-simulation stepping (advance to t_next with G(t) and breakpoints).
 - ``run_transient`` / ``run_pwl_reference``: one-shot runs.
 - ``ContactSchedule``: prescribed make/break instants.
-- ``SwitchCircuit`` and its parts, ``NetlistCircuit``: the circuit.
+- ``SwitchCircuit`` and its parts, ``McuInput`` (a switch read by a microcontroller pin),
+  ``NetlistCircuit``: the circuit.
 - ``ArcModel``: arc/breakdown of the opening gap (optionally growing with the gap distance).
 """
 
@@ -39,6 +40,7 @@ from .templates import (
     DCSource,
     FlybackDiode,
     InductiveLoad,
+    McuInput,
     ResistiveLoad,
     Snubber,
     SwitchCircuit,
@@ -60,6 +62,7 @@ __all__ = [
     "GapError",
     "InductiveLoad",
     "LibraryNotFoundError",
+    "McuInput",
     "NetlistCircuit",
     "NetlistError",
     "NetlistInputError",

@@ -13,10 +13,10 @@ from .contact import placed_contacts
 from .netlist import NetlistCircuit
 from .options import SimulationOptions
 from .probes import Probes
-from .templates import LOAD_PROBE, SwitchCircuit
+from .templates import LOAD_PROBE, McuInput, SwitchCircuit
 from .validation import check_range
 
-CircuitLike = Union[SwitchCircuit, NetlistCircuit, Circuit]
+CircuitLike = Union[SwitchCircuit, McuInput, NetlistCircuit, Circuit]
 
 #: Drive of an input channel's source: "external" (a Python function of time, through
 #: ngspice's callback) or PWL vertices (times s, values in the channel's unit, >= 0).
@@ -25,7 +25,7 @@ Drive = Union[str, tuple[np.ndarray, np.ndarray]]
 
 def circuit_netlist(circuit: CircuitLike) -> tuple[str, Probes]:
     """Netlist text (title line first, no analysis, no .end) and its probes."""
-    if isinstance(circuit, SwitchCircuit):
+    if isinstance(circuit, (SwitchCircuit, McuInput)):
         return str(circuit.build()), circuit.probes
     if isinstance(circuit, NetlistCircuit):
         return circuit.netlist(), circuit.probes
@@ -34,7 +34,7 @@ def circuit_netlist(circuit: CircuitLike) -> tuple[str, Probes]:
             f"{LOAD_PROBE}#branch" if LOAD_PROBE.lower() in {n.lower() for n in circuit.element_names} else None),
             coils=tuple(getattr(circuit, COILS_PLACED, ())))
     raise TypeError(
-        f"expected a SwitchCircuit, a NetlistCircuit or a PySpice Circuit with a contact, got {type(circuit).__name__}"
+        f"expected a SwitchCircuit, an McuInput, a NetlistCircuit or a PySpice Circuit with a contact, got {type(circuit).__name__}"
     )
 
 

@@ -38,6 +38,8 @@ import numpy as np
 
 from mech.validation import check_nonnegative, check_whole
 
+from coupling.core.logic import LogicInput
+
 ARC_BURNING_CURRENT = 1e-3  # A
 DEFAULT_SETTLE_WINDOW = 1e-3  # s
 DEFAULT_ARC_TOGGLE_LIMIT = 50  # arc on/off changes in one run above which a warning is given
@@ -52,17 +54,22 @@ class MetricSettings:
     make_guard: s or None, samples this close after a make produce no voltage metric
         (None: max(1e-12 s, 1e-9 t_end)).
     arc_toggle_limit: more arc on/off changes than this in one run give a warning.
+    logic: a Schmitt-trigger input on a node (coupling.core.logic.LogicInput), or None.
     """
 
     settle_window: float = DEFAULT_SETTLE_WINDOW
     make_guard: float | None = None
     arc_toggle_limit: int = DEFAULT_ARC_TOGGLE_LIMIT
+    logic: LogicInput | None = None
 
     def __post_init__(self):
         check_nonnegative("metrics.settle_window", self.settle_window)
         if self.make_guard is not None:
             check_nonnegative("metrics.make_guard", self.make_guard)
         check_whole("metrics.arc_toggle_limit", self.arc_toggle_limit)
+        if self.logic is not None and not isinstance(self.logic, LogicInput):
+            raise ValueError(f"metrics.logic = {self.logic!r}: expected a LogicInput (the scene builds it from "
+                             "its table) or None")
 
     def guard(self, t_end: float) -> float:
         """s: the make guard for a run of length t_end."""

@@ -100,6 +100,20 @@ class CoupledResult:
         return self._cache[key]
 
     @property
+    def logic(self) -> dict | None:
+        """The digital input's view of ``[metrics] logic``'s node (coupling.core.logic.logic_metrics),
+        or None without it."""
+        settings = getattr(getattr(self.scene, "metrics", None), "logic", None)
+        if settings is None or self.waveform_columns is None:
+            return None
+        if "logic" not in self._cache:
+            from coupling.core.logic import logic_metrics
+
+            waves = self.waveform_columns
+            self._cache["logic"] = logic_metrics(waves["time"], waves[settings.node], settings)
+        return self._cache["logic"]
+
+    @property
     def opening_columns(self) -> dict:
         """The per-opening table of ``bounce`` (openings.csv) as lists: start, end, open_duration,
         reclosed, kind, current_at_break, peak_voltage, arc_duration, arc_energy (SI)."""
@@ -135,6 +149,8 @@ class CoupledResult:
                 out["flags"] = list(out.get("flags", [])) + [flag]
         if self.scene.circuit is not None:
             out["bounce"] = _jsonable(self.bounce)
+            if self.logic is not None:
+                out["logic"] = _jsonable(self.logic)
         if self.scene.tribology is not None:
             out["tribology"] = {"source": self.scene.tribology.source,
                                 "feedback": self.scene.tribology.feedback,

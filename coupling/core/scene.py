@@ -9,6 +9,8 @@ A scene names only what it needs, and only that is built:
                   | inline [tribology.mu] and [tribology.resistance] tables (docs/tribology.md)
                   feedback = true (mu follows the contact current; false: mu = mu(0))
     [circuit]     template = "resistive" | "inductive" | "capacitive" | "current_source" | "netlist"
+                  | "mcu_input" (voltage, pull, pull_resistance, series_resistance,
+                  input_capacitance, logic_low, logic_high, contact_capacitance, leakage_conductance)
                   voltage, source_resistance (voltage templates) | current, compliance_voltage,
                   output_capacitance, output_resistance (current_source), wiring_resistance,
                   wiring_inductance, load_resistance, load_inductance, load_capacitance,
@@ -24,7 +26,8 @@ A scene names only what it needs, and only that is built:
                   align_events = true, onset_penetration (m)
     [output]      csv, parquet, plots, history, html = true | false, history_resolution (s),
                   history_max_rows
-    [metrics]     settle_window (s), make_guard (s), arc_toggle_limit (coupling.core.metrics)
+    [metrics]     settle_window (s), make_guard (s), arc_toggle_limit (coupling.core.metrics),
+                  logic = { node = "v(pin)", low, high } (V; coupling.core.logic)
 
 SI units everywhere. File paths are relative to the scene file. Every error names the
 file, the section and key as written and says what is allowed, before any solver starts.
@@ -55,7 +58,7 @@ from mech.validation import (
 )
 
 COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output", "metrics")
-TEMPLATES = ("resistive", "inductive", "capacitive", "current_source", "netlist")
+TEMPLATES = ("resistive", "inductive", "capacitive", "current_source", "netlist", "mcu_input")
 SCHEMES = ("mechanics_first", "jacobi")
 
 
@@ -327,6 +330,8 @@ _TEMPLATE_CIRCUIT = {"contact_capacitance": "contact_capacitance", "leakage_cond
 _NETLIST = {"netlist": None, "load_probe": "load_probe", "leakage_conductance": "leakage_conductance"}
 _PARTS = ("snubber", "flyback", "arc")
 _OPTION_KEYS = ("max_step", "reltol", "abstol", "vntol", "chgtol", "method", "temperature", "wall_timeout")
+_MCU_INPUT = {k: k for k in ("voltage", "pull", "pull_resistance", "series_resistance", "input_capacitance",
+                              "logic_low", "logic_high", "contact_capacitance", "leakage_conductance")}
 _SCHEDULE = {"make": "intervals", "break": "intervals", "closed_resistance": "closed_resistance",
              "edge_time": "edge_time", "opening_speed": "opening_speed"}
 
@@ -335,6 +340,8 @@ def template_keys(template: str) -> set:
     """The [circuit] keys a template uses (besides template, schedule and the ngspice options)."""
     if template == "netlist":
         return set(_NETLIST) | {"arc"}
+    if template == "mcu_input":
+        return set(_MCU_INPUT)
     source = _CURRENT_SOURCE if template == "current_source" else _VOLTAGE_SOURCE
     return set(source) | set(_WIRING) | set(_LOADS[template]) | set(_TEMPLATE_CIRCUIT) | set(_PARTS)
 
@@ -348,7 +355,7 @@ def circuit_key_names(ck) -> dict:
     for cls, keys in ((ck.DCSource, _VOLTAGE_SOURCE), (ck.CurrentSource, _CURRENT_SOURCE), (ck.Wiring, _WIRING),
                       (ck.ResistiveLoad, _LOADS["resistive"]), (ck.InductiveLoad, _LOADS["inductive"]),
                       (ck.CapacitiveLoad, _LOADS["capacitive"]), (ck.SwitchCircuit, _TEMPLATE_CIRCUIT),
-                      (ck.NetlistCircuit, _NETLIST)):
+                      (ck.NetlistCircuit, _NETLIST), (ck.McuInput, _MCU_INPUT)):
         names.update({f"{cls.__name__}.{name}": f"circuit.{key}" for key, name in keys.items() if name})
     for part, cls in zip(_PARTS, (ck.Snubber, ck.FlybackDiode, ck.ArcModel)):
         names[f"SwitchCircuit.{part}"] = names[f"NetlistCircuit.{part}"] = f"circuit.{part}"
@@ -419,6 +426,8 @@ def _circuit(table: dict, base_dir: Path, current_factor: str | None):
             path = _input_file("circuit.netlist", table["netlist"], base_dir)
             circ = ck.NetlistCircuit.from_file(path, arc=arc, contact_current_factor=current_factor,
                                                **_fields(table, _NETLIST))
+        elif template == "mcu_input":
+            circ = ck.McuInput(contact_current_factor=current_factor, **_fields(table, _MCU_INPUT))
         else:
             if template == "current_source":
                 source = ck.CurrentSource(**_fields(table, _CURRENT_SOURCE))
@@ -512,12 +521,52 @@ def _build(doc: dict, base_dir: Path, name: str) -> Scene:
         factor = tribology.laws.resistance_law.current_factor_expression("I") if tribology is not None else None
         circuit = _circuit(circuit_table, base_dir, factor)
 
-    from coupling.core.metrics import MetricSettings
-
-    coupling, output, metrics = (_section(doc, section, cls) for section, cls in (
-        ("coupling", CouplingOptions), ("output", OutputOptions), ("metrics", MetricSettings)))
+    coupling, output = (_section(doc, section, cls) for section, cls in (
+        ("coupling", CouplingOptions), ("output", OutputOptions)))
+    metrics, circuit = _metrics(doc, circuit)
     return Scene(raw=copy.deepcopy(doc), base_dir=base_dir, mech=mech, tribology=tribology, circuit=circuit,
                  coupling=coupling, output=output, name=name, metrics=metrics)
+
+
+def _metrics(doc: dict, circuit: CircuitSpec | None):
+    """([metrics] as MetricSettings, the circuit) with its ``logic`` input resolved: an
+    mcu_input template gives its pin and thresholds by default, and the node read is added
+    to the circuit's probes when they do not record it already."""
+    from coupling.core.logic import LogicInput
+    from coupling.core.metrics import MetricSettings
+
+    table = dict(check_keys("[metrics]", _table("[metrics]", doc.get("metrics", {})),
+                            [f.name for f in dataclasses.fields(MetricSettings)]))
+    defaults = None
+    if circuit is not None and circuit.template == "mcu_input":
+        from circuit.templates import MCU_PIN
+
+        pin = circuit.circuit
+        defaults = {"node": f"v({MCU_PIN})", "low": pin.logic_low, "high": pin.logic_high}
+    if "logic" not in table and defaults is None:
+        return MetricSettings(**table), circuit
+    if circuit is None:
+        raise ValueError("metrics.logic reads a node voltage of the circuit: it needs a [circuit]")
+    logic = LogicInput.from_table(table.get("logic", {}), defaults)
+    probe, circuit = _recorded(logic.node, circuit, "metrics.logic.node")
+    table["logic"] = dataclasses.replace(logic, node=probe.text)
+    return MetricSettings(**table), circuit
+
+
+def _recorded(text: str, spec: CircuitSpec, where: str):
+    """(the probe recording node voltage ``text``, the circuit spec recording it): an equal
+    probe of [circuit] probes, else a new one checked against the circuit's deck."""
+    from circuit.deck import build_deck
+    from circuit.probes import check_probes, parse_probe
+
+    wanted = parse_probe(text, where)
+    if wanted.kind != "v":
+        raise ValueError(f"{where} = {text!r}: a logic input reads a node voltage, v(node) or v(node1,node2)")
+    for probe in spec.probes:
+        if (probe.kind, probe.names) == (wanted.kind, wanted.names):
+            return probe, spec
+    (probe,) = check_probes([wanted.text], build_deck(spec.circuit, 1.0, spec.options)[0], where)
+    return probe, dataclasses.replace(spec, probes=spec.probes + (probe,))
 
 
 def _section(doc: dict, section: str, cls):

@@ -604,3 +604,88 @@ def test_free_drop_touches_down_in_free_fall_and_flies_off(free_drop):
     assert 0.0 < first["kinematic_restitution"] < 1.0
     assert numbers["final_state"] == "open"
     assert numbers["flight_acceleration"] == pytest.approx(-g, rel=1e-3)
+
+
+# --- pushbutton_debounce ------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def debounce(tmp_path_factory):
+    return _run(tmp_path_factory, "pushbutton_debounce")
+
+
+def _pin_edges(intervals, t_end: float, c: dict, r_pull: float, c_in: float) -> tuple[int, float]:
+    """(edges, margin V) of the pin on the run's own contact intervals, by the closed form of
+    the mcu_input network: after each make an exponential towards 0 with tau = R_series C
+    (R_c, milliohms, and the 5 pF across the contact neglected against kOhm and nF), after each
+    break towards Vcc with (R_pull + R_series) C; a Schmitt input with the scene's thresholds.
+    margin: the smallest distance to the threshold that would switch the input at the end of
+    an interval that does not switch it."""
+    vcc, low, high = c["voltage"], c["logic_low"], c["logic_high"]
+    bounds = [0.0] + [t for iv in intervals for t in iv if 0.0 < t < t_end] + [t_end]
+    v, level, edges, margin = vcc, True, 0, math.inf
+    for k, (t0, t1) in enumerate(zip(bounds[:-1], bounds[1:])):
+        closed = k % 2 == 1
+        r_series = c["series_resistance"]
+        target, tau = (0.0, r_series * c_in) if closed else (vcc, (r_pull + r_series) * c_in)
+        v_end = target + (v - target) * math.exp(-(t1 - t0) / tau)
+        threshold = low if level else high
+        if (level and v_end < low) or (not level and v_end > high):
+            edges, level = edges + 1, not level
+        else:
+            margin = min(margin, abs(v_end - threshold))
+        v = v_end
+    return edges, margin
+
+
+def test_debounce_edges_are_the_rc_closed_form_on_the_bounces(debounce):
+    numbers, out = debounce
+    c = _toml("pushbutton_debounce")["circuit"]
+    compared = 0
+    for row in numbers["grid"]:
+        assert row["status"] == "ok" and row["final_level"] == "low"  # pressed: the input reads low
+        expected, margin = _pin_edges(row["closed_intervals"], _toml("pushbutton_debounce")["solver"]["t_end"], c,
+                                      row["pull_resistance"], row["input_capacitance"])
+        if margin > 0.02 * c["voltage"]:  # the neglected R_c and 5 pF move the pin by < 0.5 % of Vcc
+            assert row["edges"] == expected, row
+            compared += 1
+    assert compared == len(numbers["grid"])  # no grid point is a near miss
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["logic"]["edges"] == 1 and summary["logic"]["node"] == "v(pin)"
+
+
+def test_debounce_edge_count_falls_with_r_and_c(debounce):
+    numbers, _ = debounce
+    edges = {(r["pull_resistance"], r["input_capacitance"]): r["edges"] for r in numbers["grid"]}
+    pullups, caps = sorted({k[0] for k in edges}), sorted({k[1] for k in edges})
+    for r in pullups:
+        assert all(edges[(r, a)] >= edges[(r, b)] for a, b in zip(caps[:-1], caps[1:]))
+    for cap in caps:
+        assert all(edges[(a, cap)] >= edges[(b, cap)] for a, b in zip(pullups[:-1], pullups[1:]))
+    # a press starts high and ends low: an odd number of edges; with the smallest R C the input
+    # follows every make and break (7 makes, 6 breaks in this press)
+    n_contacts = len(numbers["grid"][0]["closed_intervals"])
+    assert all(n % 2 == 1 for n in edges.values())
+    assert edges[(pullups[0], caps[0])] == 2 * n_contacts - 1 and n_contacts > 1
+
+
+def test_debounce_chosen_rc_bridges_the_longest_bounce_opening(debounce):
+    numbers, _ = debounce
+    c = _toml("pushbutton_debounce")["circuit"]
+    vcc, high, r_series = c["voltage"], c["logic_high"], c["series_resistance"]
+    longest = max(numbers["bounce_openings"])
+    contacts = [b - a for a, b in numbers["grid"][0]["closed_intervals"]]
+    chosen = numbers["chosen"]
+    assert chosen is not None and chosen["edges"] == 1
+    # every contact discharges C through R_series to ~0 (>= 5 time constants), so each opening
+    # starts from 0 and the pin reads high again after tau ln(Vcc / (Vcc - V_high))
+    for row in numbers["grid"]:
+        assert min(contacts) > 5 * r_series * row["input_capacitance"]
+        crossing = (row["pull_resistance"] + r_series) * row["input_capacitance"] * math.log(vcc / (vcc - high))
+        assert (row["edges"] == 1) == (crossing > longest), row
+    assert chosen["rc"] == min(r["rc"] for r in numbers["grid"] if r["edges"] == 1)
+    # the one edge comes when the first contact has discharged C to V_low: R_series C ln(Vcc / V_low),
+    # 12 us; the edge time is interpolated between ngspice's points, ~2.5 us apart there, off by up to
+    # h^2 / (8 tau) = 80 ns (0.7 %; measured 0.6 %)
+    assert chosen["latency"] == pytest.approx(r_series * chosen["input_capacitance"] * math.log(vcc / c["logic_low"]),
+                                              rel=0.02)
