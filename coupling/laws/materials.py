@@ -24,6 +24,11 @@ temperature; below it the ballistic Sharvin resistance takes over), so a_i >= 0.
 plastic real area F/H must stay inside the apparent (Hertz) area of the rivet when its
 radius is given; Hertz's elastic law holds up to first yield, peak pressure
 p0 = 0.57 H (p0 = 1.6 Y, H ~ 2.8 Y; Johnson, "Contact Mechanics", sec. 6).
+
+The library also carries what the contact-duty models (coupling.laws.duty) need: thermal
+data, Holm's melting and boiling voltages, the minimum arc voltage and current and the
+erosion coefficients, each with value, range and source; ``Material.datum`` names the
+datum and the model when one is missing.
 """
 
 from __future__ import annotations
