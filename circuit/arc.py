@@ -23,10 +23,18 @@ Physics kept (short arcs between contact metals, the bounce regime):
   the re-ignition voltage may grow too: V_bd(d) = V_bd0 + E_bd d (``breakdown_gradient``).
   Both default to 0: a constant U_min and V_bd, no gap needed.
 
+- Optionally (``characteristic="ayrton"``) the burning voltage follows Ayrton's form
+  U = U_min + E_col d + (C + D d) / I_f instead of growing with the current: I_f is the
+  arc current followed with the arc's time constant, held between accepted points like
+  the state (a falling characteristic inside Newton would give two solutions per point).
+- The make arc: with ``breakdown_voltage`` and ``breakdown_gradient`` a closing gap
+  strikes where V_bd0 + E_bd d falls to the voltage across it (pre-strike), by the same
+  re-ignition rule; the contact shorts the arc at the make.
+
 Not modelled: arc elongation beyond the straight column (magnetic blow-out, arc
-runners), make arcs (pre-strike on closing), erosion, and the glow discharge regime.
-Without ``column_gradient`` a DC arc with E > U_min and load current > I_min burns for
-as long as the contact stays open.
+runners), erosion (coupling.laws.duty computes it from the arc energy), and the glow
+discharge regime. Without ``column_gradient`` a DC arc with E > U_min and load current >
+I_min burns for as long as the contact stays open.
 
 Netlist: the arc path across the gap is one behavioural conductor, a dead zone
 (conducts beyond +-U_min with slope 1/R_arc) enabled by the arc state e in {0, 1},
@@ -39,6 +47,12 @@ plus the 1 GOhm of an extinguished gap::
 
 (an EXTERNAL current source: ngspice asks for its value through its own callback, so
 the contact's EXTERNAL voltage source and the arc state need no name look-up).
+
+The Ayrton characteristic keeps the dead zone and moves its threshold: e is 0 (out) or
+1 + W with W = 1/I_f (1/A), and the path conducts min(e, 1) (|v| - U)/(R_A + dU W) beyond
+U = U_min - dU + E_col d + (C + D d) W (R_A = 1e-4 ohm, dU = 1 % of U_min), so at i = I_f
+the voltage is Ayrton's U(I_f) + R_A I_f and within a step the arc is a fixed, monotone
+conductor as before.
 
 With a gap dependence (``column_gradient`` or ``breakdown_gradient`` > 0) a second
 EXTERNAL voltage source gives the gap distance, and U_min in the dead zone becomes
@@ -98,6 +112,9 @@ _APPROACH = 0.75  # fraction of the remaining distance to a threshold one step m
 RESTART = 1e-3  # the first step after the arc switches, as a fraction of the step before it
 _LEVEL_TOLERANCE = 1e-9  # of the armed filter's level, when landing on its crossing of 1/2
 _ATTRIBUTE = "_switchsim_arc"  # where add_arc records the model on a PySpice Circuit
+CHARACTERISTICS = ("linear", "ayrton")
+AYRTON_RESISTANCE = 1e-4  # ohm: the Ayrton arc's own slope (what stays of R_arc; 0.04 V at 400 A)
+AYRTON_STEP_FRACTION = 0.01  # of U_min: the held Ayrton arc's within-step voltage span (slope dU / I_f)
 
 
 @dataclass(frozen=True)
@@ -124,6 +141,18 @@ class ArcModel:
         0 default). Illustrative: air breaks down at ~3 kV/mm at mm gaps (3e6 V/m); keep
         it above ``column_gradient``, else beyond d = (V_bd0 - U_min) / (E_col - E_bd) a
         re-ignited arc cannot conduct and goes out again at the next point.
+    characteristic: "linear" (default: U_min + E_col d + R_arc |i|, the netlist as it always
+        was) or "ayrton": U = U_min + E_col d + (C + D d) / I_f, Ayrton's form (H. Ayrton,
+        The Electric Arc, 1902: U = A + B l + (C + D l) / I), A = U_min, B = E_col, with
+        I_f the arc current followed with ``time_constant``; the arc voltage no longer grows
+        with the current (``resistance`` is unused: the Ayrton arc's own slope is
+        AYRTON_RESISTANCE, 1e-4 ohm). docs/circuit.md section 7.
+    ayrton_c: C, W (V A): the falling part of the characteristic at zero gap (0: none, the
+        short metal-vapour arc near U_min). Ayrton's carbon arc in air: 11.66 W.
+    ayrton_d: D, W/m: its growth with the gap (needs the gap d(t)). Ayrton's carbon arc:
+        10.54 W/mm = 1.054e4 W/m.
+    time_constant: s, the arc's thermal time constant with which I_f follows |i| (Mayr-type
+        relaxation; order 1-10 us for arcs in air). Only with "ayrton".
     """
 
     min_voltage: float = 12.0
@@ -133,6 +162,10 @@ class ArcModel:
     breakdown_voltage: float | None = None
     column_gradient: float = 0.0
     breakdown_gradient: float = 0.0
+    characteristic: str = "linear"
+    ayrton_c: float = 0.0
+    ayrton_d: float = 0.0
+    time_constant: float = 1e-6
 
     def __post_init__(self) -> None:
         name = "ArcModel"
@@ -152,11 +185,22 @@ class ArcModel:
                 f"{name}.breakdown_gradient = {self.breakdown_gradient:g} V/m needs breakdown_voltage "
                 "(the re-ignition voltage at zero gap, V)"
             )
+        if self.characteristic not in CHARACTERISTICS:
+            raise ValueError(f"{name}.characteristic = {self.characteristic!r}: allowed values are "
+                             f"{', '.join(map(repr, CHARACTERISTICS))}")
+        check_range(name, "ayrton_c", self.ayrton_c, "W", 0.0, 1e5)
+        check_range(name, "ayrton_d", self.ayrton_d, "W/m", 0.0, 1e9)
+        check_range(name, "time_constant", self.time_constant, "s", 1e-10, 1e-2)
+        if self.characteristic != "ayrton":
+            for key in ("ayrton_c", "ayrton_d"):
+                if getattr(self, key) != 0.0:
+                    raise ValueError(f"{name}.{key} = {getattr(self, key):g} applies to characteristic = 'ayrton' "
+                                     f"(the characteristic is {self.characteristic!r})")
 
     @property
     def uses_gap(self) -> bool:
         """True if the model depends on the gap distance: every run then needs d(t)."""
-        return self.column_gradient > 0.0 or self.breakdown_gradient > 0.0
+        return self.column_gradient > 0.0 or self.breakdown_gradient > 0.0 or self.ayrton_d > 0.0
 
 
 def add_arc(circuit: Circuit, arc: ArcModel, node_a: str, node_b: str, name: str = "") -> None:
@@ -172,20 +216,17 @@ def add_arc(circuit: Circuit, arc: ArcModel, node_a: str, node_b: str, name: str
     """
     name = check_block_name("add_arc(name=...)", name)
     p_node, on_node, gap_node = named("arc_p", name), named(STATE_NODE, name), named(GAP_NODE, name)
-    u = repr(float(arc.min_voltage))
-    if arc.column_gradient > 0.0:
-        u = f"({u}+{float(arc.column_gradient)!r}*V({gap_node}))"
     v = f"V({p_node},{node_b})"
     circuit.V(named(SENSE_SOURCE, name)[1:], node_a, p_node, 0)
-    circuit.B(
-        named("Barc", name)[1:],
-        p_node,
-        node_b,
-        current_expression=(
-            f"V({on_node})*(uramp({v}-{u})-uramp(-{v}-{u}))/{float(arc.resistance)!r}"
-            f"+{OFF_CONDUCTANCE!r}*{v}"
-        ),
-    )
+    if arc.characteristic == "ayrton":
+        expression = _ayrton_expression(arc, v, f"V({on_node})", f"V({gap_node})")
+    else:
+        u = repr(float(arc.min_voltage))
+        if arc.column_gradient > 0.0:
+            u = f"({u}+{float(arc.column_gradient)!r}*V({gap_node}))"
+        expression = (f"V({on_node})*(uramp({v}-{u})-uramp(-{v}-{u}))/{float(arc.resistance)!r}"
+                      f"+{OFF_CONDUCTANCE!r}*{v}")
+    circuit.B(named("Barc", name)[1:], p_node, node_b, current_expression=expression)
     # No value after 'external' (a value segfaults ngspice 38-40 on V sources).
     circuit.I(named(STATE_SOURCE, name)[1:], circuit.gnd, on_node, "external")
     circuit.R(named("Rarc_on", name)[1:], on_node, circuit.gnd, 1)
@@ -195,6 +236,26 @@ def add_arc(circuit: Circuit, arc: ArcModel, node_a: str, node_b: str, name: str
     recorded = getattr(circuit, _ATTRIBUTE, {})
     recorded[name] = (arc, str(node_a), str(node_b))
     setattr(circuit, _ATTRIBUTE, recorded)
+
+
+def _ayrton_expression(arc: ArcModel, v: str, on: str, gap: str) -> str:
+    """The Ayrton arc's current: a dead zone at the held voltage U = U_min - dU + E_col d +
+    (C + D d) W, slope 1 / (R_A + dU W), enabled by min(e, 1); e = 0 (out) or 1 + W, W = 1/I_f
+    (1/A; 0 until the arc carries I_min), set by ArcState between accepted points. At
+    i = I_f the voltage is U_min + E_col d + (C + D d) / I_f + R_A I_f: Ayrton's form."""
+    du = AYRTON_STEP_FRACTION * float(arc.min_voltage)
+    w = f"max({on}-1,0)"
+    u = repr(float(arc.min_voltage) - du)
+    if arc.column_gradient > 0.0:
+        u += f"+{float(arc.column_gradient)!r}*{gap}"
+    c = repr(float(arc.ayrton_c))
+    if arc.ayrton_d > 0.0:
+        c = f"({c}+{float(arc.ayrton_d)!r}*{gap})"
+    if arc.ayrton_c > 0.0 or arc.ayrton_d > 0.0:
+        u += f"+{c}*{w}"
+    u = f"({u})"
+    return (f"min({on},1)*(uramp({v}-{u})-uramp(-{v}-{u}))/({AYRTON_RESISTANCE!r}+{du!r}*{w})"
+            f"+{OFF_CONDUCTANCE!r}*{v}")
 
 
 def recorded_arc(circuit: Circuit, name: str = "") -> ArcModel | None:
@@ -248,6 +309,7 @@ class ArcState:
             self._names_off += (gap.lower(),)
         self._sign_b = node_b.lower() not in ground  # v = V(a) - V(b); a grounded node reads 0
         self._sign_a = node_a.lower() not in ground
+        self._ayrton = arc.characteristic == "ayrton"
         self.start(False)
 
     def start(self, closed: bool) -> None:
@@ -260,6 +322,7 @@ class ArcState:
         self._breakpoints: list[float] = []
         self._t = -math.inf
         self._previous: tuple[float, float] | None = None  # (t, |i| or |v|) at the last point, same state
+        self.filtered_current = 0.0  # I_f of the Ayrton characteristic, A (0: not yet carrying I_min)
 
     def add_breakpoints(self, times: Sequence[float]) -> None:
         """Instants (s) where G may change (make/break, ramp corners, PWL vertices)."""
@@ -315,6 +378,8 @@ class ArcState:
                 restart = RESTART * (t - previous_t)
         self.burning = burning
         self.value = 1.0 if burning else 0.0
+        if self._ayrton:
+            self._follow(t, previous_t, current, burning and not (armed and closed))
         # The next crossing of 1/2 by the filter if the contact stays as it is: land on it.
         land = math.inf
         if closed and not armed:
@@ -335,6 +400,21 @@ class ArcState:
         if breakdown:  # |v| (less E_bd d) rising towards V_bd0
             return min(restart, self._approach(t, voltage, arc.breakdown_voltage, 1.0, floor)), land
         return restart, land
+
+    def _follow(self, t: float, previous_t: float, current: float, arcing: bool) -> None:
+        """The Ayrton arc's held state: I_f relaxes towards |i| with the arc's time constant
+        (exactly, |i| taken constant over the step), from the first point the arc carries
+        I_min; value = 1 + 1/I_f (0 out; 1 while I_f is not yet set: the arc at U_min)."""
+        arc = self.arc
+        if not arcing:
+            self.filtered_current = 0.0
+        elif self.filtered_current > 0.0:
+            decay = math.exp(-(t - previous_t) / arc.time_constant)
+            self.filtered_current = current + (self.filtered_current - current) * decay
+        elif current >= arc.min_current:
+            self.filtered_current = current
+        if self.burning and self.filtered_current > 0.0:
+            self.value = 1.0 + 1.0 / max(self.filtered_current, arc.min_current)
 
     def _approach(self, t: float, x: float, threshold: float, direction: float, floor: float) -> float:
         previous, self._previous = self._previous, (t, x)

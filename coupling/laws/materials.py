@@ -24,6 +24,11 @@ temperature; below it the ballistic Sharvin resistance takes over), so a_i >= 0.
 plastic real area F/H must stay inside the apparent (Hertz) area of the rivet when its
 radius is given; Hertz's elastic law holds up to first yield, peak pressure
 p0 = 0.57 H (p0 = 1.6 Y, H ~ 2.8 Y; Johnson, "Contact Mechanics", sec. 6).
+
+The library also carries what the contact-duty models (coupling.laws.duty) need: thermal
+data, Holm's melting and boiling voltages, the minimum arc voltage and current and the
+erosion coefficients, each with value, range and source; ``Material.datum`` names the
+datum and the model when one is missing.
 """
 
 from __future__ import annotations
@@ -36,7 +41,9 @@ from typing import Any
 
 import numpy as np
 
-from mech.validation import check_choice, check_keys, check_nonnegative, check_positive, check_whole, unknown
+from mech.validation import (
+    check_choice, check_finite, check_keys, check_nonnegative, check_positive, check_whole, unknown,
+)
 
 MIN_SPOT_RADIUS = 0.1e-6  # m: a >> the electron mean free path (Holm's diffusive constriction)
 YIELD_PRESSURE_OVER_HARDNESS = 0.57  # Hertz peak pressure at first yield / hardness
@@ -86,7 +93,8 @@ def film_resistance(film_resistivity, area):
 @dataclass(frozen=True)
 class Material:
     """A contact material: resistivity (ohm m), hardness (Pa), Young's modulus (Pa), Poisson
-    ratio, and for each the typical range and source written in the data file."""
+    ratio, and the contact-duty data (None where the library has no figure; SI units, listed
+    in ``DUTY_PROPERTIES``); for each its typical range, source and note from the data file."""
 
     name: str
     description: str
@@ -94,11 +102,66 @@ class Material:
     hardness: float
     youngs_modulus: float
     poisson_ratio: float
+    thermal_conductivity: float | None = None  # W/(m K)
+    temperature_coefficient: float | None = None  # of the resistivity, 1/K
+    melting_point: float | None = None  # K
+    boiling_point: float | None = None  # K
+    melting_voltage: float | None = None  # V (Holm)
+    boiling_voltage: float | None = None  # V (Holm)
+    density: float | None = None  # kg/m^3
+    specific_heat: float | None = None  # J/(kg K)
+    latent_heat: float | None = None  # of fusion, J/kg
+    min_arc_voltage: float | None = None  # V
+    min_arc_current: float | None = None  # A
+    erosion_anode: float | None = None  # m^3 per J of arc energy in the anodic stage
+    erosion_cathode: float | None = None  # m^3 per J of arc energy in the cathodic stage
     ranges: dict = field(default_factory=dict, compare=False)
     sources: dict = field(default_factory=dict, compare=False)
+    notes: dict = field(default_factory=dict, compare=False)
+
+    def datum(self, prop: str, model: str) -> float:
+        """The value of ``prop``; ValueError naming the datum and the model when the library has none."""
+        value = getattr(self, prop)
+        if value is None:
+            raise ValueError(f"contact material {self.name!r} has no {prop} in the material library, "
+                             f"needed by {model}: add it to the material's entry")
+        return value
 
 
 PROPERTIES = ("resistivity", "hardness", "youngs_modulus", "poisson_ratio")
+DUTY_PROPERTIES = ("thermal_conductivity", "temperature_coefficient", "melting_point", "boiling_point",
+                   "melting_voltage", "boiling_voltage", "density", "specific_heat", "latent_heat",
+                   "min_arc_voltage", "min_arc_current", "erosion_anode", "erosion_cathode")
+# Data that may be zero (an erosion-free material); every other datum must be > 0.
+_MAY_BE_ZERO = {"erosion_anode", "erosion_cathode"}
+_ENTRY_KEYS = {"description", "status", *PROPERTIES, *DUTY_PROPERTIES}
+_DATUM_KEYS = {"value", "range", "source", "note"}
+
+
+def _datum(name: str, prop: str, item) -> tuple[float, tuple[float, float], str, str]:
+    """value, range, source, note of one property table, checked (one-line errors naming it)."""
+    where = f"contact materials: {name}.{prop}"
+    if not isinstance(item, dict):
+        raise ValueError(f"{where} = {item!r}: expected a table {{ value, range, source }}")
+    check_keys(where, item, sorted(_DATUM_KEYS))
+    for key in ("value", "range", "source"):
+        if key not in item:
+            raise ValueError(f"{where}: missing {key} (each datum needs value, range and source)")
+    value = check_finite(f"{where}.value", item["value"])
+    if prop in _MAY_BE_ZERO:
+        check_nonnegative(f"{where}.value", value)
+    else:
+        check_positive(f"{where}.value", value)
+    rng = item["range"]
+    if not (isinstance(rng, list) and len(rng) == 2):
+        raise ValueError(f"{where}.range = {rng!r}: expected [low, high]")
+    lo, hi = (check_finite(f"{where}.range", x) for x in rng)
+    if not lo <= value <= hi:
+        raise ValueError(f"contact materials: {name}.{prop} = {value!r} outside its range {[lo, hi]}")
+    source = item["source"]
+    if not (isinstance(source, str) and source.strip()):
+        raise ValueError(f"{where}.source = {source!r}: expected where the figure comes from")
+    return value, (lo, hi), source, str(item.get("note", ""))
 
 
 def load_materials(text: str | None = None) -> dict[str, Material]:
@@ -108,16 +171,19 @@ def load_materials(text: str | None = None) -> dict[str, Material]:
     doc = tomllib.loads(text)
     out = {}
     for name, entry in doc.items():
-        values, ranges, sources = {}, {}, {}
-        for prop in PROPERTIES:
-            item = entry[prop]
-            values[prop] = float(item["value"])
-            ranges[prop] = tuple(float(x) for x in item["range"])
-            sources[prop] = str(item["source"])
-            lo, hi = ranges[prop]
-            if not (lo <= values[prop] <= hi):
-                raise ValueError(f"contact materials: {name}.{prop} = {values[prop]!r} outside its range {[lo, hi]}")
-        out[name] = Material(name, entry.get("description", ""), ranges=ranges, sources=sources, **values)
+        if not isinstance(entry, dict):
+            raise ValueError(f"contact materials: {name} = {entry!r}: expected a table of properties")
+        check_keys(f"contact materials: [{name}]", entry, sorted(_ENTRY_KEYS))
+        values, ranges, sources, notes = {}, {}, {}, {}
+        for prop in PROPERTIES + DUTY_PROPERTIES:
+            if prop not in entry:
+                if prop in PROPERTIES:
+                    raise ValueError(f"contact materials: [{name}] has no {prop} (every material needs "
+                                     f"{', '.join(PROPERTIES)})")
+                continue
+            values[prop], ranges[prop], sources[prop], notes[prop] = _datum(name, prop, entry[prop])
+        out[name] = Material(name, entry.get("description", ""), ranges=ranges, sources=sources, notes=notes,
+                             **values)
     return out
 
 

@@ -72,8 +72,9 @@ def test_schedule_errors_name_the_scene_key():
 
 @pytest.mark.parametrize("circuit, expected", [
     ({"arc": {"min_voltag": 10.0}}, "circuit.arc: unknown key 'min_voltag' (did you mean 'min_voltage'?); "
-                                    "allowed keys: breakdown_gradient, breakdown_voltage, column_gradient, "
-                                    "formation_time, min_current, min_voltage, resistance"),
+                                    "allowed keys: ayrton_c, ayrton_d, breakdown_gradient, breakdown_voltage, "
+                                    "characteristic, column_gradient, formation_time, min_current, min_voltage, "
+                                    "resistance, time_constant"),
     ({"snubber": {"resistanse": 1.0, "capacitance": 1e-9}}, "did you mean 'resistance'?"),
     ({"flyback": {"saturation": 1e-9}}, "did you mean 'saturation_current'?"),
     ({"complience_voltage": 10.0}, "[circuit]: unknown key 'complience_voltage' (did you mean "

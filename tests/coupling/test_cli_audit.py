@@ -71,7 +71,7 @@ LATIN1_LINE = SHIPPED.encode()[:SHIPPED.encode().index(b"3,0,")].count(b"\n") + 
     ("load_resistance = 0.0", ["circuit.load_resistance = 0 ohm is out of range"], "ResistiveLoad"),
     ("source_resistance = -1.0", ["circuit.source_resistance = -1 ohm"], "internal_resistance"),
     ("arc = {min_voltag = 10.0}", ["circuit.arc: unknown key 'min_voltag' (did you mean 'min_voltage'?)",
-                                   "allowed keys: breakdown_gradient, breakdown_voltage"], "unexpected keyword"),
+                                   "allowed keys: ayrton_c, ayrton_d, breakdown_gradient, breakdown_voltage"], "unexpected keyword"),
     ("reltol = 0.5", ["circuit.reltol = 0.5 is out of range"], "SimulationOptions"),
 ])
 def test_circuit_errors_name_the_scene_key(tmp_path, circuit, words, internal):
