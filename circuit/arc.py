@@ -202,6 +202,13 @@ class ArcModel:
         """True if the model depends on the gap distance: every run then needs d(t)."""
         return self.column_gradient > 0.0 or self.breakdown_gradient > 0.0 or self.ayrton_d > 0.0
 
+    @property
+    def gap_terms(self) -> str:
+        """The model's terms that grow with the gap, for messages ("column_gradient = 2000 V/m, ...")."""
+        terms = [("column_gradient", self.column_gradient, "V/m"), ("breakdown_gradient", self.breakdown_gradient,
+                                                                    "V/m"), ("ayrton_d", self.ayrton_d, "V A/m")]
+        return ", ".join(f"{name} = {value:g} {unit}" for name, value, unit in terms if value > 0.0)
+
 
 def add_arc(circuit: Circuit, arc: ArcModel, node_a: str, node_b: str, name: str = "") -> None:
     """Add the arc path across the contact ``name`` (``node_a``, ``node_b``) of a PySpice circuit.

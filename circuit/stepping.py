@@ -253,8 +253,7 @@ class Stepper:
             if block is not None:
                 arc = block.arc
                 raise ValueError(
-                    f"the arc model depends on the gap (column_gradient = {arc.column_gradient:g} V/m, "
-                    f"breakdown_gradient = {arc.breakdown_gradient:g} V/m): pass the gap distance d(t) >= 0 "
+                    f"the arc model depends on the gap ({arc.gap_terms}): pass the gap distance d(t) >= 0 "
                     f"in m, advance(t_next, conductance, breakpoints, gap=function_of_time_or_number)"
                     + ("" if len(self.probes.contacts) == 1 else f" (input {name})"))
             raise TypeError(f"advance() needs the input {name} (a function of time or a number)")

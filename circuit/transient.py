@@ -65,8 +65,7 @@ def _require_gap(circuit: CircuitLike, gap: object, how: str) -> None:
     arc = _single_contact(circuit, how).arc
     if gap is None and arc is not None and arc.uses_gap:
         raise ValueError(
-            f"the arc model depends on the gap (column_gradient = {arc.column_gradient:g} V/m, "
-            f"breakdown_gradient = {arc.breakdown_gradient:g} V/m): pass the gap distance d(t) >= 0 in m, {how}"
+            f"the arc model depends on the gap ({arc.gap_terms}): pass the gap distance d(t) >= 0 in m, {how}"
         )
 
 
