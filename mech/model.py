@@ -7,15 +7,16 @@ give the rigid bar, and zero friction switches the tangential machinery off.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .contact_laws import (
-    calibrate_damping, damping_formula, hertz_impact, hertz_stiffness,
-)
+from .beam_fe import beam_modes
+from .contact_laws import damping_formula, hertz_impact, hertz_stiffness
+from .damping_calibration import calibrate_damping
 from .kernel_layout import (
     D_MU0, F_BAUM, F_BETA, F_C, F_G, F_GAMMA, F_VBOUND, F_K, F_MASS, F_MAX_RATIO, F_RTIP, N_DRIVE,
     F_VREG, FRICTION_EXACT, FRICTION_NONE, FRICTION_REGULARIZED, I_FRICTION, I_N,
@@ -24,9 +25,11 @@ from .kernel_layout import (
 )
 from .mechanism import (
     MechanismArrays, build_arrays, closing_work, contact_parameters,
-    effective_contact_mass, frame_height, impulse_mass, needs_mechanism,
+    effective_contact_mass, fe_beam, frame_height, impulse_mass, needs_mechanism,
 )
-from .modal_basis import ModalBasis, build_modal_basis, sparse_invariants
+from .modal_basis import ModalBasis, _quadrature, build_modal_basis, sparse_invariants
+from .mode_count import CAP, SAFETY, choose_mode_count
+from .modes import axial_frequencies, bending_frequencies, bending_shape, free_free_roots
 from .parameters import MechScene
 from .rotations import matrix_to_quaternion, quat_to_matrix, rotation_y, rotation_z  # noqa: F401
 
@@ -533,9 +536,6 @@ def family_frequencies(bar, count: int) -> tuple[np.ndarray, np.ndarray]:
     """Hz: the first ``count`` axial and bending frequencies of ``bar`` (bending in the
     more flexible plane). Euler-Bernoulli closed forms; for the paper's shear-type bending,
     sqrt(K_jj/m) of its stiffness on the free-free shapes (its K is full within a family)."""
-    from .modal_basis import _quadrature
-    from .modes import axial_frequencies, bending_frequencies, bending_shape, free_free_roots
-
     axial = axial_frequencies(count, bar.length, bar.youngs_modulus, bar.density)
     if bar.bending == "euler_bernoulli":
         bend = bending_frequencies(count, bar.length, bar.youngs_modulus, min(bar.second_moments),
@@ -554,10 +554,6 @@ def resolve_auto_modes(scene: MechScene, safety: float | None = None):
     mech.mode_count.choose_mode_count from the Hertz contact time of the first impact
     (rigid-bar effective mass and impact speed of ``contact_scales``); safety: the
     factor of f_cut = safety / t_c (None: mode_count.SAFETY)."""
-    import dataclasses
-
-    from .mode_count import CAP, SAFETY, choose_mode_count
-
     bar = scene.bar
     if bar.axial_modes != "auto" and bar.bending_modes != "auto":
         return scene, None
@@ -585,10 +581,6 @@ def _mechanism_auto_inputs(scene: MechScene, cap: int, safety: float):
     it; bending in its more flexible plane), every one below f_cut = safety / t_c at least,
     and the Hertz time t_c of the first contact point's impact on its effective mass
     (mechanism_scales, from a small basis)."""
-    import dataclasses
-
-    from .mechanism import fe_beam
-
     bar = scene.bar
     small = dataclasses.replace(scene, bar=dataclasses.replace(bar, axial_modes=1, bending_modes=3))
     arr = build_arrays(small, True)
@@ -616,8 +608,6 @@ def frequencies_below(beam, family: str, cutoff: float, cap: int, first: int = 8
     the cap's mesh (255 elements, ~0.3 s of eigen-solves for a blade's two families)
     was most of the start of a held bar's run.
     """
-    from .beam_fe import beam_modes
-
     count = max(1, min(first, cap))
     while True:
         f = beam_modes(beam, family, count).frequencies

@@ -41,6 +41,7 @@ from .mechanism import base_velocity_jumps
 from .model import BarModel, build_model
 from .parameters import MechScene
 from .recorder import Recorder
+from .results import ImpactResult
 from .scipy_backend import METHODS as SCIPY_METHODS, ScipyStepper
 from .stepping import CompiledStepper, Stepper
 
@@ -338,9 +339,7 @@ class ImpactSolver:
         self.advance(self.scene.solver.t_end)
         return self.result()
 
-    def result(self):
-        from .results import ImpactResult
-
+    def result(self) -> ImpactResult:
         return ImpactResult(
             model=self.model,
             **self.recorder.columns(),

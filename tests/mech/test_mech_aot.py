@@ -28,7 +28,6 @@ RUN = textwrap.dedent("""
     import json, sys
     import numpy as np
     import mech.compiled
-    from mech.aot import warm_up
     from mech.scene import scene_from_dict
     from mech.solver import ImpactSolver
     steel = dict(youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0)
