@@ -76,7 +76,8 @@ def signatures() -> dict:
     for name in jit.ENTRY_POINTS:
         sigs = getattr(jit, name).nopython_signatures
         if not sigs:
-            raise RuntimeError(f"the warm-up never called {name}: add a model that reaches it to mech.aot_build.warm_up")
+            raise RuntimeError(f"the warm-up never called {name}: add a model that reaches it to "
+                               "mech.aot_build.warm_up")
         if len(sigs) > 1:
             sigs = [_merge_layouts(name, sigs)]
         out[name] = sigs[0]

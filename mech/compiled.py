@@ -54,8 +54,8 @@ def _checked(name: str, fn, check):
         try:
             check(args)
         except TypeError as err:
-            warnings.warn(f"{err}: calling numba's just-in-time {name} instead (add the call to mech.aot_build.warm_up)",
-                          CompiledArgumentWarning, stacklevel=2)
+            warnings.warn(f"{err}: calling numba's just-in-time {name} instead (add the call to "
+                          "mech.aot_build.warm_up)", CompiledArgumentWarning, stacklevel=2)
             return _jit(name)(*args)
         return fn(*args)
 
