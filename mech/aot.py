@@ -135,7 +135,13 @@ def _build(folder: Path) -> str | None:
     staging = Path(tempfile.mkdtemp(prefix=folder.name + ".build-", dir=folder.parent))
     _note("compiling the mechanics ahead of time (once per version of mech's sources; about a minute)")
     tick = time.perf_counter()
-    env = dict(os.environ, **{FORCE_JIT: "1"})
+    # The child's warm-up must compile every entry point itself: numba registers a
+    # signature on a function's dispatcher only when it compiles it, and a function loaded
+    # from numba's on-disk cache compiles none of the functions it calls (measured: after a
+    # run with SWITCHSIM_JIT=1 had filled the cache, the build failed with "the warm-up
+    # never called energies"). So the child gets an empty cache folder of its own.
+    jit_cache = staging / "jit-cache"
+    env = dict(os.environ, **{FORCE_JIT: "1", "NUMBA_CACHE_DIR": str(jit_cache)})
     try:
         code = f"from mech.aot_build import compile_into; compile_into({str(staging)!r})"
         done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
@@ -145,6 +151,7 @@ def _build(folder: Path) -> str | None:
             return tail
         if not (module_file(staging).is_file() and (staging / SIGNATURES).is_file()):
             return f"the build left no {module_file(staging).name}"
+        shutil.rmtree(jit_cache, ignore_errors=True)
         os.rename(staging, folder)
     except subprocess.TimeoutExpired:
         return f"no result after {BUILD_TIMEOUT:.0f} s"
