@@ -7,9 +7,9 @@ source: tests/mech/test_mech_aot.py compares their trajectories).
 
 What is exported: every entry point of ``mech.compiled.ENTRY_POINTS``, each with the
 signature the just-in-time dispatcher compiled when the Python side called it in small
-warm-up runs of representative models (free 3D and planar bars, a clamped blade with a
-rivet, a pivot, friction exact / regularized / none, stick, the dense output, the scipy
-backend, the damping calibration). The signatures are never written by hand, so a kernel
+warm-up runs of representative models (mech.aot_build.warm_up: free 3D and planar bars,
+a clamped blade with a rivet, a pivot, friction exact / regularized / none, stick, the
+dense output, the scipy backend, the damping calibration). The signatures are never written by hand, so a kernel
 signature that changes is picked up by the next build.
 
 Where: ``<NUMBA_CACHE_DIR or mech/__pycache__>/aot-<key>/``, the key a hash of mech's
@@ -21,7 +21,10 @@ file. When the build cannot be done (no C compiler, numba.pycc gone, a failed co
 reason is kept in ``aot-<key>.failed`` and said once on stderr; the just-in-time route is
 used then, and always with ``SWITCHSIM_JIT=1`` in the environment.
 
-``compile_into(DEST)`` is what that child runs: warm up, collect, compile into DEST.
+This module is the loader: where the module lives, loading it, starting its build and
+checking the arguments of its functions; it imports nothing of mech but the cache key
+(mech.compiled_cache). What the build child runs -- the warm-up and numba.pycc's
+compile -- is mech.aot_build, which imports the solver and is never imported here.
 """
 
 from __future__ import annotations
@@ -38,6 +41,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
+
 from .compiled_cache import PACKAGE, source_key
 
 FORCE_JIT = "SWITCHSIM_JIT"  # "1": numba's just-in-time route, no extension module
@@ -51,10 +56,8 @@ def cache_root() -> Path:
 
 
 def build_key() -> str:
-    import numpy
-
     suffix = importlib.machinery.EXTENSION_SUFFIXES[0]
-    return f"{source_key()}-np{numpy.__version__}{suffix.rsplit('.', 1)[0]}"
+    return f"{source_key()}-np{np.__version__}{suffix.rsplit('.', 1)[0]}"
 
 
 def module_folder(root: Path | None = None) -> Path:
@@ -132,9 +135,15 @@ def _build(folder: Path) -> str | None:
     staging = Path(tempfile.mkdtemp(prefix=folder.name + ".build-", dir=folder.parent))
     _note("compiling the mechanics ahead of time (once per version of mech's sources; about a minute)")
     tick = time.perf_counter()
-    env = dict(os.environ, **{FORCE_JIT: "1"})
+    # The child's warm-up must compile every entry point itself: numba registers a
+    # signature on a function's dispatcher only when it compiles it, and a function loaded
+    # from numba's on-disk cache compiles none of the functions it calls (measured: after a
+    # run with SWITCHSIM_JIT=1 had filled the cache, the build failed with "the warm-up
+    # never called energies"). So the child gets an empty cache folder of its own.
+    jit_cache = staging / "jit-cache"
+    env = dict(os.environ, **{FORCE_JIT: "1", "NUMBA_CACHE_DIR": str(jit_cache)})
     try:
-        code = f"from mech.aot import compile_into; compile_into({str(staging)!r})"
+        code = f"from mech.aot_build import compile_into; compile_into({str(staging)!r})"
         done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
                               text=True, timeout=BUILD_TIMEOUT, cwd=str(PACKAGE.parent))
         if done.returncode != 0:
@@ -142,6 +151,7 @@ def _build(folder: Path) -> str | None:
             return tail
         if not (module_file(staging).is_file() and (staging / SIGNATURES).is_file()):
             return f"the build left no {module_file(staging).name}"
+        shutil.rmtree(jit_cache, ignore_errors=True)
         os.rename(staging, folder)
     except subprocess.TimeoutExpired:
         return f"no result after {BUILD_TIMEOUT:.0f} s"
@@ -168,127 +178,6 @@ def remove_stale(folder: Path) -> None:
             stale.unlink(missing_ok=True)
 
 
-# --- the child process -----------------------------------------------------------------
-
-
-def warm_up() -> None:
-    """Call every entry point through the Python side on small representative models."""
-    import numpy as np
-
-    from .contact_laws import calibrate_damping
-    from .scene import scene_from_dict
-    from .solver import ImpactSolver
-
-    steel = dict(youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0)
-    bar3d = dict(length=0.1, diameter=0.006, tip_radius=0.003, modes=2, **steel)
-    short = dict(t_end=3e-4)
-    scenes = [
-        # 3D free bar, exact friction, restitution calibrated; a stick on the block
-        {"bar": bar3d, "initial": dict(height=1e-4, angle_deg=30.0, velocity=[0.3, 0.1, -1.0]),
-         "friction": dict(model="exact", mu=0.8), "contact": dict(restitution=0.5), "solver": short},
-        # planar free bar, regularized friction
-        {"bar": bar3d, "initial": dict(height=1e-4, angle_deg=30.0, velocity=[0.0, 0.0, -1.0]),
-         "friction": dict(model="regularized", mu=0.3), "solver": short},
-        # no friction, the paper's law
-        {"bar": bar3d, "initial": dict(height=1e-4, angle_deg=30.0, velocity=[0.0, 0.0, -1.0]),
-         "friction": dict(mu=0.0), "contact": dict(law="paper", restitution=0.8), "solver": short},
-        # a clamped blade with a rivet under a force ramp
-        {"bar": dict(length=0.02, width=0.003, thickness=0.0003, tip_radius=0.0016, modes={"axial": 1, "bending": 3},
-                     modal_damping=0.05, **steel),
-         "mount": dict(kind="clamp", position=0.02), "rivet": [dict(position=0.0015, offset=0.0, radius=0.0015)],
-         "force": [dict(position=0.01, time=[0.0, 0.001], value=[0.0, 3.0])],
-         "initial": dict(height=2e-5), "friction": dict(model="exact", mu=0.3), "solver": dict(t_end=1e-3)},
-        # a pivoted rigid arm on a spring
-        {"bar": dict(length=0.05, diameter=0.005, tip_radius=0.0025, modes=0, **steel),
-         "mount": dict(kind="pivot", position=0.05, stiffness=1.0, preload_torque=0.01),
-         "spring": [dict(anchor=[0.01, 0.0, 0.01], position=0.01, stiffness=50.0, damping=0.01)],
-         "initial": dict(height=1e-5), "solver": dict(t_end=5e-4)},
-    ]
-    for k, doc in enumerate(scenes):
-        solver = ImpactSolver(scene_from_dict(doc), keep_dense=True)
-        segment = solver.advance(doc["solver"]["t_end"] * 0.5)
-        t = 0.5 * (segment.t_start + segment.t_end)
-        segment.contact(t)
-        segment.tip_forces(t)
-        segment.state(t)
-        solver.advance(doc["solver"]["t_end"])
-        solver.contact_series(np.linspace(segment.t_start, solver.t, 5))
-        result = solver.result()
-        result.energy_table  # noqa: B018  (the compiled energy table)
-        result.contacts  # noqa: B018  (dense contact evaluation where the solver asks for it)
-        if k == 0:  # the scipy backends hand the right-hand side views of their own arrays
-            for method in ("RK45", "Radau", "BDF", "LSODA"):
-                ImpactSolver(scene_from_dict(doc), backend=f"scipy:{method}").run()
-    calibrate_damping("hunt_crossley", 0.7, 1.0, 1e10, 0.01)
-
-
-def signatures(jit) -> dict:
-    """name -> numba Signature of each entry point as the warm-up compiled it; a function
-    compiled for array arguments of several layouts is exported for any layout ('A')."""
-    out = {}
-    for name in jit.ENTRY_POINTS:
-        sigs = getattr(jit, name).nopython_signatures
-        if not sigs:
-            raise RuntimeError(f"the warm-up never called {name}: add a model that reaches it to mech.aot.warm_up")
-        if len(sigs) > 1:
-            sigs = [_merge_layouts(name, sigs)]
-        out[name] = sigs[0]
-    return out
-
-
-def _merge_layouts(name: str, sigs):
-    from numba.core import types
-
-    first = sigs[0]
-    args = list(first.args)
-    for sig in sigs[1:]:
-        if len(sig.args) != len(args) or sig.return_type != first.return_type:
-            raise RuntimeError(f"{name} was compiled for different argument kinds: {sigs}")
-        for i, (a, b) in enumerate(zip(args, sig.args)):
-            if a == b:
-                continue
-            if isinstance(a, types.Array) and isinstance(b, types.Array) and (a.dtype, a.ndim) == (b.dtype, b.ndim):
-                args[i] = a.copy(layout="A")
-            else:
-                raise RuntimeError(f"{name} was compiled for different argument types: {a} and {b}")
-    return first.return_type(*args)
-
-
-def compile_into(dest) -> None:
-    """Warm up on the JIT route, then compile every entry point into ``dest`` (a folder)."""
-    import warnings
-
-    warnings.filterwarnings("ignore", message=".*pycc.*")
-    from numba.pycc import CC
-
-    from . import compiled as jit
-
-    if jit.ROUTE != "jit":
-        raise RuntimeError(f"the build must run on the just-in-time route (set {FORCE_JIT}=1)")
-    warm_up()
-    cc = CC(MODULE, source_module=__name__)
-    cc.output_dir = str(dest)
-    cc.target_cpu = "host"  # built where it runs: the same instructions the JIT would use
-    sigs = signatures(jit)
-    for name, sig in sigs.items():
-        cc.export(name, sig)(getattr(jit, name).py_func)
-    cc.compile()
-    (Path(dest) / SIGNATURES).write_text(json.dumps({name: [_kind(a) for a in sig.args]
-                                                     for name, sig in sigs.items()}, indent=1))
-
-
-def _kind(t):
-    """What an argument of numba type ``t`` must be for the exported function (JSON):
-    ["array", dtype, ndim, layout], ["tuple", [kinds]] or ["scalar", name]."""
-    from numba.core import types
-
-    if isinstance(t, types.Array):
-        return ["array", str(t.dtype), t.ndim, t.layout]
-    if isinstance(t, types.BaseTuple):
-        return ["tuple", [_kind(e) for e in t.types]]
-    return ["scalar", str(t)]
-
-
 def argument_checks(folder: Path) -> dict:
     """name -> check(args) raising TypeError for an argument the exported function would
     misread (numba.pycc's wrappers do not check an array's dtype, rank or layout).
@@ -296,8 +185,6 @@ def argument_checks(folder: Path) -> dict:
     The checks run before every compiled call (thousands per coupled run), so passing is
     kept cheap: a test per argument with no string built unless it fails, and the model and
     work tuples, passed unchanged on every call, checked once."""
-    import numpy as np
-
     ndarray = np.ndarray
 
     def checker(kind):

@@ -35,6 +35,8 @@ class CompiledArgumentWarning(RuntimeWarning):
 
 
 def _jit(name: str):
+    # imported when first asked for, not at the top: mech.kernel and mech.integrator import
+    # numba (~0.6 s of a run's start), which the ahead-of-time route never loads
     return getattr(importlib.import_module(f".{ENTRY_POINTS[name]}", __package__), name)
 
 
@@ -52,8 +54,8 @@ def _checked(name: str, fn, check):
         try:
             check(args)
         except TypeError as err:
-            warnings.warn(f"{err}: calling numba's just-in-time {name} instead (add the call to mech.aot.warm_up)",
-                          CompiledArgumentWarning, stacklevel=2)
+            warnings.warn(f"{err}: calling numba's just-in-time {name} instead (add the call to "
+                          "mech.aot_build.warm_up)", CompiledArgumentWarning, stacklevel=2)
             return _jit(name)(*args)
         return fn(*args)
 

@@ -4,8 +4,8 @@ numba's on-disk cache (``cache=True``) checks each function against its own file
 compiled integrator that inlines the right-hand side of kernel.py is reused after
 kernel.py changed (seen here: a stale cache ran the old inertia route). Keying the folder
 by a hash of every source file of the package makes any change compile afresh; an
-unchanged package reuses its cache. ``configure`` runs when ``mech`` is imported, before
-any compiled function is defined.
+unchanged package reuses its cache. ``configure`` runs when mech.jit is imported (the
+just-in-time route and the ahead-of-time build), before any compiled function is defined.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ def source_key(folder: Path = PACKAGE) -> str:
 
 def configure() -> Path:
     """Point numba's cache at <NUMBA_CACHE_DIR or mech/__pycache__>/numba-<source key>."""
-    import numba
+    import numba  # here, not at the top: mech.aot takes source_key from this module without numba
 
     root = Path(os.environ.get("NUMBA_CACHE_DIR") or PACKAGE / "__pycache__")
     folder = root / f"numba-{source_key()}"

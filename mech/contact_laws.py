@@ -1,14 +1,16 @@
-"""Normal contact laws: Hertz stiffness, damping laws and their calibration to a restitution.
+"""Normal contact laws: Hertz stiffness, force, impact and the damping laws' closed forms.
 
-Pure functions (SI units). ``normal_force`` is also compiled into the kernel (mech.kernel),
-which calls it inside the integration loop; here it is plain Python, the readable reference.
+Pure functions (SI units) that import nothing of mech: ``normal_force`` and
+``scaled_rebound`` are also compiled into the kernel (mech.kernel), which calls them
+inside the integration loop; here they are plain Python, the readable reference. The
+calibration of a damping to a restitution, which root-finds on the compiled
+``scaled_rebound``, is mech.damping_calibration.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
 
 
 # t_c = 2.943275 delta_max / v0 for an undamped Hertz impact: 2 int_0^1 (1 - x^2.5)^-1/2 dx
@@ -74,11 +76,11 @@ def damping_formula(law: str, restitution: float, speed: float, stiffness: float
 
 def scaled_rebound(c_hat: float, beta: float) -> float:
     """Rebound speed of the dimensionless single impact y'' = -(y^1.5 + c_hat y^beta y')^+,
-    y(0) = 0, y'(0) = 1: the restitution (see ``calibrate_damping`` for the scaling).
+    y(0) = 0, y'(0) = 1: the restitution (see mech.damping_calibration for the scaling).
 
     Plain Python and also compiled (mech.kernel; mech.compiled exports it): the
-    calibration root-finds c_hat with some fifty of these solves. Classical Runge-Kutta
-    with step doubling (local error <= 1e-14 of the unit speed; the step shrinks by
+    calibration (mech.damping_calibration) root-finds c_hat with some fifty of these
+    solves. Classical Runge-Kutta with step doubling (local error <= 1e-14 of the unit speed; the step shrinks by
     itself where y^1.5 is not smooth, at the first touch). The impact is over when the
     force clips to zero during restitution (with y'' = 0 it stays zero: y^beta y' keeps
     its sign as y falls) or the mass leaves y = 0; the step that gets there is bisected
@@ -133,69 +135,3 @@ def scaled_rebound(c_hat: float, beta: float) -> float:
                 lo = mid
         return -v_end
     return math.nan
-
-
-@lru_cache(maxsize=256)
-def _scaled_damping(restitution: float, beta: float) -> float:
-    """c_hat giving ``restitution`` in the dimensionless single impact (cached).
-
-    The restitution falls monotonically with c_hat; the root in log c_hat is found by the
-    Illinois method (regula falsi that halves the stale end's value) to 1e-13.
-    """
-    from .compiled import scaled_rebound
-
-    if restitution >= 1.0:
-        return 0.0
-
-    def excess(log_c):
-        return scaled_rebound(math.exp(log_c), beta) - restitution
-
-    lo, hi = math.log(1e-8), math.log(1e4)
-    f_lo, f_hi = excess(lo), excess(hi)
-    if f_hi > 0.0:
-        raise ValueError(
-            f"contact.restitution = {restitution!r}: too small to reach with this damping law"
-        )
-    if f_lo < 0.0:
-        raise ValueError(f"contact.restitution = {restitution!r}: too close to 1 for a calibrated damping")
-    side = 0
-    x = lo
-    for _ in range(200):
-        x = (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
-        f_x = excess(x)
-        if f_x == 0.0 or hi - lo < 1e-13 * (1.0 + abs(x)):
-            break
-        if f_x < 0.0:
-            hi, f_hi = x, f_x
-            if side == -1:
-                f_lo *= 0.5
-            side = -1
-        else:
-            lo, f_lo = x, f_x
-            if side == 1:
-                f_hi *= 0.5
-            side = 1
-    return math.exp(x)
-
-
-def calibrate_damping(law: str, restitution: float, speed: float, stiffness: float,
-                      mass: float) -> float:
-    """c that makes a single impact of ``mass`` (kg) at ``speed`` (m/s) rebound with ``restitution``.
-
-    The single-impact problem integrated (``scaled_rebound``, local error 1e-14) and
-    root-found. Units of c: N s/m^2 (paper, beta = 1), N s/m^2.5 (others).
-    """
-    beta = 1.0 if law == "paper" else 1.5
-    c_hat = _scaled_damping(float(restitution), beta)
-    dstar = (mass * speed**2 / stiffness) ** 0.4
-    return c_hat * stiffness / (speed * dstar ** (beta - 1.5))
-
-
-def single_impact_restitution(law: str, damping: float, speed: float, stiffness: float,
-                              mass: float) -> float:
-    """Restitution of one impact of ``mass`` at ``speed`` with damping c (the inverse of calibrate)."""
-    beta = 1.0 if law == "paper" else 1.5
-    dstar = (mass * speed**2 / stiffness) ** 0.4
-    from .compiled import scaled_rebound
-
-    return float(scaled_rebound(damping * speed * dstar ** (beta - 1.5) / stiffness, beta))

@@ -29,7 +29,7 @@ from . import contact_laws as _contact_laws, friction as _friction, rotations as
 from .jit import njit
 from .inertia import inertia_matrix, inertia_terms, inertia_terms_sparse, schur_complement
 from .kernel_layout import (  # noqa: F401  (re-exported: the kernel's own names)
-    F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MAX_RATIO, F_RTIP, D_MU0, D_MU_SLOPE, D_T_MU,
+    F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MAX_RATIO, F_RTIP, D_VALUE, D_SLOPE, D_T0, K_MU, K_REPULSION,
     F_VREG, F_BAUM, F_VBOUND, F_BLOCK_Z, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN,
     N_FPAR, I_N, I_PLANAR, I_FRICTION, I_MOUNT, I_NLOAD, I_INERTIA, N_IPAR, INERTIA_GRAM,
     INERTIA_SPARSE, FRICTION_NONE, FRICTION_EXACT, FRICTION_REGULARIZED, MOUNT_FREE, MOUNT_CLAMP,
@@ -124,9 +124,15 @@ def tip_offset(i, xc, psi, modal, n, out):
 
 
 @njit(cache=True)
-def mu_at(t, drive):
-    """N^gamma: friction coefficient at t (s) from the drive, linear in time within a coupling step."""
-    mu = drive[D_MU0] + drive[D_MU_SLOPE] * (t - drive[D_T_MU])
+def drive_at(t, drive, row):
+    """Value of the drive channel in row ``row`` at t (s): linear in time within a step."""
+    return drive[row, D_VALUE] + drive[row, D_SLOPE] * (t - drive[row, D_T0])
+
+
+@njit(cache=True)
+def mu_at(t, drive, row):
+    """N^gamma: the friction coefficient in drive row ``row`` at t (s), clipped at zero."""
+    mu = drive_at(t, drive, row)
     return mu if mu > 0.0 else 0.0
 
 
@@ -351,12 +357,13 @@ def _tip_accel(k, R, s_tip, psi, theta, n, Rtip, Vdot, wdot, etadot, out):
 def dynamics(t, y, mdl, regime, eref, dy, aux, work):
     """Time derivative of the state into ``dy``; per-contact-point quantities into ``aux`` (2, NAUX).
 
-    mdl: the model arrays and, last, the drive (model.BarModel.kernel_arrays: the friction
-    coefficient over time, set by the caller; the model's arrays never change). regime: (2,) FREE/SLIP/STICK per
+    mdl: the model arrays and, last, the drive (model.BarModel.kernel_arrays: each contact
+    point's friction coefficient and repulsion over time, set by the caller, found through
+    the model's index array cdrive; the model's arrays never change). regime: (2,) FREE/SLIP/STICK per
     contact point (friction bookkeeping; the normal force always follows the
     penetration). eref: (2, 2) reference slip direction per contact point.
     """
-    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs, drive = mdl
+    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs, cdrive, drive = mdl
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
     fmodel = ipar[I_FRICTION]
@@ -407,11 +414,11 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work):
         thd = sg * w[1]
         f_r[1] += sg * (fpar[F_PIV_T0] - fpar[F_PIV_K] * th - fpar[F_PIV_C] * thd)
         d_load += fpar[F_PIV_C] * thd * thd
-    mu = mu_at(t, drive) if fmodel != FRICTION_NONE else 0.0
     gam = fpar[F_GAMMA]
     maxr = fpar[F_MAX_RATIO]
     d_normal = 0.0
     d_friction = 0.0
+    w_drive = 0.0  # power of the driven forces on the contact points (repulsion), W
     n_stick = 0
     Fw = sv[0:3]
     Mw = sv[3:6]
@@ -466,7 +473,9 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work):
         aux[i, A_FTY] = 0.0
         aux[i, A_VTX] = vP[i, 0]
         aux[i, A_VTY] = vP[i, 1]
-        lim = friction_limit(fn, mu, gam, maxr) if fmodel != FRICTION_NONE else 0.0
+        lim = 0.0
+        if fmodel != FRICTION_NONE:
+            lim = friction_limit(fn, mu_at(t, drive, cdrive[i, K_MU]), gam, maxr)
         aux[i, A_MARGIN] = lim
         if pen > 0.0:
             d_normal += (fn - k_h * pen * math.sqrt(pen)) * pdot
@@ -511,8 +520,23 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work):
                 aux[i, A_FTY] = fty
                 d_friction -= ftx * vP[i, 0] + fty * vP[i, 1]
                 aux[i, A_MARGIN] = lim - math.sqrt(ftx * ftx + fty * fty)
+        if pen > 0.0:
+            # a driven force on the touching contact point along the block's normal, away
+            # from it (Holm's electrodynamic repulsion of the constriction): it acts through
+            # the contact point, so it has no moment about the cap centre; its power is work
+            # put in (Q_WIN)
+            rep = drive_at(t, drive, cdrive[i, K_REPULSION])
+            if rep != 0.0:
+                Fw[0] = 0.0
+                Fw[1] = 0.0
+                Fw[2] = rep
+                Mw[0] = 0.0
+                Mw[1] = 0.0
+                Mw[2] = 0.0
+                _add_point_force(i, Fw, Mw, R, s_tip, psi, theta, n, F, f_r, f_e)
+                w_drive += rep * vP[i, 2]
 
-    w_in = 0.0
+    w_in = w_drive
     nload = ipar[I_NLOAD]
     for ld in range(nload):
         w_in_l, d_l = _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r, f_e, Fw, Mw)
@@ -857,7 +881,7 @@ def energies(y, mdl, work, out):
     Kinetic energy about a frame origin that is not the centroid (held bars):
     1/2 m V.V + V . R (w x (c + L q) + L eta) + 1/2 w J w + w B eta + 1/2 m eta.eta.
     """
-    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs, drive = mdl
+    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs, cdrive, drive = mdl
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
     r, R, q, V, w, eta, Jm, B = work[0], work[1], work[2], work[3], work[4], work[5], work[6], work[7]

@@ -14,10 +14,18 @@ from __future__ import annotations
  F_VBOUND, F_BLOCK_Z, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN) = range(17)
 N_FPAR = 17
 # the drive: what the caller changes during a run, passed beside the model's arrays (the
-# last element of the kernel's model tuple) so that the model itself never changes: the
-# friction coefficient mu (N^gamma), linear in time from D_T_MU within a coupling step
-D_MU0, D_MU_SLOPE, D_T_MU = range(3)
+# last element of the kernel's model tuple) so that the model itself never changes. One
+# row per named channel (mech.model.BarModel.drive_names), each linear in time within a
+# step: its value at D_T0 (s), its slope (per s) and D_T0
+D_VALUE, D_SLOPE, D_T0 = range(3)
 N_DRIVE = 3
+# what drives each contact point: the columns of the model's contact-drive index array
+# (cdrive[i, K_MU] is the drive row of contact point i's friction coefficient, N^gamma;
+# cdrive[i, K_REPULSION] of the force that pushes it away from the block while it touches,
+# N), and the names of those channels ("mu.<i>", "repulsion.<i>"); the kernel reads the
+# rows through cdrive only, never by name
+K_MU, K_REPULSION = range(2)
+CONTACT_DRIVES = ("mu", "repulsion")
 # ipar indices
 I_N, I_PLANAR, I_FRICTION, I_MOUNT, I_NLOAD, I_INERTIA = range(6)
 N_IPAR = 6

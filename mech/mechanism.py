@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .beam_fe import FEBeam, PointMass, beam_basis, beam_invariants, point_shapes
+from .contact_laws import hertz_stiffness
 from .kernel_layout import (
     L_AX, L_AY, L_AZ, L_BODY, L_C, L_DX, L_DY, L_DZ, L_K, L_KIND, L_POINT,
     L_T0, L_TN, LOAD_FORCE, LOAD_SPRING, N_LOAD,
@@ -169,8 +170,6 @@ def contact_parameters(cps, block, stiffness_override, dampings) -> np.ndarray:
 
     The Hertz stiffness uses the effective radius R1 R2/(R1 + R2) against a spherical block.
     """
-    from .contact_laws import hertz_stiffness
-
     cpar = np.zeros((2, 4))
     for i, cp in enumerate(cps):
         r_eff = cp.radius

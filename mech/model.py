@@ -7,26 +7,31 @@ give the rigid bar, and zero friction switches the tangential machinery off.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .contact_laws import (
-    calibrate_damping, damping_formula, hertz_impact, hertz_stiffness,
-)
+from .beam_fe import beam_modes
+from .contact_laws import damping_formula, hertz_impact, hertz_stiffness
+from .damping_calibration import calibrate_damping
+from .drives import DriveKind, kind_of
 from .kernel_layout import (
-    D_MU0, F_BAUM, F_BETA, F_C, F_G, F_GAMMA, F_VBOUND, F_K, F_MASS, F_MAX_RATIO, F_RTIP, N_DRIVE,
+    CONTACT_DRIVES, D_VALUE, F_BAUM, F_BETA, F_C, F_G, F_GAMMA, F_VBOUND, F_K, F_MASS, F_MAX_RATIO, F_RTIP,
+    N_DRIVE,
     F_VREG, FRICTION_EXACT, FRICTION_NONE, FRICTION_REGULARIZED, I_FRICTION, I_N,
     I_PLANAR, I_MOUNT, I_NLOAD, MOUNT_CLAMP, MOUNT_FREE, MOUNT_PIVOT, N_FPAR,
     F_PIV_C, F_PIV_K, F_PIV_PHI0, F_PIV_SIGN, F_PIV_T0, L_L0, I_INERTIA, INERTIA_GRAM, INERTIA_SPARSE, N_IPAR, N_LOAD, NQ, NQ_FREE, C_C, C_K, C_ON, C_R, state_sizes,
 )
 from .mechanism import (
     MechanismArrays, build_arrays, closing_work, contact_parameters,
-    effective_contact_mass, frame_height, impulse_mass, needs_mechanism,
+    effective_contact_mass, fe_beam, frame_height, impulse_mass, needs_mechanism,
 )
-from .modal_basis import ModalBasis, build_modal_basis, sparse_invariants
+from .modal_basis import ModalBasis, _quadrature, build_modal_basis, sparse_invariants
+from .mode_count import CAP, SAFETY, choose_mode_count
+from .modes import axial_frequencies, bending_frequencies, bending_shape, free_free_roots
 from .parameters import MechScene
 from .rotations import matrix_to_quaternion, quat_to_matrix, rotation_y, rotation_z  # noqa: F401
 
@@ -217,8 +222,9 @@ class BarModel:
     """The compiled model's arrays plus what Python needs to interpret the state.
 
     Built whole by ``build_model`` and never changed afterwards (frozen; its arrays are
-    not written after the build): what changes during a run -- the friction coefficient
-    mu(t) -- is the solver's drive, passed beside the arrays (``kernel_arrays``).
+    not written after the build): what changes during a run -- each contact point's
+    friction coefficient and repulsion, the named channels ``drive_names`` -- is the
+    solver's drive, passed beside the arrays (``kernel_arrays``).
     """
 
     scene: MechScene
@@ -239,18 +245,35 @@ class BarModel:
     tables: np.ndarray  # (2, n) concatenated time tables of the loads
     mechanism: MechanismArrays | None = None  # set for mechanism scenes (mech.mechanism)
     mode_count: object = None  # ModeCount when bar.modes = "auto" chose the counts, else None
+    # the drive channels: their names (rows of the drive, kernel_layout D_*), and per
+    # contact row the drive row of each of its kinds (kernel_layout K_*; -1: no such point)
+    drive_names: tuple = ()
+    cdrive: np.ndarray = None
+    input_work: bool = False  # the input-work quadrature kept although nothing of the scene needs it
 
     @property
     def n(self) -> int:
         return self.basis.n
 
     def initial_drive(self) -> np.ndarray:
-        """A new drive array (kernel_layout D_*): the scene's friction coefficient at zero
-        current, constant in time."""
-        drive = np.zeros(N_DRIVE)
+        """A new drive array (one row per channel of ``drive_names``, columns kernel_layout
+        D_*): every friction coefficient at the scene's value at zero current, every other
+        channel 0, all constant in time."""
+        drive = np.zeros((len(self.drive_names), N_DRIVE))
         fr = self.scene.friction
-        drive[D_MU0] = fr.mu_at(0.0) if fr.active else 0.0
+        drive[self.drive_rows("mu"), D_VALUE] = fr.mu_at(0.0) if fr.active else 0.0
         return drive
+
+    @functools.cached_property
+    def drive_kinds(self) -> tuple[DriveKind, ...]:
+        """The kind (mech.drives) of each drive channel, in the order of ``drive_names``."""
+        return tuple(kind_of(name) for name in self.drive_names)
+
+    def drive_rows(self, kind: str) -> np.ndarray:
+        """The drive rows of channel ``kind`` (kernel_layout CONTACT_DRIVES) of every
+        contact point, in the order of the points."""
+        k = CONTACT_DRIVES.index(kind)
+        return np.array([row for row in self.cdrive[:, k] if row >= 0], dtype=np.int64)
 
     @functools.cached_property
     def arrays(self) -> tuple:
@@ -262,13 +285,13 @@ class BarModel:
         return self.kernel_arrays(self.initial_drive())
 
     def kernel_arrays(self, drive: np.ndarray) -> tuple:
-        """The kernel's model argument with ``drive`` (float64[N_DRIVE], kernel_layout D_*)
-        as the friction coefficient over time."""
+        """The kernel's model argument with ``drive`` (float64[len(drive_names), N_DRIVE],
+        C order, kernel_layout D_*) as the driven quantities over time."""
         b = self.basis
         ptr, idx, val = self.sparse
         psi, theta, xc = self.points
         return (self.fpar, self.ipar, b.J0, ptr, idx, val, psi, theta, xc, self.cpar,
-                self.first_moments, self.load, self.tables, drive)
+                self.first_moments, self.load, self.tables, self.cdrive, drive)
 
     @property
     def state_size(self) -> int:
@@ -356,9 +379,8 @@ class BarModel:
     @property
     def nq(self) -> int:
         """Number of quadratures: the input-work and load-dissipation ones only when the
-        scene has loads or a mount."""
-        held = self.ipar[I_MOUNT] != MOUNT_FREE or self.ipar[I_NLOAD] > 0
-        return NQ if held else NQ_FREE
+        scene has loads or a mount, or the model was built with ``input_work``."""
+        return quadrature_count(self.ipar, self.input_work)
 
     def slices(self) -> dict:
         """Named slices of the state vector."""
@@ -424,8 +446,31 @@ class BarModel:
         return y
 
 
-def build_model(scene: MechScene) -> BarModel:
-    """Assemble the compiled model of ``scene`` (planar or 3D as the scene needs)."""
+def quadrature_count(ipar: np.ndarray, input_work: bool) -> int:
+    """NQ with the input-work and load-dissipation quadratures (a mount, loads, or asked
+    for: a driven force on a free bar), NQ_FREE without them (a plain free bar keeps the
+    state and error norm it always had)."""
+    held = ipar[I_MOUNT] != MOUNT_FREE or ipar[I_NLOAD] > 0
+    return NQ if held or input_work else NQ_FREE
+
+
+def contact_drives(n_points: int, n_rows: int) -> tuple[tuple, np.ndarray]:
+    """(channel names, cdrive) for ``n_points`` contact points in ``n_rows`` contact rows:
+    one channel of each kind of kernel_layout CONTACT_DRIVES per point, named
+    "<kind>.<point>", ordered by kind, then point."""
+    names = tuple(f"{kind}.{i}" for kind in CONTACT_DRIVES for i in range(n_points))
+    cdrive = np.full((n_rows, len(CONTACT_DRIVES)), -1, dtype=np.int64)
+    for k in range(len(CONTACT_DRIVES)):
+        cdrive[:n_points, k] = k * n_points + np.arange(n_points)
+    return names, cdrive
+
+
+def build_model(scene: MechScene, *, input_work: bool = False) -> BarModel:
+    """Assemble the compiled model of ``scene`` (planar or 3D as the scene needs).
+
+    input_work: keep the input-work quadrature (``work_in`` of the energy audit) even for
+    a free bar without loads, so that a driven force (``repulsion.<i>``) may act on it.
+    """
     scene, mode_count = resolve_auto_modes(scene)
     mode = scene.solver.model
     planar_ok = is_planar(scene)
@@ -480,7 +525,7 @@ def build_model(scene: MechScene) -> BarModel:
     dstar = cs.penetration_scale
     vstar = cs.reference_speed
     npos, nvel = state_sizes(n, planar)
-    nq = NQ if (ipar[I_MOUNT] != MOUNT_FREE or ipar[I_NLOAD] > 0) else NQ_FREE
+    nq = quadrature_count(ipar, input_work)
     atol = np.empty(npos + nvel + nq)
     rel = np.zeros_like(atol)
     sl = state_slices(n, planar, nq)
@@ -518,8 +563,11 @@ def build_model(scene: MechScene) -> BarModel:
         parts = dict(points=arr.points, mechanism=arr, first_moments=arr.first_moments, load=arr.load.copy(),
                      tables=arr.tables,
                      cpar=contact_parameters(arr.contacts, scene.block, scene.contact.stiffness, cs.dampings))
+    n_points = 2 if arr is None else len(arr.contacts)
+    names, cdrive = contact_drives(n_points, len(parts["cpar"]))
     model = BarModel(scene, planar, basis, cs, fpar, ipar, math.radians(scene.initial.azimuth_deg), atol, rel,
-                     max_step, sparse_invariants(basis), mode_count=mode_count, **parts)
+                     max_step, sparse_invariants(basis), mode_count=mode_count, drive_names=names, cdrive=cdrive,
+                     input_work=input_work, **parts)
     if arr is not None and arr.spring_points:
         # the springs' rest lengths are measured on the initial state, which the other
         # arrays define: a second, complete model with them
@@ -533,9 +581,6 @@ def family_frequencies(bar, count: int) -> tuple[np.ndarray, np.ndarray]:
     """Hz: the first ``count`` axial and bending frequencies of ``bar`` (bending in the
     more flexible plane). Euler-Bernoulli closed forms; for the paper's shear-type bending,
     sqrt(K_jj/m) of its stiffness on the free-free shapes (its K is full within a family)."""
-    from .modal_basis import _quadrature
-    from .modes import axial_frequencies, bending_frequencies, bending_shape, free_free_roots
-
     axial = axial_frequencies(count, bar.length, bar.youngs_modulus, bar.density)
     if bar.bending == "euler_bernoulli":
         bend = bending_frequencies(count, bar.length, bar.youngs_modulus, min(bar.second_moments),
@@ -554,10 +599,6 @@ def resolve_auto_modes(scene: MechScene, safety: float | None = None):
     mech.mode_count.choose_mode_count from the Hertz contact time of the first impact
     (rigid-bar effective mass and impact speed of ``contact_scales``); safety: the
     factor of f_cut = safety / t_c (None: mode_count.SAFETY)."""
-    import dataclasses
-
-    from .mode_count import CAP, SAFETY, choose_mode_count
-
     bar = scene.bar
     if bar.axial_modes != "auto" and bar.bending_modes != "auto":
         return scene, None
@@ -585,10 +626,6 @@ def _mechanism_auto_inputs(scene: MechScene, cap: int, safety: float):
     it; bending in its more flexible plane), every one below f_cut = safety / t_c at least,
     and the Hertz time t_c of the first contact point's impact on its effective mass
     (mechanism_scales, from a small basis)."""
-    import dataclasses
-
-    from .mechanism import fe_beam
-
     bar = scene.bar
     small = dataclasses.replace(scene, bar=dataclasses.replace(bar, axial_modes=1, bending_modes=3))
     arr = build_arrays(small, True)
@@ -616,8 +653,6 @@ def frequencies_below(beam, family: str, cutoff: float, cap: int, first: int = 8
     the cap's mesh (255 elements, ~0.3 s of eigen-solves for a blade's two families)
     was most of the start of a held bar's run.
     """
-    from .beam_fe import beam_modes
-
     count = max(1, min(first, cap))
     while True:
         f = beam_modes(beam, family, count).frequencies

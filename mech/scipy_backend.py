@@ -12,7 +12,7 @@ import numpy as np
 
 from .compiled import dynamics, events_from_aux
 from .kernel_layout import (
-    A_FN, A_Y, A_YDOT, D_MU0, DONE, EV_CLIP, EV_COMPRESSION, EV_SLIP, EV_STICK, EVENT, FREE, FRICTION_EXACT,
+    A_FN, A_Y, A_YDOT, D_VALUE, DONE, EV_CLIP, EV_COMPRESSION, EV_SLIP, EV_STICK, EVENT, FREE, FRICTION_EXACT,
     I_FRICTION, NAUX, NEV_TIP, NOT_FINITE, SLIP, STICK,
 )
 
@@ -45,6 +45,7 @@ def scipy_segment(solver, t_target: float, method: str):
     m = solver.model
     arrays = solver.arrays
     drive = solver.drive
+    mu_rows = m.drive_rows("mu")  # a coupled model's friction coefficient is every contact point's
     regime = solver.regime.copy()
     eref = solver.eref.copy()
     work = solver.work
@@ -60,7 +61,7 @@ def scipy_segment(solver, t_target: float, method: str):
     def fun(t, y):
         dy = np.empty(N + n_ext)
         if coupled is not None:
-            drive[D_MU0] = coupled.friction_coefficient(t, y[N:])
+            drive[mu_rows, D_VALUE] = coupled.friction_coefficient(t, y[N:])
         dynamics(t, y[:N], arrays, regime, eref, dy[:N], aux, work)
         if coupled is not None:
             dy[N:] = coupled.rhs(t, y[N:], aux[:, [A_Y, A_YDOT, A_FN]])
@@ -94,7 +95,7 @@ def scipy_segment(solver, t_target: float, method: str):
         def _value(t, y):
             dy = np.empty(N)
             if coupled is not None:
-                drive[D_MU0] = coupled.friction_coefficient(t, y[N:])
+                drive[mu_rows, D_VALUE] = coupled.friction_coefficient(t, y[N:])
             dynamics(t, y[:N], arrays, regime, eref, dy, aux, work)
             counter_events["nfev"] += 1
             events_from_aux(aux, eref, arrays, g)
@@ -165,7 +166,7 @@ def scipy_segment(solver, t_target: float, method: str):
         y = sol.y[:N, k]
         dy = np.empty(N)
         if coupled is not None:
-            drive[D_MU0] = coupled.friction_coefficient(sol.t[k], sol.y[N:, k])
+            drive[mu_rows, D_VALUE] = coupled.friction_coefficient(sol.t[k], sol.y[N:, k])
             rec.ext[n0 + k - 1] = sol.y[N:, k]
         dynamics(sol.t[k], y, arrays, regime, eref, dy, aux, work)
         r = n0 + k - 1
@@ -201,7 +202,7 @@ def scipy_segment(solver, t_target: float, method: str):
     solver.y[:] = sol.y[:N, -1]
     if coupled is not None:
         solver.z[:] = sol.y[N:, -1]
-        drive[D_MU0] = coupled.friction_coefficient(sol.t[-1], solver.z)
+        drive[mu_rows, D_VALUE] = coupled.friction_coefficient(sol.t[-1], solver.z)
     if not sol.success:
         return NOT_FINITE, float(sol.t[-1]), 0.0, n_new, -1
     h_next = float(sol.t[-1] - sol.t[-2]) if len(sol.t) > 1 else solver.h

@@ -1,9 +1,10 @@
 """The impact solver: advances the compiled integrator, switches regimes at events.
 
 ``ImpactSolver(scene).run()`` integrates a whole scene. For co-simulation,
-``advance(t, mu=...)`` integrates to ``t`` and returns a ``Segment`` whose dense
-output gives the state and contact forces at any time inside the step; the solver
-then resumes from where it stopped, without starting over.
+``advance(t, drives)`` integrates to ``t`` under the named drive channels given for the
+step (each contact point's friction coefficient and repulsion, mech.drives) and returns a
+``Segment`` whose dense output gives the state and contact forces at any time inside the
+step; the solver then resumes from where it stopped, without starting over.
 
 Regimes per tip: free, slip, stick. At every event the integration stops exactly at
 the event (located on the dense output), the regimes are resolved for the new state,
@@ -32,15 +33,17 @@ from .compiled import (
 )
 from .kernel_layout import (
     A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, BUFFER_FULL, DONE, EV_CLIP, EV_COMPRESSION,
-    D_MU0, D_MU_SLOPE, D_T_MU, EV_CONTACT, EV_SLIP, EV_STICK, EVENT, F_MASS, FREE, FRICTION_EXACT,
+    D_SLOPE, D_VALUE, EV_CONTACT, EV_SLIP, EV_STICK, EVENT, F_MASS, FREE, FRICTION_EXACT,
     I_FRICTION, NAUX, NEV_TIP, Q_WIN, SLIP, STATUS_TEXT, STICK, state_sizes,
 )
 from .contact_laws import hertz_impact
+from .drives import set_step, step_targets, values_at
 from .friction import REVERSAL_DEADBAND
 from .mechanism import base_velocity_jumps
 from .model import BarModel, build_model
 from .parameters import MechScene
 from .recorder import Recorder
+from .results import ImpactResult
 from .scipy_backend import METHODS as SCIPY_METHODS, ScipyStepper
 from .stepping import CompiledStepper, Stepper
 
@@ -160,9 +163,12 @@ class ImpactSolver:
     """Integrates one mechanics scene; see the module docstring for the regimes."""
 
     def __init__(self, scene: MechScene, *, keep_dense: bool = False, capacity: int = 4096,
-                 backend: str = "dopri5", coupled: CoupledStates | None = None):
+                 backend: str = "dopri5", coupled: CoupledStates | None = None, input_work: bool = False):
         """backend: "dopri5" (the compiled loop) or "scipy:<method>" (solve_ivp with
-        RK45, DOP853, Radau, BDF or LSODA on the same right-hand side and events)."""
+        RK45, DOP853, Radau, BDF or LSODA on the same right-hand side and events).
+        input_work: keep the input-work quadrature (the audit's ``work_in``) on a free bar
+        without loads too, so that a driven force ("repulsion.<i>") may act on it (a held
+        bar or one with loads always has it; without, a free bar's state is what it was)."""
         if backend != "dopri5" and not (backend.startswith("scipy:") and backend[6:] in SCIPY_METHODS):
             raise ValueError(f"backend = {backend!r}: allowed values are 'dopri5' or 'scipy:<method>' with "
                              f"<method> one of {', '.join(SCIPY_METHODS)}")
@@ -174,7 +180,7 @@ class ImpactSolver:
         self.coupled = coupled
         self.z = np.array(coupled.initial, dtype=float) if coupled is not None else np.zeros(0)
         self.scene = scene
-        self.model = build_model(scene)
+        self.model = build_model(scene, input_work=input_work)
         self.keep_dense = keep_dense
         m = self.model
         self.t = 0.0
@@ -193,11 +199,11 @@ class ImpactSolver:
         self.work = make_work(m.n)  # the compiled kernel's scratch arrays
         self._aux = np.empty((2, NAUX))
         self._dy = np.empty(m.state_size)
-        # what changes during the run besides the state: the friction coefficient over time
-        # (kernel_layout D_*), passed to the kernel beside the model's arrays
+        # what changes during the run besides the state: the named drive channels over time
+        # (one row each, kernel_layout D_*), passed to the kernel beside the model's arrays
         self.drive = m.initial_drive()
         if coupled is not None:
-            self.drive[D_MU0] = coupled.friction_coefficient(0.0, self.z)
+            self.drive[m.drive_rows("mu"), D_VALUE] = coupled.friction_coefficient(0.0, self.z)
         self.arrays = m.kernel_arrays(self.drive)
         self.recorder = Recorder(m.state_size, len(self.z), capacity, keep_dense)
         self.stepper: Stepper = CompiledStepper() if backend == "dopri5" else ScipyStepper(backend[6:])
@@ -223,19 +229,39 @@ class ImpactSolver:
     def planar(self) -> bool:
         return self.model.planar
 
+    @property
+    def drive_names(self) -> tuple[str, ...]:
+        """The drive channels of this model, which ``advance`` takes: "mu.<i>" and
+        "repulsion.<i>" of each contact point i (mech.drives)."""
+        return self.model.drive_names
+
+    def drives_now(self) -> dict[str, float]:
+        """Each drive channel's value at the current time (mu as given, before the kernel
+        clips it at zero)."""
+        return dict(zip(self.model.drive_names, values_at(self.drive, self.t).tolist()))
+
     def set_friction_coefficient(self, mu_start: float, mu_end: float | None = None,
                                  t_end: float | None = None) -> None:
-        """Friction coefficient (N^gamma) from now on: constant, or linear to ``mu_end`` at ``t_end``."""
-        drive = self.drive
-        drive[D_MU0] = max(float(mu_start), 0.0)
-        drive[D_T_MU] = self.t
-        if mu_end is None or t_end is None or t_end <= self.t:
-            drive[D_MU_SLOPE] = 0.0
-        else:
-            drive[D_MU_SLOPE] = (float(mu_end) - float(mu_start)) / (t_end - self.t)
+        """Every contact point's friction coefficient (N^gamma) from now on: constant, or
+        linear to ``mu_end`` at ``t_end``; the other channels hold their values."""
+        end = mu_start if mu_end is None or t_end is None else mu_end
+        self._set_drives(step_targets(self.model.drive_names, None, (mu_start, end)),
+                         self.t if t_end is None else t_end)
 
-    def advance(self, t_target: float, mu=None, *, stop_at_switch: bool = False) -> Segment:
-        """Integrate to ``t_target`` (s); ``mu`` = number or (mu_start, mu_end) over the step.
+    def advance(self, t_target: float, drives=None, *, mu=None, stop_at_switch: bool = False) -> Segment:
+        """Integrate to ``t_target`` (s) under the drives given for this step.
+
+        drives: {channel: value} for channels of ``drive_names``, each value a number
+        (constant over the step) or a (start, end) pair (linear in time from now to
+        ``t_target``): "mu.<i>", contact point i's friction coefficient (N^gamma; below
+        zero it acts as zero), and "repulsion.<i>" (N, >= 0), a force on contact point i
+        along the block's normal, away from it, acting while the point touches -- Holm's
+        electrodynamic repulsion of the constriction; its work counts as work put in
+        (``work_in``). A channel not given holds the value it ended the previous step
+        with. mu: a number or pair for every "mu.<i>" at once.
+
+        A new mu that changes what can stick re-resolves the regimes; a hold at rest ends
+        when a channel that moves the static equilibrium (a repulsion) changes.
 
         stop_at_switch: return at the first contact start or end (make/break) after the
         current time instead, the segment ending there (a co-simulation step in free flight
@@ -244,15 +270,8 @@ class ImpactSolver:
         """
         if not math.isfinite(t_target) or t_target < self.t:
             raise ValueError(f"t_target = {t_target!r}: must be a finite time >= the current {self.t!r} s")
-        if mu is not None:
-            drive = self.drive
-            mu_now = drive[D_MU0] + drive[D_MU_SLOPE] * (self.t - drive[D_T_MU])
-            if np.ndim(mu) == 0:
-                self.set_friction_coefficient(float(mu))
-            else:
-                self.set_friction_coefficient(float(mu[0]), float(mu[1]), t_target)
-            if self.model.ipar[I_FRICTION] == FRICTION_EXACT and drive[D_MU0] != max(mu_now, 0.0):
-                self._resolve(triggered=None)  # a new mu may change what can stick
+        targets = step_targets(self.model.drive_names, drives, mu)
+        self._set_drives(targets, t_target)
         rec = self.recorder
         n_first = rec.n
         ev_first = len(self.events)
@@ -338,9 +357,7 @@ class ImpactSolver:
         self.advance(self.scene.solver.t_end)
         return self.result()
 
-    def result(self):
-        from .results import ImpactResult
-
+    def result(self) -> ImpactResult:
         return ImpactResult(
             model=self.model,
             **self.recorder.columns(),
@@ -429,7 +446,7 @@ class ImpactSolver:
     @property
     def at_rest(self) -> bool:
         """True while the bar is held at rest (see _watch_rest): nothing in it changes before
-        ``hold_until`` unless mu changes enough to unstick a contact."""
+        ``hold_until`` unless mu changes enough to unstick a contact or a repulsion changes."""
         return self._hold_until > self.t
 
     @property
@@ -452,6 +469,37 @@ class ImpactSolver:
         return {name: self.y[s].tolist() for name, s in sl.items() if name != "quad"}
 
     # --- internals ------------------------------------------------------------------
+
+    def _set_drives(self, targets: dict, t_end: float) -> None:
+        """The drive for a step from now to ``t_end`` (s): the channels of ``targets`` (row
+        -> (start, end), checked by mech.drives.step_targets) linear over it, the others
+        held. A driven force needs the input-work quadrature; a new mu re-resolves the
+        regimes (it may change what can stick); a changed repulsion ends a hold at rest and
+        restarts the watch for rest (its static equilibrium moved)."""
+        m = self.model
+        kinds = m.drive_kinds
+        if m.nq <= Q_WIN:
+            for row, (start, end) in targets.items():
+                if kinds[row].force and (start != 0.0 or end != 0.0):
+                    raise ValueError(
+                        f"drives[{m.drive_names[row]!r}] = {(start, end)!r}: this free bar's model has no input-work "
+                        f"quadrature to put a driven force's work in the energy audit; build the solver with "
+                        f"ImpactSolver(scene, input_work=True)")
+        changed = set_step(self.drive, kinds, targets, self.t, t_end)
+        if not changed:
+            return
+        if m.ipar[I_FRICTION] == FRICTION_EXACT and any(kinds[row].friction for row in changed):
+            self._resolve(triggered=None)  # a new mu may change what can stick
+        if any(kinds[row].moves_equilibrium for row in changed):
+            if self._hold_until > self.t:
+                self._release_hold()
+            else:
+                self._restart_rest_window()
+
+    def _drives_ramping(self) -> bool:
+        """True if a channel that moves the static equilibrium changes during this step."""
+        return any(kind.moves_equilibrium and self.drive[row, D_SLOPE] != 0.0
+                   for row, kind in enumerate(self.model.drive_kinds))
 
     def _evaluate(self) -> np.ndarray:
         dynamics(self.t, self.y, self.arrays, self.regime, self.eref, self._dy, self._aux, self.work)
@@ -514,7 +562,9 @@ class ImpactSolver:
         slipping = any(self.regime[i] == SLIP and math.hypot(aux[i, A_VTX], aux[i, A_VTY]) > tol
                        for i in range(2))
         # a force on a ramp is not a constant load, however slowly the bar follows it
-        if quiet and not slipping and not self.model.loads_ramping(self.t) and self._settle_at_mean():
+        # (nor is a driven force on a ramp: a repulsion that grows within the step)
+        if (quiet and not slipping and not self.model.loads_ramping(self.t) and not self._drives_ramping()
+                and self._settle_at_mean()):
             later = [t for t in self.model.load_change_times if t > self.t]
             later += [t for t, _ in self._jumps[self._jump_index:] if t > self.t]
             self._hold_until = min(later) if later else math.inf

@@ -14,7 +14,7 @@ The integration state a stepper reads: ``t`` (s), ``h`` (s, the step in use; 0 t
 ``coupled`` (None or mech.solver.CoupledStates), ``work`` (kernel scratch), ``scene``; what
 it writes: ``y`` (and ``z``, the coupled extra states) in place to the state at the end,
 ``ev_sign``, ``stats`` (accumulated), the rows from ``recorder.n`` on (not committed: the
-solver commits them with the regimes), and ``drive`` when a coupled model sets mu.
+solver commits them with the regimes), and ``drive`` (its mu rows) when a coupled model sets mu.
 """
 
 from __future__ import annotations

@@ -28,7 +28,6 @@ RUN = textwrap.dedent("""
     import json, sys
     import numpy as np
     import mech.compiled
-    from mech.aot import warm_up
     from mech.scene import scene_from_dict
     from mech.solver import ImpactSolver
     steel = dict(youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0)
@@ -119,6 +118,53 @@ def test_a_wrong_array_inside_a_tuple_argument_is_named_and_goes_to_the_jit_func
         compiled.energies(y, model.arrays, bad, got)
     np.testing.assert_array_equal(got, expected)
     assert expected[0] > 0.0  # the bar moves down at its initial speed: kinetic energy
+
+
+def test_the_drive_channels_take_the_ahead_of_time_route():
+    """The drive (a float64 row per named channel) and the model's contact-drive index
+    array (int64, one row per contact point) are arguments the module was built for (the
+    warm-up sets every channel): a free bar driven with the input-work quadrature and a
+    held blade, every channel given and a repulsion ramped, through the dense output, the
+    contact series, the restore and the energy table, call no just-in-time function."""
+    import warnings
+
+    import mech.compiled as compiled
+    from mech.scene import scene_from_dict
+    from mech.solver import ImpactSolver
+
+    if compiled.ROUTE != "aot":
+        pytest.skip("the ahead-of-time module is not in use here")
+    kinds = json.loads((aot.module_folder() / aot.SIGNATURES).read_text())
+    model = kinds["dynamics"][2]
+    assert model[0] == "tuple"
+    assert model[1][-2:] == [["array", "int64", 2, "C"], ["array", "float64", 2, "C"]]  # cdrive, drive
+    steel = dict(youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0)
+    free = {"bar": dict(length=0.1, diameter=0.006, tip_radius=0.003, modes=2, **steel),
+            "initial": dict(height=1e-4, angle_deg=30.0, velocity=[0.3, 0.1, -1.0]),
+            "friction": dict(mu=0.5), "solver": dict(t_end=1e-3)}
+    blade = {"bar": dict(length=0.02, width=0.003, thickness=0.0003, tip_radius=0.0016,
+                         modes={"axial": 1, "bending": 3}, modal_damping=0.05, **steel),
+             "mount": dict(kind="clamp", position=0.02), "rivet": [dict(position=0.0015, offset=0.0, radius=0.0015)],
+             "force": [dict(position=0.01, time=[0.0, 0.001], value=[0.0, 3.0])],
+             "initial": dict(height=2e-5), "friction": dict(mu=0.3), "solver": dict(t_end=2e-3)}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", compiled.CompiledArgumentWarning)
+        for doc, input_work in ((free, True), (blade, False)):
+            solver = ImpactSolver(scene_from_dict(doc), keep_dense=True, input_work=input_work)
+            t_end = doc["solver"]["t_end"]
+            drives = {name: (0.0, 0.2) if name.startswith("repulsion.") else (0.4, 0.2) for name in solver.drive_names}
+            seg = solver.advance(0.5 * t_end, drives)
+            cp = solver.checkpoint()
+            t = 0.5 * (seg.t_start + seg.t_end)
+            seg.tip_forces(t)
+            seg.contact(t)
+            solver.advance(t_end, mu=0.3)
+            solver.restore(cp)
+            solver.advance(t_end, mu=0.3)
+            solver.contact_series(np.linspace(0.0, t_end, 7))
+            result = solver.result()
+            assert len(result.contacts) >= 1
+            assert np.isfinite(result.energy_table.residual.to_numpy()).all()
 
 
 def _fake_build(calls, delay=0.2):

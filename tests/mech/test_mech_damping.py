@@ -10,7 +10,8 @@ import pytest
 from scipy.integrate import quad
 
 from mech import Bar, simulate
-from mech.contact_laws import calibrate_damping, damping_formula, single_impact_restitution
+from mech.contact_laws import damping_formula
+from mech.damping_calibration import calibrate_damping, single_impact_restitution
 
 from mech_cases import hertz_closed_form, hertz_history, make_scene, steel_stiffness
 
