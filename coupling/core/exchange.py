@@ -191,3 +191,66 @@ class ContactLink:
         t0, t1, m0, m1 = log[k].T
         frac = np.where(t1 > t0, (times - t0) / np.where(t1 > t0, t1 - t0, 1.0), 0.0)
         return m0 + (m1 - m0) * np.clip(frac, 0.0, 1.0)
+
+
+class CoilLink:
+    """The relay's coil in the circuit and its armature in the mechanics, joined by the magnet
+    (SI units; coupling.laws.magnet).
+
+    Into the circuit: the coil's input channel "<label>.gap", the magnet's working air gap
+    g = rest_gap - lever * q(t) (m) along the armature's motion q (m for a plunger, rad for
+    a clapper; ``lever``: m of pole-face travel per unit of q), from the mechanics' dense
+    output. Into the mechanics: the drive "armature.force". A magnet whose force separates
+    as F = psi^2 h(g) (every flux-tube magnet: its iron carries the whole coil flux) drives
+    with psi^2 (Wb^2), extrapolated from the circuit's last points, and the mechanics
+    multiplies it by the table ``gain(q) = lever h(g(q))`` (N/Wb^2 or N m/Wb^2) along its
+    own exact path; any other magnet (a table) drives with F(psi, g) itself at the step's
+    ends, the gap at the end predicted from the armature's speed.
+    """
+
+    def __init__(self, label: str, magnet, rest_gap: float, lever: float = 1.0):
+        self.label = label
+        self.magnet = magnet
+        self.rest_gap = float(rest_gap)
+        self.lever = float(lever)
+        self.separable = bool(getattr(magnet, "separable", False))
+        self.tail = Tail()
+        self.drive_log: list[tuple[float, float, float, float]] = []
+
+    def gap(self, q: float) -> float:
+        """m: the working air gap at the armature's position q."""
+        return self.rest_gap - self.lever * q
+
+    def gain_table(self, travel: float, points: int = 201) -> tuple[np.ndarray, np.ndarray]:
+        """(q, lever h(g(q))): the mechanics' gain table over the armature's travel [0, travel],
+        denser towards the pole where h changes fastest."""
+        closed = self.rest_gap - self.lever * travel
+        gaps = closed + (self.rest_gap - closed) * np.linspace(0.0, 1.0, points) ** 2
+        q = np.sort((self.rest_gap - gaps) / self.lever)
+        return q, self.lever * np.asarray(self.magnet.force(1.0, self.rest_gap - self.lever * q), dtype=float)
+
+    def drive(self, psi_start: float, psi_end: float, q: float, q_dot: float, span: float) -> tuple[float, float]:
+        """The armature drive's values at the step's start and end (see the class docstring)."""
+        if self.separable:
+            return psi_start * psi_start, psi_end * psi_end
+        g0, g1 = self.gap(q), self.gap(q + q_dot * span)
+        return (self.lever * float(self.magnet.force(psi_start, g0)),
+                self.lever * float(self.magnet.force(psi_end, g1)))
+
+    def inputs(self, seg) -> dict:
+        """The coil's gap channel over the segment, from the armature's dense output."""
+        lo, hi = seg.t_start, seg.t_end
+
+        def gap(s: float) -> float:
+            s = lo if s < lo else (hi if s > hi else s)
+            return max(self.gap(seg.armature(s)[0]), 0.0)
+
+        return {f"{self.label}.gap": gap}
+
+    def flux(self, step) -> float:
+        """Wb: the coil's flux linkage at the step's end."""
+        return float(step.values["coil_flux_linkage" + self.label[len("coil"):]])
+
+    def observe(self, step, jumped: bool = False) -> None:
+        """Keep the circuit's last points of the flux linkage (its rate and time scale)."""
+        self.tail.observe(step.reader("time"), step.reader("coil_flux_linkage" + self.label[len("coil"):]), jumped)
