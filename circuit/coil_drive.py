@@ -31,6 +31,7 @@ from typing import Optional
 from PySpice.Spice.Netlist import Circuit
 
 from .blocks import CoilBlock
+from .probes import Probes
 from .validation import check_range
 
 SUPPRESSIONS = ("none", "diode", "zener", "rc")
@@ -112,6 +113,25 @@ class CoilDrive:
         if len(points) == 1:
             points.append((1.0, points[0][1]))  # a PWL needs two vertices
         return points
+
+    @property
+    def contacts(self) -> tuple:
+        """A coil's drive alone holds no contact (an actuator)."""
+        return ()
+
+    @property
+    def coils(self) -> tuple[CoilBlock, ...]:
+        return (self.coil,)
+
+    @property
+    def probes(self) -> Probes:
+        return Probes((), coils=self.coils)
+
+    def build(self, title: str = "switchsim coil drive") -> Circuit:
+        """The coil's drive alone as a PySpice circuit (an actuator without a contact circuit)."""
+        circuit = Circuit(title)
+        self.add_to(circuit)
+        return circuit
 
     def add_to(self, circuit: Circuit) -> None:
         """Place the supply, the coil, the driver and the suppression on a PySpice circuit."""

@@ -9,6 +9,7 @@ from PySpice.Spice.Netlist import Circuit
 
 from .arc import ArcState, recorded_arc
 from .blocks import COILS_PLACED, ContactBlock
+from .coil_drive import CoilDrive
 from .contact import placed_contacts
 from .netlist import NetlistCircuit
 from .options import SimulationOptions
@@ -16,7 +17,7 @@ from .probes import Probes
 from .templates import LOAD_PROBE, McuInput, SwitchCircuit
 from .validation import check_range
 
-CircuitLike = Union[SwitchCircuit, McuInput, NetlistCircuit, Circuit]
+CircuitLike = Union[SwitchCircuit, CoilDrive, McuInput, NetlistCircuit, Circuit]
 
 #: Drive of an input channel's source: "external" (a Python function of time, through
 #: ngspice's callback) or PWL vertices (times s, values in the channel's unit, >= 0).
@@ -25,7 +26,7 @@ Drive = Union[str, tuple[np.ndarray, np.ndarray]]
 
 def circuit_netlist(circuit: CircuitLike) -> tuple[str, Probes]:
     """Netlist text (title line first, no analysis, no .end) and its probes."""
-    if isinstance(circuit, (SwitchCircuit, McuInput)):
+    if isinstance(circuit, (SwitchCircuit, McuInput, CoilDrive)):
         return str(circuit.build()), circuit.probes
     if isinstance(circuit, NetlistCircuit):
         return circuit.netlist(), circuit.probes
@@ -34,7 +35,8 @@ def circuit_netlist(circuit: CircuitLike) -> tuple[str, Probes]:
             f"{LOAD_PROBE}#branch" if LOAD_PROBE.lower() in {n.lower() for n in circuit.element_names} else None),
             coils=tuple(getattr(circuit, COILS_PLACED, ())))
     raise TypeError(
-        f"expected a SwitchCircuit, an McuInput, a NetlistCircuit or a PySpice Circuit with a contact, got {type(circuit).__name__}"
+        f"expected a SwitchCircuit, an McuInput, a CoilDrive, a NetlistCircuit or a PySpice Circuit with a contact, "
+        f"got {type(circuit).__name__}"
     )
 
 

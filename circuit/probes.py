@@ -52,14 +52,16 @@ class Probes:
 
     def __post_init__(self) -> None:
         names = [c.name for c in self.contacts]
-        if not names or len(set(names)) != len(names):
-            raise ValueError(f"Probes.contacts: one or more contacts with distinct names, got {names!r}")
+        if len(set(names)) != len(names) or not (names or self.coils):
+            raise ValueError(f"Probes.contacts: contacts with distinct names (or none, beside a coil), got {names!r}")
 
     @property
     def column_names(self) -> tuple[str, ...]:
         """Every result column, in order: COLUMNS for one unnamed contact; else time,
         load_current, then each contact's CONTACT_COLUMNS with its suffix."""
         coils = tuple(f"{name}{c.suffix}" for c in self.coils for name in COIL_COLUMNS)
+        if not self.contacts:  # a coil's drive alone (an actuator)
+            return ("time",) + coils
         if len(self.contacts) == 1 and not self.contacts[0].name:
             return COLUMNS + coils
         return ("time", "load_current") + tuple(

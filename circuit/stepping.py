@@ -217,14 +217,14 @@ class Stepper:
         self._t = t_next
         self._finished = final
         self._steps += 1
-        first = self.probes.contacts[0].suffix
+        first = self.probes.contacts[0].suffix if self.probes.contacts else None
         return StepResult(
             t_start=t0,
             t_end=landed,
-            contact_voltage=scalars["contact_voltage" + first],
-            contact_current=scalars["contact_current" + first],
+            contact_voltage=math.nan if first is None else scalars["contact_voltage" + first],
+            contact_current=math.nan if first is None else scalars["contact_current" + first],
             load_current=scalars["load_current"],
-            arc_current=scalars["arc_current" + first],
+            arc_current=math.nan if first is None else scalars["arc_current" + first],
             points=last_index - first_index - 1,
             reader=self._reader(first_index, last_index),
             values=scalars,
@@ -235,11 +235,11 @@ class Stepper:
         """Every input channel's source -> its function of time, checked (ValueError/TypeError
         naming the channel before anything runs)."""
         given = dict(inputs or {})
-        single = self.probes.contacts[0]
         if conductance is not None or gap is not None:
-            if len(self.probes.contacts) > 1:
+            if len(self.probes.contacts) != 1:
                 raise ValueError(f"this circuit has {len(self.probes.contacts)} contacts: give each its input "
                                  f"channels, advance(t_next, inputs={{...}}) with {', '.join(self.inputs)}")
+            single = self.probes.contacts[0]
             if conductance is not None:
                 given.setdefault(f"{single.label}.conductance", conductance)
             if gap is not None and single.gap_source is not None:

@@ -121,3 +121,16 @@ def test_coil_inputs_and_checks():
     with Stepper(relay(), 1e-5, OPTIONS) as stepper:
         with pytest.raises(TypeError, match="needs the input coil.gap"):
             stepper.advance(1e-5, 0.0)
+
+
+def test_a_coil_drive_alone_is_a_circuit_of_its_own():
+    """An actuator without a contact circuit: the coil's drive alone, its gap held."""
+    drive = relay().coil
+    g = 1e-3
+    tau = K / g / (R_COIL + 1e-3)
+    with Stepper(drive, 1e-4 + 3 * tau, OPTIONS) as stepper:
+        assert set(stepper.inputs) == {"coil.gap"}
+        stepper.advance(1e-4 + 3 * tau, inputs={"coil.gap": g})
+        w = stepper.results()
+    assert list(w.columns) == ["time", "coil_current", "coil_voltage", "coil_flux_linkage"]
+    assert w.coil_current.iloc[-1] == pytest.approx(V / (R_COIL + 1e-3) * (1.0 - math.exp(-3.0)), rel=1e-3)
