@@ -1,0 +1,189 @@
+"""The relay's own sections: [coil] (its drive, a contract) and [magnet], mapped 1:1 onto
+circuit.coil_drive.CoilDrive and the magnets of coupling.laws.magnet (SI units).
+
+    [coil]    voltage (V), on_time, off_time (s: the supply switched on and off),
+              resistance (ohm, the winding), turns, suppression = "none" | "diode" |
+              "zener" | "rc", zener_voltage (V), rc_resistance (ohm), rc_capacitance (F),
+              switch_resistance (ohm), switch_capacitance (F), switch_breakdown (V),
+              edge_time (s)
+    [magnet]  model = "flux_tubes" | "table" | "plunger_solenoid" (built in); rest_gap (m,
+              the working gap with the armature on its rest stop), lever (m of pole-face
+              travel per unit of the armature's travel: 1 for a plunger, the pole's
+              distance from the hinge for a clapper); the model's own keys
+              (docs/magnet.md, "Scene section"): working_gap, pole_leakage, [[iron]],
+              [[fixed_gap]] with [[fixed_gap.tube]] (flux_tubes); currents, gaps,
+              flux_linkages, forces, force_tolerance (table)
+
+The coil's turns are the magnet's: a flux-tube magnet takes [coil] turns (the table's
+flux linkages include them already). A netlist circuit places the coil with an XCOIL
+line and takes only resistance and turns from [coil] (its drive is the netlist's).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+from dataclasses import dataclass
+from typing import Any
+
+from mech.validation import check_choice, check_keys, check_positive
+
+DRIVE_KEYS = ("voltage", "on_time", "off_time", "suppression", "zener_voltage", "rc_resistance", "rc_capacitance",
+              "switch_resistance", "switch_capacitance", "switch_breakdown", "edge_time")
+COIL_KEYS = DRIVE_KEYS + ("resistance", "turns")
+MAGNET_MODELS = ("flux_tubes", "table", "plunger_solenoid")
+PLACEMENT_KEYS = ("model", "rest_gap", "lever")
+FLUX_TUBE_KEYS = ("working_gap", "pole_leakage", "iron", "fixed_gap")
+TABLE_KEYS = ("currents", "gaps", "flux_linkages", "forces", "force_tolerance")
+
+
+@dataclass(frozen=True)
+class DeviceSpec:
+    """The relay's coil and magnet as a scene gives them.
+
+    coil: the [coil] table, checked (keys; the values are CoilDrive's and CoilBlock's to check).
+    magnet: a coupling.laws.magnet magnet (its ngspice current law and force).
+    rest_gap: m, the working gap with the armature on its rest stop.
+    lever: m of pole-face travel per unit of the armature's travel q (m or rad).
+    """
+
+    coil: dict
+    magnet: Any
+    rest_gap: float
+    lever: float = 1.0
+
+    @property
+    def resistance(self) -> float:
+        return float(self.coil["resistance"])
+
+    def current_law(self) -> str:
+        """The coil current as an ngspice expression of PSI (Wb) and GAP (m) (circuit.blocks.CoilBlock)."""
+        return self.magnet.current_expression("PSI", "GAP")
+
+    def drive(self):
+        """The coil with its drive and suppression (circuit.coil_drive.CoilDrive)."""
+        from circuit.blocks import CoilBlock
+        from circuit.coil_drive import DRIVER_NODE, SUPPLY_NODE, CoilDrive
+
+        try:
+            coil = CoilBlock("", SUPPLY_NODE, DRIVER_NODE, self.resistance, self.current_law())
+            return CoilDrive(coil, **{k: v for k, v in self.coil.items() if k in DRIVE_KEYS})
+        except (TypeError, ValueError) as err:  # in the scene's words: CoilDrive.voltage -> coil.voltage
+            raise ValueError(re.sub(r"\bCoil(Drive|Block)\.", "coil.", str(err))) from None
+
+
+def _table(where: str, value) -> dict:
+    if not isinstance(value, dict):
+        raise ValueError(f"{where}: expected a table of keys, got {value!r}")
+    return value
+
+
+def device(doc: dict) -> DeviceSpec | None:
+    """The scene's [coil] and [magnet] (both or neither), checked; None without them."""
+    if "coil" not in doc and "magnet" not in doc:
+        return None
+    if "coil" not in doc or "magnet" not in doc:
+        missing = "coil" if "coil" not in doc else "magnet"
+        raise ValueError(f"[{'magnet' if missing == 'coil' else 'coil'}] needs [{missing}]: the coil drives the "
+                         "armature through the magnet (docs/magnet.md)")
+    coil = dict(check_keys("[coil]", _table("[coil]", doc["coil"]), COIL_KEYS))
+    table = _table("[magnet]", doc["magnet"])
+    model = check_choice("magnet.model", table.get("model", "flux_tubes"), MAGNET_MODELS)
+    if model == "plunger_solenoid":
+        from coupling.laws.magnet import plunger_solenoid
+
+        check_keys("[magnet]", table, PLACEMENT_KEYS)
+        solenoid = plunger_solenoid()
+        coil.setdefault("resistance", solenoid.coil_resistance)
+        turns = coil.setdefault("turns", solenoid.magnet.turns)
+        magnet = solenoid.magnet if turns == solenoid.magnet.turns else dataclasses.replace(
+            solenoid.magnet, turns=check_positive("coil.turns", turns))
+        rest = table.get("rest_gap", solenoid.rest_gap)
+    else:
+        for key in ("resistance",) + (("turns",) if model == "flux_tubes" else ()):
+            if key not in coil:
+                raise ValueError(f"[coil] needs {key} ({'ohm, the winding' if key == 'resistance' else 'the winding'})"
+                                 f" with magnet.model = {model!r}")
+        if "rest_gap" not in table:
+            raise ValueError("[magnet] needs rest_gap (m): the working gap with the armature on its rest stop")
+        rest = table["rest_gap"]
+        if model == "flux_tubes":
+            check_keys("[magnet]", table, PLACEMENT_KEYS + FLUX_TUBE_KEYS)
+            magnet = flux_tube_magnet(table, check_positive("coil.turns", coil["turns"]))
+        else:
+            check_keys("[magnet]", table, PLACEMENT_KEYS + TABLE_KEYS)
+            if "turns" in coil:
+                raise ValueError("coil.turns: a table magnet's flux linkages include the turns; remove coil.turns")
+            magnet = table_magnet(table)
+    check_positive("coil.resistance", coil["resistance"])
+    rest = check_positive("magnet.rest_gap", rest)
+    lever = check_positive("magnet.lever", table.get("lever", 1.0))
+    return DeviceSpec(coil=coil, magnet=magnet, rest_gap=float(rest), lever=float(lever))
+
+
+def flux_tube_magnet(table: dict, turns: float):
+    """[magnet] with model = "flux_tubes" as a FluxTubeMagnet; each tube named by its key path."""
+    from coupling.laws.magnet import (
+        AIR_SHAPES, IRON_SHAPES, FixedGap, FluxTubeMagnet, LinearMaterial, PoleLeakage, TabulatedMaterial,
+        WorkingGap, magnetic_material,
+    )
+
+    if "working_gap" not in table:
+        raise ValueError("[magnet] with model = \"flux_tubes\" needs [magnet.working_gap] with its area (m^2)")
+    working = WorkingGap(**_fields("magnet.working_gap", table["working_gap"], WorkingGap),
+                         name="magnet.working_gap")
+    leakage = None
+    if "pole_leakage" in table:
+        leakage = PoleLeakage(**_fields("magnet.pole_leakage", table["pole_leakage"], PoleLeakage),
+                              name="magnet.pole_leakage")
+
+    def material(where: str, value):
+        if isinstance(value, str):
+            return magnetic_material(value, where)
+        value = _table(where, value)
+        if "relative_permeability" in value:
+            return LinearMaterial(**_fields(where, value, LinearMaterial), name=where)
+        return TabulatedMaterial(**_fields(where, value, TabulatedMaterial), name=where)
+
+    iron = []
+    for k, entry in enumerate(_list("magnet.iron", table.get("iron", []))):
+        where = f"magnet.iron[{k}]"
+        entry = dict(_table(where, entry))
+        shape = check_choice(f"{where}.shape", entry.pop("shape", None), tuple(IRON_SHAPES))
+        cls = IRON_SHAPES[shape]
+        entry["material"] = material(f"{where}.material", entry.get("material"))
+        iron.append(cls(**_fields(where, entry, cls), name=where))
+    fixed = []
+    for k, entry in enumerate(_list("magnet.fixed_gap", table.get("fixed_gap", []))):
+        where = f"magnet.fixed_gap[{k}]"
+        entry = check_keys(where, _table(where, entry), ("tube",))
+        tubes = []
+        for j, tube in enumerate(_list(f"{where}.tube", entry.get("tube", []))):
+            there = f"{where}.tube[{j}]"
+            tube = dict(_table(there, tube))
+            shape = check_choice(f"{there}.shape", tube.pop("shape", None), tuple(AIR_SHAPES))
+            cls = AIR_SHAPES[shape]
+            tubes.append(cls(**_fields(there, tube, cls), name=there))
+        fixed.append(FixedGap(tuple(tubes), name=where))
+    return FluxTubeMagnet(turns=float(turns), working_gap=working, iron=tuple(iron), fixed_gap=tuple(fixed),
+                          pole_leakage=leakage)
+
+
+def table_magnet(table: dict):
+    """[magnet] with model = "table" as a TableMagnet (checked for consistency on load)."""
+    from coupling.laws.magnet import TableMagnet
+
+    return TableMagnet(**_fields("[magnet]", {k: table[k] for k in TABLE_KEYS if k in table}, TableMagnet))
+
+
+def _fields(where: str, table, cls) -> dict:
+    """The keyword arguments of ``cls`` a table gives (its name field set by the caller)."""
+    table = _table(where, table)
+    allowed = [f.name for f in dataclasses.fields(cls) if f.name != "name"]
+    return dict(check_keys(where if where.startswith("[") else f"[{where}]", table, allowed))
+
+
+def _list(where: str, value) -> list:
+    if not isinstance(value, list):
+        raise ValueError(f"{where} = {value!r}: expected a list of tables ([[{where}]])")
+    return value
