@@ -125,6 +125,10 @@ class CoSimulation:
                           circuit_seconds=0.0)
         self._tail_t = np.zeros(0)
         self._tail_i = np.zeros(0)
+        self._contact_times: list[np.ndarray] = []  # the circuit's points sampled so far ...
+        self._contacts: list[np.ndarray] = []  # ... and the mechanics' contact there (_sample_contact)
+        self._pending = np.zeros(0)  # points beyond the mechanics' time, sampled with the next step
+        self._started = False
 
     def _mu(self, current: float) -> float:
         return float(self.laws.mu(current)) if self.feedback else float(self.laws.mu(0.0))
@@ -250,6 +254,7 @@ class CoSimulation:
         step = stepper.advance(t_next, conductance, breakpoints=breakpoints,
                                gap=gap if stepper.uses_gap else None)
         self.stats["circuit_seconds"] += time.perf_counter() - tick
+        self._sample_contact(mech, step)
         # the circuit's last points, kept across steps for the slope and its time scale
         self._tail_t = np.concatenate([self._tail_t, step.reader("time")])[-TAIL_POINTS:]
         self._tail_i = np.concatenate([self._tail_i, step.reader("load_current")])[-TAIL_POINTS:]
@@ -275,7 +280,24 @@ class CoSimulation:
         tick = time.perf_counter()
         step = stepper.advance(t_next, g, gap=gap if stepper.uses_gap else None)
         self.stats["circuit_seconds"] += time.perf_counter() - tick
+        self._sample_contact(mech, step)
         return _coupling_current(step), t_next
+
+    def _sample_contact(self, mech, step) -> None:
+        """The mechanics' contact (penetration, rate, normal force per tip) at the circuit's
+        new points of a macro step, from that step's dense output, which is then released:
+        the mechanics keeps one macro step's dense output, not the run's. (A step's reader
+        starts at the previous step's last point.)"""
+        times = step.reader("time")
+        pending = np.concatenate([self._pending, times[1:] if self._started else times])
+        self._started = True
+        # a point beyond the last record (ngspice may land a hair past the step's end) lies
+        # in the next step's first record: sampled with the next step, from that record
+        k = int(np.searchsorted(pending, mech.last_record_time, side="right"))
+        self._contact_times.append(pending[:k])
+        self._contacts.append(mech.contact_series(pending[:k]))
+        self._pending = pending[k:]
+        mech.release_dense()
 
     def _conductance(self, seg, rl, touching_at_start):
         """G_F(F_n(t)) summed over both tips (they touch the same block), S, from the dense output.
@@ -319,7 +341,11 @@ class CoSimulation:
         waves = stepper.result_columns(probes=self.scene.circuit.probes)
         kept = waves["time"] <= mech.t + 1e-15
         waves = {name: values[kept] for name, values in waves.items()}
-        contact = mech.contact_series(waves["time"])
+        # sampled step by step; points of a step that failed in the circuit are sampled now
+        done = np.concatenate(self._contact_times) if self._contact_times else np.zeros(0)
+        if not np.array_equal(waves["time"][:len(done)], done):
+            raise RuntimeError("the circuit's points differ from those sampled step by step")
+        contact = np.concatenate(self._contacts + [mech.contact_series(waves["time"][len(done):])])
         for i in range(2):
             waves[f"normal_force_{i}"] = contact[:, i, 2]
             waves[f"penetration_{i}"] = np.maximum(contact[:, i, 0], 0.0)
