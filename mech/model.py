@@ -165,12 +165,13 @@ def mechanism_scales(scene: MechScene, arr: MechanismArrays, n_modes: int) -> Co
 
 # --- the energy the scene's steady loads can release (the audit's yardstick) ------------
 
-def load_work_bound(model: "BarModel", energy: float) -> float:
+def load_work_bound(model: "BarModel", energy: float, forces: bool = True) -> float:
     """J: the most work the steady loads can do on a held bar (clamp or pivot) within its
-    range of motion, from the scene alone, before the run: gravity, every actuator force at
-    the largest magnitude its table reaches (a world or a body direction), a pivot's
-    preload torque (with its torsion spring). ``energy`` (J): what the scene brings besides
-    (initial kinetic, elastic, contact and spring energy), which can carry the bar further.
+    range of motion, from the scene alone, before the run: gravity, a pivot's preload
+    torque (with its torsion spring) and, with ``forces``, every actuator force at the
+    largest magnitude its table reaches (a world or a body direction). ``energy`` (J): what
+    the scene brings besides (initial kinetic, elastic, contact and spring energy), which
+    can carry the bar further.
 
     - Rigid rotation (pivot): the loads' potential Phi(phi) about the hinge, lowest over
       the arc of angles the bar can reach from its start without a contact cap going into
@@ -187,7 +188,7 @@ def load_work_bound(model: "BarModel", energy: float) -> float:
     if not scene.mount.held:
         return 0.0
     y0 = model.initial_state()
-    loads = _steady_loads(model)
+    loads = _steady_loads(model) if forces else []
     rigid = 0.0
     if scene.mount.kind == "pivot":
         rigid = _pivot_arc_bound(model, y0, loads, energy)
@@ -284,25 +285,42 @@ def _elastic_bound(model: "BarModel", y0: np.ndarray, loads: list, phi: float, e
     for point, d, body, mag in loads:
         dir_body = d if body else R.T @ d
         f = f + mag * (psi[point] @ dir_body)
+    free = load_release_bound(K, f, energy)
+    if not constrained or free <= 0.0:
+        return free
+    c = -(psi[0] @ R[2])  # downward displacement of contact point 0 per unit q (m)
+    gap = float(y0[1] + R[2] @ xc[0]) - float(model.cpar[0, C_R])  # its cap above the block at the start
+    k = float(model.cpar[0, C_K])
+    depth = (2.5 * (free + max(energy, 0.0)) / k) ** 0.4 if k > 0.0 else 0.0
+    return load_release_bound(K, f, energy, c, max(gap, 0.0) + depth)
+
+
+def load_release_bound(K: np.ndarray, f: np.ndarray, energy: float, c: np.ndarray | None = None,
+                       room: float = math.inf) -> float:
+    """J: the most work f.q a steady load f (N, modal) can do on a linear elastic system of
+    stiffness K (N/m, symmetric positive definite) starting at q = 0 with ``energy`` (J)
+    besides: max f.q over {1/2 q K q - f.q <= energy}, and with c (m per unit q) over
+    the part where c.q <= ``room`` (m: a contact point that may move that far towards the
+    block). A ball in the coordinates u = K^(1/2) (q - K^-1 f) of radius
+    rho = sqrt(2 energy + a), a = f K^-1 f: f.q = a + rho sqrt(a) at its best, 2a from rest
+    (twice the static work); cut by the half-space, the best lies on the cut:
+    a + f_c alpha + sqrt(a - f_c^2) sqrt(rho^2 - alpha^2), alpha = beta / |c~|,
+    beta = room - c K^-1 f, f_c = f K^-1 c / |c~|, |c~|^2 = c K^-1 c."""
     Kinv_f = np.linalg.solve(K, f)
     a = float(f @ Kinv_f)
     if a <= 0.0:
         return 0.0
-    e = max(energy, 0.0)
-    rho = math.sqrt(2.0 * e + a)
+    rho = math.sqrt(2.0 * max(energy, 0.0) + a)
     free = a + rho * math.sqrt(a)
-    if not constrained:
+    if c is None or not math.isfinite(room):
         return free
-    c = -(psi[0] @ R[2])  # downward displacement of contact point 0 per unit q (m)
     Kinv_c = np.linalg.solve(K, c)
     cc = float(c @ Kinv_c)
     if cc <= 0.0:
         return free
-    k = float(model.cpar[0, C_K])
-    depth = (2.5 * (free + e) / k) ** 0.4 if k > 0.0 else 0.0
-    beta = model.scene.initial.height + depth - float(c @ Kinv_f)
+    beta = room - float(c @ Kinv_f)
     fc = float(f @ Kinv_c) / math.sqrt(cc)
-    if rho * fc <= beta * math.sqrt(a):  # the unconstrained optimum keeps above the block
+    if rho * fc * math.sqrt(cc) <= beta * math.sqrt(a):  # the ball's best point lies in the half-space
         return free
     alpha = min(max(beta / math.sqrt(cc), -rho), rho)
     return a + fc * alpha + math.sqrt(max(a - fc * fc, 0.0)) * math.sqrt(max(rho * rho - alpha * alpha, 0.0))

@@ -27,6 +27,12 @@ MEMORY_LIMIT = 4 * 2**30
 # bytes of dense output kept beyond what the rows since the last release need (a stepper
 # fills the buffer to here before it returns, as it fills the row buffer)
 DENSE_BYTES = 64 * 2**20
+# A stepper returns when its room is full, and a return restarts its step-size control, so
+# where it returns changes the trajectory (within the tolerance). The room ends where a
+# buffer that only doubled would be full, 4096 x 2^k rows, and past CHUNK rows every CHUNK
+# rows: counted in rows ever recorded, a thinned run returns where an unthinned one does
+# and integrates the same steps; the buffer needs only CHUNK rows besides those it keeps.
+CHUNK = 16384
 
 
 def row_bytes(state_size: int, n_extra: int = 0, dense: bool = False) -> int:
@@ -37,9 +43,10 @@ def row_bytes(state_size: int, n_extra: int = 0, dense: bool = False) -> int:
 
 
 def history_memory(state_size: int, rows: int, n_extra: int = 0) -> int:
-    """Bytes the history of ``rows`` rows may take at its peak: the buffer while it doubles
-    (old and new, up to twice the rows) plus the result's copy of the rows."""
-    return 3 * rows * row_bytes(state_size, n_extra)
+    """Bytes the history of ``rows`` rows may take at its peak: the buffer of those rows and
+    a stepper's room (CHUNK) while it doubles (old and new, up to twice that) plus the
+    result's copy of the rows."""
+    return (2 * (rows + CHUNK) + rows) * row_bytes(state_size, n_extra)
 
 
 class Recorder:
@@ -64,6 +71,8 @@ class Recorder:
             raise ValueError(f"capacity = {capacity!r}: at least 2 rows")
         self.n = 0
         self.capacity = capacity
+        self.dropped = 0  # rows thinned away: n + dropped rows were recorded
+        self.room_end = capacity  # where a stepper's room ends, in rows recorded (CHUNK)
         self.keep_dense = keep_dense
         self.row_limit = row_limit
         self.on_full = None
@@ -80,39 +89,55 @@ class Recorder:
         self.dense_h = np.empty(dcap)
         self.dense_coef = np.empty((dcap, 5, state_size))
 
+    @property
+    def recorded(self) -> int:
+        """Rows recorded so far, those thinned away included."""
+        return self.n + self.dropped
+
     def reserve(self, rows: int) -> None:
-        """Make room for ``rows`` more rows after ``n`` (and one spare): past ``row_limit``
-        rows by thinning (``on_full``) first, by growing where that freed too little."""
-        if (self.n + rows + 1 > self.capacity and self.on_full is not None and self.row_limit is not None
-                and self.n >= self.row_limit):
+        """Make room for ``rows`` more rows after ``n`` (and one spare) and for a stepper's
+        room up to ``room_end``: past ``row_limit`` rows by thinning (``on_full``) first,
+        by growing where that freed too little."""
+        self._extend_room(rows)
+        if (self.n + self.room_end - self.recorded > self.capacity and self.on_full is not None
+                and self.row_limit is not None and self.n >= self.row_limit):
             self.on_full()
         self._ensure(rows)
 
-    def _ensure(self, rows: int) -> None:
-        """Grow (never thin) until ``rows`` more rows and one spare fit, dense output too.
+    def _extend_room(self, rows: int) -> None:
+        while self.recorded + rows + 1 > self.room_end:
+            self.room_end += self.room_end if self.room_end < CHUNK else CHUNK
 
-        The dense buffer spans the rows' free room (so a stepper's segments end where the
-        row buffer is full, as without it) up to DENSE_BYTES, and beyond that what the
-        current rows need: a stepper then returns more often, each time the dense buffer
-        is full (the rows since the last release are all kept)."""
-        while self.n + rows + 1 > self.capacity:
-            self._grow()
+    def _ensure(self, rows: int) -> None:
+        """Grow (never thin) until ``rows`` more rows and one spare fit, and the stepper's
+        room to ``room_end``, dense output too.
+
+        The dense buffer spans the stepper's room up to DENSE_BYTES, and beyond that what
+        the current rows need: a stepper then returns more often, each time the dense
+        buffer is full (the rows since the last release are all kept)."""
+        self._extend_room(rows)
+        need = self.n + self.room_end - self.recorded
+        if need > self.capacity:
+            cap = self.capacity
+            while cap < need:
+                cap *= 2
+            if self.row_limit is not None and self.n >= self.row_limit:
+                cap = need  # past the limit (thinning freed too little): no more than needed
+            self._grow(cap)
         if self.keep_dense:
             used = self.n - self.dense_base
-            need = used + rows + 1
-            span = self.capacity - self.dense_base
-            size = max(min(span, DENSE_BYTES // (8 * (2 + 5 * self.y.shape[1]))), need)
+            span = used + self.room_end - self.recorded
+            size = max(min(span, DENSE_BYTES // (8 * (2 + 5 * self.y.shape[1]))), used + rows + 1)
             if size > len(self.dense_t0):
                 cap = len(self.dense_t0)
                 while cap < size:
                     cap *= 2
-                cap = min(cap, max(span, need))
+                cap = min(cap, span)
                 self.dense_t0 = _grown(self.dense_t0, cap, used)
                 self.dense_h = _grown(self.dense_h, cap, used)
                 self.dense_coef = _grown(self.dense_coef, cap, used)
 
-    def _grow(self) -> None:
-        cap = 2 * self.capacity
+    def _grow(self, cap: int) -> None:
         n = self.n
         self.t, self.y, self.aux = _grown(self.t, cap, n), _grown(self.y, cap, n), _grown(self.aux, cap, n)
         self.fmax, self.regime, self.ext = _grown(self.fmax, cap, n), _grown(self.regime, cap, n), _grown(self.ext, cap, n)
@@ -123,12 +148,13 @@ class Recorder:
         the dense output (t0, h, coef) (a one-row scratch when dense output is not kept).
         Both views are equally long, so a stepper that fills one never overruns the other."""
         n = self.n
+        room = min(self.capacity - n, self.room_end - self.recorded)
+        records = (self.t[n:n + room], self.y[n:n + room], self.aux[n:n + room], self.fmax[n:n + room])
         if self.keep_dense:
             d = n - self.dense_base
-            room = min(self.capacity - n, len(self.dense_t0) - d)
-            records = (self.t[n:n + room], self.y[n:n + room], self.aux[n:n + room], self.fmax[n:n + room])
+            room = min(room, len(self.dense_t0) - d)
+            records = tuple(a[:room] for a in records)
             return records, (self.dense_t0[d:d + room], self.dense_h[d:d + room], self.dense_coef[d:d + room])
-        records = (self.t[n:], self.y[n:], self.aux[n:], self.fmax[n:])
         return records, (self.dense_t0, self.dense_h, self.dense_coef)
 
     def commit(self, rows: int, regime: np.ndarray) -> None:
@@ -192,6 +218,7 @@ class Recorder:
         self.fmax[:m] = peak
         self.fmax[m:n - dropped] = self.fmax[floor:n]
         self.n = n - dropped
+        self.dropped += dropped
         self.dense_base -= dropped if self.keep_dense else 0
         return dropped
 

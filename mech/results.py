@@ -330,35 +330,49 @@ class ImpactResult:
     @property
     def energy_scale(self) -> float:
         """J: the energy the audit is judged against: what the scene brings in, its initial
-        kinetic, elastic, contact- and spring-stored energy, plus the most work its loads
-        and drives can do, E_in + max(W_scene, W_run):
+        kinetic, elastic, contact- and spring-stored energy E_in, plus the most work its
+        loads and drives can do, max(W_rest, min(W_run, W_all)):
 
-        - W_scene, from the scene before the run: a free bar's centre can drop to its
-          lowest resting height (lying flat on the block: the centre at the tip radius),
-          m g (z_c0 - R_tip); on a held bar the steady loads (gravity, the actuator forces
-          at their largest, a pivot's preload torque) can do mech.model.load_work_bound
-          within its range of motion (a sagging blade, a pendulum, a preloaded pivot);
-        - W_run, what the drives did: the most the actuators and a moving clamp had put in
-          at any time, with the work gravity did meanwhile (a clamp lowered under gravity
-          carries the blade's weight down: its own work is less by that).
-
-        A bar at rest still has a scale (a standing bar can fall over), and where the scene
-        bounds the work, a run that gains energy by error does not enlarge its yardstick."""
+        - W_run, what the run's loads and drives did: the most that the actuators and a
+          moving clamp had put in (``work_in``), gravity had released and the springs and a
+          pivot's preload torque had given up, at any time: the energy in motion, stored
+          in the bar and dissipated, less E_in (a tight yardstick);
+        - W_rest, bounded from the scene before the run, what the loads that act on a bar
+          at rest can release: a free bar's centre can drop to its lowest resting height
+          (lying flat on the block: the centre at the tip radius), m g (z_c0 - R_tip); a
+          held bar's weight and a pivot's preload torque can do mech.model.load_work_bound
+          within its range of motion (a sagging blade, a pendulum, a preloaded pivot). A
+          bar at rest is judged against this, not against its near-zero motion;
+        - W_all, also bounded from the scene, what every load can do (the actuator forces
+          at their largest too), and the springs' energy: a run that gains energy by error
+          does not enlarge its yardstick beyond it. A moving clamp and a free bar's forces
+          have no such bound: their work is what the run measured."""
         en = self.energy_columns
         m = self.model
         z0 = float(self.states[0, m.slices()["pos"]][-1])  # centre height, z up (planar: x, z)
         scene = m.scene
-        e_in = float(en["kinetic"][0] + en["elastic"][0] + en["contact_stored"][0] + en["spring_stored"][0])
-        if scene.mount.held:
-            w_scene = self._cache.get("load_work_bound")
-            if w_scene is None:
-                from .model import load_work_bound
+        s0 = float(en["spring_stored"][0])
+        e_in = float(en["kinetic"][0] + en["elastic"][0] + en["contact_stored"][0]) + s0
+        if "scene_bounds" not in self._cache:
+            self._cache["scene_bounds"] = self._scene_bounds(e_in, z0)
+        w_rest, w_all = self._cache["scene_bounds"]
+        drive = en["work_in"] - en["potential"] - (en["spring_stored"] - s0)
+        w_run = max(float(np.max(drive)), self._dropped("max_drive_work", -math.inf))
+        return max(e_in + max(w_rest, min(w_run, w_all + s0), 0.0), 1e-300)
 
-                w_scene = self._cache["load_work_bound"] = load_work_bound(m, e_in)
-        else:  # a free bar can drop its centre to the tip radius
-            w_scene = m.basis.mass * scene.gravity * max(z0 - scene.bar.tip_radius, 0.0)
-        w_run = max(float(np.max(en["work_in"] - en["potential"])), self._dropped("max_drive_work", -math.inf))
-        return max(e_in + max(w_scene, w_run, 0.0), 1e-300)
+    def _scene_bounds(self, e_in: float, z0: float) -> tuple[float, float]:
+        """(W_rest, W_all) of ``energy_scale``, J, from the scene alone."""
+        m = self.model
+        scene = m.scene
+        if not scene.mount.held:  # a free bar can drop its centre to the tip radius
+            w_rest = m.basis.mass * scene.gravity * max(z0 - scene.bar.tip_radius, 0.0)
+            return w_rest, (math.inf if scene.forces else w_rest)
+        from .model import load_work_bound
+
+        w_rest = load_work_bound(m, e_in, forces=False)
+        if scene.mount.base_motion is not None:
+            return w_rest, math.inf
+        return w_rest, (load_work_bound(m, e_in) if scene.forces else w_rest)
 
     @property
     def deepest_penetration(self) -> float:

@@ -468,7 +468,8 @@ class ImpactSolver:
         terms = audit_terms(E, qd, first)
         th["max_abs_residual"] = max(th["max_abs_residual"], float(np.max(np.abs(audit_residual(E, qd, first)))))
         th["max_kinetic"] = max(th["max_kinetic"], float(E[:, 0].max()))
-        th["max_drive_work"] = max(th["max_drive_work"], float(np.max(terms["work_in"] - terms["potential"])))
+        drive = terms["work_in"] - terms["potential"] - (terms["spring_stored"] - first[4])
+        th["max_drive_work"] = max(th["max_drive_work"], float(np.max(drive)))
         th["max_speed"] = max(th["max_speed"], float(np.max(np.linalg.norm(Y[:, m.slices()["vel"]], axis=1))))
         pen = rec.aux[:len(drop)][drop][:, :, A_Y].max(axis=0)
         th["max_penetration"] = [max(a, float(b)) for a, b in zip(th["max_penetration"], pen)]
@@ -569,6 +570,12 @@ class ImpactSolver:
         result = np.empty_like(out)
         result[order] = out
         return result
+
+    @property
+    def dense_rows(self) -> int:
+        """Rows of dense output held (``keep_dense``): those recorded since the last
+        ``release_dense``."""
+        return self.recorder.n - self.recorder.dense_base if self.keep_dense else 0
 
     @property
     def last_record_time(self) -> float:

@@ -36,6 +36,10 @@ from coupling.core.results import CoupledResult
 from coupling.core.scene import Scene
 
 CONTACT_EVENTS = ("contact_start", "contact_end")
+# rows of the mechanics' dense output before the contact is sampled at the circuit's points
+# and the dense output released (4096 rows of a 45-state blade: 7 MB); each sampling costs
+# ~60 us of calls, so sampling every macro step cost the default relay 4 % of its run
+DENSE_FLUSH_ROWS = 4096
 
 
 class CoupledRunError(RuntimeError):
@@ -127,7 +131,7 @@ class CoSimulation:
         self._tail_i = np.zeros(0)
         self._contact_times: list[np.ndarray] = []  # the circuit's points sampled so far ...
         self._contacts: list[np.ndarray] = []  # ... and the mechanics' contact there (_sample_contact)
-        self._pending = np.zeros(0)  # points beyond the mechanics' time, sampled with the next step
+        self._pending: list[np.ndarray] = []  # the circuit's points not sampled yet
         self._started = False
 
     def _mu(self, current: float) -> float:
@@ -284,20 +288,23 @@ class CoSimulation:
         return _coupling_current(step), t_next
 
     def _sample_contact(self, mech, step) -> None:
-        """The mechanics' contact (penetration, rate, normal force per tip) at the circuit's
-        new points of a macro step, from that step's dense output, which is then released:
-        the mechanics keeps one macro step's dense output, not the run's. (A step's reader
-        starts at the previous step's last point.)"""
+        """Note the circuit's new points of a macro step (a step's reader starts at the
+        previous step's last point); once the mechanics hold DENSE_FLUSH_ROWS rows of dense
+        output, sample their contact (penetration, rate, normal force per tip) at the points
+        noted, from that dense output, and release it: the mechanics keep a few macro steps'
+        dense output, not the run's (docs/mechanics.md, "Memory")."""
         times = step.reader("time")
-        pending = np.concatenate([self._pending, times[1:] if self._started else times])
+        self._pending.append(times[1:] if self._started else times)
         self._started = True
-        # a point beyond the last record (ngspice may land a hair past the step's end) lies
-        # in the next step's first record: sampled with the next step, from that record
-        k = int(np.searchsorted(pending, mech.last_record_time, side="right"))
-        self._contact_times.append(pending[:k])
-        self._contacts.append(mech.contact_series(pending[:k]))
-        self._pending = pending[k:]
-        mech.release_dense()
+        if mech.dense_rows >= DENSE_FLUSH_ROWS:
+            pending = np.concatenate(self._pending)
+            # a point beyond the last record (ngspice may land a hair past the step's end)
+            # lies in the next step's first record: sampled later, from that record
+            k = int(np.searchsorted(pending, mech.last_record_time, side="right"))
+            self._contact_times.append(pending[:k])
+            self._contacts.append(mech.contact_series(pending[:k]))
+            self._pending = [pending[k:]]
+            mech.release_dense()
 
     def _conductance(self, seg, rl, touching_at_start):
         """G_F(F_n(t)) summed over both tips (they touch the same block), S, from the dense output.
@@ -341,7 +348,7 @@ class CoSimulation:
         waves = stepper.result_columns(probes=self.scene.circuit.probes)
         kept = waves["time"] <= mech.t + 1e-15
         waves = {name: values[kept] for name, values in waves.items()}
-        # sampled step by step; points of a step that failed in the circuit are sampled now
+        # sampled as the run went (_sample_contact); the points since are sampled now
         done = np.concatenate(self._contact_times) if self._contact_times else np.zeros(0)
         if not np.array_equal(waves["time"][:len(done)], done):
             raise RuntimeError("the circuit's points differ from those sampled step by step")

@@ -6,10 +6,12 @@ the circuit then carries currents its source cannot drive. Such a result gets th
 "unsound" (``switchsim`` exits 3), with each violated bound named, its cause and the fix.
 
 The bounds, all from the scene's own energy scale E (J, ``mech.ImpactResult.energy_scale``:
-initial kinetic + elastic + contact-stored energy + m g (z_c0 - R_tip), the potential
-energy of the centre above the lowest resting height; nothing in the scene adds
-mechanical energy after the start: contact damping, friction and modal damping only take
-it out):
+what the scene brings in, initial kinetic, elastic, contact- and spring-stored energy,
+and the most work its loads and drives can do: gravity, actuator forces, springs, a
+pivot's preload torque, a moving clamp; bounded from the scene before the run where it can
+be (docs/mechanics.md section 9, "Energy audit"). Contact damping, friction and modal
+damping only take energy out. Past their history's row budget, a run's extremes include
+the rows it thinned away (``mech.ImpactResult.thinning``)):
 
 - energy audit: max |residual| <= energy_tolerance * E ([solver] energy_tolerance);
 - speeds: the kinetic energy (translation, rotation, vibration) never exceeds E, and so
