@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize
 
-from mech.model import load_release_bound
+from mech.model import load_release_bound, load_work_bound
 from mech.scene import scene_from_dict
 from mech.solver import ImpactSolver
 
@@ -65,6 +65,7 @@ def test_a_pendulum_is_judged_against_the_fall_of_its_centre_to_the_block():
     res = ImpactSolver(scene_from_dict(arm(environment=dict(gravity=9.81)))).run()
     m = res.model.basis.mass
     fall = m * 9.81 * (L / 2) * h / (L - R)
+    assert load_work_bound(res.model, 0.0) == pytest.approx(fall, rel=1e-3)  # from the scene, before the run
     assert res.energy_scale == pytest.approx(fall, rel=1e-3)
     assert energy_at_first_contact(res) == pytest.approx(fall, rel=1e-3)
     assert res.max_kinetic <= res.energy_scale and res.flags == []
@@ -78,6 +79,7 @@ def test_a_preloaded_arm_is_judged_against_the_work_of_its_torque():
     res = ImpactSolver(scene_from_dict(arm(mount=dict(kind="pivot", position=L, preload_torque=T),
                                            initial=dict(height=h), solver=dict(t_end=0.03)))).run()
     work = T * math.asin(h / (L - R))
+    assert load_work_bound(res.model, 0.0) == pytest.approx(work, rel=1e-2)  # from the scene, before the run
     assert res.energy_scale == pytest.approx(work, rel=1e-2)
     assert energy_at_first_contact(res) == pytest.approx(work, rel=1e-3)
     assert res.max_kinetic <= res.energy_scale and res.flags == []
