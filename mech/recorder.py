@@ -75,6 +75,7 @@ class Recorder:
         self.room_end = capacity  # where a stepper's room ends, in rows recorded (CHUNK)
         self.keep_dense = keep_dense
         self.row_limit = row_limit
+        self.thin_at = row_limit if row_limit is not None else 0
         self.on_full = None
         self.on_commit = None
         self.t = np.empty(capacity)
@@ -99,14 +100,22 @@ class Recorder:
         room up to ``room_end``: past ``row_limit`` rows by thinning (``on_full``) first,
         by growing where that freed too little."""
         self._extend_room(rows)
-        if (self.n + self.room_end - self.recorded > self.capacity and self.on_full is not None
-                and self.row_limit is not None and self.n >= self.row_limit):
+        if (self.on_full is not None and self.row_limit is not None and self.n >= self.row_limit
+                and (self.n + self.room_end - self.recorded > self.capacity or self.n >= self.thin_at)):
             self.on_full()
+            # (a stepper that grows the buffer itself, solve_ivp's, fills no room: try again
+            # once half a room more is kept)
+            self.thin_at = self.n + CHUNK // 2
         self._ensure(rows)
 
     def _extend_room(self, rows: int) -> None:
         while self.recorded + rows + 1 > self.room_end:
             self.room_end += self.room_end if self.room_end < CHUNK else CHUNK
+
+    def make_room(self, rows: int) -> None:
+        """Make room for ``rows`` more rows by growing only, never thinning: for a stepper,
+        inside a segment whose first row the solver has noted."""
+        self._ensure(rows)
 
     def _ensure(self, rows: int) -> None:
         """Grow (never thin) until ``rows`` more rows and one spare fit, and the stepper's
