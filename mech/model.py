@@ -24,6 +24,7 @@ from .kernel_layout import (
     F_VREG, FRICTION_EXACT, FRICTION_NONE, FRICTION_REGULARIZED, I_FRICTION, I_N,
     I_PLANAR, I_MOUNT, I_NLOAD, MOUNT_CLAMP, MOUNT_FREE, MOUNT_PIVOT, N_FPAR,
     F_PIV_C, F_PIV_K, F_PIV_PHI0, F_PIV_SIGN, F_PIV_T0, L_L0, I_INERTIA, INERTIA_GRAM, INERTIA_SPARSE, N_IPAR, N_LOAD, NQ, NQ_FREE, C_C, C_K, C_ON, C_R, state_sizes,
+    L_BODY, L_DX, L_DZ, L_KIND, L_POINT, L_T0, L_TN, LOAD_FORCE,
 )
 from .mechanism import (
     MechanismArrays, build_arrays, closing_work, contact_parameters,
@@ -165,6 +166,169 @@ def mechanism_scales(scene: MechScene, arr: MechanismArrays, n_modes: int) -> Co
         shortest_contact=hertz_impact(m_min, k0, v_max).contact_time,
         energy_scale=max(e_avail, 1e-12), speed_bound=v_max, dampings=tuple(dampings),
     )
+
+
+# --- the energy the scene's steady loads can release (the audit's yardstick) ------------
+
+def load_work_bound(model: "BarModel", energy: float, forces: bool = True) -> float:
+    """J: the most work the steady loads can do on a held bar (clamp or pivot) within its
+    range of motion, from the scene alone, before the run: gravity, a pivot's preload
+    torque (with its torsion spring) and, with ``forces``, every actuator force at the
+    largest magnitude its table reaches (a world or a body direction). ``energy`` (J): what
+    the scene brings besides (initial kinetic, elastic, contact and spring energy), which
+    can carry the bar further.
+
+    - Rigid rotation (pivot): the loads' potential Phi(phi) about the hinge, lowest over
+      the arc of angles the bar can reach from its start without a contact cap going into
+      the block (deeper than the Hertz penetration that energy could make): Phi(phi0) -
+      min Phi. A pendulum released above the block: m g times its centre's drop until the
+      cap meets the block; a preload torque T: T times the angle to the block.
+    - Elastic modes: a load f (modal forces, N) on stiffness K releases f.q, at most
+      a (1 + sqrt(1 + 2 e / a)) with a = f K^-1 f (2a from rest: twice the static work) for
+      the energy e otherwise present; a clamped blade's contact point cannot go below the
+      block (its gap and the penetration), which bounds q further
+      (``_elastic_bound``).
+    Free bars are bounded in mech.results (their centre's drop to the block)."""
+    scene = model.scene
+    if not scene.mount.held:
+        return 0.0
+    y0 = model.initial_state()
+    loads = _steady_loads(model) if forces else []
+    rigid = 0.0
+    if scene.mount.kind == "pivot":
+        rigid = _pivot_arc_bound(model, y0, loads, energy)
+    if model.n == 0:
+        return rigid
+    phis = [float(y0[2])]
+    if scene.mount.kind == "pivot":  # the modal loads turn with the bar: their largest over a turn
+        phis += list(float(y0[2]) + np.linspace(-math.pi, math.pi, 64, endpoint=False))
+    constrained = scene.mount.kind == "clamp"
+    return rigid + max(_elastic_bound(model, y0, loads, phi, energy + rigid, constrained) for phi in phis)
+
+
+def _steady_loads(model: "BarModel") -> list:
+    """(point index, direction (3,), body frame?, magnitude N) of each actuator force, at
+    the value of largest magnitude its table reaches."""
+    out = []
+    for row in model.load:
+        if int(row[L_KIND]) != LOAD_FORCE:
+            continue
+        values = model.tables[1, int(row[L_T0]):int(row[L_T0]) + int(row[L_TN])]
+        f = float(values[np.argmax(np.abs(values))]) if len(values) else 0.0
+        out.append((int(row[L_POINT]), np.array(row[L_DX:L_DZ + 1]), bool(row[L_BODY]), f))
+    return out
+
+
+def _pivot_arc_bound(model: "BarModel", y0: np.ndarray, loads: list, energy: float) -> float:
+    """J: Phi(phi0) - min Phi over the arc of the rigid rotation the block allows (see
+    load_work_bound); Phi: gravity, the forces, the preload torque and torsion spring."""
+    fp = model.fpar
+    m = model.basis.mass
+    c = model.first_moments[:, 0]  # kg m, about the hinge (the frame origin)
+    psi, _, xc = model.points
+    phi0 = float(y0[2])
+    caps = [(xc[i], model.cpar[i, C_R]) for i in range(2) if model.cpar[i, C_ON] != 0.0]
+
+    def potential(phi):
+        phi = np.asarray(phi, dtype=float)
+        cos, sin = np.cos(phi), np.sin(phi)
+        v = fp[F_G] * (m * y0[1] + (-sin * c[0] + cos * c[2]))
+        th = fp[F_PIV_SIGN] * (phi - fp[F_PIV_PHI0])
+        v = v + 0.5 * fp[F_PIV_K] * th * th - fp[F_PIV_T0] * th
+        for point, d, body, f in loads:
+            p = xc[point]
+            if body:  # a force turning with the bar: a constant torque about the hinge
+                v = v - f * (d[0] * p[2] - d[2] * p[0]) * (phi - phi0)
+            else:
+                x = y0[0] + cos * p[0] + sin * p[2]
+                z = y0[1] - sin * p[0] + cos * p[2]
+                v = v - f * (d[0] * x + d[2] * z)
+        return v
+
+    def clearance(phi, depth):
+        """m: the lowest cap's height above the block at angle(s) phi, plus ``depth``."""
+        phi = np.asarray(phi, dtype=float)
+        z = [y0[1] - np.sin(phi) * p[0] + np.cos(phi) * p[2] - r for p, r in caps]
+        return np.min(z, axis=0) + depth
+
+    def limit(direction, depth):
+        """The angle where a cap first meets the block turning from phi0 (at most a turn)."""
+        grid = phi0 + direction * np.linspace(0.0, 2.0 * math.pi, 4097)
+        below = np.flatnonzero(clearance(grid, depth) < 0.0)
+        if not len(below) or below[0] == 0:
+            return float(grid[-1] if not len(below) else phi0)
+        lo, hi = float(grid[below[0] - 1]), float(grid[below[0]])
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if clearance(mid, depth) >= 0.0 else (lo, mid)
+        return lo
+
+    def bound(depth):
+        lo, hi = limit(-1.0, depth), limit(1.0, depth)
+        phis = np.concatenate([np.linspace(lo, hi, 20001), [lo, hi]])
+        return max(float(potential(phi0) - np.min(potential(phis))), 0.0)
+
+    k = float(np.max(model.cpar[:, C_K]))
+    first = bound(0.0)
+    # the caps may sink in by the Hertz penetration the energy makes: (5/2 E / k)^(2/5)
+    depth = (2.5 * (first + energy) / k) ** 0.4 if k > 0.0 else 0.0
+    return bound(depth)
+
+
+def _elastic_bound(model: "BarModel", y0: np.ndarray, loads: list, phi: float, energy: float,
+                   constrained: bool) -> float:
+    """J: the most work the steady loads do on the elastic modes at the bar's angle phi
+    (see load_work_bound): max f.q over {1/2 q K q - f.q <= e}, and with ``constrained``
+    (clamp) over the part where contact point 0 stays above the block less the penetration
+    depth, a ball cut by a half-space, in closed form."""
+    psi, _, xc = model.points
+    K = model.basis.stiffness
+    R = rotation_y(phi)
+    g = model.fpar[F_G]
+    L = model.first_moments[:, 1:model.n + 1]  # kg: the modes' first moments
+    f = -g * (R[2] @ L)
+    for point, d, body, mag in loads:
+        dir_body = d if body else R.T @ d
+        f = f + mag * (psi[point] @ dir_body)
+    free = load_release_bound(K, f, energy)
+    if not constrained or free <= 0.0:
+        return free
+    c = -(psi[0] @ R[2])  # downward displacement of contact point 0 per unit q (m)
+    gap = float(y0[1] + R[2] @ xc[0]) - float(model.cpar[0, C_R])  # its cap above the block at the start
+    k = float(model.cpar[0, C_K])
+    depth = (2.5 * (free + max(energy, 0.0)) / k) ** 0.4 if k > 0.0 else 0.0
+    return load_release_bound(K, f, energy, c, max(gap, 0.0) + depth)
+
+
+def load_release_bound(K: np.ndarray, f: np.ndarray, energy: float, c: np.ndarray | None = None,
+                       room: float = math.inf) -> float:
+    """J: the most work f.q a steady load f (N, modal) can do on a linear elastic system of
+    stiffness K (N/m, symmetric positive definite) starting at q = 0 with ``energy`` (J)
+    besides: max f.q over {1/2 q K q - f.q <= energy}, and with c (m per unit q) over
+    the part where c.q <= ``room`` (m: a contact point that may move that far towards the
+    block). A ball in the coordinates u = K^(1/2) (q - K^-1 f) of radius
+    rho = sqrt(2 energy + a), a = f K^-1 f: f.q = a + rho sqrt(a) at its best, 2a from rest
+    (twice the static work); cut by the half-space, the best lies on the cut:
+    a + f_c alpha + sqrt(a - f_c^2) sqrt(rho^2 - alpha^2), alpha = beta / |c~|,
+    beta = room - c K^-1 f, f_c = f K^-1 c / |c~|, |c~|^2 = c K^-1 c."""
+    Kinv_f = np.linalg.solve(K, f)
+    a = float(f @ Kinv_f)
+    if a <= 0.0:
+        return 0.0
+    rho = math.sqrt(2.0 * max(energy, 0.0) + a)
+    free = a + rho * math.sqrt(a)
+    if c is None or not math.isfinite(room):
+        return free
+    Kinv_c = np.linalg.solve(K, c)
+    cc = float(c @ Kinv_c)
+    if cc <= 0.0:
+        return free
+    beta = room - float(c @ Kinv_f)
+    fc = float(f @ Kinv_c) / math.sqrt(cc)
+    if rho * fc * math.sqrt(cc) <= beta * math.sqrt(a):  # the ball's best point lies in the half-space
+        return free
+    alpha = min(max(beta / math.sqrt(cc), -rho), rho)
+    return a + fc * alpha + math.sqrt(max(a - fc * fc, 0.0)) * math.sqrt(max(rho * rho - alpha * alpha, 0.0))
 
 
 def _pivot_parameters(fpar: np.ndarray, scene: MechScene, xc: np.ndarray) -> None:

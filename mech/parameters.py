@@ -13,11 +13,37 @@ from dataclasses import dataclass, field
 from typing import Callable, Literal, Union
 
 from .validation import (
-    check_bool, check_choice, check_count, check_finite, check_nonnegative, check_position, check_positive,
-    check_range, check_table, check_vector3, check_whole,
+    check_bool, check_choice, check_count, check_finite, check_magnitude, check_nonnegative, check_position,
+    check_positive, check_range, check_table, check_vector3, check_whole,
 )
 
 MuLike = Union[float, Callable[[float], float]]
+
+# Bounds of the values a scene may give (docs/scene_keys.md, "Bounds"). Far beyond any
+# switch contact, they keep every product the model forms finite (bar.length = 1e300 made
+# the inertia overflow to inf, initial.velocity = 1e300 the kinetic energy) and bound the
+# work and memory a run can be asked for.
+LENGTH_MAX = 10.0  # m: lengths, radii, heights, offsets, anchors, a clamp's travel
+SPEED_MAX = 1e3  # m/s: initial speeds, reference and resolution speeds
+ANGULAR_SPEED_MAX = 1e5  # rad/s
+MODULUS_MAX = 1e13  # Pa: ten times diamond's
+DENSITY_MIN, DENSITY_MAX = 1.0, 1e5  # kg/m^3: from air (nothing solid is lighter) to four times osmium
+MASS_MAX = 1e3  # kg: a rivet's mass
+GRAVITY_MAX = 1e3  # m/s^2: a hundred g
+FORCE_MAX = 1e9  # N: actuator forces, spring preloads
+TORQUE_MAX = 1e10  # N m: a pivot's preload (FORCE_MAX at LENGTH_MAX)
+STIFFNESS_MAX = 1e12  # N/m of a spring, N m/rad of a pivot
+CONTACT_STIFFNESS_MAX = 1e16  # N/m^1.5 (Hertz for steel on steel, 5 mm caps: 1.1e10)
+DAMPING_MAX = 1e15  # of springs (N s/m), a pivot (N m s/rad) and the contact law
+MU_MAX = 1e3  # N^gamma
+T_END_MAX = 1e3  # s: the longest run (a switch's motion lasts milliseconds)
+MAX_STEPS_MAX = 100_000_000  # accepted + rejected steps: minutes to hours of integration
+HISTORY_ROWS_MIN, HISTORY_ROWS_MAX = 100, 10_000_000  # rows of the history a run keeps in memory
+HISTORY_ROWS = 100_000  # the default: twice what history.csv keeps at most by default ([output])
+ENERGY_TOLERANCE_MAX = 5e-3  # a larger audit residual is an energy error of the size a bounce dissipates
+TABLE_POINTS_MAX = 100_000  # points of a force table or a clamp's travel
+LOADS_MAX = 100  # [[force]] and [[spring]] entries together
+DIRECTION_MAX = 1e6  # components of a force's direction before it is normalized
 
 
 @dataclass(frozen=True)
@@ -51,32 +77,33 @@ class Bar:
     modal_damping: float = 0.0
 
     def __post_init__(self):
-        check_positive("bar.length", self.length)
+        check_positive("bar.length", self.length, high=LENGTH_MAX)
         if self.diameter is not None:
             if self.width is not None or self.thickness is not None:
                 raise ValueError(
                     "bar.diameter and bar.width/bar.thickness: give either bar.diameter (round section) "
                     "or bar.width and bar.thickness (rectangular section), not both"
                 )
-            check_positive("bar.diameter", self.diameter)
+            check_positive("bar.diameter", self.diameter, high=LENGTH_MAX)
         else:
             if self.width is None or self.thickness is None:
                 raise ValueError("bar.diameter: a section is needed: bar.diameter, or bar.width and bar.thickness")
-            check_positive("bar.width", self.width)
-            check_positive("bar.thickness", self.thickness)
-        check_positive("bar.tip_radius", self.tip_radius)
-        check_positive("bar.youngs_modulus", self.youngs_modulus)
+            check_positive("bar.width", self.width, high=LENGTH_MAX)
+            check_positive("bar.thickness", self.thickness, high=LENGTH_MAX)
+        check_positive("bar.tip_radius", self.tip_radius, high=LENGTH_MAX)
+        check_positive("bar.youngs_modulus", self.youngs_modulus, high=MODULUS_MAX)
         check_range("bar.poisson_ratio", self.poisson_ratio, -1.0, 0.5)
-        check_positive("bar.density", self.density)
+        check_range("bar.density", self.density, DENSITY_MIN, DENSITY_MAX, closed_low=True, closed_high=True)
         check_count("bar.axial_modes", self.axial_modes, auto=True)
         check_count("bar.bending_modes", self.bending_modes, auto=True)
         check_choice("bar.bending", self.bending, ("euler_bernoulli", "paper_shear"))
         check_range("bar.modal_damping", self.modal_damping, 0.0, 1.0, closed_low=True)
         half = self.section_half_width
         if self.tip_radius < half * (1.0 - 1e-12):
+            what = "half the diameter" if self.diameter is not None else "half the section's diagonal"
             raise ValueError(
-                f"bar.tip_radius = {self.tip_radius!r}: must be >= {half!r} m (half the section "
-                "width) so the spherical cap covers the section"
+                f"bar.tip_radius = {self.tip_radius!r}: must be >= {half!r} m ({what}) so the spherical "
+                "cap covers the section"
             )
         if 2.0 * self.tip_radius >= self.length:
             raise ValueError(
@@ -143,16 +170,16 @@ class Block:
     offset: float = 0.0
 
     def __post_init__(self):
-        check_positive("block.youngs_modulus", self.youngs_modulus)
+        check_positive("block.youngs_modulus", self.youngs_modulus, high=MODULUS_MAX)
         check_range("block.poisson_ratio", self.poisson_ratio, -1.0, 0.5)
         check_choice("block.shape", self.shape, ("plane", "sphere"))
         if self.shape == "sphere":
             if self.radius is None:
                 raise ValueError("block.radius: needed for block.shape = 'sphere' (m)")
-            check_positive("block.radius", self.radius)
+            check_positive("block.radius", self.radius, high=LENGTH_MAX)
         elif self.radius is not None:
             raise ValueError("block.radius: only a spherical block has a radius; set block.shape = 'sphere'")
-        check_finite("block.offset", self.offset)
+        check_magnitude("block.offset", self.offset, LENGTH_MAX)
 
 
 CONTACT_LAWS = ("paper", "hunt_crossley", "lankarani_nikravesh", "flores")
@@ -185,15 +212,15 @@ class Contact:
         if self.damping is not None and self.restitution is not None:
             raise ValueError("contact.damping and contact.restitution: give one of them, not both")
         if self.damping is not None:
-            check_nonnegative("contact.damping", self.damping)
+            check_nonnegative("contact.damping", self.damping, high=DAMPING_MAX)
         elif self.restitution is not None:
             check_range("contact.restitution", self.restitution, 0.0, 1.0, closed_high=True)
         else:
             raise ValueError("contact.restitution: give contact.damping (c) or contact.restitution (target e)")
         if self.reference_speed is not None:
-            check_positive("contact.reference_speed", self.reference_speed)
+            check_positive("contact.reference_speed", self.reference_speed, high=SPEED_MAX)
         if self.stiffness is not None:
-            check_positive("contact.stiffness", self.stiffness)
+            check_positive("contact.stiffness", self.stiffness, high=CONTACT_STIFFNESS_MAX)
         if self.calibration == "formula" and self.law == "paper" and self.damping is None:
             raise ValueError(
                 "contact.calibration = 'formula': the paper law has no closed form; use 'exact'"
@@ -227,11 +254,11 @@ class Friction:
 
     def __post_init__(self):
         if not callable(self.mu):
-            check_nonnegative("friction.mu", self.mu)
+            check_nonnegative("friction.mu", self.mu, high=MU_MAX)
         check_range("friction.gamma", self.gamma, 0.0, 1.0, closed_low=True)
         check_choice("friction.model", self.model, ("exact", "regularized"))
         check_positive("friction.max_ratio", self.max_ratio, allow_inf=True)
-        check_positive("friction.regularization_speed", self.regularization_speed)
+        check_positive("friction.regularization_speed", self.regularization_speed, high=SPEED_MAX)
 
     @property
     def active(self) -> bool:
@@ -275,12 +302,12 @@ class Initial:
             raise ValueError(
                 f"initial.height = {h!r}: the bar would start inside the block; must be >= 0"
             )
+        check_nonnegative("initial.height", h, high=LENGTH_MAX)
         check_range("initial.angle_deg", self.angle_deg, -90.0, 90.0, closed_low=True, closed_high=True)
-        check_finite("initial.azimuth_deg", self.azimuth_deg)
-        object.__setattr__(self, "velocity", check_vector3("initial.velocity", self.velocity))
-        object.__setattr__(
-            self, "angular_velocity", check_vector3("initial.angular_velocity", self.angular_velocity)
-        )
+        check_magnitude("initial.azimuth_deg", self.azimuth_deg, 360.0)
+        object.__setattr__(self, "velocity", check_vector3("initial.velocity", self.velocity, SPEED_MAX))
+        object.__setattr__(self, "angular_velocity", check_vector3(
+            "initial.angular_velocity", self.angular_velocity, ANGULAR_SPEED_MAX))
         check_bool("initial.resting", self.resting)
         if self.resting and not (abs(self.angle_deg) < 1e-9 or abs(abs(self.angle_deg) - 90.0) < 1e-9):
             raise ValueError(
@@ -306,7 +333,12 @@ class SolverOptions:
     max_step: s, upper bound on the step (None: a quarter of the shortest contact time
     estimated from the Hertz closed form, so no contact can be stepped over).
     stick_velocity_tol: m/s, slip speeds below this at a slip-direction event are stops.
-    energy_tolerance: relative energy residual above which the result is flagged.
+    energy_tolerance: relative energy residual above which the result is flagged, in
+    (0, ENERGY_TOLERANCE_MAX].
+    max_steps: accepted and rejected steps before the run stops unfinished.
+    history_rows: rows of the history a run keeps in memory: beyond them the older rows are
+    thinned to a uniform time grid, every event and regime change kept (mech.recorder);
+    the memory a run takes grows with this, not with its steps.
     """
 
     rtol: float = 1e-6
@@ -316,16 +348,18 @@ class SolverOptions:
     stick_velocity_tol: float = 1e-6
     energy_tolerance: float = 1e-3
     max_steps: int = 5_000_000
+    history_rows: int = HISTORY_ROWS
 
     def __post_init__(self):
         check_range("solver.rtol", self.rtol, 1e-13, RTOL_MAX, closed_high=True)
-        check_positive("solver.t_end", self.t_end)
+        check_positive("solver.t_end", self.t_end, high=T_END_MAX)
         check_choice("solver.model", self.model, ("auto", "planar", "3d"))
         if self.max_step is not None:
-            check_positive("solver.max_step", self.max_step)
-        check_positive("solver.stick_velocity_tol", self.stick_velocity_tol)
-        check_positive("solver.energy_tolerance", self.energy_tolerance)
-        check_whole("solver.max_steps", self.max_steps, 1)
+            check_positive("solver.max_step", self.max_step, high=T_END_MAX)
+        check_positive("solver.stick_velocity_tol", self.stick_velocity_tol, high=SPEED_MAX)
+        check_positive("solver.energy_tolerance", self.energy_tolerance, high=ENERGY_TOLERANCE_MAX)
+        check_whole("solver.max_steps", self.max_steps, 1, MAX_STEPS_MAX)
+        check_whole("solver.history_rows", self.history_rows, HISTORY_ROWS_MIN, HISTORY_ROWS_MAX)
 
 
 MOUNT_KINDS = ("free", "clamp", "pivot")
@@ -369,9 +403,9 @@ class Mount:
                 if getattr(self, key) != 0.0:
                     raise ValueError(f"mount.{key}: a torsion spring belongs to a pivot; "
                                      f"mount.kind = {self.kind!r}")
-        check_nonnegative("mount.stiffness", self.stiffness)
-        check_finite("mount.preload_torque", self.preload_torque)
-        check_nonnegative("mount.damping", self.damping)
+        check_nonnegative("mount.stiffness", self.stiffness, high=STIFFNESS_MAX)
+        check_magnitude("mount.preload_torque", self.preload_torque, TORQUE_MAX)
+        check_nonnegative("mount.damping", self.damping, high=DAMPING_MAX)
         if self.base_motion is not None:
             if self.kind != "clamp":
                 raise ValueError("mount.base_motion: only a clamped bar has a moving base "
@@ -380,7 +414,8 @@ class Mount:
             if not isinstance(bm, dict) or set(bm) != {"time", "displacement"}:
                 raise ValueError(f"mount.base_motion = {bm!r}: expected "
                                  "{time = [...], displacement = [[x, y, z], ...]}")
-            ts, ds = check_table("mount.base_motion", bm["time"], bm["displacement"], width=3)
+            ts, ds = check_table("mount.base_motion", bm["time"], bm["displacement"], width=3, time_high=T_END_MAX,
+                                 value_high=LENGTH_MAX, max_points=TABLE_POINTS_MAX)
             object.__setattr__(self, "base_motion", {"time": ts, "displacement": ds})
 
     @property
@@ -408,7 +443,7 @@ class PointForce:
     def __post_init__(self):
         n = self.name
         check_finite(f"{n}.position", self.position)
-        d = check_vector3(f"{n}.direction", self.direction)
+        d = check_vector3(f"{n}.direction", self.direction, DIRECTION_MAX)
         norm = math.sqrt(sum(v * v for v in d))
         if norm == 0.0:
             raise ValueError(f"{n}.direction = {list(d)!r}: must not be the zero vector")
@@ -417,11 +452,12 @@ class PointForce:
         if self.magnitude is not None:
             if self.time is not None or self.value is not None:
                 raise ValueError(f"{n}: give magnitude (constant) or time and value (a table), not both")
-            check_finite(f"{n}.magnitude", self.magnitude)
+            check_magnitude(f"{n}.magnitude", self.magnitude, FORCE_MAX)
         else:
             if self.time is None or self.value is None:
                 raise ValueError(f"{n}: give magnitude (N) or both time (s) and value (N) tables")
-            ts, vs = check_table(f"{n}", self.time, self.value)
+            ts, vs = check_table(f"{n}", self.time, self.value, time_high=T_END_MAX, value_high=FORCE_MAX,
+                                 max_points=TABLE_POINTS_MAX)
             object.__setattr__(self, "time", ts)
             object.__setattr__(self, "value", vs)
 
@@ -449,16 +485,16 @@ class Spring:
 
     def __post_init__(self):
         n = self.name
-        object.__setattr__(self, "anchor", check_vector3(f"{n}.anchor", self.anchor))
+        object.__setattr__(self, "anchor", check_vector3(f"{n}.anchor", self.anchor, LENGTH_MAX))
         check_finite(f"{n}.position", self.position)
-        check_positive(f"{n}.stiffness", self.stiffness)
-        check_nonnegative(f"{n}.damping", self.damping)
+        check_positive(f"{n}.stiffness", self.stiffness, high=STIFFNESS_MAX)
+        check_nonnegative(f"{n}.damping", self.damping, high=DAMPING_MAX)
         if self.preload is not None and self.rest_length is not None:
             raise ValueError(f"{n}: give preload or rest_length, not both")
         if self.preload is not None:
-            check_finite(f"{n}.preload", self.preload)
+            check_magnitude(f"{n}.preload", self.preload, FORCE_MAX)
         if self.rest_length is not None:
-            check_nonnegative(f"{n}.rest_length", self.rest_length)
+            check_nonnegative(f"{n}.rest_length", self.rest_length, high=LENGTH_MAX)
 
 
 @dataclass(frozen=True)
@@ -482,11 +518,11 @@ class Rivet:
     def __post_init__(self):
         n = self.name
         check_finite(f"{n}.position", self.position)
-        check_finite(f"{n}.offset", self.offset)
-        check_positive(f"{n}.radius", self.radius)
-        check_nonnegative(f"{n}.mass", self.mass)
+        check_magnitude(f"{n}.offset", self.offset, LENGTH_MAX)
+        check_positive(f"{n}.radius", self.radius, high=LENGTH_MAX)
+        check_nonnegative(f"{n}.mass", self.mass, high=MASS_MAX)
         if self.youngs_modulus is not None:
-            check_positive(f"{n}.youngs_modulus", self.youngs_modulus)
+            check_positive(f"{n}.youngs_modulus", self.youngs_modulus, high=MODULUS_MAX)
         if self.poisson_ratio is not None:
             check_range(f"{n}.poisson_ratio", self.poisson_ratio, -1.0, 0.5)
 
@@ -508,7 +544,7 @@ class MechScene:
     rivets: tuple = ()
 
     def __post_init__(self):
-        check_nonnegative("environment.gravity", self.gravity)
+        check_nonnegative("environment.gravity", self.gravity, high=GRAVITY_MAX)
         for name, cls in (("bar", Bar), ("block", Block), ("contact", Contact),
                           ("friction", Friction), ("initial", Initial), ("solver", SolverOptions),
                           ("mount", Mount)):
@@ -520,6 +556,9 @@ class MechScene:
             for item in items:
                 if not isinstance(item, cls):
                     raise ValueError(f"{name}: expected {cls.__name__} entries, got {type(item).__name__}")
+        if len(self.forces) + len(self.springs) > LOADS_MAX:
+            raise ValueError(f"[[force]], [[spring]]: {len(self.forces)} forces and {len(self.springs)} springs; "
+                             f"at most {LOADS_MAX} together")
         self._check_mechanism()
 
     def _check_mechanism(self) -> None:

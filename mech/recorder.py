@@ -5,6 +5,13 @@ write the rows of a segment from ``n`` on and the solver then ``commit``s them w
 regimes they were integrated in; the solver's own single points (the start, a hold at
 rest) go through ``append``. The buffers grow by doubling, so a long run costs amortised
 O(1) per row; ``truncate`` drops the rows after a checkpoint.
+
+Memory in proportion to what is kept, not to the steps taken: once ``row_limit`` rows are
+recorded, ``reserve`` asks the solver (``on_full``) to ``thin`` the older rows before the
+buffers grow again (mech.solver.ImpactSolver keeps every event and regime change and one
+row per interval of a uniform time grid). The dense output (``keep_dense``) covers only the
+rows since the last ``release_dense``: a co-simulation samples what it needs of a macro
+step and releases it, so that buffer holds one macro step's steps, not the run's.
 """
 
 from __future__ import annotations
@@ -13,72 +20,163 @@ import numpy as np
 
 from .kernel_layout import A_FN, NAUX
 
+# bytes a run may take for its history (with the growth of its buffers and the copy a
+# result makes): a scene whose solver.history_rows would need more is refused before it
+# runs (docs/scene_keys.md, "Bounds"; coupling adds its waveforms to the same bound)
+MEMORY_LIMIT = 4 * 2**30
+# bytes of dense output kept beyond what the rows since the last release need (a stepper
+# fills the buffer to here before it returns, as it fills the row buffer)
+DENSE_BYTES = 64 * 2**20
+# A stepper returns when its room is full, and a return restarts its step-size control, so
+# where it returns changes the trajectory (within the tolerance). The room ends where a
+# buffer that only doubled would be full, 4096 x 2^k rows, and past CHUNK rows every CHUNK
+# rows: counted in rows ever recorded, a thinned run returns where an unthinned one does
+# and integrates the same steps; the buffer needs only CHUNK rows besides those it keeps.
+CHUNK = 16384
+
+
+def row_bytes(state_size: int, n_extra: int = 0, dense: bool = False) -> int:
+    """Bytes of one history row (t, state, aux, peak force, regimes, extra states), and with
+    ``dense`` of one row of dense output (start, length, 5 x state coefficients)."""
+    base = 8 * (1 + state_size + 2 * NAUX + 2 + 2 + n_extra)
+    return base + (8 * (2 + 5 * state_size) if dense else 0)
+
+
+def history_memory(state_size: int, rows: int, n_extra: int = 0) -> int:
+    """Bytes the history of ``rows`` rows may take at its peak: the buffer of those rows and
+    a stepper's room (CHUNK) while it doubles (old and new, up to twice that) plus the
+    result's copy of the rows."""
+    return (2 * (rows + CHUNK) + rows) * row_bytes(state_size, n_extra)
+
 
 class Recorder:
     """Growable buffers of the history (all SI, one row per record):
 
     - t (s), y (state), aux (2, NAUX) per contact point, fmax (2,) the largest normal force
-      (N) sampled over the step that ends at the row, regime (2,) per contact point, ext
-      (the extra states of a coupled model, mech.solver.CoupledStates);
-    - with ``keep_dense``, each row's dense output: the step's start (s), length (s) and
-      its 5 x N DOPRI5 coefficients (mech.integrator.dense_eval).
+      (N) sampled over the step that ends at the row (after thinning: since the kept row
+      before), regime (2,) per contact point, ext (the extra states of a coupled model,
+      mech.solver.CoupledStates);
+    - with ``keep_dense``, each row's dense output from row ``dense_base`` on: the step's
+      start (s), length (s) and its 5 x N DOPRI5 coefficients (mech.integrator.dense_eval),
+      row k at index k - dense_base.
+
+    row_limit: rows before ``reserve`` calls ``on_full`` (None: grow without limit);
+    on_full() may thin the rows (the buffers grow if that left too little room);
+    on_commit(start, rows) sees every committed batch of rows (the solver's checks).
     """
 
-    def __init__(self, state_size: int, n_extra: int = 0, capacity: int = 4096, keep_dense: bool = False):
+    def __init__(self, state_size: int, n_extra: int = 0, capacity: int = 4096, keep_dense: bool = False,
+                 row_limit: int | None = None):
         if capacity < 2:
             raise ValueError(f"capacity = {capacity!r}: at least 2 rows")
         self.n = 0
         self.capacity = capacity
+        self.dropped = 0  # rows thinned away: n + dropped rows were recorded
+        self.room_end = capacity  # where a stepper's room ends, in rows recorded (CHUNK)
         self.keep_dense = keep_dense
+        self.row_limit = row_limit
+        self.thin_at = row_limit if row_limit is not None else 0
+        self.on_full = None
+        self.on_commit = None
         self.t = np.empty(capacity)
         self.y = np.empty((capacity, state_size))
         self.aux = np.empty((capacity, 2, NAUX))
         self.fmax = np.empty((capacity, 2))
         self.regime = np.empty((capacity, 2), dtype=np.int64)
         self.ext = np.empty((capacity, n_extra))
+        self.dense_base = 0
         dcap = capacity if keep_dense else 1
         self.dense_t0 = np.empty(dcap)
         self.dense_h = np.empty(dcap)
         self.dense_coef = np.empty((dcap, 5, state_size))
 
+    @property
+    def recorded(self) -> int:
+        """Rows recorded so far, those thinned away included."""
+        return self.n + self.dropped
+
     def reserve(self, rows: int) -> None:
-        """Make room for ``rows`` more rows after ``n`` (and one spare)."""
-        while self.n + rows + 1 > self.capacity:
-            self._grow()
+        """Make room for ``rows`` more rows after ``n`` (and one spare) and for a stepper's
+        room up to ``room_end``: past ``row_limit`` rows by thinning (``on_full``) first,
+        by growing where that freed too little."""
+        self._extend_room(rows)
+        if (self.on_full is not None and self.row_limit is not None and self.n >= self.row_limit
+                and (self.n + self.room_end - self.recorded > self.capacity or self.n >= self.thin_at)):
+            self.on_full()
+            # (a stepper that grows the buffer itself, solve_ivp's, fills no room: try again
+            # once half a room more is kept)
+            self.thin_at = self.n + CHUNK // 2
+        self._ensure(rows)
 
-    def _grow(self) -> None:
-        cap = 2 * self.capacity
-        n = self.n
+    def _extend_room(self, rows: int) -> None:
+        while self.recorded + rows + 1 > self.room_end:
+            self.room_end += self.room_end if self.room_end < CHUNK else CHUNK
 
-        def grown(a):
-            b = np.empty((cap,) + a.shape[1:], dtype=a.dtype)
-            b[:n] = a[:n]
-            return b
+    def make_room(self, rows: int) -> None:
+        """Make room for ``rows`` more rows by growing only, never thinning: for a stepper,
+        inside a segment whose first row the solver has noted."""
+        self._ensure(rows)
 
-        self.t, self.y, self.aux, self.fmax = grown(self.t), grown(self.y), grown(self.aux), grown(self.fmax)
-        self.regime, self.ext = grown(self.regime), grown(self.ext)
+    def _ensure(self, rows: int) -> None:
+        """Grow (never thin) until ``rows`` more rows and one spare fit, and the stepper's
+        room to ``room_end``, dense output too.
+
+        The dense buffer spans the stepper's room up to DENSE_BYTES, and beyond that what
+        the current rows need: a stepper then returns more often, each time the dense
+        buffer is full (the rows since the last release are all kept)."""
+        self._extend_room(rows)
+        need = self.n + self.room_end - self.recorded
+        if need > self.capacity:
+            cap = self.capacity
+            while cap < need:
+                cap *= 2
+            if self.row_limit is not None and self.n >= self.row_limit:
+                cap = need  # past the limit (thinning freed too little): no more than needed
+            self._grow(cap)
         if self.keep_dense:
-            self.dense_t0, self.dense_h, self.dense_coef = (grown(self.dense_t0), grown(self.dense_h),
-                                                            grown(self.dense_coef))
+            used = self.n - self.dense_base
+            span = used + self.room_end - self.recorded
+            size = max(min(span, DENSE_BYTES // (8 * (2 + 5 * self.y.shape[1]))), used + rows + 1)
+            if size > len(self.dense_t0):
+                cap = len(self.dense_t0)
+                while cap < size:
+                    cap *= 2
+                cap = min(cap, span)
+                self.dense_t0 = _grown(self.dense_t0, cap, used)
+                self.dense_h = _grown(self.dense_h, cap, used)
+                self.dense_coef = _grown(self.dense_coef, cap, used)
+
+    def _grow(self, cap: int) -> None:
+        n = self.n
+        self.t, self.y, self.aux = _grown(self.t, cap, n), _grown(self.y, cap, n), _grown(self.aux, cap, n)
+        self.fmax, self.regime, self.ext = _grown(self.fmax, cap, n), _grown(self.regime, cap, n), _grown(self.ext, cap, n)
         self.capacity = cap
 
     def free_rows(self) -> tuple[tuple, tuple]:
         """Views of the rows from ``n`` on, for a stepper to write into: (t, y, aux, fmax) and
-        the dense output (t0, h, coef) (a one-row scratch when dense output is not kept)."""
+        the dense output (t0, h, coef) (a one-row scratch when dense output is not kept).
+        Both views are equally long, so a stepper that fills one never overruns the other."""
         n = self.n
-        records = (self.t[n:], self.y[n:], self.aux[n:], self.fmax[n:])
+        room = min(self.capacity - n, self.room_end - self.recorded)
+        records = (self.t[n:n + room], self.y[n:n + room], self.aux[n:n + room], self.fmax[n:n + room])
         if self.keep_dense:
-            return records, (self.dense_t0[n:], self.dense_h[n:], self.dense_coef[n:])
+            d = n - self.dense_base
+            room = min(room, len(self.dense_t0) - d)
+            records = tuple(a[:room] for a in records)
+            return records, (self.dense_t0[d:d + room], self.dense_h[d:d + room], self.dense_coef[d:d + room])
         return records, (self.dense_t0, self.dense_h, self.dense_coef)
 
     def commit(self, rows: int, regime: np.ndarray) -> None:
         """Count the ``rows`` a stepper wrote after ``n`` as recorded, in ``regime``."""
-        self.regime[self.n:self.n + rows] = regime
+        start = self.n
+        self.regime[start:start + rows] = regime
         self.n += rows
+        if self.on_commit is not None and rows:
+            self.on_commit(start, rows)
 
     def append(self, t: float, y: np.ndarray, aux: np.ndarray, regime: np.ndarray, ext: np.ndarray) -> None:
         """Record one point (a zero-length step: its dense output is the state itself)."""
-        self.reserve(1)
+        self._ensure(1)
         k = self.n
         self.t[k] = t
         self.y[k] = y
@@ -87,17 +185,51 @@ class Recorder:
         self.regime[k] = regime
         self.ext[k] = ext
         if self.keep_dense:
-            self.dense_t0[k] = t
-            self.dense_h[k] = 1.0
-            self.dense_coef[k] = 0.0
-            self.dense_coef[k, 0] = y
+            d = k - self.dense_base
+            self.dense_t0[d] = t
+            self.dense_h[d] = 1.0
+            self.dense_coef[d] = 0.0
+            self.dense_coef[d, 0] = y
         self.n += 1
 
     def truncate(self, n: int) -> None:
         """Drop the rows from ``n`` on (a return to a checkpoint)."""
-        if not 0 <= n <= self.n:
-            raise ValueError(f"n = {n!r}: must lie in [0, {self.n}]")
+        if not self.dense_base <= n <= self.n:
+            raise ValueError(f"n = {n!r}: must lie in [{self.dense_base}, {self.n}]")
         self.n = n
+
+    def release_dense(self) -> None:
+        """Forget the dense output of every row so far (the next rows' fill the buffer from
+        its start): what the caller needed of it has been sampled."""
+        self.dense_base = self.n
+
+    def thin(self, keep: np.ndarray) -> int:
+        """Drop the rows k < len(keep) where ``keep[k]`` is False, moving the later rows down;
+        each kept row's peak force becomes the largest over the rows dropped before it (back
+        to the kept row before). ``keep`` must keep its last row and may not reach into rows
+        with dense output. Returns the number of rows dropped."""
+        floor = len(keep)
+        if floor == 0 or not keep[-1]:
+            raise ValueError("thin: the last row of the thinned range must be kept")
+        if self.keep_dense and floor > self.dense_base:
+            raise ValueError(f"thin: rows from {self.dense_base} on carry dense output; release it first")
+        idx = np.flatnonzero(keep)
+        m = len(idx)
+        dropped = floor - m
+        if not dropped:
+            return 0
+        starts = np.concatenate(([0], idx[:-1] + 1))
+        peak = np.maximum.reduceat(self.fmax[:floor], starts, axis=0)
+        n = self.n
+        for a in (self.t, self.y, self.aux, self.regime, self.ext):
+            a[:m] = a[idx]
+            a[m:n - dropped] = a[floor:n]
+        self.fmax[:m] = peak
+        self.fmax[m:n - dropped] = self.fmax[floor:n]
+        self.n = n - dropped
+        self.dropped += dropped
+        self.dense_base -= dropped if self.keep_dense else 0
+        return dropped
 
     @property
     def last_aux(self) -> np.ndarray:
@@ -111,8 +243,19 @@ class Recorder:
                     peak_force=self.fmax[s].copy(), regimes=self.regime[s].copy(), extra_states=self.ext[s].copy())
 
     def dense(self, start: int = 0, stop: int | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Copies of the dense output (t0, h, coef) of rows [start, stop) (keep_dense only)."""
+        """Copies of the dense output (t0, h, coef) of rows [start, stop) (keep_dense only;
+        rows from ``dense_base`` on)."""
         if not self.keep_dense:
             raise ValueError("dense output is recorded only with keep_dense=True")
-        s = slice(start, self.n if stop is None else stop)
+        stop = self.n if stop is None else stop
+        if start < self.dense_base:
+            raise ValueError(f"rows before {self.dense_base} have no dense output any more (released)")
+        s = slice(start - self.dense_base, stop - self.dense_base)
         return self.dense_t0[s].copy(), self.dense_h[s].copy(), self.dense_coef[s].copy()
+
+
+def _grown(a: np.ndarray, cap: int, used: int) -> np.ndarray:
+    """A copy of ``a`` with ``cap`` rows, its first ``used`` rows kept."""
+    b = np.empty((cap,) + a.shape[1:], dtype=a.dtype)
+    b[:used] = a[:used]
+    return b

@@ -58,6 +58,11 @@ class ImpactResult:
     stats: dict
     projection_energy: float = 0.0
     extra_states: np.ndarray | None = None  # (records, size) of CoupledStates, if any
+    # None: every step is a row; else the history was thinned as it was made (mech.solver,
+    # ImpactSolver._thin_history): resolution (s), until (s: every step after), rows_dropped,
+    # and the extremes of the rows dropped: max_abs_residual, max_kinetic, max_drive_work (J),
+    # max_speed (m/s), max_penetration (m, per contact point)
+    thinning: dict | None = None
     _cache: dict = field(default_factory=dict, repr=False)
 
     # --- frames -------------------------------------------------------------------------
@@ -113,26 +118,8 @@ class ImpactResult:
             m = self.model
             E = energy_table(self.states, m.arrays)
             qd = self.states[:, m.slices()["quad"]]
-            held = qd.shape[1] > Q_WIN  # quadratures of input work and load dissipation
-            zero = np.zeros(len(self.t))
-            c = {
-                "time": self.t,
-                "kinetic": E[:, 0],
-                "elastic": E[:, 1],
-                "potential": E[:, 2] - E[0, 2],
-                "contact_stored": E[:, 3],
-                "normal_dissipation": qd[:, Q_DNORMAL],
-                "friction_dissipation": qd[:, Q_DFRICTION],
-                "modal_dissipation": qd[:, Q_DMODAL],
-                "spring_stored": E[:, 4],
-                "load_dissipation": qd[:, Q_DLOAD] if held else zero,
-                "work_in": qd[:, Q_WIN] if held else zero,
-            }
-            e0 = E[0, 0] + E[0, 1] + E[0, 3] + E[0, 4]
-            total = (c["kinetic"] + c["elastic"] + c["potential"] + c["contact_stored"] + c["normal_dissipation"]
-                     + c["friction_dissipation"] + c["modal_dissipation"] + c["spring_stored"]
-                     + c["load_dissipation"] - c["work_in"])
-            c["residual"] = e0 - total + self._projection_series()
+            c = {"time": self.t, **audit_terms(E, qd, E[0])}
+            c["residual"] = audit_residual(E, qd, E[0]) + self._projection_series()
             self._cache["energy_columns"] = c
         return self._cache["energy_columns"]
 
@@ -312,33 +299,85 @@ class ImpactResult:
             "friction_dissipation": float(en["friction_dissipation"][-1]),
             "modal_dissipation": float(en["modal_dissipation"][-1]),
             "residual": float(en["residual"][-1]),
-            "relative_residual": float(np.max(np.abs(en["residual"])) / scale),
+            "relative_residual": self.max_abs_residual / scale,
         }
+
+    def _dropped(self, key: str, default: float) -> float:
+        """An extreme of the rows thinned away (``thinning``), or ``default`` if none were."""
+        return float(self.thinning[key]) if self.thinning else default
+
+    @property
+    def max_abs_residual(self) -> float:
+        """J: the largest |energy residual| over the run (the rows thinned away included)."""
+        return max(float(np.max(np.abs(self.energy_columns["residual"]))), self._dropped("max_abs_residual", 0.0))
+
+    @property
+    def max_kinetic(self) -> float:
+        """J: the largest kinetic energy over the run (the rows thinned away included)."""
+        return max(float(self.energy_columns["kinetic"].max()), self._dropped("max_kinetic", 0.0))
+
+    @property
+    def max_speed(self) -> float:
+        """m/s: the largest speed of the frame's origin (a free bar's centre) over the run."""
+        speed = float(np.max(np.linalg.norm(self.states[:, self.model.slices()["vel"]], axis=1)))
+        return max(speed, self._dropped("max_speed", 0.0))
+
+    def _max_penetration(self, i: int) -> float:
+        """m: contact point i's deepest penetration (negative: its closest approach) over the run."""
+        deepest = float(np.max(self.aux[:, i, A_Y])) if len(self.aux) else -math.inf
+        return max(deepest, self.thinning["max_penetration"][i]) if self.thinning else deepest
 
     @property
     def energy_scale(self) -> float:
         """J: the energy the audit is judged against: what the scene brings in, its initial
-        kinetic, elastic, contact- and spring-stored energy, the most work its actuators and
-        a moving clamp put in, plus (a free bar) the potential energy of the centre above
-        its lowest resting height (lying flat on the block: the centre at the tip radius),
-        m g (z_c0 - R_tip). A bar at rest still has a scale (a standing bar can fall
-        over), and a run that gains energy by error does not enlarge its own yardstick."""
+        kinetic, elastic, contact- and spring-stored energy E_in, plus the most work its
+        loads and drives can do, max(W_rest, min(W_run, W_all)):
+
+        - W_run, what the run's loads and drives did: the most that the actuators and a
+          moving clamp had put in (``work_in``), gravity had released and the springs and a
+          pivot's preload torque had given up, at any time: the energy in motion, stored
+          in the bar and dissipated, less E_in (a tight yardstick);
+        - W_rest, bounded from the scene before the run, what the loads that act on a bar
+          at rest can release: a free bar's centre can drop to its lowest resting height
+          (lying flat on the block: the centre at the tip radius), m g (z_c0 - R_tip); a
+          held bar's weight and a pivot's preload torque can do mech.model.load_work_bound
+          within its range of motion (a sagging blade, a pendulum, a preloaded pivot). A
+          bar at rest is judged against this, not against its near-zero motion;
+        - W_all, also bounded from the scene, what every load can do (the actuator forces
+          at their largest too), and the springs' energy: a run that gains energy by error
+          does not enlarge its yardstick beyond it. A moving clamp and a free bar's forces
+          have no such bound: their work is what the run measured."""
         en = self.energy_columns
         m = self.model
         z0 = float(self.states[0, m.slices()["pos"]][-1])  # centre height, z up (planar: x, z)
         scene = m.scene
-        # a held bar cannot fall; a free one can drop its centre to the tip radius
-        drop = 0.0 if scene.mount.held else max(z0 - scene.bar.tip_radius, 0.0)
-        e_in = float(en["kinetic"][0] + en["elastic"][0] + en["contact_stored"][0] + en["spring_stored"][0])
-        # actuators and a moving clamp bring energy in while the run goes on: the most they
-        # had put in at any time belongs to the yardstick too
-        work = max(float(en["work_in"].max()), 0.0)
-        return max(e_in + work + m.basis.mass * scene.gravity * drop, 1e-300)
+        s0 = float(en["spring_stored"][0])
+        e_in = float(en["kinetic"][0] + en["elastic"][0] + en["contact_stored"][0]) + s0
+        if "scene_bounds" not in self._cache:
+            self._cache["scene_bounds"] = self._scene_bounds(e_in, z0)
+        w_rest, w_all = self._cache["scene_bounds"]
+        drive = en["work_in"] - en["potential"] - (en["spring_stored"] - s0)
+        w_run = max(float(np.max(drive)), self._dropped("max_drive_work", -math.inf))
+        return max(e_in + max(w_rest, min(w_run, w_all + s0), 0.0), 1e-300)
+
+    def _scene_bounds(self, e_in: float, z0: float) -> tuple[float, float]:
+        """(W_rest, W_all) of ``energy_scale``, J, from the scene alone."""
+        m = self.model
+        scene = m.scene
+        if not scene.mount.held:  # a free bar can drop its centre to the tip radius
+            w_rest = m.basis.mass * scene.gravity * max(z0 - scene.bar.tip_radius, 0.0)
+            return w_rest, (math.inf if scene.forces else w_rest)
+        from .model import load_work_bound
+
+        w_rest = load_work_bound(m, e_in, forces=False)
+        if scene.mount.base_motion is not None:
+            return w_rest, math.inf
+        return w_rest, (load_work_bound(m, e_in) if scene.forces else w_rest)
 
     @property
     def deepest_penetration(self) -> float:
         """m: the deepest penetration of any contact point into the block over the run (0: none)."""
-        return float(max(np.max(self.aux[:, :, A_Y]), 0.0)) if len(self.aux) else 0.0
+        return max(self._max_penetration(0), self._max_penetration(1), 0.0) if len(self.aux) else 0.0
 
     @property
     def contact_depths(self) -> list[tuple[str, float, float]]:
@@ -353,7 +392,7 @@ class ImpactResult:
             r = float(self.model.cpar[i, C_R])
             if block.shape == "sphere":
                 r = r * block.radius / (r + block.radius)
-            out.append((f"contact point {i}", float(np.max(self.aux[:, i, A_Y])), r))
+            out.append((f"contact point {i}", self._max_penetration(i), r))
         return out
 
     @property
@@ -376,7 +415,18 @@ class ImpactResult:
         return dict(self.stats, model="planar" if m.planar else "3d", modes=m.n, states=m.state_size,
                     friction=("none", "exact", "regularized")[int(m.ipar[2])],
                     damping=m.contact.damping, stiffness=m.contact.stiffness,
-                    modes_rule=m.mode_count.reason if m.mode_count is not None else "explicit")
+                    modes_rule=m.mode_count.reason if m.mode_count is not None else "explicit",
+                    history=self.history_resolution)
+
+    @property
+    def history_resolution(self) -> dict:
+        """The history's resolution: rows (the records kept), resolution (s: one row per
+        interval of this grid besides the event and regime-change rows, up to
+        ``thinned_until``; 0: every step) and thinned_until (s: every step after it)."""
+        th = self.thinning
+        if not th:
+            return {"rows": len(self.t), "resolution": 0.0, "thinned_until": 0.0}
+        return {"rows": len(self.t), "resolution": float(th["resolution"]), "thinned_until": float(th["until"])}
 
     def to_summary(self) -> dict:
         """The JSON summary: contacts, restitution, energy, solver, flags."""
@@ -403,6 +453,36 @@ class ImpactResult:
         self.phases.to_csv(out / "phases.csv", index=False)
         self.event_table.to_csv(out / "events.csv", index=False)
         return out
+
+
+def audit_terms(E: np.ndarray, qd: np.ndarray, first: np.ndarray) -> dict:
+    """The energy audit's terms per record (J) from ``energy_table`` rows E (records, 5),
+    the quadratures qd (records, nq) and the first record's energies ``first`` (5,)."""
+    held = qd.shape[1] > Q_WIN  # quadratures of input work and load dissipation
+    zero = np.zeros(len(E))
+    return {
+        "kinetic": E[:, 0],
+        "elastic": E[:, 1],
+        "potential": E[:, 2] - first[2],
+        "contact_stored": E[:, 3],
+        "normal_dissipation": qd[:, Q_DNORMAL],
+        "friction_dissipation": qd[:, Q_DFRICTION],
+        "modal_dissipation": qd[:, Q_DMODAL],
+        "spring_stored": E[:, 4],
+        "load_dissipation": qd[:, Q_DLOAD] if held else zero,
+        "work_in": qd[:, Q_WIN] if held else zero,
+    }
+
+
+def audit_residual(E: np.ndarray, qd: np.ndarray, first: np.ndarray) -> np.ndarray:
+    """J per record: the energy the audit cannot place, E0 less every term it names (module
+    docstring; the stick projections' credit is added by the result, at its last record)."""
+    c = audit_terms(E, qd, first)
+    e0 = first[0] + first[1] + first[3] + first[4]
+    total = (c["kinetic"] + c["elastic"] + c["potential"] + c["contact_stored"] + c["normal_dissipation"]
+             + c["friction_dissipation"] + c["modal_dissipation"] + c["spring_stored"]
+             + c["load_dissipation"] - c["work_in"])
+    return e0 - total
 
 
 def planar_quaternions(azimuth: float, angles: np.ndarray) -> np.ndarray:

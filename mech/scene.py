@@ -15,7 +15,8 @@ default listed in docs/scene_keys.md; ``DEFAULT_SCENE_TOML`` is one scene, not t
     [initial]   height, angle_deg, azimuth_deg, velocity [3], angular_velocity [3]
     [contact]   law, restitution | damping, reference_speed, calibration, stiffness
     [friction]  mu, gamma, model, max_ratio, regularization_speed
-    [solver]    rtol, t_end, model, max_step, stick_velocity_tol, energy_tolerance, max_steps
+    [solver]    rtol, t_end, model, max_step, stick_velocity_tol, energy_tolerance, max_steps,
+                history_rows
     [environment] gravity
 
 Unknown sections or keys are errors that name them (a typo must not silently fall back

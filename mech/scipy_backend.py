@@ -160,7 +160,7 @@ def scipy_segment(solver, t_target: float, method: str):
                     first_step=min(solver.h, m.max_step, t_target - solver.t) if solver.h > 0 else None)
     solver.stats[2] += counter["nfev"]
     n_new = len(sol.t) - 1
-    rec.reserve(n_new + 1)
+    rec.make_room(n_new + 1)  # (never thinned here: the solver holds row indices of this segment)
     n0 = rec.n
     for k in range(1, len(sol.t)):
         y = sol.y[:N, k]

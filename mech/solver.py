@@ -32,7 +32,7 @@ from .compiled import (
     project_to_stick,
 )
 from .kernel_layout import (
-    A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, BUFFER_FULL, DONE, EV_CLIP, EV_COMPRESSION,
+    A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, BUFFER_FULL, C_ON, C_R, DONE, EV_CLIP, EV_COMPRESSION,
     D_SLOPE, D_VALUE, EV_CONTACT, EV_SLIP, EV_STICK, EVENT, F_MASS, FREE, FRICTION_EXACT,
     I_FRICTION, NAUX, NEV_TIP, Q_WIN, SLIP, STATUS_TEXT, STICK, state_sizes,
 )
@@ -42,7 +42,7 @@ from .friction import REVERSAL_DEADBAND
 from .mechanism import base_velocity_jumps
 from .model import BarModel, build_model
 from .parameters import MechScene
-from .recorder import Recorder
+from .recorder import MEMORY_LIMIT, Recorder, history_memory
 from .results import ImpactResult
 from .scipy_backend import METHODS as SCIPY_METHODS, ScipyStepper
 from .stepping import CompiledStepper, Stepper
@@ -205,7 +205,18 @@ class ImpactSolver:
         if coupled is not None:
             self.drive[m.drive_rows("mu"), D_VALUE] = coupled.friction_coefficient(0.0, self.z)
         self.arrays = m.kernel_arrays(self.drive)
-        self.recorder = Recorder(m.state_size, len(self.z), capacity, keep_dense)
+        rows = scene.solver.history_rows
+        if history_memory(m.state_size, rows, len(self.z)) > MEMORY_LIMIT:
+            raise ValueError(
+                f"solver.history_rows = {rows}: with {m.state_size} states per row the history could take "
+                f"{history_memory(m.state_size, rows, len(self.z)) / 2**30:.3g} GiB, more than the "
+                f"{MEMORY_LIMIT / 2**30:g} GiB a run may take; keep fewer rows (or fewer modes)")
+        self.recorder = Recorder(m.state_size, len(self.z), capacity, keep_dense, row_limit=rows)
+        self.recorder.on_full = self._make_room
+        self.recorder.on_commit = self._check_rows
+        self._thin_mid_run = False  # thinning inside advance: only in run() (no index is held then)
+        self.thinning = dict(resolution=0.0, until=0.0, rows_dropped=0, max_abs_residual=0.0, max_kinetic=0.0,
+                             max_drive_work=-math.inf, max_speed=0.0, max_penetration=[-math.inf, -math.inf])
         self.stepper: Stepper = CompiledStepper() if backend == "dopri5" else ScipyStepper(backend[6:])
         self._jumps = base_velocity_jumps(scene)
         self._jump_index = 0
@@ -353,11 +364,37 @@ class ImpactSolver:
                        _arrays=m.kernel_arrays(self.drive.copy()))
 
     def run(self):
-        """Integrate to ``solver.t_end`` and return the ``ImpactResult``."""
-        self.advance(self.scene.solver.t_end)
+        """Integrate to ``solver.t_end`` and return the ``ImpactResult``.
+
+        The history is thinned as it is made once it holds ``solver.history_rows`` rows
+        (without ``keep_dense``; see ``_thin_history``). Running out of memory ends the run
+        as any failure does: a MechSolverError with the partial result."""
+        self._thin_mid_run = not self.keep_dense
+        try:
+            self.advance(self.scene.solver.t_end)
+        except MemoryError as err:
+            self._thin_mid_run = False
+            raise MechSolverError(f"mechanics ran out of memory at t = {self.t!r} s ({_one_line(err)})",
+                                  self.t, self.named_state(), partial=self._partial_after_memory_error()) from err
+        finally:
+            self._thin_mid_run = False
         return self.result()
 
+    def _partial_after_memory_error(self):
+        """The result so far, after a MemoryError: as it stands, or from a history thinned to
+        a quarter of its rows (the result copies its rows), or None."""
+        try:
+            return self.result()
+        except MemoryError:
+            pass
+        try:
+            self._thin_history(self.recorder.n, rows=max(self.recorder.n // 4, 2))
+            return self.result()
+        except MemoryError:
+            return None
+
     def result(self) -> ImpactResult:
+        th = self.thinning
         return ImpactResult(
             model=self.model,
             **self.recorder.columns(),
@@ -366,7 +403,108 @@ class ImpactSolver:
                        rhs_evals=int(self.stats[2]), events=int(self.stats[3]),
                        wall_time=self.wall_time),
             projection_energy=self.projection_energy,
+            thinning=dict(th, max_penetration=list(th["max_penetration"])) if th["rows_dropped"] else None,
         )
+
+    # --- memory: the history in proportion to what is kept ------------------------------
+
+    def release_dense(self) -> None:
+        """Forget the dense output recorded so far (``keep_dense``), between two ``advance``
+        calls, once what is needed of it has been sampled (a co-simulation samples each
+        macro step's contact forces at the circuit's points, then releases them); the
+        history is then thinned if it holds more than ``solver.history_rows`` rows.
+        ``contact_series`` afterwards covers only the later steps."""
+        rec = self.recorder
+        rec.release_dense()
+        if rec.n >= rec.row_limit:
+            self._thin_history(self._protected_row())
+
+    def _protected_row(self) -> int:
+        """The first row a thinning must keep, with every row after it: the rows of the
+        current rest window (``_watch_rest`` averages the state over them)."""
+        rec = self.recorder
+        return int(min(np.searchsorted(rec.t[:rec.n], self._rest_t0, side="left"), rec.n - 1))
+
+    def _make_room(self) -> None:
+        """Recorder.on_full: thin the history inside ``run`` (never while another caller of
+        ``advance`` may hold row indices)."""
+        if self._thin_mid_run:
+            self._thin_history(self._protected_row())
+
+    def _thin_history(self, floor: int, rows: int | None = None) -> None:
+        """Thin the rows before ``floor`` to about ``rows`` (default: half of
+        ``solver.history_rows``) on a uniform time grid anchored at the first row: of the
+        rows in each interval of the grid the first is kept, and always the first and the
+        last row, the rows on either side of every event and every change of a regime (so
+        the contact intervals, their impulses and restitutions, and the phases are those of
+        the unthinned run). The grid's interval only grows, so earlier rows are never finer
+        than later ones. Of the rows dropped, what the result's checks read is kept as
+        extremes: the largest energy residual, kinetic energy, input work, speed and
+        penetration (mech.results.ImpactResult reads them with its own rows), and each
+        kept row's peak force covers the rows dropped before it."""
+        rec = self.recorder
+        if floor < 3:
+            return
+        target = max((rec.row_limit if rows is None else rows) // 2, 1)
+        t = rec.t[:floor]
+        th = self.thinning
+        span = float(t[-1] - t[0])
+        th["resolution"] = max(th["resolution"], span / target if span > 0.0 else 0.0)
+        keep = np.zeros(floor, bool)
+        keep[[0, -1]] = True
+        if th["resolution"] > 0.0:
+            bins = np.floor((t - t[0]) / th["resolution"])
+            keep[np.flatnonzero(np.diff(bins) > 0) + 1] = True
+        change = np.flatnonzero(np.any(rec.regime[1:floor] != rec.regime[:floor - 1], axis=1))
+        keep[change] = True
+        keep[change + 1] = True
+        if self.events:
+            times = np.fromiter((e["time"] for e in self.events), float, len(self.events))
+            k = np.searchsorted(t, times[times <= t[-1]])
+            keep[np.minimum(k, floor - 1)] = True
+            keep[np.maximum(k - 1, 0)] = True
+        drop = ~keep
+        if not drop.any():
+            return
+        self._record_dropped(drop)
+        th["rows_dropped"] += rec.thin(keep)
+        th["until"] = float(rec.t[int(np.count_nonzero(keep)) - 1])
+
+    def _record_dropped(self, drop: np.ndarray) -> None:
+        """The extremes of the rows ``drop`` (bool over the first rows) that the result's
+        checks read (see _thin_history), folded into ``thinning``."""
+        from .results import audit_residual, audit_terms
+
+        rec = self.recorder
+        th = self.thinning
+        m = self.model
+        Y = rec.y[:len(drop)][drop]
+        E = energy_table(Y, m.arrays)  # (as the result computes its own rows' energies)
+        first = energy_table(rec.y[:1], m.arrays)[0]
+        qd = Y[:, m.slices()["quad"]]
+        terms = audit_terms(E, qd, first)
+        th["max_abs_residual"] = max(th["max_abs_residual"], float(np.max(np.abs(audit_residual(E, qd, first)))))
+        th["max_kinetic"] = max(th["max_kinetic"], float(E[:, 0].max()))
+        drive = terms["work_in"] - terms["potential"] - (terms["spring_stored"] - first[4])
+        th["max_drive_work"] = max(th["max_drive_work"], float(np.max(drive)))
+        th["max_speed"] = max(th["max_speed"], float(np.max(np.linalg.norm(Y[:, m.slices()["vel"]], axis=1))))
+        pen = rec.aux[:len(drop)][drop][:, :, A_Y].max(axis=0)
+        th["max_penetration"] = [max(a, float(b)) for a, b in zip(th["max_penetration"], pen)]
+
+    def _check_rows(self, start: int, rows: int) -> None:
+        """Recorder.on_commit: stop a run whose contact point has sunk deeper into the block
+        than its cap's radius. The cap is then wholly inside the block: no contact law
+        describes that, nothing after it means anything, and such a run (the relay's blade
+        under a 5.4 MN armature force) otherwise goes on at steps of 1e-9 s for hours."""
+        pen = self.recorder.aux[start:start + rows, :, A_Y].max(axis=0)
+        cps = self.model.cpar
+        for i in range(2):
+            if cps[i, C_ON] != 0.0 and pen[i] > cps[i, C_R]:
+                raise MechSolverError(
+                    f"contact point {i} went {pen[i]:.3g} m into the block by t = {self.t!r} s, deeper than its "
+                    f"cap's {cps[i, C_R]:.3g} m radius: no contact law describes that; the loads press the "
+                    f"contact far beyond what it can carry (forces, springs, gravity)", self.t, self.named_state(),
+                    partial=self.result())
 
     def set_modal_state(self, q=None, eta=None) -> None:
         """Start from given modal coordinates q (m) and speeds eta (m/s), before integrating.
@@ -402,13 +540,17 @@ class ImpactSolver:
         """Everything needed to return to this instant with ``restore`` (records after it are dropped)."""
         return dict(t=self.t, y=self.y.copy(), z=self.z.copy(), h=self.h, regime=self.regime.copy(),
                     eref=self.eref.copy(), ev_sign=self.ev_sign.copy(), stats=self.stats.copy(),
-                    n=self.recorder.n, n_events=len(self.events), projection_energy=self.projection_energy,
+                    n=self.recorder.n, thinned=self.thinning["rows_dropped"],
+                    n_events=len(self.events), projection_energy=self.projection_energy,
                     drive=self.drive.copy(), jump_index=self._jump_index,
                     rest=(self._hold_until, self._hold_regime.copy(), self._rest_t0, self._rest_ke,
                           [list(h) for h in self.holds]))
 
     def restore(self, cp: dict) -> None:
         """Return to a ``checkpoint`` (e.g. to redo a coupling step so it ends at an event)."""
+        if cp.get("thinned", 0) != self.thinning["rows_dropped"]:
+            raise ValueError("restore: the history was thinned after this checkpoint (release_dense); "
+                             "take a new checkpoint")
         self.t, self.h = cp["t"], cp["h"]
         self.y[:] = cp["y"]
         self.z[:] = cp["z"]
@@ -434,14 +576,29 @@ class ImpactSolver:
         order = np.argsort(times, kind="stable")
         rec = self.recorder
         n = rec.n
-        if len(times) and (times[order[0]] < rec.t[0] - 1e-15 or times[order[-1]] > self.t + 1e-15):
-            raise ValueError(f"times must lie in [{rec.t[0]!r}, {self.t!r}] s")
+        b = rec.dense_base  # (rows before it were released, release_dense)
+        start = rec.dense_t0[0] if 0 < b < n else rec.t[min(b, n - 1)]  # the first kept step's start
+        if len(times) and (times[order[0]] < start - 1e-15 or times[order[-1]] > self.t + 1e-15):
+            raise ValueError(f"times must lie in [{start!r}, {self.t!r}] s"
+                             + (" (the dense output before was released)" if b else ""))
         out = np.empty((len(times), 2, 3))
-        dense_contact(times[order], rec.t[:n], rec.dense_t0[:n], rec.dense_h[:n], rec.dense_coef[:n],
-                      rec.regime[:n], self.arrays, self.eref, self.work, out)
+        dense_contact(times[order], rec.t[b:n], rec.dense_t0[:n - b], rec.dense_h[:n - b], rec.dense_coef[:n - b],
+                      rec.regime[b:n], self.arrays, self.eref, self.work, out)
         result = np.empty_like(out)
         result[order] = out
         return result
+
+    @property
+    def dense_rows(self) -> int:
+        """Rows of dense output held (``keep_dense``): those recorded since the last
+        ``release_dense``."""
+        return self.recorder.n - self.recorder.dense_base if self.keep_dense else 0
+
+    @property
+    def last_record_time(self) -> float:
+        """s: the time of the history's last row (the dense output reaches no further: a
+        time beyond it lies in the next step)."""
+        return float(self.recorder.t[self.recorder.n - 1])
 
     @property
     def at_rest(self) -> bool:
@@ -912,3 +1069,9 @@ class ImpactSolver:
                 self.ev_sign[b + EV_COMPRESSION] = -self.ev_sign[b + EV_COMPRESSION]
             else:
                 self.ev_sign[b + EV_COMPRESSION] = 1.0 if gd >= 0.0 else -1.0
+
+
+def _one_line(err: BaseException) -> str:
+    """An exception as one line: its type and first line of text."""
+    text = str(err).strip().splitlines()
+    return f"{type(err).__name__}: {text[0]}" if text else type(err).__name__

@@ -28,8 +28,9 @@ def check_finite(name: str, value) -> float:
     return value
 
 
-def check_positive(name: str, value, *, allow_inf: bool = False) -> float:
-    """A number > 0; ``allow_inf`` accepts +inf (a bound that may be switched off)."""
+def check_positive(name: str, value, *, allow_inf: bool = False, high: float | None = None) -> float:
+    """A number > 0; ``allow_inf`` accepts +inf (a bound that may be switched off); ``high``:
+    the largest value allowed (mech.parameters' bounds)."""
     if allow_inf and isinstance(value, (float, np.floating)) and value == math.inf:
         return math.inf
     try:
@@ -38,15 +39,28 @@ def check_positive(name: str, value, *, allow_inf: bool = False) -> float:
         if allow_inf:
             raise ValueError(f"{name} = {value!r}: expected a number > 0 or inf") from None
         raise
+    if high is not None and not value <= high:
+        raise ValueError(f"{name} = {value!r}: allowed range is (0, {high:g}]")
     if value <= 0.0:
         raise ValueError(f"{name} = {value!r}: must be > 0" + (" (inf allowed)" if allow_inf else ""))
     return value
 
 
-def check_nonnegative(name: str, value) -> float:
+def check_nonnegative(name: str, value, *, high: float | None = None) -> float:
+    """A number >= 0 (and <= ``high`` when given)."""
     value = check_finite(name, value)
     if value < 0.0:
-        raise ValueError(f"{name} = {value!r}: must be >= 0")
+        raise ValueError(f"{name} = {value!r}: must be >= 0" + (f" (allowed range [0, {high:g}])" if high else ""))
+    if high is not None and value > high:
+        raise ValueError(f"{name} = {value!r}: allowed range is [0, {high:g}]")
+    return value
+
+
+def check_magnitude(name: str, value, high: float) -> float:
+    """A finite number of absolute value <= ``high`` (either sign)."""
+    value = check_finite(name, value)
+    if abs(value) > high:
+        raise ValueError(f"{name} = {value!r}: allowed range is [-{high:g}, {high:g}]")
     return value
 
 
@@ -91,29 +105,39 @@ def check_count(name: str, value, high: int = 40, auto: bool = False):
     return check_whole(name, value, 0, high, note=' or "auto"' if auto else "")
 
 
-def check_vector3(name: str, value) -> tuple[float, float, float]:
+def check_vector3(name: str, value, high: float | None = None) -> tuple[float, float, float]:
+    """Three finite numbers (each of absolute value <= ``high`` when given)."""
     try:
         items = list(value)
     except TypeError:
         raise ValueError(f"{name} = {value!r}: expected a list of 3 numbers") from None
     if isinstance(value, (str, dict)) or len(items) != 3:
         raise ValueError(f"{name} = {value!r}: expected a list of 3 numbers")
-    return tuple(check_finite(f"{name}[{i}]", v) for i, v in enumerate(items))
+    if high is None:
+        return tuple(check_finite(f"{name}[{i}]", v) for i, v in enumerate(items))
+    return tuple(check_magnitude(f"{name}[{i}]", v, high) for i, v in enumerate(items))
 
 
-def check_table(name: str, times, values=None, *, width: int | None = None):
-    """A time table: times strictly increasing, finite, >= 0; values finite, one per time
-    (``width``: each value a list of that many numbers). Returns (times, values) as tuples."""
+def check_table(name: str, times, values=None, *, width: int | None = None, time_high: float | None = None,
+                value_high: float | None = None, max_points: int | None = None):
+    """A time table: times strictly increasing, finite, >= 0 (and <= ``time_high``); values
+    finite, one per time (``width``: each value a list of that many numbers; each number of
+    absolute value <= ``value_high``); at most ``max_points`` points. Returns (times,
+    values) as tuples."""
     numbers = (int, float, np.integer, np.floating)
     items = list(times) if hasattr(times, "__iter__") and not isinstance(times, (str, dict)) else None
     if items is None or not all(isinstance(v, numbers) and not isinstance(v, bool) for v in items):
-        raise ValueError(f"{name}.time = {times!r}: expected a list of numbers (s)")
+        raise ValueError(f"{name}.time = {_short(times)}: expected a list of numbers (s)")
+    if max_points is not None and len(items) > max_points:
+        raise ValueError(f"{name}.time: {len(items)} points; at most {max_points} allowed")
     ts = [float(v) for v in items]
     if not ts:
         raise ValueError(f"{name}.time: the table is empty; give at least one time")
     for k, t in enumerate(ts):
         if not math.isfinite(t) or t < 0.0:
             raise ValueError(f"{name}.time[{k}] = {t!r}: times must be finite and >= 0 s")
+        if time_high is not None and t > time_high:
+            raise ValueError(f"{name}.time[{k}] = {t!r}: allowed range is [0, {time_high:g}] s")
         if k and t <= ts[k - 1]:
             raise ValueError(f"{name}.time[{k}] = {t!r}: times must increase strictly "
                              f"(previous {ts[k - 1]!r})")
@@ -130,10 +154,17 @@ def check_table(name: str, times, values=None, *, width: int | None = None):
     out = []
     for k, v in enumerate(vals):
         if width is None:
-            out.append(check_finite(f"{name}[{k}]", v))
+            out.append(check_finite(f"{name}[{k}]", v) if value_high is None
+                       else check_magnitude(f"{name}[{k}]", v, value_high))
         else:
-            out.append(check_vector3(f"{name}[{k}]", v))
+            out.append(check_vector3(f"{name}[{k}]", v, value_high))
     return tuple(ts), tuple(out)
+
+
+def _short(value, limit: int = 80) -> str:
+    """repr of a value, cut to ``limit`` characters (a table of 10^6 numbers is not quoted whole)."""
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 5] + " ...]"
 
 
 def check_position(name: str, value, length: float) -> float:

@@ -95,6 +95,9 @@ def _command(args) -> int:
     except KeyboardInterrupt:  # before the run started (loading, checking): nothing written
         print("switchsim: interrupted", file=sys.stderr)
         return 130
+    except MemoryError as err:  # outside a run (a run turns its own into a failed, partial result)
+        print(f"switchsim: out of memory: {_one_line(err)}", file=sys.stderr)
+        return 1
     return 1
 
 

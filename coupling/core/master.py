@@ -41,6 +41,10 @@ from coupling.core.policy import StepPolicy
 from coupling.core.results import CoupledResult
 from coupling.core.scene import Scene
 
+# rows of the mechanics' dense output before the contact is sampled at the circuit's points
+# and the dense output released (4096 rows of a 45-state blade: 7 MB); each sampling costs
+# ~60 us of calls, so sampling every macro step cost the default relay 4 % of its run
+DENSE_FLUSH_ROWS = 4096
 
 class CoupledRunError(RuntimeError):
     """A coupled run failed; ``partial`` holds the CoupledResult up to the failure."""
@@ -137,6 +141,10 @@ class CoSimulation:
         self.links = self._links()
         self.stats = dict(macro_steps=0, aligned_steps=0, contact_steps=0, mech_seconds=0.0,
                           circuit_seconds=0.0)
+        self._contact_times: list[np.ndarray] = []  # the circuit's points sampled so far ...
+        self._contacts: list[np.ndarray] = []  # ... and the mechanics' contact there (_sample_contact)
+        self._pending: list[np.ndarray] = []  # the circuit's points not sampled yet
+        self._started = False
 
     @property
     def mu_log(self) -> list[tuple[float, float, float, float]]:
@@ -266,6 +274,7 @@ class CoSimulation:
         tick = time.perf_counter()
         step = stepper.advance(t_next, inputs=inputs, breakpoints=breakpoints)
         self.stats["circuit_seconds"] += time.perf_counter() - tick
+        self._sample_contact(mech, step)
         jumped = bool(switching) or aligned
         link.observe(step, jumped)
         # a step cut at a make/break ends at a current jump even when the re-run mechanics
@@ -283,7 +292,28 @@ class CoSimulation:
         tick = time.perf_counter()
         step = stepper.advance(t_next, inputs=inputs)
         self.stats["circuit_seconds"] += time.perf_counter() - tick
+        self._sample_contact(mech, step)
         return link.current(step), t_next
+
+    def _sample_contact(self, mech, step) -> None:
+        """Note the circuit's new points of a macro step (a step's reader starts at the
+        previous step's last point); once the mechanics hold DENSE_FLUSH_ROWS rows of dense
+        output, sample their contact (penetration, rate, normal force per tip) at the points
+        noted, from that dense output, and release it: the mechanics keep a few macro steps'
+        dense output, not the run's (docs/mechanics.md, "Memory")."""
+        times = step.reader("time")
+        self._pending.append(times[1:] if self._started else times)
+        self._started = True
+        if mech.dense_rows >= DENSE_FLUSH_ROWS:
+            pending = np.concatenate(self._pending)
+            # a point beyond the last record (ngspice may land a hair past the step's end)
+            # lies in the next step's first record: sampled later, from that record
+            k = int(np.searchsorted(pending, mech.last_record_time, side="right"))
+            self._contact_times.append(pending[:k])
+            self._contacts.append(mech.contact_series(pending[:k]))
+            self._pending = [pending[k:]]
+            mech.release_dense()
+
 
     # --- results -------------------------------------------------------------------------
 
@@ -291,7 +321,11 @@ class CoSimulation:
         waves = stepper.result_columns(probes=self.scene.circuit.probes)
         kept = waves["time"] <= mech.t + 1e-15
         waves = {name: values[kept] for name, values in waves.items()}
-        contact = mech.contact_series(waves["time"])
+        # sampled as the run went (_sample_contact); the points since are sampled now
+        done = np.concatenate(self._contact_times) if self._contact_times else np.zeros(0)
+        if not np.array_equal(waves["time"][:len(done)], done):
+            raise RuntimeError("the circuit's points differ from those sampled step by step")
+        contact = np.concatenate(self._contacts + [mech.contact_series(waves["time"][len(done):])])
         for i in range(2):
             waves[f"normal_force_{i}"] = contact[:, i, 2]
             waves[f"penetration_{i}"] = np.maximum(contact[:, i, 0], 0.0)

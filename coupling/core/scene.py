@@ -49,7 +49,8 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from mech.parameters import Friction, MechScene, SolverOptions
+from mech.parameters import HISTORY_ROWS_MAX, LENGTH_MAX, T_END_MAX, Friction, MechScene, SolverOptions
+from mech.recorder import DENSE_BYTES, MEMORY_LIMIT, history_memory
 from mech.scene import SCENE_SECTIONS as MECH_SECTIONS
 from mech.scene import read_toml
 from mech.scene import scene_from_dict as mech_scene_from_dict
@@ -58,6 +59,17 @@ from mech.validation import (
 )
 
 COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output", "metrics")
+# macro steps a coupled run may take at most (t_end / macro_step, every step in contact):
+# each costs a mechanics advance and an ngspice step (~0.1-1 ms), so 1e6 is minutes to an
+# hour; a 1e-9 s macro step over 5 ms (5e6) is refused before it starts
+MACRO_STEPS_MAX = 1_000_000
+# waveform points per macro step and bytes per point and column, for the memory estimate:
+# ngspice lands at least once per step (the default relay: about 2), and a point is held by
+# ngspice's vectors, the result's columns and the files written from them
+POINTS_PER_MACRO_STEP = 4
+WAVE_COPIES = 3
+MECH_WAVE_COLUMNS = 8  # normal_force_0/1, penetration_0/1, normal_force, gap, mu (+1 spare)
+MACRO_STEP_LOG_BYTES = 152  # the friction coefficient's log, one entry per macro step
 TEMPLATES = ("resistive", "inductive", "capacitive", "current_source", "netlist", "mcu_input")
 SCHEMES = ("mechanics_first", "jacobi")
 
@@ -94,14 +106,14 @@ class CouplingOptions:
 
     def __post_init__(self):
         check_choice("coupling.scheme", self.scheme, SCHEMES)
-        check_positive("coupling.macro_step", self.macro_step)
+        check_positive("coupling.macro_step", self.macro_step, high=T_END_MAX)
         if self.max_macro_step is not None:
-            check_positive("coupling.max_macro_step", self.max_macro_step)
+            check_positive("coupling.max_macro_step", self.max_macro_step, high=T_END_MAX)
             if self.max_macro_step < self.macro_step:
                 raise ValueError(f"coupling.max_macro_step = {self.max_macro_step!r}: must be >= "
                                  f"coupling.macro_step = {self.macro_step!r}")
         check_bool("coupling.align_events", self.align_events)
-        check_nonnegative("coupling.onset_penetration", self.onset_penetration)
+        check_nonnegative("coupling.onset_penetration", self.onset_penetration, high=LENGTH_MAX)
 
     @property
     def free_step(self) -> float:
@@ -115,8 +127,8 @@ class OutputOptions:
 
     history_resolution, history_max_rows: history.csv keeps the records on either side of
     every event and regime change and, of the rest, one per interval of
-    max(history_resolution, run length / history_max_rows) (s; both 0: every solver step);
-    docs/coupling.md, "Outputs".
+    max(history_resolution, run length / history_max_rows) (s; both 0: every record the run
+    kept, at most [solver] history_rows besides those); docs/coupling.md, "Outputs".
     """
 
     csv: bool = True
@@ -130,8 +142,9 @@ class OutputOptions:
     def __post_init__(self):
         for name in ("csv", "parquet", "plots", "history", "html"):
             check_bool(f"output.{name}", getattr(self, name))
-        check_nonnegative("output.history_resolution", self.history_resolution)
-        check_whole("output.history_max_rows", self.history_max_rows, note=" (0: no limit)")
+        check_nonnegative("output.history_resolution", self.history_resolution, high=T_END_MAX)
+        check_whole("output.history_max_rows", self.history_max_rows, 0, HISTORY_ROWS_MAX,
+                    note=" (0: every record the run kept)")
 
     def history_interval(self, duration: float) -> float:
         """s: the history's resolution for a run of ``duration`` s (0: every record)."""
@@ -524,8 +537,91 @@ def _build(doc: dict, base_dir: Path, name: str) -> Scene:
     coupling, output = (_section(doc, section, cls) for section, cls in (
         ("coupling", CouplingOptions), ("output", OutputOptions)))
     metrics, circuit = _metrics(doc, circuit)
-    return Scene(raw=copy.deepcopy(doc), base_dir=base_dir, mech=mech, tribology=tribology, circuit=circuit,
-                 coupling=coupling, output=output, name=name, metrics=metrics)
+    scene = Scene(raw=copy.deepcopy(doc), base_dir=base_dir, mech=mech, tribology=tribology, circuit=circuit,
+                  coupling=coupling, output=output, name=name, metrics=metrics)
+    check_work(scene)
+    return scene
+
+
+def macro_steps(scene: Scene) -> float:
+    """The most macro steps a coupled run takes: t_end / macro_step (every step in contact)."""
+    return scene.t_end / scene.coupling.macro_step if scene.kind == "coupled" else 0.0
+
+
+def memory_estimate(scene: Scene) -> dict:
+    """Bytes a run of ``scene`` may take at most, by part, before it starts:
+
+    - history: the mechanics' rows (mech.recorder.history_memory of [solver] history_rows
+      rows of the largest state the scene can have: "auto" modes at their cap), and in a
+      coupled run the dense output of the current macro step (mech.recorder.DENSE_BYTES);
+    - waveforms: the circuit's points, t_end / TMAX plus POINTS_PER_MACRO_STEP per macro
+      step (a schedule: per make and break), each column held WAVE_COPIES times, and the
+      macro steps' log;
+    - total. Events (each a row of events.csv) come on top: they are what a run keeps.
+    """
+    out = {"history": 0, "waveforms": 0}
+    if scene.mech is not None:
+        states = _largest_state(scene.mech)
+        out["history"] = history_memory(states, scene.mech.solver.history_rows)
+        if scene.kind == "coupled":
+            out["history"] += DENSE_BYTES
+    if scene.circuit is not None:
+        t_end = scene.t_end
+        points = t_end / scene.circuit.options.tmax(t_end)
+        steps = macro_steps(scene)
+        if scene.circuit.schedule is not None:
+            steps = 2 * len(scene.circuit.schedule.intervals)
+        points += POINTS_PER_MACRO_STEP * steps + 2
+        from circuit.probes import COLUMNS
+
+        columns = len(COLUMNS) + len(scene.circuit.probes) + (MECH_WAVE_COLUMNS if scene.mech is not None else 0)
+        out["waveforms"] = int(points * columns * 8 * WAVE_COPIES + MACRO_STEP_LOG_BYTES * macro_steps(scene))
+    out["total"] = out["history"] + out["waveforms"]
+    return out
+
+
+def _largest_state(mech: MechScene) -> int:
+    """The longest state vector the scene's model can have: its mode counts ("auto": at the
+    cap of mech.mode_count), planar or 3D as mech.model.is_planar decides, with the input-work
+    quadratures of a held or loaded bar."""
+    from mech.kernel_layout import NQ, NQ_FREE, state_sizes
+    from mech.mode_count import CAP
+    from mech.model import is_planar
+
+    bar = mech.bar
+    planar = mech.mount.held or (mech.solver.model != "3d" and is_planar(mech))
+    axial = CAP if bar.axial_modes == "auto" else bar.axial_modes
+    bending = CAP if bar.bending_modes == "auto" else bar.bending_modes
+    n = axial + bending * (1 if planar else 2)
+    npos, nvel = state_sizes(n, planar)
+    return npos + nvel + (NQ if (mech.mount.held or mech.forces or mech.springs) else NQ_FREE)
+
+
+def check_work(scene: Scene) -> None:
+    """Refuse, before anything runs, a scene whose macro steps or memory exceed what a run
+    may take (MACRO_STEPS_MAX, mech.recorder.MEMORY_LIMIT; docs/scene_keys.md, "Bounds"),
+    naming the key that sets the largest part."""
+    count = macro_steps(scene)
+    if count > MACRO_STEPS_MAX:
+        raise ValueError(
+            f"coupling.macro_step = {scene.coupling.macro_step!r} s: t_end / macro_step = {count:.3g} macro steps "
+            f"(solver.t_end = {scene.t_end!r} s), more than the {MACRO_STEPS_MAX:.0e} a run may take; "
+            "use a longer macro step or a shorter t_end")
+    est = memory_estimate(scene)
+    if est["total"] <= MEMORY_LIMIT:
+        return
+    if est["history"] >= est["waveforms"]:
+        key = f"solver.history_rows = {scene.mech.solver.history_rows}"
+        fix = "keep fewer rows (or set the mode counts lower than their cap)"
+    else:
+        opts = scene.circuit.options
+        key = (f"circuit.max_step = {opts.max_step!r} s" if opts.max_step is not None
+               and scene.t_end / opts.max_step > POINTS_PER_MACRO_STEP * macro_steps(scene)
+               else f"coupling.macro_step = {scene.coupling.macro_step!r} s")
+        fix = "use a longer step or a shorter t_end"
+    raise ValueError(f"{key}: the run could take {est['total'] / 2**30:.3g} GiB (history "
+                     f"{est['history'] / 2**30:.3g}, waveforms {est['waveforms'] / 2**30:.3g}), more than the "
+                     f"{MEMORY_LIMIT / 2**30:g} GiB a run may take; {fix}")
 
 
 def _metrics(doc: dict, circuit: CircuitSpec | None):

@@ -6,10 +6,12 @@ the circuit then carries currents its source cannot drive. Such a result gets th
 "unsound" (``switchsim`` exits 3), with each violated bound named, its cause and the fix.
 
 The bounds, all from the scene's own energy scale E (J, ``mech.ImpactResult.energy_scale``:
-initial kinetic + elastic + contact-stored energy + m g (z_c0 - R_tip), the potential
-energy of the centre above the lowest resting height; nothing in the scene adds
-mechanical energy after the start: contact damping, friction and modal damping only take
-it out):
+what the scene brings in, initial kinetic, elastic, contact- and spring-stored energy,
+and the most work its loads and drives can do: gravity, actuator forces, springs, a
+pivot's preload torque, a moving clamp; bounded from the scene before the run where it can
+be (docs/mechanics.md section 9, "Energy audit"). Contact damping, friction and modal
+damping only take energy out. Past their history's row budget, a run's extremes include
+the rows it thinned away (``mech.ImpactResult.thinning``)):
 
 - energy audit: max |residual| <= energy_tolerance * E ([solver] energy_tolerance);
 - speeds: the kinetic energy (translation, rotation, vibration) never exceeds E, and so
@@ -147,13 +149,14 @@ def assess(result) -> dict:
     if mres is not None and len(mres.t):
         scene = mres.model.scene
         scale = float(mres.energy_scale)
-        residual = float(np.max(np.abs(mres.energy_columns["residual"])))  # (numpy: no pandas to run)
-        # from the records themselves, not the history table (a long run's table is large)
-        speed = float(np.max(np.linalg.norm(mres.states[:, mres.model.slices()["vel"]], axis=1)))
+        # from the records themselves and the extremes of those a long run thinned away
+        # (mech.ImpactResult.thinning), not from the history table
+        residual = mres.max_abs_residual
+        speed = mres.max_speed
         pen = mres.deepest_penetration
         v_max = speed_bound(scale, scene.bar.mass)
         y_max = penetration_bound(scale, float(mres.solver["stiffness"]), scene.bar.mass * scene.gravity)
-        kinetic = float(mres.energy_columns["kinetic"].max())
+        kinetic = mres.max_kinetic
         out.update(energy_scale=scale, relative_residual=residual / scale if scale > 0 else None,
                    max_kinetic=kinetic, max_speed=speed, speed_bound=v_max, max_penetration=pen,
                    penetration_bound=y_max)

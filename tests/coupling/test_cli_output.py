@@ -286,9 +286,10 @@ def interrupted_time(out: Path) -> float:
 @pytest.mark.slow
 def test_ctrl_c_in_a_coupled_run_writes_the_partial_result_marked_interrupted_and_exits_130(tmp_path):
     """A real SIGINT to the command, once its run loop reports progress."""
-    # The bouncing bar closing the circuit: far longer than the test waits.
-    scene = write(tmp_path, "long.toml", BOUNCING.replace("[output]", COUPLED[COUPLED.index("[tribology]"):
-                                                                       COUPLED.index("[output]")] + "[output]"))
+    # The bouncing bar closing the circuit: far longer than the test waits (1 s: 5e5 macro
+    # steps, within the 1e6 a run may take; 10 s would be refused before it starts).
+    scene = write(tmp_path, "long.toml", BOUNCING.replace("t_end = 10.0", "t_end = 1.0").replace(
+        "[output]", COUPLED[COUPLED.index("[tribology]"):COUPLED.index("[output]")] + "[output]"))
     out = tmp_path / "out"
     env = dict(os.environ, PYTHONPATH=str(ROOT))
     # a non-interactive parent leaves SIGINT ignored in its children: restore the default

@@ -30,15 +30,19 @@ def _scene_key_units() -> dict[str, str]:
     return out
 
 
-def _bounce_units() -> dict[str, str]:
-    """"bounce.key" -> unit, from docs/coupling.md's bounce-metrics table, where a meaning
-    starts with its unit ("s, first and last make ...")."""
+def _bounce_units(section: str = "Bounce metrics", prefix: str = "bounce") -> dict[str, str]:
+    """"bounce.key" -> unit, from docs/coupling.md's bounce-metrics table (or another
+    section's), where a meaning starts with its unit ("s, first and last make ...")."""
     out = {}
+    inside = False
     for line in (DOCS / "coupling.md").read_text().splitlines():
-        m = re.match(r"^\| ((?:`\w+`(?:, )?)+) \| (s|V|J|A|ohm), ", line)
-        if m:
+        if line.startswith("#"):
+            inside = line.startswith(f"### {section}")
+            continue
+        m = re.match(r"^\| ((?:`\w+`(?:, )?)+) \| (s|V|J|A|ohm)[,;] ", line)
+        if inside and m:
             for key in re.findall(r"`(\w+)`", m.group(1)):
-                out[f"bounce.{key}"] = m.group(2)
+                out[f"{prefix}.{key}"] = m.group(2)
     return out
 
 
@@ -57,6 +61,9 @@ def test_bounce_units_are_those_of_docs_coupling():
     doc = _bounce_units()
     assert len(doc) >= 8  # first/last make, times, the three peaks, arc energy
     assert {k: SUMMARY[k].unit for k in doc} == doc
+    logic = _bounce_units("Digital inputs", "logic")
+    assert len(logic) >= 4  # first and last edge, burst, margin
+    assert {k: SUMMARY[k].unit for k in logic} == logic
 
 
 def _summaries():
