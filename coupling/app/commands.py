@@ -26,8 +26,8 @@ def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = Fa
                 overwrite: bool = False, check: bool = False, plots: bool = False) -> int:
     from coupling.core.master import CoupledRunError, RunInterrupted, run
     from coupling.app.output import ResultFolder, scene_identity
+    from coupling.core.results import RunStatus
     from coupling.core.scene import default_scene, load_scene
-    from coupling.core.soundness import assess
 
     scene = default_scene() if scene_path is None else load_scene(scene_path)  # validates before running
     if plots:
@@ -45,10 +45,6 @@ def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = Fa
     except CoupledRunError as err:
         return _write_partial(folder, err.partial, extra, f"{err}", EXIT_FAILED)
     try:
-        soundness = assess(result)
-        extra["soundness"] = soundness
-        if soundness["problems"] and result.status == "ok":
-            result.status = "unsound"
         folder.write(result, extra)
     except KeyboardInterrupt:
         _say(f"interrupted while writing the result; {out} was left as it was")
@@ -61,10 +57,10 @@ def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = Fa
              f"{out} was left as it was")
         return EXIT_FAILED
     _result_lines(result.summary)
-    for problem in soundness["problems"]:
+    for problem in result.problems:
         _say(f"unsound: {problem}")
     _say(f"status {result.status}; wrote {out}")
-    return EXIT_UNSOUND if soundness["problems"] else EXIT_OK
+    return EXIT_UNSOUND if result.status is RunStatus.UNSOUND else EXIT_OK
 
 
 def plot_command(result_dir: str) -> int:
@@ -99,7 +95,7 @@ def _write_partial(folder, partial, extra: dict, message: str, code: int) -> int
         _say(f"{message}; the partial result could not be written: {type(err).__name__}: "
              f"{' '.join(str(getattr(err, 'strerror', None) or err).split())}")
         return code
-    _say(f"{message}; what was computed is in {folder.path} (status {partial.status.split(':')[0]!r})")
+    _say(f"{message}; what was computed is in {folder.path} (status {partial.status.value!r})")
     return code
 
 

@@ -100,7 +100,7 @@ _SUMMARY = {
                   "laws.resistance.film_resistivity": ("film resistivity", "ohm m^2")},
 }
 # columns a sweep adds to every row (coupling.app.sweep)
-_SWEEP = {"wall_time": ("wall time", "s"), "finished_at": ("finish time since 1970 (Unix time)", "s")}
+_SWEEP = {"wall_time": ("wall time", "s"), "stopped_at": ("where the run stopped", "s"), "finished_at": ("finish time since 1970 (Unix time)", "s")}
 SUMMARY = {f"{section}.{key}": Quantity(*v) for section, keys in _SUMMARY.items() for key, v in keys.items()}
 SUMMARY.update({key: Quantity(*v) for key, v in _SWEEP.items()})
 

@@ -387,6 +387,7 @@ def execute(sweep_doc: dict, run_doc: dict, wave_dir: str | None) -> dict:
             result = run(scene)
             summary = result.summary
             waveforms = result.waveforms
+            status, error = result.status.value, result.message or None  # judged where it was made
         except CoupledRunError as err:
             status, error = "failed", _one_line(err)
             summary = err.partial.summary if err.partial is not None else None

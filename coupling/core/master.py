@@ -38,7 +38,7 @@ from mech import ImpactSolver
 
 from coupling.core.exchange import CONTACT_EVENTS, ContactLink
 from coupling.core.policy import StepPolicy
-from coupling.core.results import CoupledResult
+from coupling.core.results import CoupledResult, RunStatus
 from coupling.core.scene import Scene
 
 # rows of the mechanics' dense output before the contact is sampled at the circuit's points
@@ -172,7 +172,8 @@ class CoSimulation:
             partial = None
             try:
                 partial = CoupledResult(scene=sc, mechanics=mech.result(), waveform_columns=None,
-                                        stats=dict(self.stats), status=f"failed at t = 0.0 s: {err}")
+                                        stats=dict(self.stats), status=RunStatus.FAILED,
+                                        message=f"{type(err).__name__}: {err}", stopped_at=0.0)
             except Exception:  # noqa: BLE001 - best effort
                 pass
             raise CoupledRunError(f"coupled run failed at t = 0.0 s: {type(err).__name__}: {err}", partial) from err
@@ -212,23 +213,23 @@ class CoSimulation:
                     self.stats["contact_steps"] += int(touching)
                     self.progress(t)
                 self.stats["wall_time"] = time.perf_counter() - tick
-                return self._result(mech, stepper, status="ok")
+                return self._result(mech, stepper)
         except KeyboardInterrupt as err:  # Ctrl-C: keep what was computed
             self.stats["wall_time"] = time.perf_counter() - tick
             t_stop = min(float(mech.t), t_end)
-            partial = self._partial(mech, stepper, f"interrupted at t = {t_stop!r} s")
+            partial = self._partial(mech, stepper, RunStatus.INTERRUPTED, "Ctrl-C", t_stop)
             raise RunInterrupted(f"interrupted at t = {t_stop!r} s", partial) from err
         except Exception as err:  # a failure keeps what was computed and says why
             self.stats["wall_time"] = time.perf_counter() - tick
             t_fail = _failure_time(err, t)
-            partial = self._partial(mech, stepper, f"failed at t = {t_fail!r} s: {err}")
+            partial = self._partial(mech, stepper, RunStatus.FAILED, f"{type(err).__name__}: {err}", t_fail)
             raise CoupledRunError(f"coupled run failed at t = {t_fail!r} s: {type(err).__name__}: {err}",
                                   partial) from err
 
-    def _partial(self, mech, stepper, status: str) -> CoupledResult | None:
+    def _partial(self, mech, stepper, status: RunStatus, message: str, stopped_at: float) -> CoupledResult | None:
         """The result up to a failure or interruption (best effort: None if even that fails)."""
         try:
-            return self._result(mech, stepper, status=status)
+            return self._result(mech, stepper, status=status, message=message, stopped_at=stopped_at)
         except Exception:  # noqa: BLE001
             return None
 
@@ -317,7 +318,8 @@ class CoSimulation:
 
     # --- results -------------------------------------------------------------------------
 
-    def _result(self, mech, stepper, status: str) -> CoupledResult:
+    def _result(self, mech, stepper, status: RunStatus = RunStatus.OK, message: str = "",
+                stopped_at: float | None = None) -> CoupledResult:
         waves = stepper.result_columns(probes=self.scene.circuit.probes)
         kept = waves["time"] <= mech.t + 1e-15
         waves = {name: values[kept] for name, values in waves.items()}
@@ -335,41 +337,52 @@ class CoSimulation:
                                 np.maximum(0.0, -np.max(contact[:, :, 0], axis=1)))
         waves["mu"] = self.links[0].mu_series(waves["time"])
         return CoupledResult(scene=self.scene, mechanics=mech.result(), waveform_columns=waves,
-                             stats=dict(self.stats, circuit=stepper.stats), status=status)
+                             stats=dict(self.stats, circuit=stepper.stats), status=status, message=message,
+                             stopped_at=stopped_at)
 
 
 def run(scene: Scene, *, progress: bool = False, check: bool = False) -> CoupledResult:
-    """Run any scene: mechanics only, circuit only (prescribed schedule) or coupled.
-    check: also rerun it refined and write summary.accuracy (coupling/app/accuracy.py)."""
+    """Run any scene: mechanics only, circuit only (prescribed schedule) or coupled, and judge
+    the result (``CoupledResult.judge``: ok or unsound). check: also rerun it refined and
+    write summary.accuracy (coupling/app/accuracy.py). A failed or interrupted run raises
+    CoupledRunError or RunInterrupted with what it computed (status failed or interrupted)."""
     if check:
         from coupling.app.accuracy import run_checked
 
         return run_checked(scene, progress=progress)
     if scene.kind == "coupled":
-        return CoSimulation(scene, progress=progress).run()
+        return CoSimulation(scene, progress=progress).run().judge()
     if scene.kind == "mechanics":
-        from mech.solver import MechSolverError
+        return _run_mechanics(scene).judge()
+    return _run_schedule(scene).judge()
 
-        tick = time.perf_counter()
-        solver = ImpactSolver(scene.mech)
+
+def _run_mechanics(scene: Scene) -> CoupledResult:
+    from mech.solver import MechSolverError
+
+    tick = time.perf_counter()
+    solver = ImpactSolver(scene.mech)
+    try:
+        result = solver.run()
+    except MechSolverError as err:
+        partial = None
+        if err.partial_result is not None:
+            partial = CoupledResult(scene=scene, mechanics=err.partial_result, waveform_columns=None, stats={},
+                                    status=RunStatus.FAILED, message=str(err), stopped_at=float(err.t))
+        raise CoupledRunError(str(err), partial) from err
+    except KeyboardInterrupt as err:
         try:
-            result = solver.run()
-        except MechSolverError as err:
+            partial = CoupledResult(scene=scene, mechanics=solver.result(), waveform_columns=None,
+                                    stats=dict(wall_time=time.perf_counter() - tick), status=RunStatus.INTERRUPTED,
+                                    message="Ctrl-C", stopped_at=float(solver.t))
+        except Exception:  # noqa: BLE001 - best effort
             partial = None
-            if err.partial_result is not None:
-                partial = CoupledResult(scene=scene, mechanics=err.partial_result, waveform_columns=None,
-                                        stats={}, status=f"failed at t = {float(err.t)!r} s: {err}")
-            raise CoupledRunError(str(err), partial) from err
-        except KeyboardInterrupt as err:
-            status = f"interrupted at t = {float(solver.t)!r} s"
-            try:
-                partial = CoupledResult(scene=scene, mechanics=solver.result(), waveform_columns=None,
-                                        stats=dict(wall_time=time.perf_counter() - tick), status=status)
-            except Exception:  # noqa: BLE001 - best effort
-                partial = None
-            raise RunInterrupted(status, partial) from err
-        return CoupledResult(scene=scene, mechanics=result, waveform_columns=None,
-                             stats=dict(wall_time=time.perf_counter() - tick), status="ok")
+        raise RunInterrupted(f"interrupted at t = {float(solver.t)!r} s", partial) from err
+    return CoupledResult(scene=scene, mechanics=result, waveform_columns=None,
+                         stats=dict(wall_time=time.perf_counter() - tick))
+
+
+def _run_schedule(scene: Scene) -> CoupledResult:
     from circuit import run_transient
 
     tick = time.perf_counter()
@@ -378,13 +391,11 @@ def run(scene: Scene, *, progress: bool = False, check: bool = False) -> Coupled
         waves = run_transient(spec.circuit, spec.schedule, scene.t_end, options=spec.options,
                               probes=spec.probes)
     except KeyboardInterrupt as err:  # the one-shot transient has no partial waveforms
-        raise RunInterrupted("interrupted", CoupledResult(scene=scene, mechanics=None, waveform_columns=None,
-                                                          stats={}, status="interrupted")) from err
+        raise RunInterrupted("interrupted", CoupledResult(scene=scene, mechanics=None, waveform_columns=None, stats={},
+                                                          status=RunStatus.INTERRUPTED, message="Ctrl-C")) from err
     except Exception as err:  # noqa: BLE001 - a failed circuit run still leaves its summary
         raise CoupledRunError(f"circuit run failed: {type(err).__name__}: {err}",
                               CoupledResult(scene=scene, mechanics=None, waveform_columns=None, stats={},
-                                            status=f"failed: {err}")) from err
+                                            status=RunStatus.FAILED, message=f"{type(err).__name__}: {err}")) from err
     return CoupledResult(scene=scene, mechanics=None, waveform_columns={k: waves[k].to_numpy() for k in waves.columns},
-                         stats=dict(wall_time=time.perf_counter() - tick), status="ok")
-
-
+                         stats=dict(wall_time=time.perf_counter() - tick))

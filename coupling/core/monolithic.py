@@ -188,4 +188,4 @@ def run_monolithic(scene: Scene, *, method: str = "Radau", rtol: float | None = 
         "normal_force": forces.sum(axis=1), "mu": np.array([mu(i) for i in i_loop], dtype=float),
     }
     return CoupledResult(scene=scene, mechanics=mech_result, waveform_columns=waves,
-                         stats=dict(wall_time=wall, method=method, rtol=tol), status="ok")
+                         stats=dict(wall_time=wall, method=method, rtol=tol))

@@ -9,6 +9,7 @@ coupling.core.diagnostics.
 
 from __future__ import annotations
 
+import enum
 import json
 import math
 from dataclasses import dataclass, field
@@ -46,6 +47,23 @@ def bounce_metrics(intervals, t_end: float, waveforms: dict | None, closed_at_en
                            waveforms["contact_voltage"], loop, arc, settings=settings)
 
 
+class RunStatus(str, enum.Enum):
+    """How a run ended, one value of four (a ``str``: ``result.status == "ok"`` reads as it says).
+
+    ok: finished and physically sound; unsound: finished, but a soundness bound is violated
+    (``CoupledResult.problems``; the command line exits 3); failed: stopped by an error
+    (``message``; exit 1); interrupted: stopped by Ctrl-C (exit 130). A failed or interrupted
+    run keeps what it computed up to ``stopped_at``."""
+
+    OK = "ok"
+    UNSOUND = "unsound"
+    FAILED = "failed"
+    INTERRUPTED = "interrupted"
+
+    def __str__(self) -> str:
+        return self.value
+
+
 @dataclass
 class CoupledResult:
     """What a run produced. mechanics: mech.ImpactResult or None; waveform_columns: name ->
@@ -58,9 +76,33 @@ class CoupledResult:
     mechanics: object | None
     waveform_columns: dict | None
     stats: dict
-    status: str = "ok"
+    status: RunStatus = RunStatus.OK
+    message: str = ""  # why it failed, was interrupted or is unsound ("" when ok)
+    stopped_at: float | None = None  # s: where a failed or interrupted run stopped
     accuracy: dict | None = None  # summary.accuracy of run(scene, check=True) (coupling/app/accuracy.py)
+    soundness: dict | None = None  # what judge() measured: extremes, bounds and problems (coupling.core.soundness)
     _cache: dict = field(default_factory=dict, repr=False)
+
+    def __post_init__(self):
+        self.status = RunStatus(self.status)
+
+    @property
+    def problems(self) -> list[str]:
+        """One line per violated soundness bound (empty when sound, or not judged)."""
+        return list((self.soundness or {}).get("problems", []))
+
+    def judge(self) -> "CoupledResult":
+        """Judge the finished run's soundness (coupling.core.soundness.assess): an ok run with a
+        violated bound becomes unsound, its message naming each problem. Done where a run is
+        made (``coupling.run``), so the API, the command line and sweep rows carry the same
+        status. Returns the result itself."""
+        from coupling.core.soundness import assess
+
+        self.soundness = assess(self)
+        if self.problems and self.status is RunStatus.OK:
+            self.status = RunStatus.UNSOUND
+            self.message = "; ".join(self.problems)
+        return self
 
     @property
     def waveforms(self):
@@ -141,7 +183,11 @@ class CoupledResult:
         """summary.json: the mechanics keys (contacts, restitution, energy, solver, flags),
         bounce, run statistics and status."""
         out: dict = {"scene": getattr(self.scene, "name", "scene"), "kind": self.scene.kind,
-                     "status": self.status}
+                     "status": self.status.value}
+        if self.message:
+            out["message"] = self.message
+        if self.stopped_at is not None:
+            out["stopped_at"] = self.stopped_at
         if self.mechanics is not None:
             out.update(self.mechanics.to_summary())
             flag = jacobi_step_flag(self)
@@ -157,6 +203,8 @@ class CoupledResult:
                                 "laws": self.scene.tribology.laws.to_dict()}
         out["warnings"] = list(self.warnings)
         out["run"] = _jsonable(self.stats)
+        if self.soundness is not None:
+            out["soundness"] = _jsonable(self.soundness)
         if self.accuracy is not None:
             out["accuracy"] = _jsonable(self.accuracy)
         return out

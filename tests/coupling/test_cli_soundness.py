@@ -81,10 +81,7 @@ def test_rtol_above_the_range_shown_sound_is_refused_before_the_run(tmp_path, ca
     assert not (tmp_path / "out").exists()
 
 
-def test_an_unsound_run_ends_unsound_with_exit_3_and_names_cause_and_fix(tmp_path, capsys):
-    """A run whose energy audit misses its tolerance: written, status 'unsound', exit 3."""
-    scene = tmp_path / "strict.toml"
-    scene.write_text(textwrap.dedent("""
+STRICT = """
         [bar]
         modes = 2
         [initial]
@@ -96,7 +93,13 @@ def test_an_unsound_run_ends_unsound_with_exit_3_and_names_cause_and_fix(tmp_pat
         energy_tolerance = 1e-13
         [output]
         plots = false
-        """))
+        """
+
+
+def test_an_unsound_run_ends_unsound_with_exit_3_and_names_cause_and_fix(tmp_path, capsys):
+    """A run whose energy audit misses its tolerance: written, status 'unsound', exit 3."""
+    scene = tmp_path / "strict.toml"
+    scene.write_text(textwrap.dedent(STRICT))
     out = tmp_path / "out"
     assert main(["run", str(scene), "--out", str(out), "--quiet"]) == 3
     err = capsys.readouterr().err
@@ -133,3 +136,24 @@ def test_a_loose_integration_is_caught_and_the_fix_the_message_names_works():
     assert loose["relative_residual"] > 1e-3
     tight = judged(1e-5)
     assert tight["problems"] == [] and tight["relative_residual"] < 1e-4
+
+
+def test_the_api_and_a_sweep_row_judge_the_same_run_the_same_way(tmp_path):
+    """One judge where the result is made: coupling.run and a sweep row say "unsound" with the
+    same problem the command line names (before, only the command line judged)."""
+    from coupling import load_scene, run
+    from coupling.app.sweep import execute
+    from coupling.core.results import RunStatus
+
+    path = tmp_path / "strict.toml"
+    path.write_text(textwrap.dedent(STRICT))
+    result = run(load_scene(path))
+    assert result.status is RunStatus.UNSOUND and result.status == "unsound"
+    assert len(result.problems) == 1 and result.problems[0].startswith("energy audit")
+    assert result.summary["status"] == "unsound" and result.summary["message"] == result.problems[0]
+    sound = run(load_scene(path).set("solver.energy_tolerance", 1e-3))
+    assert sound.status is RunStatus.OK and not sound.problems and "message" not in sound.summary
+    doc = {"base": load_scene(path).raw, "common": {}, "base_dir": str(tmp_path), "base_name": "strict",
+           "waveforms": False}
+    row = execute(doc, {"run_id": "r0", "name": "strict", "params": {}}, None)
+    assert row["status"] == "unsound" and row["error"] == result.problems[0]

@@ -129,7 +129,7 @@ def test_a_failed_run_writes_what_it_has_and_says_why(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "failed" in err and "too many steps" in err
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
-    assert summary["status"].startswith("failed")
+    assert summary["status"] == "failed"
     assert (tmp_path / "out" / "history.csv").exists() and (tmp_path / "out" / "waveforms.csv").exists()
 
 
