@@ -189,6 +189,7 @@ def run_warnings(result) -> list[str]:
         line = toggle_warning(toggles, settings.arc_toggle_limit if settings is not None else 50)
         if line:
             out.append(line)
+        out += incomplete_break_warnings(result.operations)
         ranges = _law_ranges(scene)
         if ranges is not None and "normal_force" in w:
             name, force_range, current_range, note = ranges
@@ -201,6 +202,23 @@ def run_warnings(result) -> list[str]:
                                  else w["contact_current"])[closed]
                 out += [line + "; the current factor is held at its edge value" for line in range_warnings(
                     name + ": current", (float(current.min()), float(current.max())), current_range, "A")]
+    return out
+
+
+def incomplete_break_warnings(operations: list[dict]) -> list[str]:
+    """One line per break whose arc still burned when the run ended: its arc duration,
+    energy and peak voltage are those of a truncated arc."""
+    out = []
+    for op in operations:
+        brk = op.get("break")
+        if brk is None or brk.get("complete", True):
+            continue
+        more = brk.get("more_time_needed")
+        need = (f"about {more * 1e3:.3g} ms more at the rate its current falls" if more is not None else
+                "its current was not falling, so how much longer cannot be estimated")
+        out.append(f"the break at t = {brk['time'] * 1e3:.4g} ms: its arc still burned when the run ended (after "
+                   f"{(brk['arc_duration'] or 0.0) * 1e3:.3g} ms): arc duration, energy and peak voltage are "
+                   f"truncated; run longer ([solver] t_end): {need}")
     return out
 
 

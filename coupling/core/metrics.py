@@ -32,6 +32,7 @@ Definitions (SI: s, V, A, J), documented for users in docs/coupling.md ("Bounce 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -219,6 +220,11 @@ def bounce_metrics(intervals, t_end: float, closed_at_end: bool, t=None, v=None,
         out["settle_note"] = "not settled: the run ends open (no settle time)"
     else:
         out["settle_note"] = "the contact never closed"
+    first = first_make_operation(iv, t_end, settings, t_start)
+    if first is not None:  # a run that makes and breaks: the top-level keys are its first make's
+        out.update(first_make=first["time"], last_make=first["time"] + first["bounce_time"],
+                   bounces=first["bounces"], total_bounce_time=first["bounce_time"], settled=first["settled"],
+                   settle_time=first["settle_time"], settle_note=None if first["settled"] else out["settle_note"])
     if t is None or v is None or len(t) == 0:
         return out
     t = np.asarray(t, float)
@@ -230,8 +236,9 @@ def bounce_metrics(intervals, t_end: float, closed_at_end: bool, t=None, v=None,
     # The voltage peaks are the openings' (module docstring): a closed contact's is I R_c.
     out["peak_contact_voltage"] = max((r["peak_voltage"] for r in rows if r["peak_voltage"] is not None),
                                       default=None)
-    out["peak_bounce_voltage"] = max((r["peak_voltage"] for r in rows if r["reclosed"] and r["peak_voltage"] is not None),
-                                     default=None)
+    bounce_end = math.inf if first is None else first["time"] + first["bounce_time"]
+    out["peak_bounce_voltage"] = max((r["peak_voltage"] for r in rows if r["reclosed"] and r["end"] <= bounce_end
+                                      and r["peak_voltage"] is not None), default=None)
     if rows and not rows[-1]["reclosed"]:
         last = rows[-1]
         out["peak_final_opening_voltage"] = last["peak_voltage"]
@@ -244,7 +251,160 @@ def bounce_metrics(intervals, t_end: float, closed_at_end: bool, t=None, v=None,
     return out
 
 
+def first_make_operation(intervals, t_end: float, settings: MetricSettings, t_start: float = 0.0) -> dict | None:
+    """The first operation's make when the run also breaks (an operation with a break, or a
+    later episode): the top-level bounce keys then describe that make alone, as a user
+    expects, not the make and the break mixed. None for a run that only makes (its keys
+    stay those of the whole run)."""
+    ops = operations(intervals, t_end, settings=settings, t_start=t_start)
+    if not ops or "make" not in ops[0] or not any("break" in op for op in ops):
+        return None
+    return ops[0]["make"]
+
+
 def settles(window: float) -> float:
     """The settle criterion with a relative round-off allowance (a final closure of exactly
     the window counts)."""
     return window * (1.0 - 1e-12)
+
+
+# --- operations: what each make and each break of a run did -------------------------------
+
+def episodes(intervals, window: float) -> list[list[tuple[float, float]]]:
+    """The closed intervals (s) grouped into switching episodes: consecutive intervals whose
+    openings are shorter than ``window`` (s) belong together (bounces at a make, chatter at a
+    break); an opening of at least ``window`` ends an episode."""
+    groups: list[list[tuple[float, float]]] = []
+    for a, b in merge_intervals(intervals):
+        if groups and a - groups[-1][-1][1] < settles(window):
+            groups[-1].append((a, b))
+        else:
+            groups.append([(a, b)])
+    return groups
+
+
+def _current_window(t, i, start, end) -> tuple[float, float]:
+    """(peak |i| in A, integral of i^2 dt in A^2 s) over [start, end]."""
+    sel = (t >= start) & (t <= end)
+    if not sel.any():
+        return 0.0, 0.0
+    return float(np.max(np.abs(i[sel]))), trapezoid(t[sel], i[sel] ** 2)
+
+
+def _arc_end(t, i_arc, start: float) -> float | None:
+    """s: where the arc that burns after ``start`` goes out (its last burning sample's
+    successor), None when it still burns at the last sample."""
+    if i_arc is None:
+        return start
+    sel = t >= start
+    ts, burning = t[sel], np.abs(i_arc[sel]) > ARC_BURNING_CURRENT
+    if not len(ts) or not burning.any():
+        return start
+    if burning[-1]:
+        return None
+    last = int(np.flatnonzero(burning)[-1])
+    return float(ts[last + 1])
+
+
+def _more_arc_time(t, i_arc, i_min: float | None) -> float | None:
+    """s: how much longer a still-burning arc needs to reach I_min at the rate its current
+    falls over the run's last tenth of burning (None: it does not fall, no estimate)."""
+    burning = np.flatnonzero(np.abs(i_arc) > ARC_BURNING_CURRENT)
+    if len(burning) < 3 or i_min is None:
+        return None
+    first = t[burning[0]]
+    sel = t >= t[-1] - 0.1 * (t[-1] - first)
+    ts, ia = t[sel], np.abs(i_arc[sel])
+    if len(ts) < 2 or ts[-1] <= ts[0]:
+        return None
+    rate = (ia[-1] - ia[0]) / (ts[-1] - ts[0])
+    if rate >= 0.0:
+        return None
+    return max(ia[-1] - i_min, 0.0) / -rate
+
+
+def operations(intervals, t_end: float, t=None, v=None, i_loop=None, i_contact=None, i_arc=None,
+               settings: MetricSettings | None = None, min_arc_current: float | None = None,
+               t_start: float = 0.0) -> list[dict]:
+    """The run as a sequence of operations (summary.json ``operations``; docs/coupling.md).
+
+    A switching episode (``episodes``, window = ``settle_window``) whose closure lasts at least
+    the settle window holds a make and, unless the run ends closed, a break:
+    - make: from the episode's first make through its bounces to the start of the held
+      closure (the first closure lasting the window). ``time`` (s), ``bounces`` (openings
+      before the held closure), ``bounce_time`` (s, last make - first make of the make
+      part), ``settle_time`` (s, start of the held closure - first make; None when it never
+      held), ``peak_current`` (A, largest |loop current| from the first make to one settle
+      window into the held closure: the inrush), ``i2t`` (A^2 s, integral of the loop
+      current squared over the same window), ``arc_energy`` (J, the bounce openings' arcs),
+      ``make_energy`` (J, dissipated in the contact and its arcs over the window: integral of
+      v (i_contact + i_arc) dt);
+    - break: from the first separation after the last held closure through any chatter to
+      the arc's end. ``time`` (s), ``current_at_break`` (A, the loop current just before),
+      ``arc_duration`` (s, time with |i_arc| > 1 mA), ``arc_energy`` (J), ``peak_voltage``
+      (V), ``complete`` (False when the run ended with the arc still burning; then
+      ``more_time_needed`` (s) estimates how much longer it needed to reach I_min, or None).
+    An episode that never holds is a make that did not settle; if it then opens, its break
+    follows. A run that starts closed begins with a held closure (no make).
+    """
+    settings = settings or MetricSettings()
+    window = settings.settle_window
+    guard = settings.guard(t_end)
+    have_waves = t is not None and v is not None and len(t) > 0
+    if have_waves:
+        t, v = np.asarray(t, float), np.asarray(v, float)
+        i_loop = np.asarray(i_loop, float) if i_loop is not None else np.zeros_like(t)
+        i_contact = np.asarray(i_contact, float) if i_contact is not None else i_loop
+        i_arc = np.asarray(i_arc, float) if i_arc is not None else None
+        power = np.abs(v * i_arc) if i_arc is not None else None
+        dissipated = v * (i_contact + (i_arc if i_arc is not None else 0.0))
+    out = []
+    for group in episodes(intervals, window):
+        held = [k for k, (a, b) in enumerate(group) if b - a >= settles(window)]
+        starts_closed = group[0][0] <= t_start + guard
+        ends_closed = group[-1][1] >= t_end - guard
+        first_held = held[0] if held else None
+        op: dict = {}
+        if not starts_closed:
+            make_part = group[:first_held + 1] if first_held is not None else group
+            makes = [a for a, _ in make_part]
+            settle_at = group[first_held][0] if first_held is not None else None
+            make = dict(time=makes[0], bounces=len(make_part) - 1, bounce_time=makes[-1] - makes[0],
+                        settle_time=None if settle_at is None else settle_at - makes[0],
+                        settled=settle_at is not None, peak_current=None, i2t=None, arc_energy=None,
+                        make_energy=None)
+            if have_waves:
+                end = min(t_end, (settle_at + window) if settle_at is not None else make_part[-1][1])
+                make["peak_current"], make["i2t"] = _current_window(t, i_loop, makes[0], end)
+                sel = (t >= makes[0]) & (t <= end)
+                make["make_energy"] = trapezoid(t[sel], dissipated[sel])
+                bounce_sel = np.zeros_like(t, bool)
+                for (_, b), (a_next, _) in zip(make_part[:-1], make_part[1:]):
+                    bounce_sel |= (t >= b) & (t <= a_next)
+                make["arc_energy"] = trapezoid(t, np.where(bounce_sel, power, 0.0)) if power is not None else 0.0
+            op["make"] = make
+        if not ends_closed:
+            last_held = held[-1] if held else len(group) - 1
+            brk_time = group[last_held][1]
+            brk = dict(time=brk_time, current_at_break=None, arc_duration=None, arc_energy=None,
+                       peak_voltage=None, complete=True)
+            if have_waves:
+                arc_out = _arc_end(t, i_arc, group[-1][1])
+                end = t_end if arc_out is None else max(arc_out, group[-1][1])
+                brk["current_at_break"] = _left_value(t, i_loop, brk_time, guard)
+                if i_arc is not None:
+                    brk["arc_duration"] = arc_duration(t, i_arc, brk_time, end)
+                    sel = (t >= brk_time) & (t <= end)
+                    brk["arc_energy"] = trapezoid(t[sel], power[sel])
+                else:
+                    brk["arc_duration"], brk["arc_energy"] = 0.0, 0.0
+                makes_after = [a for a, _ in group[last_held + 1:]]
+                excluded = make_instant_mask(t, makes_after, guard)
+                brk["peak_voltage"] = _peak(v, (t >= brk_time) & (t <= end) & ~excluded)
+                if arc_out is None:
+                    brk["complete"] = False
+                    brk["more_time_needed"] = _more_arc_time(t, i_arc, min_arc_current)
+            op["break"] = brk
+        if op:
+            out.append(op)
+    return out

@@ -21,6 +21,7 @@ from mech.results import REGIME_NAMES
 
 from coupling.core.metrics import MetricSettings, merge_intervals
 from coupling.core.metrics import bounce_metrics as _bounce_metrics
+from coupling.core.metrics import operations as _operations
 
 
 OPENING_COLUMNS = ("start", "end", "open_duration", "reclosed", "kind", "current_at_break", "peak_voltage",
@@ -156,6 +157,29 @@ class CoupledResult:
         return self._cache["logic"]
 
     @property
+    def operations(self) -> list[dict]:
+        """The run as a sequence of operations, each a ``make`` and/or a ``break``
+        (coupling.core.metrics.operations; summary.json ``operations``, docs/coupling.md)."""
+        if self.scene.circuit is None:
+            return []
+        if "operations" not in self._cache:
+            w = self.waveform_columns
+            settings = getattr(self.scene, "metrics", None)
+            if w is None or not len(w["time"]) or "contact_voltage" not in w:
+                ops = _operations(self.closed_intervals, self.scene.t_end, settings=settings)
+            else:
+                arc = w.get("arc_current")
+                loop = w.get("load_current")
+                if loop is None or not np.all(np.isfinite(loop)):  # no load probe: metallic + arc current
+                    loop = w["contact_current"] + (arc if arc is not None else 0.0)
+                model = getattr(getattr(self.scene.circuit, "circuit", None), "arc", None)
+                ops = _operations(self.closed_intervals, self.scene.t_end, w["time"], w["contact_voltage"], loop,
+                                  w["contact_current"], arc, settings,
+                                  min_arc_current=None if model is None else model.min_current)
+            self._cache["operations"] = ops
+        return self._cache["operations"]
+
+    @property
     def opening_columns(self) -> dict:
         """The per-opening table of ``bounce`` (openings.csv) as lists: start, end, open_duration,
         reclosed, kind, current_at_break, peak_voltage, arc_duration, arc_energy (SI)."""
@@ -195,6 +219,7 @@ class CoupledResult:
                 out["flags"] = list(out.get("flags", [])) + [flag]
         if self.scene.circuit is not None:
             out["bounce"] = _jsonable(self.bounce)
+            out["operations"] = _jsonable(self.operations)
             if self.logic is not None:
                 out["logic"] = _jsonable(self.logic)
         if self.scene.tribology is not None:
