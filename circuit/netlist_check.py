@@ -2,15 +2,19 @@
 
 A netlist file, and every file it includes, is read here (never by ngspice): ``.include``
 / ``.inc`` and ``.lib FILE SECTION`` are inlined, paths taken relative to the folder of
-the file that names them, with a depth limit and cycle detection. Every logical line
-(``+`` continuation lines joined, comments dropped) must then be on an allow-list:
+the file that names them, with a depth limit, cycle detection and bounds on the files,
+lines and bytes read in all (an include fan-out would otherwise read 10^depth files).
+Every logical line (``+`` continuation lines joined, comments dropped) must then be on an
+allow-list:
 
 - element lines whose first letter is a SPICE device (``ELEMENT_LETTERS``) with at
   least the fields that device needs (a value or a model, not just nodes);
 - dot-cards in ``ALLOWED_CARDS`` (model, subcircuit and parameter definitions);
 - ``.options`` with names in ``ALLOWED_OPTIONS`` only.
 
-Everything else is refused with ``NetlistInputError``: ``.control``/``.endc`` blocks and
+No ``.func`` or ``.param`` may depend on itself (ngspice crashes on a recursive function
+and ends its session on a circular parameter). Everything else is refused with
+``NetlistInputError``: ``.control``/``.endc`` blocks and
 ``*#`` lines (ngspice runs them as commands, ``shell`` included), a ``*ng_script`` title
 (it turns the whole deck into a command script), analysis and output cards, ``.title``,
 XSPICE ``A`` devices (some read files), element names that are ngspice commands.

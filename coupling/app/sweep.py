@@ -8,10 +8,12 @@ scene key, as ``Scene.set`` takes them), built from one design:
 - ``random`` / ``lhs``: ``samples`` seeded draws (uniform, or Latin hypercube through
   scipy.stats.qmc) inside [low, high] per parameter, log-uniform with ``log = true``.
 
-Every run's scene is built and validated in the client before anything starts. Runs go
-to dask.distributed workers (a LocalCluster of process workers, one thread each, by
-default; an existing scheduler by address): a worker process imports once and runs
-scene after scene, never two at once (one ngspice per process). As each run finishes the
+Every run's scene is built and validated in the client before anything starts (and the
+design's size, MAX_RUNS, before it is built). Runs go to dask.distributed workers (a
+LocalCluster of process workers, one thread each, on loopback with TLS credentials of its
+own, by default; an existing scheduler by address): a worker process imports once and
+runs scene after scene, never two at once (one ngspice per process); a worker whose
+ngspice ended its session is restarted before it runs another. As each run finishes the
 client appends its row (run_id, name, the parameters, every scalar of summary.json
 flattened with dots, status, error, wall_time, session) to a Parquet dataset, one file
 per small batch under ``OUT/results/``, each written whole (temporary file, then rename):
@@ -21,9 +23,10 @@ per small batch under ``OUT/results/``, each written whole (temporary file, then
 A failed run is a row with status "failed" and its error; it never stops the sweep. The
 client keeps only a bounded window of runs in flight and no waveforms (a run's waveforms,
 on request, are written by the worker to ``OUT/waveforms/<run_id>.parquet``), so its
-memory does not grow with the sweep. ``resume=True`` runs only the runs without a row:
-after Ctrl-C, a killed worker (Dask reruns its run elsewhere) or a killed client, nothing
-finished is redone and nothing is lost or written twice. ``OUT`` must be reachable from
+memory does not grow with the sweep. ``resume=True`` runs the runs without a row and
+reruns the failed ones (their rows replaced): after Ctrl-C, a killed worker (Dask reruns
+its run elsewhere) or a killed client, nothing finished is redone and nothing is lost or
+written twice; one invocation at a time holds the folder (a lock on OUT/.sweep.lock). ``OUT`` must be reachable from
 the client (rows) and, for waveforms, from the workers (a shared file system).
 
 Sweep file (TOML, SI units)::
