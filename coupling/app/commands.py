@@ -104,14 +104,22 @@ def plot_command(result_dir: str) -> int:
     from coupling.app.plots import save_plots, stored_result
 
     try:
-        paths = save_plots(stored_result(folder), folder)
+        stored = stored_result(folder)
     except OSError as err:
-        _say(f"could not draw into {folder}: {err.strerror or err}")
-        return EXIT_FAILED
+        _say(f"error: {result_dir}: the result's files cannot be read: {err.strerror or err}")
+        return EXIT_INPUT
     except Exception as err:  # noqa: BLE001 - a damaged table of the result: one line, not a traceback
         _say(f"error: {result_dir}: the result's files cannot be read back ({type(err).__name__}: "
              f"{' '.join(str(err).split())[:200]}); the result is damaged: run the scene again")
         return EXIT_INPUT
+    try:
+        paths = save_plots(stored, folder)
+    except OSError as err:
+        _say(f"could not draw into {folder}: {err.strerror or err}")
+        return EXIT_FAILED
+    except Exception as err:  # noqa: BLE001 - a table that reads but cannot be drawn: one line
+        _say(f"could not draw the plots of {folder}: {type(err).__name__}: {' '.join(str(err).split())[:200]}")
+        return EXIT_FAILED
     _say(f"wrote {', '.join(p.name for p in paths) or 'no plots (the folder has no waveforms or history)'} "
          f"into {folder}")
     return EXIT_OK
