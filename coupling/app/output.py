@@ -93,6 +93,8 @@ def recover(out: str, marker: str = "summary.json") -> str | None:
     working folders of a killed run are named, never deleted (after a kill right after the
     exchange one may hold files put into the folder during that run). Returns the lines to
     show, or None."""
+    if not isinstance(out, str) or not out.strip():
+        return None
     try:
         path = Path(out).expanduser().absolute()
         if not path.parent.is_dir():
@@ -112,8 +114,8 @@ def recover(out: str, marker: str = "summary.json") -> str | None:
             lines.append(f"{', '.join(sorted(p.name for p in left))} beside {out}: left by a run that was killed; "
                          "delete it when you no longer need it")
         return "; ".join(lines) or None
-    except OSError as err:
-        return f"{out}: could not check for an interrupted replacement: {err.strerror or err}"
+    except OSError:  # a place that cannot be listed: the destination's own check says so
+        return None
 
 
 @dataclasses.dataclass
