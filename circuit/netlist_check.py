@@ -2,15 +2,19 @@
 
 A netlist file, and every file it includes, is read here (never by ngspice): ``.include``
 / ``.inc`` and ``.lib FILE SECTION`` are inlined, paths taken relative to the folder of
-the file that names them, with a depth limit and cycle detection. Every logical line
-(``+`` continuation lines joined, comments dropped) must then be on an allow-list:
+the file that names them, with a depth limit, cycle detection and bounds on the files,
+lines and bytes read in all (an include fan-out would otherwise read 10^depth files).
+Every logical line (``+`` continuation lines joined, comments dropped) must then be on an
+allow-list:
 
 - element lines whose first letter is a SPICE device (``ELEMENT_LETTERS``) with at
   least the fields that device needs (a value or a model, not just nodes);
 - dot-cards in ``ALLOWED_CARDS`` (model, subcircuit and parameter definitions);
 - ``.options`` with names in ``ALLOWED_OPTIONS`` only.
 
-Everything else is refused with ``NetlistInputError``: ``.control``/``.endc`` blocks and
+No ``.func`` or ``.param`` may depend on itself (ngspice crashes on a recursive function
+and ends its session on a circular parameter). Everything else is refused with
+``NetlistInputError``: ``.control``/``.endc`` blocks and
 ``*#`` lines (ngspice runs them as commands, ``shell`` included), a ``*ng_script`` title
 (it turns the whole deck into a command script), analysis and output cards, ``.title``,
 XSPICE ``A`` devices (some read files), element names that are ngspice commands.
@@ -32,9 +36,16 @@ from .errors import NetlistInputError
 
 #: Largest include depth (the netlist itself is depth 0).
 MAX_INCLUDE_DEPTH = 8
-#: Largest size of one netlist file and of all files read for one netlist, bytes.
+#: Largest size of one netlist file and of all files read for one netlist, bytes (a file
+#: included twice counts twice).
 MAX_FILE_BYTES = 20_000_000
 MAX_TOTAL_BYTES = 50_000_000
+#: Most files read for one netlist, every ``.include``/``.lib`` reference counted (an include
+#: fan-out, each file including the next ten times, would otherwise read 10^depth files).
+MAX_INCLUDED_FILES = 1000
+#: Most lines read for one netlist, all files together: checking costs ~4 us a line, so
+#: this bounds the check to a few seconds.
+MAX_TOTAL_LINES = 1_000_000
 
 #: First letters of the SPICE element lines accepted, with the fewest fields each needs
 #: (the name included): R1 a b 1k has 4.
@@ -198,22 +209,39 @@ def logical_lines(text: str, file: str = "<text>", first_is_title: bool = True) 
 @dataclass
 class _ReadState:
     total: int = 0
+    files: int = 0
+    lines: int = 0
 
 
 def _read_bytes(path: Path, where: str, state: _ReadState) -> bytes:
+    state.files += 1
+    if state.files > MAX_INCLUDED_FILES:
+        raise NetlistInputError(f"{where}: the netlist reads more than {MAX_INCLUDED_FILES} files "
+                                "(every .include/.lib counted, repeats included)")
     try:
         if not path.is_file():
-            raise NetlistInputError(f"{where}: {'a folder' if path.is_dir() else 'no such file'}: {str(path)!r}")
+            kind = "a folder" if path.is_dir() else "not a regular file" if path.exists() else "no such file"
+            raise NetlistInputError(f"{where}: {kind}: {str(path)!r}")
         size = path.stat().st_size
         if size > MAX_FILE_BYTES:
             raise NetlistInputError(f"{where}: file {str(path)!r} is {size} bytes, more than the "
                                     f"{MAX_FILE_BYTES} allowed for a netlist")
-        state.total += size
-        if state.total > MAX_TOTAL_BYTES:
-            raise NetlistInputError(f"{where}: the netlist and its includes exceed {MAX_TOTAL_BYTES} bytes")
-        return path.read_bytes()
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_FILE_BYTES + 1)  # a file growing while it is read stops here
     except OSError as err:
         raise NetlistInputError(f"{where}: cannot read {str(path)!r} ({err.strerror or type(err).__name__})") from None
+    if len(data) > MAX_FILE_BYTES:
+        raise NetlistInputError(f"{where}: file {str(path)!r} is more than the {MAX_FILE_BYTES} bytes allowed "
+                                "for a netlist")
+    state.total += len(data)
+    if state.total > MAX_TOTAL_BYTES:
+        raise NetlistInputError(f"{where}: the netlist and its includes exceed {MAX_TOTAL_BYTES} bytes "
+                                "(a file included several times counts each time)")
+    state.lines += data.count(b"\n") + 1
+    if state.lines > MAX_TOTAL_LINES:
+        raise NetlistInputError(f"{where}: the netlist and its includes exceed {MAX_TOTAL_LINES} lines "
+                                "(a file included several times counts each time)")
+    return data
 
 
 def _include_target(line: NetlistLine, tokens: list[str]) -> str:
@@ -346,6 +374,92 @@ def _check_expressions(lines: list[NetlistLine]) -> None:
                                             "no '.param' line defines")
 
 
+_FUNC = re.compile(r"\.func\s+([a-z_]\w*)\s*\(([^()]*)\)\s*=?\s*(.*)$")
+_MASKED = re.compile(r"\{[^{}]*\}|'[^']*'")
+
+
+def _assignments(text: str) -> list[tuple[str, str]]:
+    """(name, value) of each top-level ``name = value`` of a .param or .subckt line (text in
+    braces or quotes is a value, never an assignment)."""
+    masked = _MASKED.sub(lambda m: " " * len(m.group(0)), text)
+    found = list(_ASSIGNED.finditer(masked))
+    return [(m.group(1), text[m.end(): found[k + 1].start() if k + 1 < len(found) else len(text)])
+            for k, m in enumerate(found)]
+
+
+def _check_definitions(lines: list[NetlistLine]) -> None:
+    """No '.func' or '.param' may depend on itself, directly or through others: ngspice
+    expands a recursive function until its stack overflows (a segmentation fault that ends
+    the process, even when the function is never used) and ends its session on a circular
+    parameter ('cannot recover'). Definitions inside a subcircuit are local to it."""
+    defined: dict[tuple[str, str], NetlistLine] = {}
+    uses: dict[tuple[str, str], set[str]] = {}
+    scope = ""
+    for line in lines[1:]:
+        low = line.text.lower()
+        head = low.split(None, 1)[0]
+        if head == ".subckt":
+            tokens = low.split()
+            scope = tokens[1] if len(tokens) > 1 else "?"
+            pairs = _assignments(low)
+        elif head == ".ends":
+            scope = ""
+            continue
+        elif head == ".param":
+            pairs = _assignments(low[len(".param"):])
+        elif head == ".func":
+            match = _FUNC.match(low)
+            if match is None:
+                raise NetlistInputError(f"{_where(line.file, line.line)}: a '.func' line is "
+                                        "'.func name(arguments) {expression}'")
+            arguments = {a.strip() for a in match.group(2).split(",")}
+            names = {m.group(1) for m in _IDENTIFIER.finditer(_PROBE_CALL.sub("0", match.group(3)))} - arguments
+            key = (scope, match.group(1))
+            defined.setdefault(key, line)
+            uses.setdefault(key, set()).update(names)
+            continue
+        else:
+            continue
+        for name, value in pairs:
+            key = (scope, name)
+            defined.setdefault(key, line)
+            uses.setdefault(key, set()).update(m.group(1) for m in _IDENTIFIER.finditer(_PROBE_CALL.sub("0", value)))
+
+    def resolve(scope: str, name: str) -> tuple[str, str] | None:
+        for key in ((scope, name), ("", name)):
+            if key in defined:
+                return key
+        return None
+
+    edges = {key: [r for n in names if (r := resolve(key[0], n)) is not None] for key, names in uses.items()}
+    state: dict[tuple[str, str], int] = {}  # 1: on the current path, 2: done
+    for root in edges:
+        if root in state:
+            continue
+        path, stack = [root], [iter(edges[root])]
+        state[root] = 1
+        while stack:
+            child = next(stack[-1], None)
+            if child is None:
+                state[path.pop()] = 2
+                stack.pop()
+                continue
+            if state.get(child) == 1:
+                cycle = path[path.index(child):]
+                first = defined[cycle[0]]
+                others = ", ".join(dict.fromkeys(f"{defined[k].file} line {defined[k].line}" for k in cycle[1:]
+                                                 if defined[k] is not first))
+                kind = "'.func'" if first.text.lower().startswith(".func") else "parameter"
+                raise NetlistInputError(
+                    f"{_where(first.file, first.line)}: this {kind} depends on itself"
+                    f"{f' (through the definitions at {others})' if others else ''}: recursive functions crash "
+                    "ngspice and circular parameters end its session; not allowed")
+            if child not in state:
+                state[child] = 1
+                path.append(child)
+                stack.append(iter(edges[child]))
+
+
 def check_lines(lines: list[NetlistLine]) -> None:
     """Check logical lines (title first) against the allow-list; raises NetlistInputError.
 
@@ -400,6 +514,7 @@ def check_lines(lines: list[NetlistLine]) -> None:
         elif letter == "x":
             uses.append((line, "subckt", None))
     _check_expressions(lines)
+    _check_definitions(lines)
     for line, kind, positions in uses:
         tokens = line.text.split()
         where = _where(line.file, line.line)

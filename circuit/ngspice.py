@@ -606,6 +606,12 @@ class NgspiceSession(NgSpiceShared):
         if self.owner is not None and self.owner() is owner:
             self.owner = None
 
+    @property
+    def exited(self) -> bool:
+        """True once ngspice has ended its session ("cannot recover"): no circuit can run in
+        this process any more (a sweep worker is then restarted)."""
+        return self._exit_status is not None
+
 
 def _zero(t: float) -> float:
     return 0.0

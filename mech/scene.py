@@ -190,8 +190,8 @@ def _held_defaults(doc: dict) -> dict:
 
 def read_toml(path) -> dict:
     """The parsed TOML document of a scene file, or a one-line error: missing file, a folder
-    or device instead of a file, text that is not UTF-8 (with line and column), bad TOML,
-    an empty document (an empty scene would silently run every default: refused).
+    or device instead of a file, text that is not UTF-8 (with line and column), bad TOML
+    (nesting too deep for the parser included), an empty document (an empty scene would silently run every default: refused).
     A UTF-8 byte-order mark, as some Windows editors write, is accepted."""
     path = check_file("scene", path)
     name = str(path)
@@ -212,6 +212,8 @@ def read_toml(path) -> dict:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise ValueError(f"{name}: not valid TOML: {err}") from None
+    except RecursionError:  # tomllib parses nested arrays and inline tables recursively
+        raise ValueError(f"{name}: arrays or inline tables nested too deeply (a scene needs a few levels)") from None
     if not doc:
         raise ValueError(f"{name}: the scene is empty (no sections); an empty scene would silently run "
                          "every default: name the sections you mean (see docs/mechanics.md)")

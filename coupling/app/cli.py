@@ -4,10 +4,16 @@ coupling/app/commands.py."""
 
 from __future__ import annotations
 
-import argparse
-import gc
-import os
 import sys
+
+if __name__ == "__main__":  # python -m coupling.app.cli: no module from the working folder (coupling/__main__.py)
+    from coupling.__main__ import drop_working_folder
+
+    drop_working_folder()
+
+import argparse  # noqa: E402
+import gc  # noqa: E402
+import os  # noqa: E402
 
 
 def _build_parser() -> argparse.ArgumentParser:
@@ -35,7 +41,9 @@ def _build_parser() -> argparse.ArgumentParser:
 
     fit = sub.add_parser("fit", help="fit gamma, mu(I) and R_c(F_n, I) to tribometer data")
     fit.add_argument("data", help="tribometer CSV (see docs/tribology.md for its form)")
-    fit.add_argument("--out", required=True, help="output directory (created if missing)")
+    fit.add_argument("--out", required=True, help="output directory (created if missing; written whole)")
+    fit.add_argument("--overwrite", action="store_true",
+                     help="replace a non-empty --out folder that is not a previous fit of this data file")
     # --- sweep: coupling/app/sweep.py ---
     sweep = sub.add_parser("sweep", help="run a design sweep of a scene on Dask (see docs/sweeps.md)")
     sweep.add_argument("sweep", help="sweep TOML file: base scene and the parameters to vary")
@@ -82,7 +90,7 @@ def _command(args) -> int:
         if args.command == "fit":
             from coupling.app.fit import fit_command
 
-            return fit_command(args.data, args.out)
+            return fit_command(args.data, args.out, overwrite=args.overwrite)
         if args.command == "sweep":
             from coupling.app.sweep import sweep_command
 

@@ -1,5 +1,5 @@
 """What `switchsim run` does: load a scene (or the default), check the destination, run,
-judge the result's soundness, write the result folder, report.
+write the result folder (the run judges itself: coupling.run), report.
 
 Exit codes (docs/coupling.md, "Outputs"): 0 ok; 1 the run failed (what was computed is
 written, status "failed ..."); 2 bad input or destination (nothing runs, nothing is
@@ -25,15 +25,20 @@ def default_out(scene_path: str | None) -> str:
 def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = False,
                 overwrite: bool = False, check: bool = False, plots: bool = False) -> int:
     from coupling.core.master import CoupledRunError, RunInterrupted, run
-    from coupling.app.output import ResultFolder, scene_identity
+    from coupling.app.output import ResultFolder, project_matplotlib, recover, scene_identity
     from coupling.core.results import RunStatus
     from coupling.core.scene import default_scene, load_scene
 
     scene = default_scene() if scene_path is None else load_scene(scene_path)  # validates before running
     if plots:
         scene = scene.set("output.plots", True)
+    if scene.output.plots:
+        project_matplotlib()
     if out_dir is None:
         out_dir = default_out(scene_path)
+    restored = recover(out_dir)  # a replacement of it killed half-way: the previous result back first
+    if restored:
+        _say(restored)
     folder = ResultFolder.check(out_dir, scene_identity(scene, scene_path), overwrite=overwrite)
     extra = {"scene_file": folder.identity["scene_file"]}
     out = folder.path
@@ -57,6 +62,8 @@ def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = Fa
              f"{out} was left as it was")
         return EXIT_FAILED
     _result_lines(result.summary)
+    for note in folder.notes:
+        _say(note)
     for problem in result.problems:
         _say(f"unsound: {problem}")
     _say(f"status {result.status}; wrote {out}")
@@ -65,16 +72,49 @@ def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = Fa
 
 def plot_command(result_dir: str) -> int:
     """Draw the PNG plots of a result folder into it (each file written whole, by rename)."""
-    from coupling.app.plots import save_plots, stored_result
+    import json
 
+    from coupling.app.output import project_matplotlib, recover
+
+    restored = recover(result_dir)
+    if restored:
+        _say(restored)
     folder = Path(result_dir)
-    if not (folder / "summary.json").is_file():
+    summary = folder / "summary.json"
+    if not summary.is_file():
         _say(f"error: {result_dir!r} holds no summary.json: give a folder that `switchsim run` wrote")
         return EXIT_INPUT
     try:
-        paths = save_plots(stored_result(folder), folder)
+        doc = json.loads(summary.read_bytes())
+    except OSError as err:
+        _say(f"error: {summary}: cannot be read: {err.strerror or err}")
+        return EXIT_INPUT
+    except (ValueError, RecursionError) as err:  # truncated or not JSON
+        _say(f"error: {summary}: not a switchsim summary (not valid JSON: {' '.join(str(err).split())}); "
+             "the result is damaged: run the scene again")
+        return EXIT_INPUT
+    if not isinstance(doc, dict):
+        _say(f"error: {summary}: not a switchsim summary (a JSON {type(doc).__name__}, not an object)")
+        return EXIT_INPUT
+    project_matplotlib()
+    from coupling.app.plots import save_plots, stored_result
+
+    try:
+        stored = stored_result(folder)
+    except OSError as err:
+        _say(f"error: {result_dir}: the result's files cannot be read: {err.strerror or err}")
+        return EXIT_INPUT
+    except Exception as err:  # noqa: BLE001 - a damaged table of the result: one line, not a traceback
+        _say(f"error: {result_dir}: the result's files cannot be read back ({type(err).__name__}: "
+             f"{' '.join(str(err).split())[:200]}); the result is damaged: run the scene again")
+        return EXIT_INPUT
+    try:
+        paths = save_plots(stored, folder)
     except OSError as err:
         _say(f"could not draw into {folder}: {err.strerror or err}")
+        return EXIT_FAILED
+    except Exception as err:  # noqa: BLE001 - a table that reads but cannot be drawn: one line
+        _say(f"could not draw the plots of {folder}: {type(err).__name__}: {' '.join(str(err).split())[:200]}")
         return EXIT_FAILED
     _say(f"wrote {', '.join(p.name for p in paths) or 'no plots (the folder has no waveforms or history)'} "
          f"into {folder}")

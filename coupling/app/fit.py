@@ -73,19 +73,37 @@ def _check_out(out_dir: str) -> Path:
     return out
 
 
-def fit_command(data_path: str, out_dir: str) -> int:
+def fit_command(data_path: str, out_dir: str, *, overwrite: bool = False) -> int:
     """Fit DATA.csv, write DIR/fit.json and the PNG figures, print a summary; returns 0.
 
-    Bad input raises ValueError (or FileNotFoundError) with a one-line message.
+    DIR is written as a run's result folder is (coupling/app/output.py): whole or not at all
+    (an interruption while drawing leaves DIR as it was), a folder holding anything but a
+    fit of the same data file only with ``overwrite``. Bad input raises ValueError (or
+    FileNotFoundError) with a one-line message.
     """
-    out = _check_out(out_dir)  # before the fit: a bad destination fails at once
+    import sys
+
+    from coupling.app.output import ResultFolder, fit_identity, project_matplotlib, recover
+
+    _check_out(out_dir)  # before the fit: a bad destination fails at once
+    restored = recover(out_dir, marker=FIT_JSON)
+    if restored:
+        print(f"switchsim: {restored}", file=sys.stderr)
+    folder = ResultFolder.check(out_dir, fit_identity(data_path), overwrite=overwrite)
     df = read_tribometer_csv(data_path)
     fit = fit_tribometer(df)
-    out.mkdir(parents=True, exist_ok=True)
-    fit.to_json(out / FIT_JSON)
+    project_matplotlib()
     from coupling.app.fit_plots import save_plots  # matplotlib only once the fit is done
 
-    pngs = save_plots(fit, df, out)
+    names: list[str] = []
+
+    def fill(staging: Path) -> None:
+        names.extend(p.name for p in save_plots(fit, df, staging))
+        fit.to_json(staging / FIT_JSON)  # last: a folder with fit.json is a finished fit
+
+    out = folder.publish(fill)
     print(summary(fit))
-    print("wrote " + ", ".join(str(p) for p in [out / FIT_JSON, *pngs]))
+    print("wrote " + ", ".join(str(Path(out_dir) / n) for n in [FIT_JSON, *names]))
+    for note in folder.notes:
+        print(f"switchsim: {note}", file=sys.stderr)
     return 0

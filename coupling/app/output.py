@@ -1,14 +1,22 @@
-"""Writing a run's result folder: complete or not there at all.
+"""Writing a result folder (a run's, a fit's): complete or not there at all.
 
 - The destination is checked before anything runs (``ResultFolder``): an empty name, an
   existing file or device, a folder that cannot be written, the current folder itself,
-  or a non-empty folder that is not a previous result of the same scene (without
-  ``overwrite``) are refused with one line.
+  or a non-empty folder that is not a previous result of the same scene (of the same data
+  file, for a fit) without ``overwrite`` are refused with one line.
 - Everything is written into a fresh hidden folder beside the destination (same parent,
-  same file system), ``summary.json`` last; that folder then takes the destination's place
-  by rename. A previous result there is replaced whole (its old files never mix with the
-  new ones); an interruption or error while writing removes the unfinished folder and
-  leaves the previous result as it was.
+  same file system), ``summary.json`` last; that folder then takes the destination's place:
+  where the destination exists, the two are exchanged in one atomic rename (Linux
+  ``renameat2(RENAME_EXCHANGE)``), so the destination always holds a whole result, the old
+  or the new. A previous result there is replaced whole (its old files never mix with the
+  new ones), except files put into the folder during the run: they are carried over into
+  the new result (one whose name the result also writes makes the run refuse to replace
+  anything, without ``overwrite``). An interruption or error while writing removes the
+  unfinished folder and leaves the previous result as it was.
+- Where the exchange is not available, the previous result is first renamed aside to
+  ``.switchsim-old.<token>.<name>``; a kill between that rename and the next leaves no
+  folder at the destination, and the next ``switchsim run`` or ``switchsim plot`` of it
+  puts the previous result back (``recover``).
 - The mechanics history is thinned (``thin_history``) to ``[output] history_resolution``,
   coarser where ``history_max_rows`` needs it: its size is bounded by that row budget
   plus the events, however many steps the solver took.
@@ -18,18 +26,26 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import errno
+import fcntl
 import itertools
 import json
 import math
 import os
 import re
 import shutil
+import sys
 import tempfile
+import uuid
 from pathlib import Path
 
 import numpy as np
 
 STAGING_PREFIX = ".switchsim-"  # hidden working folders beside the destination
+OLD_PREFIX = ".switchsim-old."  # the previous result set aside, where no atomic exchange exists
+_OLD_NAME = re.compile(r"^\.switchsim-old\.[0-9a-f]{8}\.(.+)$", re.S)
+_STAGING_NAME = re.compile(r"^\.switchsim-(.+)-[a-z0-9_]{8}$", re.S)  # tempfile.mkdtemp's names
+RENAME_EXCHANGE = 2  # linux/fs.h
 
 
 class DestinationError(ValueError):
@@ -42,18 +58,64 @@ def scene_identity(scene, scene_path: str | None) -> dict:
             "scene_file": None if scene_path is None else str(Path(scene_path).resolve())}
 
 
+def fit_identity(data_path: str) -> dict:
+    """What marks a folder as a fit of this data file: its fit.json names the same file."""
+    return {"marker": "fit.json", "data_file": str(Path(data_path).resolve()), "what": "a fit of this data file"}
+
+
 def previous_result_of(folder: Path, identity: dict) -> bool:
     """True if ``folder`` holds a switchsim result (summary.json with a status) of the same
-    scene (same scene file; for the built-in default scene, the same name)."""
+    scene (same scene file; for the built-in default scene, the same name), or for a fit's
+    identity a fit.json of the same data file."""
+    marker = identity.get("marker", "summary.json")
     try:
-        summary = json.loads((folder / "summary.json").read_text())
-    except (OSError, ValueError):
+        doc = json.loads((folder / marker).read_text())
+    except (OSError, ValueError, RecursionError):
         return False
-    if not isinstance(summary, dict) or "status" not in summary:
+    if not isinstance(doc, dict):
         return False
-    if identity["scene_file"] is not None or summary.get("scene_file") is not None:
-        return summary.get("scene_file") == identity["scene_file"]
-    return summary.get("scene") == identity["scene"]
+    if marker == "fit.json":
+        source = doc.get("source")
+        try:
+            return isinstance(source, str) and str(Path(source).resolve()) == identity["data_file"]
+        except (OSError, RuntimeError, ValueError):
+            return False
+    if "status" not in doc:
+        return False
+    if identity["scene_file"] is not None or doc.get("scene_file") is not None:
+        return doc.get("scene_file") == identity["scene_file"]
+    return doc.get("scene") == identity["scene"]
+
+
+def recover(out: str, marker: str = "summary.json") -> str | None:
+    """What a killed replacement of ``out`` left (see the module docstring): with no folder
+    at ``out`` and the previous result set aside beside it, that result is put back. Hidden
+    working folders of a killed run are named, never deleted (after a kill right after the
+    exchange one may hold files put into the folder during that run). Returns the lines to
+    show, or None."""
+    if not isinstance(out, str) or not out.strip():
+        return None
+    try:
+        path = Path(out).expanduser().absolute()
+        if not path.parent.is_dir():
+            return None
+        siblings = list(path.parent.iterdir())
+        aside = sorted((p for p in siblings
+                        if (m := _OLD_NAME.match(p.name)) and m.group(1) == path.name
+                        and p.is_dir() and not p.is_symlink() and (p / marker).is_file()),
+                       key=lambda p: p.stat().st_mtime)
+        lines = []
+        if aside and not (path.exists() or path.is_symlink()):
+            os.rename(aside.pop(), path)
+            lines.append(f"restored {out}: a replacement of it was interrupted and had set its previous result aside")
+        left = aside + [p for p in siblings if (m := _STAGING_NAME.match(p.name)) and m.group(1) == path.name
+                        and p.is_dir() and not p.is_symlink() and not _in_use(p)]
+        if left:
+            lines.append(f"{', '.join(sorted(p.name for p in left))} beside {out}: left by a run that was killed; "
+                         "delete it when you no longer need it")
+        return "; ".join(lines) or None
+    except OSError:  # a place that cannot be listed: the destination's own check says so
+        return None
 
 
 @dataclasses.dataclass
@@ -63,6 +125,8 @@ class ResultFolder:
     path: Path
     identity: dict
     overwrite: bool = False
+    before: frozenset | None = None  # the names in the folder when it was checked (None: no folder)
+    notes: list = dataclasses.field(default_factory=list)  # what the swap left for the user to know
 
     @classmethod
     def check(cls, out: str, identity: dict, *, overwrite: bool = False) -> "ResultFolder":
@@ -96,9 +160,9 @@ class ResultFolder:
             if any(path.iterdir()):
                 if not previous_result_of(path, identity):
                     if not overwrite:
-                        raise DestinationError(
-                            f"{where} holds files that are not a switchsim result of this scene; "
-                            "give another --out, or --overwrite to replace the folder whole")
+                        what = identity.get("what", "a switchsim result of this scene")
+                        raise DestinationError(f"{where} holds files that are not {what}; give another --out, "
+                                               "or --overwrite to replace the folder whole")
                     if any(p.is_dir() and not p.is_symlink() for p in path.iterdir()):
                         raise DestinationError(
                             f"{where} holds sub-folders (switchsim never writes any): it is not a result "
@@ -113,33 +177,178 @@ class ResultFolder:
         except OSError as err:
             raise DestinationError(f"{where}: cannot create a folder in {str(parent)!r}: "
                                    f"{err.strerror or err}") from None
-        return cls(path=path.absolute(), identity=identity, overwrite=overwrite)
+        before = frozenset(os.listdir(path)) if path.is_dir() else None
+        return cls(path=path.absolute(), identity=identity, overwrite=overwrite, before=before)
 
     def write(self, result, summary_extra: dict | None = None) -> Path:
         """Write ``result`` (a CoupledResult) and put it in place; returns the folder."""
+        return self.publish(lambda staging: write_files(result, staging, summary_extra))
+
+    def publish(self, fill) -> Path:
+        """``fill(folder)`` writes the files into a fresh hidden folder, which then takes the
+        destination's place (module docstring); returns the destination."""
         staging = Path(tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}{self.path.name}-", dir=self.path.parent))
+        new = staging.stat().st_ino  # which folder is the new result, whichever name it has now
+        held = _hold(staging)  # tells `recover` the folder is in use; released when this process ends
         try:
             _make_public(staging)
-            write_files(result, staging, summary_extra)
-            self._swap(staging)
+            fill(staging)
+            old = self._swap(staging)
         except BaseException:
-            shutil.rmtree(staging, ignore_errors=True)
+            if _inode(self.path) == new:  # interrupted after the exchange: staging is the previous result
+                self._finish(staging)
+            else:
+                shutil.rmtree(staging, ignore_errors=True)
             raise
+        finally:
+            os.close(held)
+        if old is not None:
+            self._finish(old)
         return self.path
 
-    def _swap(self, staging: Path) -> None:
-        if not (self.path.exists() or self.path.is_symlink()):
-            os.rename(staging, self.path)
-            return
-        old = Path(tempfile.mkdtemp(prefix=f"{STAGING_PREFIX}old-{self.path.name}-", dir=self.path.parent))
-        os.rmdir(old)
-        os.rename(self.path, old)
+    def _finish(self, old: Path) -> None:
+        kept = self._carry_over(old)
+        if kept:
+            self.notes.append(f"{', '.join(sorted(kept))} appeared in {self.path} as the result was put in "
+                              f"place; kept in {old}")
+        else:
+            shutil.rmtree(old, ignore_errors=True)
+
+    def _swap(self, staging: Path) -> Path | None:
+        """Put ``staging`` at the destination; returns the folder now holding the previous
+        result (to carry over and delete), or None. Raises before anything moved."""
+        path = self.path
+        if not (path.exists() or path.is_symlink()):
+            try:
+                os.rename(staging, path)
+                return None
+            except OSError as err:  # the folder appeared during the run
+                if not (path.exists() or path.is_symlink()):
+                    raise
+        if path.is_symlink() or not path.is_dir():
+            raise DestinationError(f"--out {str(path)!r} became a file or a link during the run; nothing was "
+                                   "replaced")
+        added = set(os.listdir(path)) - (self.before or frozenset())
+        clash = added & set(os.listdir(staging))
+        if clash and not self.overwrite:
+            raise DestinationError(
+                f"--out {str(path)!r}: {', '.join(sorted(clash))} appeared there during the run and the result "
+                "would replace it; nothing was replaced: move it away and run again (or --overwrite)")
+        if _exchange(staging, path):
+            return staging  # now the previous result
+        old = path.parent / f"{OLD_PREFIX}{uuid.uuid4().hex[:8]}.{path.name}"
+        os.rename(path, old)
         try:
-            os.rename(staging, self.path)
+            os.rename(staging, path)
         except BaseException:
-            os.rename(old, self.path)  # put the previous result back
+            os.rename(old, path)  # put the previous result back
             raise
-        shutil.rmtree(old, ignore_errors=True)
+        return old
+
+    def _carry_over(self, old: Path) -> set:
+        """Move the files put into the folder during the run from the previous result into
+        the new one; returns those left behind (the new result has a file of that name,
+        which only ``overwrite`` lets win)."""
+        kept = set()
+        for name in set(os.listdir(old)) - (self.before or frozenset()):
+            target = self.path / name
+            if target.exists() or target.is_symlink():
+                if not self.overwrite:
+                    kept.add(name)
+                continue
+            try:
+                os.rename(old / name, target)
+            except OSError:
+                kept.add(name)
+        return kept
+
+
+def _hold(folder: Path) -> int:
+    """An open descriptor of ``folder`` holding an exclusive flock on it (close it to release)."""
+    fd = os.open(folder, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        pass  # a file system without flock: `recover` then sees the folder as left over, which it only reports
+    return fd
+
+
+def _in_use(folder: Path) -> bool:
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        return False
+    except OSError:
+        return True
+    finally:
+        os.close(fd)  # closing releases a lock taken here
+
+
+def _inode(path: Path) -> int | None:
+    try:
+        return path.stat().st_ino
+    except OSError:
+        return None
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two folders in one atomic rename (Linux renameat2 RENAME_EXCHANGE); False where
+    the system or the file system has no such rename (nothing moved then)."""
+    global _RENAMEAT2
+    if _RENAMEAT2 is None:
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            fn = libc.renameat2
+            fn.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p, ctypes.c_uint]
+            fn.restype = ctypes.c_int
+            _RENAMEAT2 = (fn, ctypes)
+        except (OSError, AttributeError):  # not glibc >= 2.28 (or not Linux)
+            _RENAMEAT2 = False
+    if not _RENAMEAT2:
+        return False
+    fn, ctypes = _RENAMEAT2
+    at_fdcwd = -100
+    if fn(at_fdcwd, os.fsencode(a), at_fdcwd, os.fsencode(b), RENAME_EXCHANGE) == 0:
+        return True
+    code = ctypes.get_errno()
+    if code in (errno.EINVAL, errno.ENOSYS, errno.ENOTSUP, errno.EOPNOTSUPP):
+        return False  # e.g. a file system without the exchange: the two-rename route
+    raise OSError(code, os.strerror(code), str(b))
+
+
+_RENAMEAT2 = None  # (renameat2, ctypes) once looked up, False where there is none
+
+
+def project_matplotlib() -> None:
+    """Import matplotlib with its own default settings, whatever the working folder holds.
+
+    matplotlib reads ``./matplotlibrc`` first when it is imported: a file there changed the
+    plots or broke them (``text.usetex: True`` without LaTeX is a traceback at the first
+    label), and a FIFO of that name would block the import. The working folder is
+    untrusted (docs/circuit.md), so matplotlib is imported from an empty private folder and
+    its settings are then reset to the package's defaults (which also drops a user-wide
+    matplotlibrc). Called by the command line before it draws."""
+    if "matplotlib" not in sys.modules:
+        try:
+            here = os.getcwd()
+        except OSError:  # the working folder was removed: nothing there to read
+            here = None
+        with tempfile.TemporaryDirectory(prefix="switchsim-mpl-") as empty:
+            if here is not None:
+                os.chdir(empty)
+            try:
+                import matplotlib  # noqa: F401
+            finally:
+                if here is not None:
+                    os.chdir(here)
+    import matplotlib
+
+    matplotlib.rcdefaults()
 
 
 def write_files(result, folder: Path, summary_extra: dict | None = None) -> None:

@@ -8,10 +8,12 @@ scene key, as ``Scene.set`` takes them), built from one design:
 - ``random`` / ``lhs``: ``samples`` seeded draws (uniform, or Latin hypercube through
   scipy.stats.qmc) inside [low, high] per parameter, log-uniform with ``log = true``.
 
-Every run's scene is built and validated in the client before anything starts. Runs go
-to dask.distributed workers (a LocalCluster of process workers, one thread each, by
-default; an existing scheduler by address): a worker process imports once and runs
-scene after scene, never two at once (one ngspice per process). As each run finishes the
+Every run's scene is built and validated in the client before anything starts (and the
+design's size, MAX_RUNS, before it is built). Runs go to dask.distributed workers (a
+LocalCluster of process workers, one thread each, on loopback with TLS credentials of its
+own, by default; an existing scheduler by address): a worker process imports once and
+runs scene after scene, never two at once (one ngspice per process); a worker whose
+ngspice ended its session is restarted before it runs another. As each run finishes the
 client appends its row (run_id, name, the parameters, every scalar of summary.json
 flattened with dots, status, error, wall_time, session) to a Parquet dataset, one file
 per small batch under ``OUT/results/``, each written whole (temporary file, then rename):
@@ -21,9 +23,10 @@ per small batch under ``OUT/results/``, each written whole (temporary file, then
 A failed run is a row with status "failed" and its error; it never stops the sweep. The
 client keeps only a bounded window of runs in flight and no waveforms (a run's waveforms,
 on request, are written by the worker to ``OUT/waveforms/<run_id>.parquet``), so its
-memory does not grow with the sweep. ``resume=True`` runs only the runs without a row:
-after Ctrl-C, a killed worker (Dask reruns its run elsewhere) or a killed client, nothing
-finished is redone and nothing is lost or written twice. ``OUT`` must be reachable from
+memory does not grow with the sweep. ``resume=True`` runs the runs without a row and
+reruns the failed ones (their rows replaced): after Ctrl-C, a killed worker (Dask reruns
+its run elsewhere) or a killed client, nothing finished is redone and nothing is lost or
+written twice; one invocation at a time holds the folder (a lock on OUT/.sweep.lock). ``OUT`` must be reachable from
 the client (rows) and, for waveforms, from the workers (a shared file system).
 
 Sweep file (TOML, SI units)::
@@ -70,6 +73,20 @@ _SWEEP_KEYS = {"scene", "design", "samples", "seed", "waveforms", "set", "grid",
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,99}$")
 RESERVED = ("run_id", "name", "status", "error", "wall_time", "session", "finished_at")
 
+#: Most runs one sweep may hold: counted before the design is built (a 1e10 grid took
+#: 5.6 GB before it failed); every run's scene is checked before anything runs, ~0.3 ms
+#: each for the default scene, so this many take about 30 s. Split a larger study.
+MAX_RUNS = 100_000
+#: Largest sweep file, bytes (checked before it is read).
+MAX_SWEEP_FILE_BYTES = 16_000_000
+#: How long `--scheduler` waits for a Dask scheduler to answer, s.
+SCHEDULER_TIMEOUT = 5.0
+#: Waveform columns of a coupled run besides the circuit's (circuit.COLUMNS) and the
+#: scene's [circuit] probes: the contact force and penetration per tip, the arc's gap, mu.
+COUPLED_COLUMNS = ("normal_force_0", "penetration_0", "normal_force_1", "penetration_1", "normal_force", "gap", "mu")
+#: Times a run is resubmitted because it found its worker's ngspice ended before it started.
+_MAX_RETRIES = 3
+
 
 # --- the design ------------------------------------------------------------------------
 
@@ -96,6 +113,7 @@ class Sweep:
     base_name: str = "scene"
     waveforms: bool | tuple[str, ...] = False
     common: dict = dataclasses.field(default_factory=dict)
+    checked: bool = dataclasses.field(default=False, init=False, compare=False, repr=False)  # set by check()
 
     # constructors ----------------------------------------------------------------------
     @classmethod
@@ -105,7 +123,9 @@ class Sweep:
         keys = list(values)
         for key in keys:
             if not isinstance(values[key], (list, tuple)) or not values[key]:
-                raise ValueError(f"sweep grid {key!r} = {values[key]!r}: expected a non-empty list of values")
+                raise ValueError(f"sweep grid {key!r} = {values[key]!r:.200}: expected a non-empty list of values")
+        sizes = [len(values[key]) for key in keys]
+        _check_size(math.prod(sizes), f"sweep grid: {' x '.join(map(str, sizes))} values")
         combos: list[dict] = [{}]
         for key in keys:
             combos = [dict(c, **{key: v}) for c in combos for v in values[key]]
@@ -115,7 +135,8 @@ class Sweep:
     def cases(cls, base, cases: list, **kw) -> "Sweep":
         """Runs given one by one: dicts of "section.key" values, each with an optional "name"."""
         if not isinstance(cases, (list, tuple)) or not cases:
-            raise ValueError(f"sweep cases = {cases!r}: expected a non-empty list of tables")
+            raise ValueError(f"sweep cases = {cases!r:.200}: expected a non-empty list of tables")
+        _check_size(len(cases), "sweep cases")
         out = []
         for k, case in enumerate(cases):
             if not isinstance(case, dict):
@@ -134,6 +155,7 @@ class Sweep:
             raise ValueError(f"sweep design = {method!r}: allowed values are 'lhs', 'random'")
         if not isinstance(samples, int) or isinstance(samples, bool) or samples < 1:
             raise ValueError(f"sweep samples = {samples!r}: expected an integer >= 1")
+        _check_size(samples, "sweep samples")
         if not isinstance(seed, int) or isinstance(seed, bool):
             raise ValueError(f"sweep seed = {seed!r}: expected an integer")
         ranges = _flatten_keys(ranges, leaf=lambda v: isinstance(v, dict) and "low" in v)
@@ -203,12 +225,23 @@ class Sweep:
         return scene_from_dict(self.document(run), base_dir=self.base_dir, name=f"{self.base_name} [{run.run_id}]")
 
     def check(self) -> None:
-        """Build every run's scene: a bad key or value is reported, naming the run, before anything runs."""
+        """Build every run's scene: a bad key or value is reported, naming the run, before
+        anything runs; so is a ``waveforms`` column no run records (with a did-you-mean)."""
+        columns: set[str] = set()
         for run in self.runs:
             try:
-                self.scene(run)
-            except ValueError as err:
+                scene = self.scene(run)
+            except (ValueError, FileNotFoundError) as err:
                 raise ValueError(f"sweep run {run.run_id} ({_describe(run.params)}): {err}") from None
+            columns.update(_waveform_columns(scene))
+        if isinstance(self.waveforms, tuple):
+            from mech.validation import suggest
+
+            for column in self.waveforms:
+                if column not in columns:
+                    raise ValueError(f"sweep waveforms: unknown column {column!r}{suggest(column, columns)}; "
+                                     f"the runs record: {', '.join(sorted(columns)) or 'none (no circuit)'}")
+        object.__setattr__(self, "checked", True)
 
     def fingerprint(self) -> str:
         """A hash of what the sweep computes (base, common values, runs, waveforms): a resume
@@ -273,6 +306,22 @@ def _range(key: str, spec) -> tuple[str, float, float, bool]:
     return key, float(spec[0]), float(spec[1]), log
 
 
+def _check_size(runs: int, what: str) -> None:
+    if runs > MAX_RUNS:
+        raise ValueError(f"{what} make {runs} runs, more than the {MAX_RUNS} one sweep may hold "
+                         "(coupling.app.sweep.MAX_RUNS): split the study into several sweeps")
+
+
+def _waveform_columns(scene) -> tuple[str, ...]:
+    """The waveform columns a run of ``scene`` records (none without a circuit)."""
+    if scene.circuit is None:
+        return ()
+    from circuit import COLUMNS
+
+    probes = tuple(p.text for p in scene.circuit.probes)
+    return COLUMNS + (COUPLED_COLUMNS if scene.kind == "coupled" else ()) + probes
+
+
 def _waveforms_option(value) -> bool | tuple[str, ...]:
     if isinstance(value, bool):
         return value
@@ -285,13 +334,46 @@ def _describe(params: dict) -> str:
     return ", ".join(f"{k} = {v!r}" for k, v in params.items()) or "base scene"
 
 
-def load_sweep(path) -> Sweep:
-    """Read and validate a sweep TOML file (see the module docstring); every run's scene is checked."""
-    path = Path(path)
+def _read_sweep_file(path) -> dict:
+    """The TOML document of a sweep file, checked as any input file is: a regular file (not
+    a folder, device or pipe, which are never opened), at most MAX_SWEEP_FILE_BYTES, UTF-8
+    text (line and column of the first bad byte), valid TOML; one line otherwise."""
+    from mech.validation import check_file
+
+    path = check_file("sweep file", path)
     try:
-        doc = tomllib.loads(path.read_text())
+        size = path.stat().st_size
+        if size > MAX_SWEEP_FILE_BYTES:
+            raise ValueError(f"sweep file {str(path)!r} is {size} bytes, more than the {MAX_SWEEP_FILE_BYTES} "
+                             "a sweep file may have")
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_SWEEP_FILE_BYTES + 1)
+    except OSError as err:
+        raise ValueError(f"sweep file {str(path)!r} cannot be read: {err.strerror or err}") from None
+    if len(data) > MAX_SWEEP_FILE_BYTES:
+        raise ValueError(f"sweep file {str(path)!r} grew beyond the {MAX_SWEEP_FILE_BYTES} bytes a sweep file may "
+                         "have while it was read")
+    if data.startswith(b"\xef\xbb\xbf"):
+        data = data[3:]
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        line = data.count(b"\n", 0, err.start) + 1
+        column = err.start - (data.rfind(b"\n", 0, err.start) + 1) + 1
+        raise ValueError(f"{path}: line {line}, column {column}: byte 0x{data[err.start]:02x} is not UTF-8 text; "
+                         "save the sweep file as UTF-8") from None
+    try:
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise ValueError(f"{path}: not valid TOML: {err}") from None
+    except RecursionError:
+        raise ValueError(f"{path}: arrays or inline tables nested too deeply") from None
+
+
+def load_sweep(path) -> Sweep:
+    """Read and validate a sweep TOML file (see the module docstring); every run's scene is checked."""
+    doc = _read_sweep_file(path)
+    path = Path(path)
     table = doc.get("sweep")
     if not isinstance(table, dict) or set(doc) != {"sweep"}:
         raise ValueError(f"{path}: expected one [sweep] table (with scene, design and the design's values); "
@@ -380,6 +462,11 @@ def execute(sweep_doc: dict, run_doc: dict, wave_dir: str | None) -> dict:
     summary = None
     status, error = "ok", None
     with _RUN_LOCK:
+        worker = _worker_address()
+        if worker is not None and _ngspice_exited():
+            # an earlier run here ended ngspice: this process cannot run a circuit; the client
+            # restarts the worker and submits the run again
+            return {**row, "_retry": worker}
         try:
             doc = apply_changes(sweep_doc["base"], {**sweep_doc["common"], **params})
             scene = scene_from_dict(doc, base_dir=sweep_doc["base_dir"], name=f"{sweep_doc['base_name']} "
@@ -407,7 +494,33 @@ def execute(sweep_doc: dict, run_doc: dict, wave_dir: str | None) -> dict:
                 continue
             row[f"summary.{key}" if key in row or key in RESERVED else key] = value
     row.update(status=status, error=error, wall_time=time.perf_counter() - tick)
+    if worker is not None and _ngspice_exited():
+        row["_restart"] = worker  # this run ended ngspice ("cannot recover"): the worker needs a new process
     return row
+
+
+def _worker_address() -> str | None:
+    """The Dask worker this runs in, or None (run_sweep_inline)."""
+    if "distributed" not in sys.modules:
+        return None
+    from distributed import get_worker
+
+    try:
+        return get_worker().address
+    except ValueError:  # not in a worker
+        return None
+
+
+def _ngspice_exited() -> bool:
+    """True when this process's ngspice has ended its session (only a new process has one)."""
+    if "circuit.ngspice" not in sys.modules:
+        return False  # no circuit ran here
+    from circuit.ngspice import get_session
+
+    try:
+        return get_session().exited
+    except Exception:  # noqa: BLE001 - no ngspice to be had at all: the runs say why themselves
+        return False
 
 
 def _one_line(err) -> str:
@@ -448,12 +561,39 @@ def read_results(out_dir, columns: list[str] | None = None):
 
 def finished_run_ids(out_dir) -> set[str]:
     """run_id of every run with a row (reads that one column only)."""
+    return set(_row_statuses(Path(out_dir)))
+
+
+def _row_statuses(out: Path) -> dict[str, str]:
+    """run_id -> status of every row (two columns read)."""
     import pyarrow.parquet as pq
 
-    done: set[str] = set()
-    for f in _result_files(Path(out_dir)):
-        done.update(pq.read_table(f, columns=["run_id"]).column("run_id").to_pylist())
-    return done
+    statuses: dict[str, str] = {}
+    for f in _result_files(out):
+        table = pq.read_table(f, columns=["run_id", "status"])
+        statuses.update(zip(table.column("run_id").to_pylist(), table.column("status").to_pylist()))
+    return statuses
+
+
+def _drop_rows(out: Path, run_ids: set[str]) -> None:
+    """Remove the rows of ``run_ids`` from the batch files (each rewritten whole, by rename;
+    a batch left empty is deleted): a rerun's row then replaces them, never joins them."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+    import pyarrow.parquet as pq
+
+    for f in _result_files(out):
+        table = pq.read_table(f)
+        keep = pc.invert(pc.is_in(table.column("run_id"), value_set=pa.array(sorted(run_ids))))
+        if pc.all(keep).as_py():
+            continue
+        kept = table.filter(keep)
+        if kept.num_rows == 0:
+            f.unlink()
+            continue
+        tmp = f.with_name(f".{f.name}.{uuid.uuid4().hex}.tmp")
+        pq.write_table(kept, tmp)
+        os.replace(tmp, f)
 
 
 def read_waveforms(out_dir, run_id: str):
@@ -510,6 +650,7 @@ class SweepReport:
     run_seconds: float = 0.0
     interrupted: bool = False
     out_dir: str = ""
+    rerun: int = 0  # runs that had a failed row and were run again (resume)
 
     @property
     def complete(self) -> bool:
@@ -553,11 +694,70 @@ def default_workers() -> int:
         return max(1, os.cpu_count() or 1)
 
 
-def _manifest(sweep: Sweep, out: Path, resume: bool) -> None:
+def _sweep_folder(out_dir) -> Path:
+    """The --out folder, created if missing; one line for a file, a device or no permission."""
+    if not isinstance(out_dir, (str, os.PathLike)) or not str(out_dir).strip():
+        raise ValueError(f"--out {out_dir!r}: give the name of a folder for the sweep's results")
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        kind = "a file" if out.is_file() else "not a folder (a device or special file)"
+        raise ValueError(f"--out {str(out_dir)!r} is {kind}; give a folder name")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise ValueError(f"--out {str(out_dir)!r}: cannot create the folder: {err.strerror or err}") from None
+    return out
+
+
+class _FolderLock:
+    """An exclusive lock on a sweep folder for one invocation (flock on OUT/.sweep.lock, let
+    go by the system when the process ends, however it ends): two invocations on the same
+    folder would both run the runs without a row, and write them twice."""
+
+    def __init__(self, out: Path):
+        self.path = out / ".sweep.lock"
+        self.fd: int | None = None
+
+    def __enter__(self) -> "_FolderLock":
+        import fcntl
+
+        try:
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+        except OSError as err:
+            raise ValueError(f"--out {str(self.path.parent)!r}: cannot write there: {err.strerror or err}") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            holder = os.read(fd, 64).decode("ascii", "replace").strip() or "another process"
+            os.close(fd)
+            raise ValueError(f"{self.path.parent} is in use by another sweep (process {holder}): "
+                             "wait for it to finish, or use another --out") from None
+        os.ftruncate(fd, 0)
+        os.write(fd, str(os.getpid()).encode())
+        self.fd = fd
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self.fd is not None:
+            os.close(self.fd)  # releases the lock; the empty file stays (harmless)
+            self.fd = None
+
+
+def _manifest(sweep: Sweep, out: Path, resume: bool, write: bool = True) -> None:
+    """Write OUT/sweep.json for a new sweep (``write``); for one with rows already, check it
+    is the same sweep and that --resume was asked for. A folder without rows (a sweep that
+    never got to run: its cluster did not start, it was stopped at once) starts over."""
     path = out / "sweep.json"
     fingerprint = sweep.fingerprint()
-    if path.is_file():
-        old = json.loads(path.read_text())
+    has_rows = bool(_result_files(out))
+    if path.is_file() and has_rows:
+        try:
+            old = json.loads(path.read_bytes())
+            if not isinstance(old, dict):
+                raise ValueError(f"a JSON {type(old).__name__}, not an object")
+        except (OSError, ValueError, RecursionError) as err:
+            raise ValueError(f"{path}: damaged, not the record of a sweep ({' '.join(str(err).split())[:120]}): "
+                             "the rows in its results/ cannot be matched to a sweep; choose another --out") from None
         if not resume:
             raise ValueError(f"{out} already holds a sweep: pass --resume (resume=True) to continue it, "
                              "or choose another --out")
@@ -565,8 +765,10 @@ def _manifest(sweep: Sweep, out: Path, resume: bool) -> None:
             raise ValueError(f"{out} holds a different sweep (fingerprint {old.get('fingerprint')}, this one "
                              f"{fingerprint}): the base scene, values or runs changed; choose another --out")
         return
-    if _result_files(out):
+    if has_rows:
         raise ValueError(f"{out}/results holds results without sweep.json: choose another --out")
+    if not write:
+        return
     doc = dict(fingerprint=fingerprint, base_name=sweep.base_name, base_dir=sweep.base_dir, base=sweep.base,
                common=sweep.common, waveforms=sweep.waveforms, parameters=sweep.parameters,
                runs=[dataclasses.asdict(r) for r in sweep.runs])
@@ -590,30 +792,153 @@ WORKER_SETTINGS = {
 
 def local_cluster(workers: int, **kw):
     """A dask LocalCluster for sweeps: `workers` processes with one thread each (one ngspice
-    per process), no dashboard, and WORKER_SETTINGS (no profiler, no aggressive malloc trim)."""
+    per process), no dashboard, WORKER_SETTINGS (no profiler, no aggressive malloc trim),
+    listening on loopback only and with Dask's own security: TLS with credentials made for
+    this cluster alone (``Security.temporary()``, mutual: a process without them can neither
+    connect to the scheduler nor to a worker or nanny, so none can run code in the workers).
+    ``Client(cluster)`` takes the credentials from the cluster."""
     import dask
     from distributed import LocalCluster
+    from distributed.security import Security
 
+    kw.setdefault("security", Security.temporary())
+    kw.setdefault("protocol", "tls://")
+    kw.setdefault("host", "127.0.0.1")
     with dask.config.set(WORKER_SETTINGS):
         return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
                             silence_logs=40, **kw)
 
 
+def _refuse_in_a_worker_start() -> None:
+    """A script without ``if __name__ == "__main__":`` is imported again by every worker
+    process the local cluster starts (multiprocessing's spawn runs the main module as
+    ``__mp_main__``), and so calls run_sweep again there: stop that worker at once with
+    the fix, instead of a cluster that never starts."""
+    # while spawn re-runs the script, it is sys.modules["__mp_main__"] but not yet "__main__"
+    if "__mp_main__" in sys.modules and sys.modules["__mp_main__"] is not sys.modules.get("__main__"):
+        raise SystemExit(f"switchsim sweep: {_GUARD_HINT}")
+
+
+_GUARD_HINT = ("a Dask worker process imported the script that calls run_sweep and ran it again: put the sweep "
+               "under `if __name__ == \"__main__\":` (docs/sweeps.md, Python)")
+
+
+def _scheduler_client(scheduler: str):
+    """A Client of the Dask scheduler at ``scheduler``, or one line within SCHEDULER_TIMEOUT.
+
+    The address is parsed and its port tried with a plain socket first: a Client that fails
+    to connect is left half-built in a reference cycle, and when the garbage collector
+    later ends it from another thread its close() can deadlock the next Client's start
+    (seen in one process: a sweep with a wrong --scheduler, then a good one)."""
+    import gc
+    import socket
+
+    from distributed import Client
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    if not isinstance(scheduler, str):
+        raise ValueError(f"--scheduler {scheduler!r}: expected an address, e.g. tcp://127.0.0.1:8786")
+    try:
+        scheme, location = parse_address(scheduler)
+        host, port = parse_host_port(location) if scheme in ("tcp", "tls") else (None, None)
+    except (ValueError, TypeError) as err:
+        raise ValueError(f"--scheduler {scheduler!r}: not a Dask scheduler address ({_one_line(err)[:160]}); "
+                         "e.g. tcp://127.0.0.1:8786") from None
+    unreachable = None
+    if host is not None:
+        try:
+            socket.create_connection((host, port), timeout=SCHEDULER_TIMEOUT).close()
+        except OSError as err:
+            unreachable = f"{type(err).__name__}: {err.strerror or err}"
+    if unreachable is None and scheme == "tcp":
+        unreachable = _ask_identity(scheduler)
+    if unreachable is None:
+        try:
+            return Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT}s")
+        except (OSError, TimeoutError, ValueError, TypeError) as err:
+            unreachable = f"{type(err).__name__}: {_one_line(err)[:160]}"
+        gc.collect()  # the failed Client ends here, in this thread (see above)
+    raise ValueError(f"--scheduler {scheduler!r}: no Dask scheduler answered within {SCHEDULER_TIMEOUT:g} s "
+                     f"({unreachable}); start one (`dask scheduler`) or check the address")
+
+
+def _ask_identity(address: str) -> str | None:
+    """None if a Dask scheduler at ``address`` says who it is within SCHEDULER_TIMEOUT, else
+    why not: a port that accepts connections and says nothing would hold a Client's start
+    for as long as it stays open (Dask's connect timeout ends at the TCP connection)."""
+    import asyncio
+
+    from distributed.core import rpc
+
+    try:
+        asyncio.get_running_loop()
+        return None  # called from a running event loop (a notebook): the Client's own checks only
+    except RuntimeError:
+        pass
+
+    async def identity():
+        async with rpc(address, timeout=SCHEDULER_TIMEOUT) as remote:
+            return await remote.identity()
+
+    try:
+        info = asyncio.run(asyncio.wait_for(identity(), SCHEDULER_TIMEOUT))
+    except (OSError, asyncio.TimeoutError, TimeoutError):
+        return "the port takes connections but no Dask scheduler speaks there"
+    except Exception as err:  # noqa: BLE001 - anything else that answered: not a scheduler
+        return f"{type(err).__name__}: {_one_line(err)[:120]}"
+    kind = info.get("type") if isinstance(info, dict) else None
+    return None if kind == "Scheduler" else f"a Dask {kind or 'process'} answers there, not a scheduler"
+
+
+def _start_local(n: int):
+    """A local cluster of ``n`` workers and its client; one line saying why if it cannot start."""
+    from distributed import Client
+
+    try:
+        cluster = local_cluster(n)
+    except Exception as err:  # noqa: BLE001 - Dask reports a worker that died at start in several ways
+        main = sys.modules.get("__main__")
+        hint = (f"; if run_sweep is called from a script: {_GUARD_HINT}" if getattr(main, "__spec__", None) is None
+                and getattr(main, "__file__", None) else "")
+        raise RuntimeError(f"the local Dask cluster did not start ({type(err).__name__}: "
+                           f"{_one_line(err)[:160]}){hint}") from None
+    try:
+        return cluster, Client(cluster)
+    except BaseException:
+        cluster.close()
+        raise
+
+
 def run_sweep(sweep: Sweep, out_dir, *, workers: int | None = None, scheduler: str | None = None,
               client=None, resume: bool = False, progress: bool = True, window: int | None = None) -> SweepReport:
-    """Run every run of ``sweep`` without a row in OUT/results, on Dask; rows appended as runs finish.
+    """Run every run of ``sweep`` without a row in OUT/results (or with a failed one, on
+    resume), on Dask; rows appended as runs finish.
 
     workers: worker processes of the local cluster (default: the machine's CPUs);
     scheduler: address of an existing Dask scheduler ("tcp://host:8786") instead of a local
     cluster; client: a distributed.Client to use as it is (left open); resume: continue a
-    sweep already in out_dir; window: runs in flight at once (default 2 per worker). Ctrl-C stops cleanly: what finished is kept (``interrupted``).
+    sweep already in out_dir, failed runs included; window: runs in flight at once (default
+    2 per worker). Ctrl-C stops cleanly: what finished is kept (``interrupted``). One
+    invocation at a time per out_dir (a second one is refused). A worker whose ngspice
+    ended ("cannot recover") is restarted before it runs anything else.
     """
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    _manifest(sweep, out, resume)
-    done_ids = finished_run_ids(out) if resume else set()
-    todo = [r for r in sweep.runs if r.run_id not in done_ids]
-    report = SweepReport(total=len(sweep.runs), skipped=len(sweep.runs) - len(todo), out_dir=str(out))
+    _refuse_in_a_worker_start()
+    if workers is not None and (not isinstance(workers, int) or isinstance(workers, bool) or workers < 1):
+        raise ValueError(f"workers = {workers!r}: expected an integer >= 1")
+    if not sweep.checked:
+        sweep.check()
+    out = _sweep_folder(out_dir)
+    with _FolderLock(out):
+        return _run_locked(sweep, out, workers, scheduler, client, resume, progress, window)
+
+
+def _run_locked(sweep, out: Path, workers, scheduler, client, resume, progress, window) -> SweepReport:
+    _manifest(sweep, out, resume, write=False)  # a folder holding another sweep: refused before any cluster
+    statuses = _row_statuses(out) if resume else {}
+    failed_before = {run_id for run_id, status in statuses.items() if status == "failed"}
+    todo = [r for r in sweep.runs if r.run_id not in statuses or r.run_id in failed_before]
+    report = SweepReport(total=len(sweep.runs), skipped=len(sweep.runs) - len(todo), out_dir=str(out),
+                         rerun=len(failed_before & {r.run_id for r in sweep.runs}))
     line = _ProgressLine(report.total, report.skipped, progress)
     if not todo:
         line(0, 0, final=True)
@@ -623,32 +948,41 @@ def run_sweep(sweep: Sweep, out_dir, *, workers: int | None = None, scheduler: s
         wave_dir = out / "waveforms"
         wave_dir.mkdir(exist_ok=True)
         wave_dir = str(wave_dir.resolve())
-    if workers is not None and (not isinstance(workers, int) or workers < 1):
-        raise ValueError(f"workers = {workers!r}: expected an integer >= 1")
-    from distributed import Client, as_completed
+    from distributed import as_completed
 
     tick = time.monotonic()
     session = f"{time.strftime('%Y%m%dT%H%M%S')}-{uuid.uuid4().hex[:6]}"
-    writer = RowWriter(out / "results", session)
     sweep_doc = dict(base=sweep.base, base_dir=str(Path(sweep.base_dir).resolve()), base_name=sweep.base_name,
                      common=sweep.common, waveforms=sweep.waveforms)
     cluster = None
     own_client = client is None
     started = None
+    writer = None
     try:
         if not own_client:
             n = max(1, len(client.scheduler_info().get("workers", {})))
         elif scheduler is not None:
-            client = Client(scheduler, timeout="30s")
+            client = _scheduler_client(scheduler)
             n = max(1, len(client.scheduler_info().get("workers", {})))
         else:
             n = workers or default_workers()
-            cluster = local_cluster(n)
-            client = Client(cluster)
+            cluster, client = _start_local(n)
+        _manifest(sweep, out, resume)
+        if progress:  # only now: bad input before this point is one line and nothing else
+            print(f"switchsim sweep: {len(sweep.runs)} runs of {sweep.base_name}, varying "
+                  f"{', '.join(sweep.parameters) or 'nothing'}", file=sys.stderr)
+            if report.rerun:
+                print(f"switchsim sweep: rerunning {report.rerun} failed run(s); their rows are replaced",
+                      file=sys.stderr)
+        if failed_before:
+            _drop_rows(out, failed_before)  # only now: a sweep that could not start keeps its rows as they were
+        writer = RowWriter(out / "results", session)
         line.start = started = time.monotonic()  # the rate counts runs, not the cluster's start
         pending = iter(todo)
         in_flight = as_completed()
         runs_of: dict = {}
+        retries: dict[str, int] = {}
+        restarted: set[str] = set()
 
         def submit(run: Run) -> None:
             future = _submit(client, sweep_doc, run, wave_dir)
@@ -665,6 +999,18 @@ def run_sweep(sweep: Sweep, out_dir, *, workers: int | None = None, scheduler: s
                 row = {"run_id": run.run_id, "name": run.name, **{k: _cell(v) for k, v in run.params.items()},
                        "status": "failed", "error": f"{type(err).__name__}: {_one_line(err)}", "wall_time": None}
             future.release()
+            dead = row.pop("_restart", None) or row.get("_retry")
+            if dead is not None and dead not in restarted:
+                restarted.add(dead)
+                _restart_worker(client, dead, run, progress)
+            if row.get("_retry"):  # it never ran: its worker's ngspice had ended before it started
+                retries[run.run_id] = retries.get(run.run_id, 0) + 1
+                if retries[run.run_id] <= _MAX_RETRIES:
+                    submit(run)
+                    continue
+                row = {"run_id": run.run_id, "name": run.name, **{k: _cell(v) for k, v in run.params.items()},
+                       "status": "failed", "error": "every worker it was sent to had lost its ngspice "
+                                                    "(restarting them failed)", "wall_time": None}
             row.update(session=session, finished_at=time.time())
             writer.add(row)
             report.done += 1
@@ -675,10 +1021,12 @@ def run_sweep(sweep: Sweep, out_dir, *, workers: int | None = None, scheduler: s
     except KeyboardInterrupt:
         report.interrupted = True
     finally:
-        writer.flush()
+        if writer is not None:
+            writer.flush()
         report.seconds = time.monotonic() - tick
         report.run_seconds = time.monotonic() - started if started is not None else 0.0
-        line(report.done, report.failed, final=True)
+        if started is not None:
+            line(report.done, report.failed, final=True)
         for closable in ((client, cluster) if own_client else ()):
             if closable is not None:
                 try:
@@ -686,6 +1034,18 @@ def run_sweep(sweep: Sweep, out_dir, *, workers: int | None = None, scheduler: s
                 except (Exception, KeyboardInterrupt):  # noqa: BLE001 - after Ctrl-C or a lost scheduler
                     report.interrupted = True  # best effort; the rows are already written
     return report
+
+
+def _restart_worker(client, address: str, run: Run, progress: bool) -> None:
+    """Give the worker at ``address`` a new process (its nanny starts one; ngspice cannot be
+    restarted inside a process). A worker without a nanny is removed from the cluster."""
+    try:
+        outcome = client.restart_workers([address], timeout=120, raise_for_error=False).get(address, "gone")
+    except Exception as err:  # noqa: BLE001 - the sweep goes on with the other workers
+        outcome = f"{type(err).__name__}: {_one_line(err)}"
+    if progress:
+        print(f"switchsim sweep: run {run.run_id} ended ngspice in its worker; worker restarted ({outcome})",
+              file=sys.stderr)
 
 
 def _take(iterator, n: int) -> list:
@@ -713,24 +1073,31 @@ def run_sweep_inline(sweep: Sweep) -> list[dict]:
 
 def sweep_command(path: str, out_dir: str, *, workers: int | None = None, scheduler: str | None = None,
                   resume: bool = False, quiet: bool = False) -> int:
-    """`switchsim sweep SWEEP.toml --out DIR`: 0 when every run has a row, 1 if some failed,
-    130 when interrupted (continue with --resume)."""
+    """`switchsim sweep SWEEP.toml --out DIR`: 0 when every run has a row, 1 if some failed
+    (or the cluster could not start), 130 when interrupted (continue with --resume); bad
+    input (the sweep file, --out, --scheduler, a folder in use) raises ValueError: one line, 2."""
     try:
         sweep = load_sweep(path)
-        if not quiet:
-            print(f"switchsim sweep: {len(sweep.runs)} runs of {sweep.base_name}, varying "
-                  f"{', '.join(sweep.parameters) or 'nothing'}", file=sys.stderr)
         report = run_sweep(sweep, out_dir, workers=workers, scheduler=scheduler, resume=resume, progress=not quiet)
     except KeyboardInterrupt:  # before the runs started, or a second Ctrl-C while stopping
         print(f"switchsim sweep: interrupted; the rows written are in {out_dir}/results; continue with --resume",
               file=sys.stderr)
         return 130
+    except RuntimeError as err:  # the local cluster did not start
+        print(f"switchsim sweep: {_one_line(err)}", file=sys.stderr)
+        return 1
+    except (ValueError, FileNotFoundError):
+        raise  # bad input: the command line's one line and exit 2
+    except Exception as err:  # noqa: BLE001 - e.g. the scheduler went away mid-sweep
+        print(f"switchsim sweep: stopped ({type(err).__name__}: {_one_line(err)[:200]}); the rows written are in "
+              f"{out_dir}/results; continue with --resume", file=sys.stderr)
+        return 1
     if report.interrupted:
         print(f"switchsim sweep: interrupted; {report.skipped + report.done} of {report.total} runs have rows in "
               f"{out_dir}/results; continue with --resume", file=sys.stderr)
         return 130
     if not quiet:
-        print(f"switchsim sweep: {report.done} run(s) now, {report.skipped} already done, {report.failed} failed, "
-              f"{report.seconds:.1f} s; results in {out_dir}/results (coupling.app.sweep.read_results)",
-              file=sys.stderr)
+        print(f"switchsim sweep: {report.done} run(s) now ({report.rerun} of them failed before), "
+              f"{report.skipped} already done, {report.failed} failed, {report.seconds:.1f} s; results in "
+              f"{out_dir}/results (coupling.app.sweep.read_results)", file=sys.stderr)
     return 1 if report.failed else 0

@@ -346,6 +346,13 @@ def run(scene: Scene, *, progress: bool = False, check: bool = False) -> Coupled
     the result (``CoupledResult.judge``: ok or unsound). check: also rerun it refined and
     write summary.accuracy (coupling/app/accuracy.py). A failed or interrupted run raises
     CoupledRunError or RunInterrupted with what it computed (status failed or interrupted)."""
+    if not isinstance(scene, Scene):
+        hint = f"load_scene({str(scene)!r})" if isinstance(scene, str) or hasattr(scene, "__fspath__") else \
+            "load_scene('scene.toml'), default_scene() or scene_from_dict(document)"
+        raise TypeError(f"run() takes a Scene, got {type(scene).__name__} {scene!r:.60}: {hint} first")
+    for name, value in (("progress", progress), ("check", check)):
+        if not isinstance(value, bool):
+            raise TypeError(f"run({name}={value!r:.60}): pass True or False")
     if check:
         from coupling.app.accuracy import run_checked
 

@@ -718,6 +718,11 @@ def _rebuild_scene(raw: dict, base_dir: str, name: str) -> Scene:
 
 def load_scene(path) -> Scene:
     """Read and validate a scene TOML file (SI units; paths inside are relative to it)."""
+    if isinstance(path, Scene):
+        raise TypeError("load_scene() takes the path of a scene TOML file; this is already a Scene: pass it to run()")
+    if not (isinstance(path, str) or hasattr(path, "__fspath__")):
+        raise TypeError(f"load_scene() takes the path of a scene TOML file (str or pathlib.Path), got "
+                        f"{type(path).__name__} {path!r:.60}; the built-in scene is default_scene()")
     path = Path(path)
     return scene_from_dict(read_toml(path), base_dir=path.parent, name=str(path))
 

@@ -87,6 +87,21 @@ def test_history_resolution_is_validated(tmp_path):
     assert "output.history_resolution = -1e-05" in line and ">= 0" in line
 
 
+@pytest.mark.parametrize("value", ["[" * 5000 + "]" * 5000, "{a = " * 2000 + "1" + "}" * 2000],
+                         ids=["5000 nested arrays", "2000 nested inline tables"])
+def test_deeply_nested_values_are_one_line_not_a_recursion_traceback(tmp_path, value):
+    """tomllib parses nested arrays and inline tables recursively: past Python's stack this
+    was a RecursionError traceback; the Python API says the same line."""
+    from coupling.core.scene import load_scene
+
+    scene = tmp_path / "deep.toml"
+    scene.write_text(f"[bar]\nlength = {value}\n")
+    line = assert_one_line_error(*run_cli(["run", str(scene), "--out", str(tmp_path / "o")]))
+    assert line == f"switchsim: error: {scene}: arrays or inline tables nested too deeply (a scene needs a few levels)"
+    with pytest.raises(ValueError, match="nested too deeply"):
+        load_scene(scene)
+
+
 # --- generated bad documents -------------------------------------------------------------
 
 def toml_str(s: str) -> str:

@@ -23,6 +23,7 @@ pytest.importorskip("distributed")
 psutil = pytest.importorskip("psutil")
 
 from coupling.app.sweep import finished_run_ids, read_results  # noqa: E402
+from dask_cli_cluster import dask_cli_cluster  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 RUNS = 10
@@ -58,15 +59,12 @@ def _write(tmp_path: Path) -> Path:
 
 
 @pytest.fixture(scope="module")
-def scheduler():
-    """One Dask cluster (a worker process with its nanny) shared by the sweeps of this module
-    through --scheduler: the worker imports once. (The local-cluster path, `--workers`, is
-    the same `local_cluster` the example test runs.)"""
-    env = {"PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
-    from coupling.app.sweep import local_cluster
-
-    with local_cluster(1, env=env) as cluster:
-        yield cluster.scheduler_address
+def scheduler(tmp_path_factory):
+    """One Dask cluster shared by the sweeps of this module through --scheduler, started as a
+    user starts one (`dask scheduler`, one `dask worker`): the worker imports once. (The
+    local cluster, `--workers`, is tested in test_sweep_cluster.py.)"""
+    with dask_cli_cluster(tmp_path_factory.mktemp("dask"), workers=1) as (address, _, _):
+        yield address
 
 
 def _start(sweep: Path, out: Path, *extra: str) -> subprocess.Popen:
