@@ -351,24 +351,51 @@ def project_matplotlib() -> None:
     matplotlib.rcdefaults()
 
 
-def write_files(result, folder: Path, summary_extra: dict | None = None) -> None:
-    """Write all of a result's files into ``folder``, summary.json last."""
-    scene = result.scene
-    opts = scene.output
-    # the result writes its own tables and plots; the history is written thinned, here
-    view = dataclasses.replace(result, scene=dataclasses.replace(
-        scene, output=dataclasses.replace(opts, history=False)))
-    summary = view.write_tables(folder)
-    if result.mechanics is not None and opts.history:
-        t = result.mechanics.t
-        interval = opts.history_interval(float(t[-1] - t[0]) if len(t) else 0.0)
-        kept = thin_history(result.mechanics, interval)
-        from coupling.core.results import REGIME_NAMES
+def save_result(result, out_dir, *, overwrite: bool = False, scene_path: str | None = None) -> Path:
+    """``CoupledResult.save``: the result folder checked and written as the command line does."""
+    folder = ResultFolder.check(str(out_dir), scene_identity(result.scene, scene_path), overwrite=overwrite)
+    return folder.write(result)
 
-        write_csv(folder / "history.csv", thin_result(result.mechanics, kept).history_columns,
-                  codes={"regime_0": REGIME_NAMES, "regime_1": REGIME_NAMES})
-        summary["history"] = {"file": "history.csv", "resolution": interval,
-                              "rows": int(len(kept)), "solver_records": int(len(t))}
+
+def write_files(result, folder: Path, summary_extra: dict | None = None) -> None:
+    """Write all of a result's files into ``folder``, summary.json last: the waveforms (CSV,
+    parquet, the interactive waveforms.html), openings.csv, the mechanics tables (history.csv
+    thinned to ``[output] history_resolution``) and PNG plots, as the scene's [output] asks.
+    The one writer of result folders: ``switchsim run`` and ``CoupledResult.save``."""
+    from coupling.core.results import REGIME_NAMES, event_columns
+
+    opts = result.scene.output
+    summary = result.summary
+    if result.waveform_columns is not None:
+        if getattr(opts, "html", True):
+            from coupling.app.waveview import write_waveform_html
+
+            html = write_waveform_html(result, folder / "waveforms.html")
+            summary["waveforms_html"] = "waveforms.html" if html == "written" else html
+        waves = result.waveform_columns
+        if opts.csv:
+            write_csv(folder / "waveforms.csv", waves)
+        if opts.parquet:
+            write_parquet(folder / "waveforms.parquet", waves)
+        if result.scene.circuit is not None:
+            write_csv(folder / "openings.csv", result.opening_columns)
+    m = result.mechanics
+    if m is not None:
+        if opts.history:
+            t = m.t
+            interval = opts.history_interval(float(t[-1] - t[0]) if len(t) else 0.0)
+            kept = thin_history(m, interval)
+            write_csv(folder / "history.csv", thin_result(m, kept).history_columns,
+                      codes={"regime_0": REGIME_NAMES, "regime_1": REGIME_NAMES})
+            summary["history"] = {"file": "history.csv", "resolution": interval,
+                                  "rows": int(len(kept)), "solver_records": int(len(t))}
+        write_csv(folder / "contacts.csv", m.contact_columns)
+        write_csv(folder / "phases.csv", m.phase_columns)
+        write_csv(folder / "events.csv", event_columns(m.events))
+    if opts.plots:
+        from coupling.app.plots import save_plots
+
+        save_plots(result, folder)
     summary.update(summary_extra or {})
     _write_text(folder / "summary.json", json.dumps(_jsonable(summary), indent=2))
 

@@ -10,7 +10,6 @@ coupling.core.diagnostics.
 from __future__ import annotations
 
 import enum
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -234,48 +233,14 @@ class CoupledResult:
             out["accuracy"] = _jsonable(self.accuracy)
         return out
 
-    def save(self, out_dir) -> Path:
-        """Write the waveforms (CSV, parquet, the interactive waveforms.html), openings.csv,
-        the mechanics tables and PNG plots, as the scene's [output] asks, then summary.json."""
-        out = Path(out_dir)
-        summary = self.write_tables(out)
-        (out / "summary.json").write_text(json.dumps(summary, indent=2))
-        return out
+    def save(self, out_dir, *, overwrite: bool = False) -> Path:
+        """Write the result folder ``out_dir`` as ``switchsim run --out`` does, by the same
+        writer (coupling.app.output; imported here, when called: results are made in the core,
+        folders written by the application): whole or not at all, summary.json last; a folder
+        holding other files is refused unless ``overwrite`` (then replaced whole). Returns it."""
+        from coupling.app.output import save_result
 
-    def write_tables(self, out: Path) -> dict:
-        """Every file of ``save`` but summary.json, into the folder ``out`` (made if missing);
-        returns the summary with what the writing found (``waveforms_html``)."""
-        from coupling.app.output import write_csv, write_parquet
-
-        out.mkdir(parents=True, exist_ok=True)
-        opts = self.scene.output
-        summary = self.summary
-        if self.waveform_columns is not None and getattr(opts, "html", True):
-            from coupling.app.waveview import write_waveform_html
-
-            html = write_waveform_html(self, out / "waveforms.html")
-            summary["waveforms_html"] = "waveforms.html" if html == "written" else html
-        if self.waveform_columns is not None:
-            waves = self.waveform_columns
-            if opts.csv:
-                write_csv(out / "waveforms.csv", waves)
-            if opts.parquet:
-                write_parquet(out / "waveforms.parquet", waves)
-            if self.scene.circuit is not None:
-                write_csv(out / "openings.csv", self.opening_columns)
-        m = self.mechanics
-        if m is not None:
-            if opts.history:
-                write_csv(out / "history.csv", m.history_columns, codes={"regime_0": REGIME_NAMES,
-                                                                         "regime_1": REGIME_NAMES})
-            write_csv(out / "contacts.csv", m.contact_columns)
-            write_csv(out / "phases.csv", m.phase_columns)
-            write_csv(out / "events.csv", event_columns(m.events))
-        if opts.plots:
-            from coupling.app.plots import save_plots
-
-            save_plots(self, out)
-        return summary
+        return save_result(self, out_dir, overwrite=overwrite)
 
 
 def event_columns(events: list[dict]) -> dict:

@@ -134,3 +134,32 @@ def test_parquet_and_csv_hold_the_same_values(tmp_path):
             assert np.array_equal(back.view(np.uint64), stored[ok].view(np.uint64))
         else:
             assert [int(c) for c in from_csv] == stored.tolist()
+
+
+def test_the_api_and_the_command_line_write_the_same_folder(tmp_path):
+    """One writer: result.save and `switchsim run` give the same files, history.csv thinned
+    alike (the API wrote every solver record before), and save refuses a folder of other
+    files as the command line does."""
+    import pytest
+
+    from coupling import default_scene, run
+    from coupling.app.cli import main
+    from coupling.app.output import DestinationError
+
+    from coupling.core.scene import default_scene_text
+
+    scene = default_scene().set("solver.t_end", 1e-3)
+    path = tmp_path / "s.toml"
+    path.write_text(default_scene_text().replace("t_end = 0.005", "t_end = 0.001"))
+    assert main(["run", str(path), "--out", str(tmp_path / "cli"), "--quiet"]) == 0
+    run(scene).save(tmp_path / "api")
+    names = sorted(p.name for p in (tmp_path / "cli").iterdir())
+    assert names == sorted(p.name for p in (tmp_path / "api").iterdir())
+    cli = (tmp_path / "cli" / "history.csv").read_text().splitlines()
+    api = (tmp_path / "api" / "history.csv").read_text().splitlines()
+    assert len(cli) == len(api) and cli[0] == api[0]
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("keep me")
+    with pytest.raises(DestinationError, match="holds files that are not"):
+        run(scene).save(tmp_path / "mine")
+    assert (tmp_path / "mine" / "notes.txt").read_text() == "keep me"
