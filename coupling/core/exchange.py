@@ -109,6 +109,12 @@ class ContactLink:
         """N^gamma: the friction coefficient at the loop current (A)."""
         return float(self.laws.mu(current)) if self.feedback else float(self.laws.mu(0.0))
 
+    def drives(self, mech, mu_start: float, mu_end: float) -> dict:
+        """The mechanics' drives this link sets over a step: ``mu.<i>`` of each of its contact
+        points the model has (N^gamma, at the step's start and end)."""
+        names = mech.drive_names
+        return {f"mu.{i}": (mu_start, mu_end) for i in self.points if f"mu.{i}" in names}
+
     # -- into the circuit --
 
     def inputs(self, seg, touching_at_start, gap_wanted: bool) -> dict:

@@ -250,7 +250,7 @@ class CoSimulation:
         # being redone there with the current extrapolated to that end: the mechanics stop
         # at it (instead of integrating the bounces beyond and returning to it).
         in_flight = cp is not None and not np.any(touching)
-        seg = mech.advance(t_next, mu=(mu0, link.mu(current_at(t_next))), stop_at_switch=in_flight)
+        seg = mech.advance(t_next, link.drives(mech, mu0, link.mu(current_at(t_next))), stop_at_switch=in_flight)
         switching = [e["time"] for e in seg.events if e["kind"] in CONTACT_EVENTS]
         aligned = False
         if cp is not None and switching:
@@ -264,7 +264,7 @@ class CoSimulation:
                 # stopped flight step is redone in full)
                 t_next = t_next if end is None else end
                 mech.restore(cp)
-                seg = mech.advance(t_next, mu=(mu0, link.mu(current_at(t_next))))
+                seg = mech.advance(t_next, link.drives(mech, mu0, link.mu(current_at(t_next))))
                 self.stats["aligned_steps"] += int(end is not None)
                 switching = [e["time"] for e in seg.events if e["kind"] in CONTACT_EVENTS]
                 aligned = end is not None
@@ -287,7 +287,7 @@ class CoSimulation:
         mu = link.mu(i_now)
         inputs = link.held_inputs(mech.contact_now(), stepper.uses_gap)
         tick = time.perf_counter()
-        mech.advance(t_next, mu=mu)
+        mech.advance(t_next, link.drives(mech, mu, mu))
         self.stats["mech_seconds"] += time.perf_counter() - tick
         link.mu_log.append((t, t_next, mu, mu))
         tick = time.perf_counter()
