@@ -74,6 +74,31 @@ def warm_up() -> None:
                                                           else 0.2 for name in names})
         segment.tip_forces(0.5 * (segment.t_start + segment.t_end))
         driven.result().energy_table  # noqa: B018
+    # the armature: alone (a bar-less model) with a gain table, and driving a clamped
+    # blade through its card; its dense output, history table and events
+    armature = dict(kind="plunger", mass=0.02, travel=1e-3, stop_stiffness=1e9, stop_damping=20.0,
+                    spring_rate=100.0, spring_preload=0.1, damping=0.01)
+    alone = {"armature": dict(armature, force_gain=dict(position=[0.0, 5e-4, 1e-3], gain=[1.0, 1.5, 3.0])),
+             "solver": dict(t_end=5e-3)}
+    card = {"bar": dict(length=0.02, width=0.003, thickness=0.0003, tip_radius=0.0016,
+                        modes={"axial": 1, "bending": 3}, **steel),
+            "mount": dict(kind="clamp", position=0.02), "rivet": [dict(position=0.0015, radius=0.0015)],
+            "armature": dict(armature, card_position=0.01, card_lever=1.0, card_free_travel=2e-4,
+                             card_stiffness=1e5, card_damping=0.1),
+            "initial": dict(height=2e-4), "contact": dict(reference_speed=0.5), "solver": dict(t_end=4e-3)}
+    for doc in (alone, card):
+        solver = ImpactSolver(scene_from_dict(doc), keep_dense=True)
+        t_end = doc["solver"]["t_end"]
+        segment = solver.advance(0.5 * t_end, {"armature.force": (0.0, 3.0)})
+        t = 0.5 * (segment.t_start + segment.t_end)
+        segment.armature(t)
+        segment.tip_forces(t)
+        segment.contact(t)
+        solver.armature_now()
+        solver.advance(t_end, {"armature.force": 3.0})
+        result = solver.result()
+        result.history_columns  # noqa: B018  (the compiled armature table)
+        result.energy_table  # noqa: B018
     calibrate_damping("hunt_crossley", 0.7, 1.0, 1e10, 0.01)
 
 

@@ -25,8 +25,9 @@ from . import aot
 # module of its numba source
 ENTRY_POINTS = {
     "dense_contact": "integrator", "dense_eval": "integrator", "dense_tip_forces": "integrator",
-    "events_from_aux": "integrator", "integrate": "integrator", "dynamics": "kernel", "energies": "kernel",
+    "event_values": "integrator", "integrate": "integrator", "dynamics": "kernel", "energies": "kernel",
     "energy_table": "kernel", "make_work": "kernel", "project_to_stick": "kernel", "scaled_rebound": "kernel",
+    "armature_table": "kernel", "armature_force": "kernel",
 }
 
 

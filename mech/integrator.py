@@ -19,7 +19,8 @@ from .jit import njit
 from .kernel import (
     A_FN, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_COMPRESSION, EV_CONTACT, EV_SLIP, EV_STICK,
     C_C, C_K, C_ON, C_R, F_BETA, F_BLOCK_Z, F_VBOUND, F_VREG, FRICTION_EXACT, I_FRICTION, I_N, I_PLANAR, NEV_TIP, SLIP, STICK,
-    dynamics, normal_force, tip_offset, unpack,
+    AP_HMAX, AP_TRAVEL, EA_CARD, EA_POLE, EA_REST, EA_SEAT, EA_TURN, I_ARMATURE, I_ARM_CARD, I_MOUNT, MOUNT_NONE,
+    NEV, arm_offset, armature_force, card_penetration, dynamics, load_point_motion, normal_force, tip_offset, unpack,
 )
 from .friction import REVERSAL_DEADBAND
 from .kernel_layout import (  # noqa: F401  (re-exported: the integrator's status codes)
@@ -59,8 +60,60 @@ def _dense_coefficients(y, ynew, h, k1, k3, k4, k5, k6, k7, coef):
 
 
 @njit(cache=True)
+def event_values(t, y, aux, eref, mdl, g):
+    """Event function values into g (NEV) at t (s): the contact points' (events_from_aux) from
+    a dynamics evaluation's aux, then the armature's from the state y (armature_events)."""
+    events_from_aux(aux, eref, mdl, g)
+    armature_events(t, y, mdl, g)
+
+
+@njit(cache=True)
+def armature_events(t, y, mdl, g):
+    """The armature's event functions into g[2 NEV_TIP:], each positive while open (1 where the
+    model has none of it, never crossing): the rest stop q, the pole stop travel - q
+    (-1 while seated on it: held closed), the card's gap to the bar (m); while a stop is
+    closed and the armature not seated, its speed (a turn); while seated, the force
+    pressing it onto its stop (kernel.armature_force)."""
+    ipar = mdl[1]
+    base = 2 * NEV_TIP
+    for k in range(base, NEV):
+        g[k] = 1.0
+    if ipar[I_ARMATURE] == 0:
+        return
+    n = ipar[I_N]
+    planar = ipar[I_PLANAR]
+    off = arm_offset(n, planar, ipar[I_MOUNT])
+    apar = mdl[14]  # (kernel.dynamics: the model tuple's order)
+    closed = mdl[16]
+    qa = y[off]
+    seated = closed[EA_SEAT] != 0.0
+    g[base + EA_REST] = -1.0 if seated and closed[EA_REST] != 0.0 else qa
+    g[base + EA_POLE] = -1.0 if seated and closed[EA_POLE] != 0.0 else apar[AP_TRAVEL] - qa
+    if seated:
+        f = armature_force(t, y, mdl)
+        g[base + EA_SEAT] = f if closed[EA_POLE] != 0.0 else -f
+    elif closed[EA_REST] != 0.0 or closed[EA_POLE] != 0.0:
+        g[base + EA_TURN] = y[off + 1]
+    pc = ipar[I_ARM_CARD]
+    if pc >= 0:
+        r = np.empty(3)
+        R = np.empty((3, 3))
+        q = np.empty(n)
+        V = np.empty(3)
+        w = np.empty(3)
+        eta = np.empty(n)
+        x = np.empty(3)
+        v = np.empty(3)
+        unpack(y, n, planar, r, R, q, V, w, eta)
+        load_point_motion(pc, mdl[8], mdl[6], r, R, q, V, w, eta, n, x, v)
+        pen, _ = card_penetration(qa, y[off + 1], x[2], v[2], apar)
+        g[base + EA_CARD] = -pen
+
+
+@njit(cache=True)
 def events_from_aux(aux, eref, mdl, g):
-    """Event function values (see kernel.event_values) from a dynamics evaluation's aux."""
+    """The contact points' event function values into g[:2 NEV_TIP] from a dynamics
+    evaluation's aux."""
     beta = mdl[0][F_BETA]
     vres = mdl[0][F_VREG]
     cpar = mdl[9]
@@ -82,6 +135,8 @@ def events_from_aux(aux, eref, mdl, g):
 @njit(cache=True)
 def _active(k, g_old, g_new, regime, fmodel):
     """Whether event k is watched in a step with end values g_old, g_new."""
+    if k >= 2 * NEV_TIP:
+        return True  # the armature's: its stops and card, always (constant where absent)
     i = k // NEV_TIP
     kind = k % NEV_TIP
     if kind == EV_CONTACT:
@@ -142,9 +197,11 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
     rec_t, rec_y, rec_aux, rec_fmax = rec
     dense_t0, dense_h, dense_coef = dense
     N = y.shape[0]
-    nev = 2 * NEV_TIP
+    nev = NEV
     fpar = mdl[0]
     fmodel = mdl[1][I_FRICTION]
+    arm = mdl[1][I_ARMATURE] != 0
+    aclosed = mdl[16]
     k1 = np.empty(N)
     k2 = np.empty(N)
     k3 = np.empty(N)
@@ -168,7 +225,7 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
 
     dynamics(t, y, mdl, regime, eref, k1, aux_old, work)
     stats[2] += 1
-    events_from_aux(aux_old, eref, mdl, g_old)
+    event_values(t, y, aux_old, eref, mdl, g_old)
     if h <= 0.0:  # initial step from the derivative scale (Hairer's heuristic, simplified)
         d0 = 0.0
         d1 = 0.0
@@ -199,6 +256,13 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
         hcap = hmax
         if gap > 0.0 and 0.5 * gap / fpar[F_VBOUND] > hmax:
             hcap = 0.5 * gap / fpar[F_VBOUND]
+        if arm and aclosed[EA_SEAT] == 0.0 and (
+                aclosed[EA_REST] != 0.0 or aclosed[EA_POLE] != 0.0 or aclosed[EA_CARD] != 0.0):
+            # an armature's stop or card closed: within the explicit method's accurate range
+            # (beyond |lambda h| ~ 1 its steps amplify the contact's ringing, which the error
+            # estimate then holds only at ~100 times the tolerance)
+            if hcap > mdl[14][AP_HMAX]:
+                hcap = mdl[14][AP_HMAX]
         if h > hcap:
             h = hcap
         last = False
@@ -240,7 +304,7 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
             continue
         # accepted: events
         facold = max(err, 1e-4)
-        events_from_aux(aux_new, eref, mdl, g_new)
+        event_values(t + h, ynew, aux_new, eref, mdl, g_new)
         _dense_coefficients(y, ynew, h, k1, k3, k4, k5, k6, k7, coef)
         first_k = -1
         h_continue = h
@@ -268,7 +332,7 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
                 dense_eval(coef, tc, ymid)
                 dynamics(t + tc * h, ymid, mdl, regime, eref, ytmp, aux_stage, work)
                 stats[2] += 1
-                events_from_aux(aux_stage, eref, mdl, g_mid)
+                event_values(t + tc * h, ymid, aux_stage, eref, mdl, g_mid)
                 gc = g_mid[k]
                 if s * gc > 0.0:
                     a = tc
@@ -310,7 +374,7 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
                     _rk_stages(t, y, trial * h, k1, k2, k3, k4, k5, k6, k7, ytmp, ymid, mdl,
                                regime, eref, aux_stage, aux_new, work)
                     stats[2] += 6
-                    events_from_aux(aux_new, eref, mdl, g_mid)
+                    event_values(t + trial * h, ymid, aux_new, eref, mdl, g_mid)
                     gt = g_mid[first_k]
                     if s_ev * gt < 0.0:
                         hi = trial
@@ -461,6 +525,13 @@ def tip_forces(y, mdl, out):
     kinematics alone (the normal force follows the penetration and its rate; no
     accelerations, so a fraction of a right-hand side's cost)."""
     fpar, ipar, psi, xc, cpar = mdl[0], mdl[1], mdl[6], mdl[8], mdl[9]
+    if ipar[I_MOUNT] == MOUNT_NONE:  # no bar: no contact point
+        out[0] = 0.0
+        out[1] = 0.0
+        out[2] = 1e300
+        out[3] = -1e3
+        out[4] = -1e3
+        return
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
     r = np.empty(3)

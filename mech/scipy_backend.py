@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .compiled import dynamics, events_from_aux
+from .compiled import dynamics, event_values
 from .kernel_layout import (
     A_FN, A_Y, A_YDOT, D_VALUE, DONE, EV_CLIP, EV_COMPRESSION, EV_SLIP, EV_STICK, EVENT, FREE, FRICTION_EXACT,
-    I_FRICTION, NAUX, NEV_TIP, NOT_FINITE, SLIP, STICK,
+    I_FRICTION, NAUX, NEV, NEV_TIP, NOT_FINITE, SLIP, STICK,
 )
 
 from .stepping import Outcome
@@ -52,7 +52,7 @@ def scipy_segment(solver, t_target: float, method: str):
     rec = solver.recorder
     aux = np.empty((2, NAUX))
     aux_mid = np.empty((2, NAUX))
-    g = np.empty(2 * NEV_TIP)
+    g = np.empty(NEV)
     N = m.state_size
     counter = {"nfev": 0}
     coupled = solver.coupled
@@ -73,7 +73,8 @@ def scipy_segment(solver, t_target: float, method: str):
     fexact = m.ipar[I_FRICTION] == FRICTION_EXACT
 
     def make_event(k):
-        i, kind = divmod(k, NEV_TIP)
+        # the contact points' events (tip i, kind), then the armature's (always watched)
+        i, kind = divmod(k, NEV_TIP) if k < 2 * NEV_TIP else (-1, -1)
         seen = {}  # t -> value at the last few times asked (see below)
 
         def ev(t, y):
@@ -98,7 +99,7 @@ def scipy_segment(solver, t_target: float, method: str):
                 drive[mu_rows, D_VALUE] = coupled.friction_coefficient(t, y[N:])
             dynamics(t, y[:N], arrays, regime, eref, dy, aux, work)
             counter_events["nfev"] += 1
-            events_from_aux(aux, eref, arrays, g)
+            event_values(t, y[:N], aux, eref, arrays, g)
             if kind == EV_SLIP and not (fexact and regime[i] == SLIP):
                 return solver.ev_sign[k]
             if kind == EV_STICK and not (fexact and regime[i] == STICK):
@@ -122,7 +123,7 @@ def scipy_segment(solver, t_target: float, method: str):
         return ev
 
     t_start = solver.t
-    events = [make_event(k) for k in range(2 * NEV_TIP)]
+    events = [make_event(k) for k in range(NEV)]
     rtol = solver.scene.solver.rtol
     # solve_ivp's error test is |err| <= atol + rtol |y| for every component, so positions
     # also get a relative share (the compiled loop holds them to atol alone): the baseline

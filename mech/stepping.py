@@ -10,7 +10,7 @@ the same right-hand side, events and history rows; only how the steps are taken 
   LSODA), the independent routes of the tests and the accuracy study.
 
 The integration state a stepper reads: ``t`` (s), ``h`` (s, the step in use; 0 to choose),
-``regime``, ``eref``, ``model``, ``arrays`` (``model.kernel_arrays(drive)``), ``drive``,
+``regime``, ``eref``, ``model``, ``arrays`` (``model.kernel_arrays(drive, armature_closed)``), ``drive``,
 ``coupled`` (None or mech.solver.CoupledStates), ``work`` (kernel scratch), ``scene``; what
 it writes: ``y`` (and ``z``, the coupled extra states) in place to the state at the end,
 ``ev_sign``, ``stats`` (accumulated), the rows from ``recorder.n`` on (not committed: the
