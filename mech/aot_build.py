@@ -20,6 +20,7 @@ from numba.core import types  # (the build child loads numba anyway: it compiles
 from . import compiled as jit
 from .aot import FORCE_JIT, MODULE, SIGNATURES
 from .damping_calibration import calibrate_damping
+from .kernel_layout import NAUX
 from .scene import scene_from_dict
 from .solver import ImpactSolver
 
@@ -62,6 +63,7 @@ def warm_up() -> None:
         solver.contact_series(np.linspace(segment.t_start, solver.t, 5))
         result = solver.result()
         result.energy_table  # noqa: B018  (the compiled energy table)
+        jit.energies(solver.y, solver.arrays, solver.work, np.empty(5), solver.arm)  # (as a hold calls it)
         result.contacts  # noqa: B018  (dense contact evaluation where the solver asks for it)
         if k == 0:  # the scipy backends hand the right-hand side views of their own arrays
             for method in ("RK45", "Radau", "BDF", "LSODA"):
@@ -96,24 +98,34 @@ def warm_up() -> None:
         segment.contact(t)
         solver.armature_now()
         solver.advance(t_end, {"armature.force": 3.0})
+        solver.contact_series(np.linspace(0.0, t_end, 5))
         result = solver.result()
         result.history_columns  # noqa: B018  (the compiled armature table)
         result.energy_table  # noqa: B018
+        # the stick projection with an armature (reached only when a contact of such a
+        # model comes to rest: called here directly)
+        jit.project_to_stick(solver.t, solver.y.copy(), solver.arrays, solver.regime, solver.eref,
+                             np.empty((2, NAUX)), solver.work, solver.arm)
     calibrate_damping("hunt_crossley", 0.7, 1.0, 1e10, 0.01)
 
 
 def signatures() -> dict:
-    """name -> numba Signature of each entry point as the warm-up compiled it; a function
-    compiled for array arguments of several layouts is exported for any layout ('A')."""
+    """export name -> numba Signature of each entry point as the warm-up compiled it; a
+    function compiled for array arguments of several layouts is exported for any layout
+    ('A'). A VARIANTS entry point is exported twice: for its last argument None (a model
+    without an armature) under its name, for the armature's arrays as "<name>_armature"."""
     out = {}
     for name in jit.ENTRY_POINTS:
         sigs = getattr(jit, name).nopython_signatures
-        if not sigs:
-            raise RuntimeError(f"the warm-up never called {name}: add a model that reaches it to "
-                               "mech.aot_build.warm_up")
-        if len(sigs) > 1:
-            sigs = [_merge_layouts(name, sigs)]
-        out[name] = sigs[0]
+        groups = {name: sigs}
+        if name in jit.VARIANTS:
+            groups = {name: [s for s in sigs if s.args[-1] == types.none],
+                      name + jit.ARMATURE_SUFFIX: [s for s in sigs if s.args[-1] != types.none]}
+        for export, group in groups.items():
+            if not group:
+                raise RuntimeError(f"the warm-up never called {export}: add a model that reaches it to "
+                                   "mech.aot_build.warm_up")
+            out[export] = _merge_layouts(export, group) if len(group) > 1 else group[0]
     return out
 
 
@@ -148,7 +160,7 @@ def compile_into(dest) -> None:
     cc.target_cpu = "host"  # built where it runs: the same instructions the JIT would use
     sigs = signatures()
     for name, sig in sigs.items():
-        cc.export(name, sig)(getattr(jit, name).py_func)
+        cc.export(name, sig)(getattr(jit, name.removesuffix(jit.ARMATURE_SUFFIX)).py_func)
     cc.compile()
     (Path(dest) / SIGNATURES).write_text(json.dumps({name: [_kind(a) for a in sig.args]
                                                      for name, sig in sigs.items()}, indent=1))

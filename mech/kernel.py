@@ -114,7 +114,7 @@ def make_work(n):
         np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3)),  # s_tip sdot_tip theta_dot_tip (body)
         np.zeros((2, 3)),  # vP world
         np.zeros((4, 3)), np.zeros((4, n)), np.zeros((4, 3)),  # unit responses: wdot etadot Vdot
-        np.zeros(12), np.zeros((3, 3)),  # small vectors, Schur complement
+        np.zeros(12), np.zeros((3, 3)),  # small vectors (an armature's terms at 6-10), Schur complement
     )
 
 
@@ -402,12 +402,13 @@ def armature_terms(t, qa, va, pen_card, pen_card_rate, ipar, apar, again, closed
 
 
 @njit(cache=True)
-def armature_force(t, y, mdl):
+def armature_force(t, y, mdl, arm):
     """N (N m for a clapper): the force on the armature along q at t (s) in state y, of
     everything but its stops: the drive times the gain, the return spring, the viscous
     damping and the card's reaction. Seated on a stop, this presses it there (towards the
-    pole: the pole stop; its negative: the rest stop)."""
-    ipar, xc, psi, apar, again, aclosed, drive = mdl[1], mdl[8], mdl[6], mdl[14], mdl[15], mdl[16], mdl[17]
+    pole: the pole stop; its negative: the rest stop). arm: the model's armature arrays."""
+    ipar, psi, xc, drive = mdl[1], mdl[6], mdl[8], mdl[14]
+    apar, again, aclosed = arm
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
     off = arm_offset(n, planar, ipar[I_MOUNT])
@@ -444,15 +445,18 @@ def card_penetration(qa, va, z, vz, apar):
 
 
 @njit(cache=True)
-def _armature_alone(t, y, ipar, apar, again, closed, drive, dy, aux):
+def _armature_alone(t, y, ipar, arm, drive, dy, aux, sv):
     """dynamics of a model without a bar: the armature's two states, its quadratures (the
-    drive's work, the dissipation), and the two contact rows of aux switched off."""
+    drive's work, the dissipation), its terms into sv[6:11] as beside a bar
+    (_armature_on_bar), and the two contact rows of aux switched off."""
+    apar, again, closed = arm
     for i in range(2):
         for c_ in range(NAUX):
             aux[i, c_] = 0.0
         aux[i, A_Y] = -1e3
-    terms = np.empty(4)
+    terms = sv[6:10]
     armature_terms(t, y[0], y[1], 0.0, 0.0, ipar, apar, again, closed, drive, terms)
+    sv[10] = 0.0
     if closed[EA_SEAT] != 0.0:  # seated on its stop: held there
         dy[0] = 0.0
         dy[1] = 0.0
@@ -466,7 +470,56 @@ def _armature_alone(t, y, ipar, apar, again, closed, drive, dy, aux):
 
 
 @njit(cache=True)
-def dynamics(t, y, mdl, regime, eref, dy, aux, work):
+def _armature_on_bar(t, y, n, planar, mount, ipar, arm, drive, xc, psi, theta,
+                     r, R, q, V, w, eta, F, f_r, f_e, Fw, Mw, sv):
+    """The armature beside a bar (dynamics): its terms into sv[6:10] (armature_terms) and the
+    card's penetration into sv[10] (for the events: mech.integrator.armature_events), its
+    card's force on the bar's point (down, world -z) into the bar's generalized forces.
+    Returns (the drive's power, the dissipated power), W."""
+    apar, again, aclosed = arm
+    off = arm_offset(n, planar, mount)
+    qa = y[off]
+    va = y[off + 1]
+    pc = ipar[I_ARM_CARD]
+    pen_c = 0.0
+    pen_c_rate = 0.0
+    s0 = 0.0
+    s1 = 0.0
+    s2 = 0.0
+    if pc >= 0:
+        xcard = np.empty(3)
+        vcard = np.empty(3)
+        s0, s1, s2 = load_point_motion(pc, xc, psi, r, R, q, V, w, eta, n, xcard, vcard)
+        pen_c, pen_c_rate = card_penetration(qa, va, xcard[2], vcard[2], apar)
+    terms = sv[6:10]
+    armature_terms(t, qa, va, pen_c, pen_c_rate, ipar, apar, again, aclosed, drive, terms)
+    sv[10] = pen_c
+    if terms[1] > 0.0:
+        Fw[0] = 0.0
+        Fw[1] = 0.0
+        Fw[2] = -terms[1]
+        Mw[0] = 0.0
+        Mw[1] = 0.0
+        Mw[2] = 0.0
+        _add_force_at(pc, s0, s1, s2, Fw, Mw, R, psi, theta, n, F, f_r, f_e)
+    return terms[2], terms[3]
+
+
+@njit(cache=True)
+def _armature_rates(y, base, arm, sv, dy):
+    """The armature's two rates into dy[base:base + 2] (its force in sv[6], _armature_on_bar);
+    held while seated."""
+    apar, _, aclosed = arm
+    if aclosed[EA_SEAT] != 0.0:
+        dy[base] = 0.0
+        dy[base + 1] = 0.0
+    else:
+        dy[base] = y[base + 1]
+        dy[base + 1] = sv[6] / apar[AP_MASS]
+
+
+@njit(cache=True)
+def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
     """Time derivative of the state into ``dy``; per-contact-point quantities into ``aux`` (2, NAUX).
 
     mdl: the model arrays and, last, the drive (model.BarModel.kernel_arrays: each contact
@@ -475,11 +528,18 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work):
     model's arrays never change). regime: (2,) FREE/SLIP/STICK per
     contact point (friction bookkeeping; the normal force always follows the
     penetration). eref: (2, 2) reference slip direction per contact point.
+    arm: None, or the armature's arrays (model.BarModel.kernel_armature: its parameters
+    AP_*, its gain table, its contacts' states EA_*). An argument of its own, not in mdl:
+    numba compiles the kernel once for None, where every armature branch is removed
+    before the code is generated, so a model without an armature runs the code it ran
+    before the armature existed (measured: in mdl, the same branches, never taken, made
+    the default scene's run 10 % slower).
     """
-    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs, cdrive, apar, again, aclosed, drive = mdl
-    if ipar[I_MOUNT] == MOUNT_NONE:
-        _armature_alone(t, y, ipar, apar, again, aclosed, drive, dy, aux)
-        return
+    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs, cdrive, drive = mdl
+    if arm is not None:
+        if ipar[I_MOUNT] == MOUNT_NONE:
+            _armature_alone(t, y, ipar, arm, drive, dy, aux, work[22])
+            return
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
     fmodel = ipar[I_FRICTION]
@@ -659,37 +719,11 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work):
         w_in += w_in_l
         d_load += d_l
 
-    arm = ipar[I_ARMATURE] != 0
-    terms = sv[6:10]
-    va = 0.0
-    if arm:
-        # the armature (a rigid body of its own, q along its travel) and its card, which
-        # presses the bar's card point down (world -z) and takes the reaction back
-        off = arm_offset(n, planar, mount)
-        qa = y[off]
-        va = y[off + 1]
-        pc = ipar[I_ARM_CARD]
-        pen_c = 0.0
-        pen_c_rate = 0.0
-        s0 = 0.0
-        s1 = 0.0
-        s2 = 0.0
-        if pc >= 0:
-            xcard = np.empty(3)
-            vcard = np.empty(3)
-            s0, s1, s2 = load_point_motion(pc, xc, psi, r, R, q, V, w, eta, n, xcard, vcard)
-            pen_c, pen_c_rate = card_penetration(qa, va, xcard[2], vcard[2], apar)
-        armature_terms(t, qa, va, pen_c, pen_c_rate, ipar, apar, again, aclosed, drive, terms)
-        if terms[1] > 0.0:
-            Fw[0] = 0.0
-            Fw[1] = 0.0
-            Fw[2] = -terms[1]
-            Mw[0] = 0.0
-            Mw[1] = 0.0
-            Mw[2] = 0.0
-            _add_force_at(pc, s0, s1, s2, Fw, Mw, R, psi, theta, n, F, f_r, f_e)
-        w_in += terms[2]
-        d_load += terms[3]
+    if arm is not None:
+        w_arm, d_arm = _armature_on_bar(t, y, n, planar, mount, ipar, arm, drive, xc, psi, theta,
+                                        r, R, q, V, w, eta, F, f_r, f_e, Fw, Mw, sv)
+        w_in += w_arm
+        d_load += d_arm
 
     _solve_mounted(mount, F, f_r, f_e, Ainv, B, m, n, Vdot, wdot, etadot)
 
@@ -738,13 +772,8 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work):
         for j in range(n):
             dy[13 + n + j] = etadot[j]
     base = npos + nvel
-    if arm:
-        if aclosed[EA_SEAT] != 0.0:  # seated on its stop: held there
-            dy[base] = 0.0
-            dy[base + 1] = 0.0
-        else:
-            dy[base] = va
-            dy[base + 1] = terms[0] / apar[AP_MASS]
+    if arm is not None:
+        _armature_rates(y, base, arm, sv, dy)
         base += N_ARM
     dy[base + Q_DNORMAL] = d_normal
     dy[base + Q_DFRICTION] = d_friction
@@ -976,7 +1005,7 @@ def _apply_stick(fpar, n, planar, mount, R, w, eta, s_tip, sd_tip, th_tip, vP, r
 
 
 @njit(cache=True)
-def project_to_stick(t, y, mdl, regime, eref, aux, work):
+def project_to_stick(t, y, mdl, regime, eref, aux, work, arm=None):
     """Remove the slip velocity of every sticking tip by the smallest change of the speeds
     in the kinetic-energy metric: du = -M^-1 G^T (G M^-1 G^T)^-1 v_t, in the directions a
     slip at rest can be removed in (_rest_projection_solve). Returns the kinetic energy
@@ -986,7 +1015,7 @@ def project_to_stick(t, y, mdl, regime, eref, aux, work):
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
     dy = np.empty(y.shape[0])
-    dynamics(t, y, mdl, regime, eref, dy, aux, work)
+    dynamics(t, y, mdl, regime, eref, dy, aux, work, arm)
     (r, R, q, V, w, eta, Jm, B, Ainv, f_r, f_e, F, wdot, etadot, Vdot,
      s_tip, sd_tip, th_tip, vP, u_wdot, u_etadot, u_Vdot, sv, Amat) = work
     tips, ns = _sticking_tips(regime, aux)
@@ -1046,7 +1075,7 @@ def armature_energy(qa, va, pen_card, apar, has_card):
 
 
 @njit(cache=True)
-def energies(y, mdl, work, out):
+def energies(y, mdl, work, out, arm=None):
     """out = (kinetic, elastic strain, gravity potential, stored Hertz energy, stored
     energy of springs and the pivot's torsion spring incl. its preload), all J; an
     armature's kinetic energy counts in the first, its return spring's, stops' and card's
@@ -1055,11 +1084,11 @@ def energies(y, mdl, work, out):
     Kinetic energy about a frame origin that is not the centroid (held bars):
     1/2 m V.V + V . R (w x (c + L q) + L eta) + 1/2 w J w + w B eta + 1/2 m eta.eta.
     """
-    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs, cdrive, apar, again, aclosed, drive = mdl
+    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs, cdrive, drive = mdl
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
-    if ipar[I_MOUNT] == MOUNT_NONE:
-        kin, stored = armature_energy(y[0], y[1], 0.0, apar, False)
+    if arm is not None and ipar[I_MOUNT] == MOUNT_NONE:
+        kin, stored = armature_energy(y[0], y[1], 0.0, arm[0], False)
         out[0] = kin
         out[1] = 0.0
         out[2] = 0.0
@@ -1130,7 +1159,8 @@ def energies(y, mdl, work, out):
     if ipar[I_MOUNT] == MOUNT_PIVOT:
         th = fpar[F_PIV_SIGN] * (y[2] - fpar[F_PIV_PHI0])
         sp += 0.5 * fpar[F_PIV_K] * th * th - fpar[F_PIV_T0] * th
-    if ipar[I_ARMATURE] != 0:
+    if arm is not None:
+        apar = arm[0]
         off = arm_offset(n, planar, ipar[I_MOUNT])
         pc = ipar[I_ARM_CARD]
         pen_c = 0.0
@@ -1148,12 +1178,13 @@ def energies(y, mdl, work, out):
 
 
 @njit(cache=True)
-def armature_table(Y, mdl):
+def armature_table(Y, mdl, arm):
     """(records, 6) of the state history Y: the armature's q (m or rad), its rate, the
     card's force on the bar (N), the stops' force on the armature (N or N m, positive
     towards the pole: the rest stop's push), the card's penetration past the bar's point
     (m) and its rate (m/s) (0 without a card)."""
-    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs, cdrive, apar, again, _, _ = mdl
+    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs, cdrive, _ = mdl
+    apar = arm[0]
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
     mount = ipar[I_MOUNT]
@@ -1186,13 +1217,13 @@ def armature_table(Y, mdl):
 
 
 @njit(cache=True)
-def energy_table(Y, mdl):
+def energy_table(Y, mdl, arm=None):
     """(records, 5): ``energies`` of every row of the state history Y."""
     n = mdl[1][0]
     work = make_work(n)
     out = np.empty((Y.shape[0], 5))
     e = np.empty(5)
     for k in range(Y.shape[0]):
-        energies(Y[k], mdl, work, e)
+        energies(Y[k], mdl, work, e, arm)
         out[k] = e
     return out

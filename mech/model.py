@@ -363,19 +363,31 @@ class BarModel:
         scene's constant friction coefficient as its drive: the same tuple object on every
         call, so the compiled route's argument check (mech.aot) validates it once rather
         than at each of thousands of calls. A solver passes its own drive instead
-        (``kernel_arrays``). (Its armature's contacts all open: for what follows from the
-        state alone, energies and tables.)"""
-        return self.kernel_arrays(self.initial_drive(), np.zeros(NEV_ARM))
+        (``kernel_arrays``)."""
+        return self.kernel_arrays(self.initial_drive())
 
-    def kernel_arrays(self, drive: np.ndarray, closed: np.ndarray) -> tuple:
+    def kernel_arrays(self, drive: np.ndarray) -> tuple:
         """The kernel's model argument with ``drive`` (float64[len(drive_names), N_DRIVE],
-        C order, kernel_layout D_*) as the driven quantities over time and ``closed``
-        (float64[NEV_ARM]: which of the armature's stops and card the solver holds closed)."""
+        C order, kernel_layout D_*) as the driven quantities over time."""
         b = self.basis
         ptr, idx, val = self.sparse
         psi, theta, xc = self.points
         return (self.fpar, self.ipar, b.J0, ptr, idx, val, psi, theta, xc, self.cpar,
-                self.first_moments, self.load, self.tables, self.cdrive, self.apar, self.again, closed, drive)
+                self.first_moments, self.load, self.tables, self.cdrive, drive)
+
+    def kernel_armature(self, closed: np.ndarray):
+        """The kernel's armature argument (kernel.dynamics: ``arm``): None without an
+        armature, else (apar, again, closed) with ``closed`` (float64[NEV_ARM], kernel_layout
+        EA_*) the states of its stops and card that the solver keeps."""
+        if not self.has_armature:
+            return None
+        return (self.apar, self.again, closed)
+
+    @functools.cached_property
+    def armature_arrays(self):
+        """``kernel_armature`` with every stop and the card open, the same tuple on every call
+        (for what follows from the state alone: energies, the armature's table)."""
+        return self.kernel_armature(np.zeros(NEV_ARM))
 
     @property
     def has_bar(self) -> bool:

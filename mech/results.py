@@ -111,7 +111,7 @@ class ImpactResult:
         normal/friction/modal dissipation, spring_stored, load_dissipation, work_in, residual (J)."""
         if "energy_columns" not in self._cache:
             m = self.model
-            E = energy_table(self.states, m.arrays)
+            E = energy_table(self.states, m.arrays, m.armature_arrays)
             qd = self.states[:, m.slices()["quad"]]
             held = qd.shape[1] > Q_WIN  # quadratures of input work and load dissipation
             zero = np.zeros(len(self.t))
@@ -208,7 +208,7 @@ class ImpactResult:
         travel from the rest stop), armature_velocity (m/s or rad/s), armature_stop_force
         (N or N m on the armature, + the rest stop's push, - the pole stop's) and, with a
         card, card_force (N, its push on the bar)."""
-        a = armature_table(self.states, self.model.arrays)
+        a = armature_table(self.states, self.model.arrays, self.model.armature_arrays)
         out = {"armature_position": a[:, 0], "armature_velocity": a[:, 1], "armature_stop_force": a[:, 3]}
         if self.model.scene.armature.has_card:
             out["card_force"] = a[:, 2]

@@ -44,6 +44,7 @@ def scipy_segment(solver, t_target: float, method: str):
 
     m = solver.model
     arrays = solver.arrays
+    arm = solver.arm
     drive = solver.drive
     mu_rows = m.drive_rows("mu")  # a coupled model's friction coefficient is every contact point's
     regime = solver.regime.copy()
@@ -62,7 +63,7 @@ def scipy_segment(solver, t_target: float, method: str):
         dy = np.empty(N + n_ext)
         if coupled is not None:
             drive[mu_rows, D_VALUE] = coupled.friction_coefficient(t, y[N:])
-        dynamics(t, y[:N], arrays, regime, eref, dy[:N], aux, work)
+        dynamics(t, y[:N], arrays, regime, eref, dy[:N], aux, work, arm)
         if coupled is not None:
             dy[N:] = coupled.rhs(t, y[N:], aux[:, [A_Y, A_YDOT, A_FN]])
         counter["nfev"] += 1
@@ -97,9 +98,9 @@ def scipy_segment(solver, t_target: float, method: str):
             dy = np.empty(N)
             if coupled is not None:
                 drive[mu_rows, D_VALUE] = coupled.friction_coefficient(t, y[N:])
-            dynamics(t, y[:N], arrays, regime, eref, dy, aux, work)
+            dynamics(t, y[:N], arrays, regime, eref, dy, aux, work, arm)
             counter_events["nfev"] += 1
-            event_values(t, y[:N], aux, eref, arrays, g)
+            event_values(y[:N], aux, work[22], eref, arrays, g, arm)
             if kind == EV_SLIP and not (fexact and regime[i] == SLIP):
                 return solver.ev_sign[k]
             if kind == EV_STICK and not (fexact and regime[i] == STICK):
@@ -169,7 +170,7 @@ def scipy_segment(solver, t_target: float, method: str):
         if coupled is not None:
             drive[mu_rows, D_VALUE] = coupled.friction_coefficient(sol.t[k], sol.y[N:, k])
             rec.ext[n0 + k - 1] = sol.y[N:, k]
-        dynamics(sol.t[k], y, arrays, regime, eref, dy, aux, work)
+        dynamics(sol.t[k], y, arrays, regime, eref, dy, aux, work, arm)
         r = n0 + k - 1
         rec.t[r] = sol.t[k]
         rec.y[r] = y
@@ -187,7 +188,7 @@ def scipy_segment(solver, t_target: float, method: str):
             samples[4] = aux[:, A_FN]
             for j, f in enumerate((0.25, 0.5, 0.75), start=1):
                 dynamics(sol.t[k - 1] + f * h, sol.sol(sol.t[k - 1] + f * h)[:N], arrays, regime, eref, dy,
-                         aux_mid, work)
+                         aux_mid, work, arm)
                 samples[j] = aux_mid[:, A_FN]
             peak = samples.max(axis=0)
             for tip in range(2):
@@ -196,7 +197,7 @@ def scipy_segment(solver, t_target: float, method: str):
                 if curvature < 0.0:
                     shift = 0.5 * (samples[j - 1, tip] - samples[j + 1, tip]) / curvature
                     tm = sol.t[k - 1] + 0.25 * (j + shift) * h
-                    dynamics(tm, sol.sol(tm)[:N], arrays, regime, eref, dy, aux_mid, work)
+                    dynamics(tm, sol.sol(tm)[:N], arrays, regime, eref, dy, aux_mid, work, arm)
                     peak[tip] = max(peak[tip], aux_mid[tip, A_FN])
             rec.fmax[r] = np.maximum(rec.fmax[r], peak)
     solver.stats[0] += n_new

@@ -105,6 +105,7 @@ class Segment:
     _regime: np.ndarray
     _eref: np.ndarray
     _arrays: tuple = field(repr=False)  # the kernel's arguments with the drive of the segment
+    _arm: tuple = field(repr=False, default=None)  # and its armature's (kernel.dynamics), or None
     _work: tuple = field(repr=False, default=None)
     _out: np.ndarray = field(repr=False, default_factory=lambda: np.empty(5))
     _last_t: float = field(repr=False, default=float("nan"))
@@ -134,7 +135,7 @@ class Segment:
         k = int(np.searchsorted(self._t_valid, t)) if len(self._t_valid) else 0
         k = min(k, max(len(self._regime) - 1, 0))
         regime = self._regime[k] if len(self._regime) else np.zeros(2, np.int64)
-        dynamics(t, y, self._arrays, regime, self._eref, dy, aux, self._work)
+        dynamics(t, y, self._arrays, regime, self._eref, dy, aux, self._work, self._arm)
         return aux[:, [A_Y, A_YDOT, A_FN]].copy()
 
     def normal_force(self, t: float) -> float:
@@ -238,7 +239,8 @@ class ImpactSolver:
         # which of the armature's stops and card are closed (kernel_layout EA_*): set at its
         # events from the watched sides (_armature_signs), read by the kernel
         self.armature_closed = np.zeros(NEV - 2 * NEV_TIP)
-        self.arrays = m.kernel_arrays(self.drive, self.armature_closed)
+        self.arrays = m.kernel_arrays(self.drive)
+        self.arm = m.kernel_armature(self.armature_closed)  # (None without an armature)
         self.recorder = Recorder(m.state_size, len(self.z), capacity, keep_dense)
         self.stepper: Stepper = CompiledStepper() if backend == "dopri5" else ScipyStepper(backend[6:])
         self._jumps = base_velocity_jumps(scene)
@@ -406,7 +408,8 @@ class ImpactSolver:
         return Segment(t_start, self.t, self.events[ev_first:], m, t0, hh,
                        rec.t[n_first:n_last].copy(), coef, start_state,
                        rec.regime[n_first:n_last].copy(), self.eref.copy(),
-                       _arrays=m.kernel_arrays(self.drive.copy(), self.armature_closed.copy()))
+                       _arrays=m.kernel_arrays(self.drive.copy()),
+                       _arm=m.kernel_armature(self.armature_closed.copy()))
 
     def run(self):
         """Integrate to ``solver.t_end`` and return the ``ImpactResult``."""
@@ -495,7 +498,7 @@ class ImpactSolver:
             raise ValueError(f"times must lie in [{rec.t[0]!r}, {self.t!r}] s")
         out = np.empty((len(times), 2, 3))
         dense_contact(times[order], rec.t[:n], rec.dense_t0[:n], rec.dense_h[:n], rec.dense_coef[:n],
-                      rec.regime[:n], self.arrays, self.eref, self.work, out)
+                      rec.regime[:n], self.arrays, self.eref, self.work, out, self.arm)
         result = np.empty_like(out)
         result[order] = out
         return result
@@ -561,7 +564,7 @@ class ImpactSolver:
                    for row, kind in enumerate(self.model.drive_kinds))
 
     def _evaluate(self) -> np.ndarray:
-        dynamics(self.t, self.y, self.arrays, self.regime, self.eref, self._dy, self._aux, self.work)
+        dynamics(self.t, self.y, self.arrays, self.regime, self.eref, self._dy, self._aux, self.work, self.arm)
         return self._aux
 
     # --- contacts at rest ------------------------------------------------------------
@@ -604,7 +607,7 @@ class ImpactSolver:
             self._restart_rest_window()
             return
         if n_rec:  # the largest kinetic energy of the new records, in one compiled call
-            self._rest_ke = max(self._rest_ke, float(energy_table(rec.y[n0:n0 + n_rec], self.arrays)[:, 0].max()))
+            self._rest_ke = max(self._rest_ke, float(energy_table(rec.y[n0:n0 + n_rec], self.arrays, self.arm)[:, 0].max()))
         if self.t - self._rest_t0 < self.model.rest_window * (1.0 - 1e-12):
             return
         # closed throughout: a window that began in flight (a segment ending at touchdown
@@ -651,7 +654,7 @@ class ImpactSolver:
         saved = (self.y.copy(), self.regime.copy(), self.eref.copy(), self.ev_sign.copy(), self.projection_energy,
                  self.armature_closed.copy())
         e = self._rest_e
-        energies(self.y, self.arrays, self.work, e)
+        energies(self.y, self.arrays, self.work, e, self.arm)
         before = float(e.sum())
         self.y[pos] = np.trapezoid(rec.y[first:n][:, pos], t, axis=0) / (t[-1] - t[0])
         self.y[vel] = 0.0
@@ -669,7 +672,7 @@ class ImpactSolver:
             (self.y[:], self.regime[:], self.eref[:], self.ev_sign[:], self.projection_energy,
              self.armature_closed[:]) = saved
             return False
-        energies(self.y, self.arrays, self.work, e)
+        energies(self.y, self.arrays, self.work, e, self.arm)
         self.projection_energy += float(e.sum()) - before
         return True
 
@@ -751,13 +754,13 @@ class ImpactSolver:
         sl = m.slices()
         n = m.n
         e = np.empty(5)
-        energies(self.y, self.arrays, self.work, e)
+        energies(self.y, self.arrays, self.work, e, self.arm)
         ke_before = e[0]
         R = m.rotation(self.y)
         self.y[sl["vel"]] += (dv[0], dv[2]) if m.planar else dv
         L = m.first_moments[:, 1:n + 1]
         self.y[sl["eta"]] -= (L.T @ (R.T @ dv)) / m.fpar[F_MASS]
-        energies(self.y, self.arrays, self.work, e)
+        energies(self.y, self.arrays, self.work, e, self.arm)
         if resolve:  # (a jump at t = 0 comes before the first record: the audit starts after it)
             self.y[sl["quad"].start + Q_WIN] += e[0] - ke_before
             self._resolve(triggered=None)
@@ -841,7 +844,7 @@ class ImpactSolver:
         for k in (EA_REST, EA_POLE, EA_CARD):
             self.armature_closed[k] = 1.0 if self.ev_sign[base + k] < 0.0 else 0.0
         if np.any(closed != self.armature_closed):
-            event_values(self.t, self.y, self._aux, self.eref, self.arrays, g)
+            event_values(self.y, self._evaluate(), self.work[22], self.eref, self.arrays, g, self.arm)
             for k in (base + EA_TURN, base + EA_SEAT):
                 if triggered != k:
                     self.ev_sign[k] = 1.0 if g[k] >= 0.0 else -1.0
@@ -851,7 +854,7 @@ class ImpactSolver:
         if not self.model.has_armature:
             return
         g = np.empty(NEV)
-        event_values(self.t, self.y, self._evaluate(), self.eref, self.arrays, g)
+        event_values(self.y, self._evaluate(), self.work[22], self.eref, self.arrays, g, self.arm)
         self._armature_signs(g, triggered)
 
     def _armature_event(self, k: int) -> None:
@@ -880,7 +883,7 @@ class ImpactSolver:
         pressing the armature onto it, N or N m)."""
         a = self.model.armature_index
         arm = self.scene.armature
-        force = float(armature_force(self.t, self.y, self.arrays))
+        force = float(armature_force(self.t, self.y, self.arrays, self.arm))
         if self.armature_closed[EA_POLE]:
             return EA_POLE, float(self.y[a]) - arm.travel, force
         if self.armature_closed[EA_REST]:
@@ -917,12 +920,12 @@ class ImpactSolver:
             if stop < 0 or press <= 0.0 or abs(k_stop * pen - press) > press:
                 return
         e = self._rest_e
-        energies(self.y, self.arrays, self.work, e)
+        energies(self.y, self.arrays, self.work, e, self.arm)
         before = float(e.sum())
         self.y[a] = 0.0 if stop == EA_REST else arm.travel
         self.y[a + 1] = 0.0
         self.armature_closed[EA_SEAT] = 1.0
-        energies(self.y, self.arrays, self.work, e)
+        energies(self.y, self.arrays, self.work, e, self.arm)
         self._armature_resolve()
         self._log_armature(stop, "seat", energy=float(e.sum()) - before, press=press)
 
@@ -942,7 +945,7 @@ class ImpactSolver:
         name, stop = ARMATURE_EVENTS[k]
         if edge == "seat":
             name, edge = "armature", "seat"
-        q, v, card, _, pen_card, pen_card_rate = armature_table(self.y[None, :], self.arrays)[0]
+        q, v, card, _, pen_card, pen_card_rate = armature_table(self.y[None, :], self.arrays, self.arm)[0]
         travel = self.scene.armature.travel
         if k == EA_CARD:
             pen, rate, force = pen_card, pen_card_rate, card
@@ -1027,7 +1030,7 @@ class ImpactSolver:
                 rest[i] = SLIP  # (not at rest: left out of the projection)
         if any_rest:
             self.projection_energy += project_to_stick(
-                self.t, self.y, self.arrays, rest, self.eref, self._aux, self.work)
+                self.t, self.y, self.arrays, rest, self.eref, self._aux, self.work, self.arm)
 
     def _slip_reference(self, i: int, aux: np.ndarray, resisted: np.ndarray) -> np.ndarray:
         """Reference direction of a slip that starts at tip i from (near) rest: the direction
@@ -1117,7 +1120,7 @@ class ImpactSolver:
         self.regime[:] = new
         aux = self._evaluate()
         g = np.empty(NEV)
-        event_values(self.t, self.y, aux, self.eref, self.arrays, g)
+        event_values(self.y, aux, self.work[22], self.eref, self.arrays, g, self.arm)
         self._armature_signs(g, triggered)
         for i in range(2):
             b = NEV_TIP * i

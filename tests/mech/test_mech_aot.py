@@ -137,9 +137,12 @@ def test_the_drive_channels_take_the_ahead_of_time_route():
     kinds = json.loads((aot.module_folder() / aot.SIGNATURES).read_text())
     model = kinds["dynamics"][2]
     assert model[0] == "tuple"
-    assert model[1][13] == ["array", "int64", 2, "C"] and model[1][-1] == ["array", "float64", 2, "C"]  # cdrive, drive
-    # the armature's parameters, gain table and contact states
-    assert model[1][14:17] == [["array", "float64", 1, "C"], ["array", "float64", 2, "C"], ["array", "float64", 1, "C"]]
+    assert model[1][-2:] == [["array", "int64", 2, "C"], ["array", "float64", 2, "C"]]  # cdrive, drive
+    # the armature's arrays are an argument of their own: None (no armature), or its
+    # parameters, gain table and contact states in the "_armature" export
+    assert kinds["dynamics"][-1] == ["scalar", "none"]
+    assert kinds["dynamics_armature"][-1] == ["tuple", [["array", "float64", 1, "C"], ["array", "float64", 2, "C"],
+                                                        ["array", "float64", 1, "C"]]]
     steel = dict(youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0)
     free = {"bar": dict(length=0.1, diameter=0.006, tip_radius=0.003, modes=2, **steel),
             "initial": dict(height=1e-4, angle_deg=30.0, velocity=[0.3, 0.1, -1.0]),
