@@ -549,8 +549,8 @@ class Armature:
             return
         own, other = ("mass", "inertia") if self.kind == "plunger" else ("inertia", "mass")
         if getattr(self, other) is not None:
-            raise ValueError(f"armature.{other}: a {self.kind} has {'a mass (kg)' if own == 'mass' else 'an inertia (kg m^2)'}; "
-                             f"give armature.{own} instead")
+            has = "a mass (kg)" if own == "mass" else "an inertia (kg m^2)"
+            raise ValueError(f"armature.{other}: a {self.kind} has {has}; give armature.{own} instead")
         if getattr(self, own) is None:
             raise ValueError(f"armature.{own}: needed for armature.kind = {self.kind!r} "
                              f"({'kg' if own == 'mass' else 'kg m^2 about the hinge'})")

@@ -33,7 +33,8 @@ from .compiled import (
 )
 from .kernel_layout import (
     A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, BUFFER_FULL, DONE, EV_CLIP, EV_COMPRESSION,
-    D_SLOPE, D_VALUE, EA_CARD, EA_POLE, EA_REST, EA_SEAT, EA_TURN, EV_CONTACT, EV_SLIP, EV_STICK, EVENT, F_MASS, FREE, FRICTION_EXACT,
+    D_SLOPE, D_VALUE, EA_CARD, EA_POLE, EA_REST, EA_SEAT, EA_TURN, EV_CONTACT, EV_SLIP, EV_STICK, EVENT, F_MASS, FREE,
+    FRICTION_EXACT,
     I_FRICTION, NAUX, NEV, NEV_TIP, Q_WIN, SLIP, STATUS_TEXT, STICK, state_sizes,
 )
 from .contact_laws import hertz_impact
@@ -437,8 +438,8 @@ class ImpactSolver:
 
     def start_from(self, **parts) -> None:
         """Overwrite named parts of the initial state before integrating: any key of
-        ``model.slices()`` except "quad" (pos, angle or quat, q, vel, omega, eta; SI, the
-        solver's frame). For what a scene cannot say: a modal initial condition, a start
+        ``model.slices()`` except "quad" (pos, angle or quat, q, vel, omega, eta, armature;
+        SI, the solver's frame). For what a scene cannot say: a modal initial condition, a start
         already in contact. The run's first record and the regimes are redone."""
         if self.t != 0.0 or self.recorder.n != 1:
             raise ValueError("start_from: only before the first advance")
@@ -454,7 +455,10 @@ class ImpactSolver:
             self.y[sl[name]] = arr
         self._initial_state = self.y.copy()
         self.recorder.truncate(0)
+        self.armature_closed[:] = 0.0
         self._resolve(triggered=None)
+        if self.model.has_armature:
+            self._seat(start=True)
         self._record_point()
 
     def checkpoint(self) -> dict:
@@ -607,7 +611,8 @@ class ImpactSolver:
             self._restart_rest_window()
             return
         if n_rec:  # the largest kinetic energy of the new records, in one compiled call
-            self._rest_ke = max(self._rest_ke, float(energy_table(rec.y[n0:n0 + n_rec], self.arrays, self.arm)[:, 0].max()))
+            kinetic = energy_table(rec.y[n0:n0 + n_rec], self.arrays, self.arm)[:, 0]
+            self._rest_ke = max(self._rest_ke, float(kinetic.max()))
         if self.t - self._rest_t0 < self.model.rest_window * (1.0 - 1e-12):
             return
         # closed throughout: a window that began in flight (a segment ending at touchdown
