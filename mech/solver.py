@@ -955,9 +955,9 @@ class ImpactSolver:
         if k == EA_CARD:
             pen, rate, force = pen_card, pen_card_rate, card
         elif k == EA_REST:
-            pen, rate, force = -q, -v, self.scene.armature.stop_stiffness * max(-q, 0.0)
+            pen, rate, force = -q, -v, self.scene.armature.stop_stiffness * max(0.0, -q)
         else:
-            pen, rate, force = q - travel, v, self.scene.armature.stop_stiffness * max(q - travel, 0.0)
+            pen, rate, force = q - travel, v, self.scene.armature.stop_stiffness * max(0.0, q - travel)
         self.events.append(dict(
             time=self.t, tip=-1, kind=f"{name}_{edge}", stop=stop,
             regime_before="", regime_after="", penetration=float(pen), penetration_rate=float(rate),
