@@ -178,6 +178,11 @@ def remove_stale(folder: Path) -> None:
             stale.unlink(missing_ok=True)
 
 
+def argument_count(folder: Path, name: str) -> int:
+    """How many arguments the exported function ``name`` takes."""
+    return len(json.loads((folder / SIGNATURES).read_text())[name])
+
+
 def argument_checks(folder: Path) -> dict:
     """name -> check(args) raising TypeError for an argument the exported function would
     misread (numba.pycc's wrappers do not check an array's dtype, rank or layout).

@@ -20,6 +20,7 @@ from numba.core import types  # (the build child loads numba anyway: it compiles
 from . import compiled as jit
 from .aot import FORCE_JIT, MODULE, SIGNATURES
 from .damping_calibration import calibrate_damping
+from .kernel_layout import NAUX
 from .scene import scene_from_dict
 from .solver import ImpactSolver
 
@@ -62,6 +63,7 @@ def warm_up() -> None:
         solver.contact_series(np.linspace(segment.t_start, solver.t, 5))
         result = solver.result()
         result.energy_table  # noqa: B018  (the compiled energy table)
+        jit.energies(solver.y, solver.arrays, solver.work, np.empty(5), solver.arm)  # (as a hold calls it)
         result.contacts  # noqa: B018  (dense contact evaluation where the solver asks for it)
         if k == 0:  # the scipy backends hand the right-hand side views of their own arrays
             for method in ("RK45", "Radau", "BDF", "LSODA"):
@@ -74,21 +76,56 @@ def warm_up() -> None:
                                                           else 0.2 for name in names})
         segment.tip_forces(0.5 * (segment.t_start + segment.t_end))
         driven.result().energy_table  # noqa: B018
+    # the armature: alone (a bar-less model) with a gain table, and driving a clamped
+    # blade through its card; its dense output, history table and events
+    armature = dict(kind="plunger", mass=0.02, travel=1e-3, stop_stiffness=1e9, stop_damping=20.0,
+                    spring_rate=100.0, spring_preload=0.1, damping=0.01)
+    alone = {"armature": dict(armature, force_gain=dict(position=[0.0, 5e-4, 1e-3], gain=[1.0, 1.5, 3.0])),
+             "solver": dict(t_end=5e-3)}
+    card = {"bar": dict(length=0.02, width=0.003, thickness=0.0003, tip_radius=0.0016,
+                        modes={"axial": 1, "bending": 3}, **steel),
+            "mount": dict(kind="clamp", position=0.02), "rivet": [dict(position=0.0015, radius=0.0015)],
+            "armature": dict(armature, card_position=0.01, card_lever=1.0, card_free_travel=2e-4,
+                             card_stiffness=1e5, card_damping=0.1),
+            "initial": dict(height=2e-4), "contact": dict(reference_speed=0.5), "solver": dict(t_end=4e-3)}
+    for doc in (alone, card):
+        solver = ImpactSolver(scene_from_dict(doc), keep_dense=True)
+        t_end = doc["solver"]["t_end"]
+        segment = solver.advance(0.5 * t_end, {"armature.force": (0.0, 3.0)})
+        t = 0.5 * (segment.t_start + segment.t_end)
+        segment.armature(t)
+        segment.tip_forces(t)
+        segment.contact(t)
+        solver.armature_now()
+        solver.advance(t_end, {"armature.force": 3.0})
+        solver.contact_series(np.linspace(0.0, t_end, 5))
+        result = solver.result()
+        result.history_columns  # noqa: B018  (the compiled armature table)
+        result.energy_table  # noqa: B018
+        # the stick projection with an armature (reached only when a contact of such a
+        # model comes to rest: called here directly)
+        jit.project_to_stick(solver.t, solver.y.copy(), solver.arrays, solver.regime, solver.eref,
+                             np.empty((2, NAUX)), solver.work, solver.arm)
     calibrate_damping("hunt_crossley", 0.7, 1.0, 1e10, 0.01)
 
 
 def signatures() -> dict:
-    """name -> numba Signature of each entry point as the warm-up compiled it; a function
-    compiled for array arguments of several layouts is exported for any layout ('A')."""
+    """export name -> numba Signature of each entry point as the warm-up compiled it; a
+    function compiled for array arguments of several layouts is exported for any layout
+    ('A'). A VARIANTS entry point is exported twice: for its last argument None (a model
+    without an armature) under its name, for the armature's arrays as "<name>_armature"."""
     out = {}
     for name in jit.ENTRY_POINTS:
         sigs = getattr(jit, name).nopython_signatures
-        if not sigs:
-            raise RuntimeError(f"the warm-up never called {name}: add a model that reaches it to "
-                               "mech.aot_build.warm_up")
-        if len(sigs) > 1:
-            sigs = [_merge_layouts(name, sigs)]
-        out[name] = sigs[0]
+        groups = {name: sigs}
+        if name in jit.VARIANTS:
+            groups = {name: [s for s in sigs if s.args[-1] == types.none],
+                      name + jit.ARMATURE_SUFFIX: [s for s in sigs if s.args[-1] != types.none]}
+        for export, group in groups.items():
+            if not group:
+                raise RuntimeError(f"the warm-up never called {export}: add a model that reaches it to "
+                                   "mech.aot_build.warm_up")
+            out[export] = _merge_layouts(export, group) if len(group) > 1 else group[0]
     return out
 
 
@@ -123,7 +160,7 @@ def compile_into(dest) -> None:
     cc.target_cpu = "host"  # built where it runs: the same instructions the JIT would use
     sigs = signatures()
     for name, sig in sigs.items():
-        cc.export(name, sig)(getattr(jit, name).py_func)
+        cc.export(name, sig)(getattr(jit, name.removesuffix(jit.ARMATURE_SUFFIX)).py_func)
     cc.compile()
     (Path(dest) / SIGNATURES).write_text(json.dumps({name: [_kind(a) for a in sig.args]
                                                      for name, sig in sigs.items()}, indent=1))

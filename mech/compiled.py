@@ -25,9 +25,16 @@ from . import aot
 # module of its numba source
 ENTRY_POINTS = {
     "dense_contact": "integrator", "dense_eval": "integrator", "dense_tip_forces": "integrator",
-    "events_from_aux": "integrator", "integrate": "integrator", "dynamics": "kernel", "energies": "kernel",
+    "event_values": "integrator", "integrate": "integrator", "dynamics": "kernel", "energies": "kernel",
     "energy_table": "kernel", "make_work": "kernel", "project_to_stick": "kernel", "scaled_rebound": "kernel",
+    "armature_table": "kernel", "armature_force": "kernel",
 }
+# entry points whose last argument is the armature's arrays (kernel.dynamics: ``arm``, None
+# without an armature): numba compiles them once for each, and the module exports the
+# second as "<name>_armature"; a call is routed by that argument (None when left out)
+VARIANTS = ("dense_contact", "dynamics", "energies", "energy_table", "event_values", "integrate",
+            "project_to_stick")
+ARMATURE_SUFFIX = "_armature"
 
 
 class CompiledArgumentWarning(RuntimeWarning):
@@ -64,14 +71,37 @@ def _checked(name: str, fn, check):
     return call
 
 
+def _variant(name: str, plain, armature, count: int):
+    """A VARIANTS entry point: ``plain`` or ``armature`` (both _checked) by its last argument,
+    the armature's arrays (``count`` arguments in all; left out: None)."""
+    def call(*args):
+        if len(args) < count:
+            args = args + (None,)
+        return (plain if args[-1] is None else armature)(*args)
+
+    call.__name__ = call.__qualname__ = name
+    call.__doc__ = plain.__doc__ + f" (for a model with an armature: {name}{ARMATURE_SUFFIX})"
+    return call
+
+
+def _load_aot(module, folder) -> dict:
+    checks = aot.argument_checks(folder)
+    out = {}
+    for name in ENTRY_POINTS:
+        fn = _checked(name, getattr(module, name), checks[name])
+        if name in VARIANTS:
+            arm = name + ARMATURE_SUFFIX
+            fn = _variant(name, fn, _checked(name, getattr(module, arm), checks[arm]), aot.argument_count(folder, name))
+        out[name] = fn
+    return out
+
+
 _loaded = aot.load()
 if _loaded is not None:
     ROUTE = "aot"
-    _module, _folder = _loaded
-    _checks = aot.argument_checks(_folder)
-    globals().update({name: _checked(name, getattr(_module, name), _checks[name]) for name in ENTRY_POINTS})
+    globals().update(_load_aot(*_loaded))
 else:
     ROUTE = "jit"
     globals().update({name: _jit(name) for name in ENTRY_POINTS})
 
-__all__ = list(ENTRY_POINTS) + ["ROUTE", "jit_dispatcher"]
+__all__ = list(ENTRY_POINTS) + ["ROUTE", "VARIANTS", "ARMATURE_SUFFIX", "jit_dispatcher"]

@@ -1,11 +1,12 @@
 """The named drive channels: what a caller changes during a run, linear in time within a step.
 
-A model's channels (mech.model.BarModel.drive_names) are one of each kind below per
-contact point i, named "<kind>.<i>"; the solver keeps their values in the drive array
-(kernel_layout D_*: value at D_T0, slope, D_T0 per row), which the kernel reads through
-the model's index array ``cdrive`` (kernel_layout K_*), never by name. What the solver
-must know of a kind to step it, hold at rest or audit its energy is here; the kernel's
-use of it is in mech.kernel.dynamics.
+A model's channels (mech.model.BarModel.drive_names) are one of each contact kind below
+per contact point i, named "<kind>.<i>", then "armature.force" when the scene has an
+armature; the solver keeps their values in the drive array (kernel_layout D_*: value at
+D_T0, slope, D_T0 per row), which the kernel reads through the model's index array
+``cdrive`` (kernel_layout K_*) and ipar[I_ARM_DRIVE], never by name. What the solver must
+know of a kind to step it, hold at rest or audit its energy is here; the kernel's use of
+it is in mech.kernel.dynamics.
 """
 
 from __future__ import annotations
@@ -40,7 +41,7 @@ class DriveKind:
     force: bool = False
 
 
-KINDS = {
+CONTACT_KINDS = {
     # the friction coefficient of the generalized law |F_t| = mu F_n^(1 - gamma): moves no
     # equilibrium by itself; whether a stick survives a new mu the solver checks itself
     "mu": DriveKind("N^gamma", clipped=True, friction=True),
@@ -48,7 +49,14 @@ KINDS = {
     # along the block's normal, away from it, on a touching contact point
     "repulsion": DriveKind("N", minimum=0.0, moves_equilibrium=True, force=True),
 }
-assert tuple(KINDS) == CONTACT_DRIVES  # one description per kernel column K_*
+assert tuple(CONTACT_KINDS) == CONTACT_DRIVES  # one description per kernel column K_*
+# the armature's drive: its force along q is this channel times the gain table at q (N,
+# or N m for a clapper, with no table; the coupling passes a magnet's flux linkage
+# squared, Wb^2, with the table h(g(q)) in N/Wb^2); positive towards the pole
+ARMATURE_DRIVE = "armature.force"
+KINDS = {**CONTACT_KINDS,
+         "armature": DriveKind("N (N m for a clapper) per unit of the gain table", moves_equilibrium=True,
+                               force=True)}
 
 
 def kind_of(name: str) -> DriveKind:

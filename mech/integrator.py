@@ -19,7 +19,8 @@ from .jit import njit
 from .kernel import (
     A_FN, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_COMPRESSION, EV_CONTACT, EV_SLIP, EV_STICK,
     C_C, C_K, C_ON, C_R, F_BETA, F_BLOCK_Z, F_VBOUND, F_VREG, FRICTION_EXACT, I_FRICTION, I_N, I_PLANAR, NEV_TIP, SLIP, STICK,
-    dynamics, normal_force, tip_offset, unpack,
+    AP_HMAX, AP_TRAVEL, EA_CARD, EA_POLE, EA_REST, EA_SEAT, EA_TURN, I_ARM_CARD, I_MOUNT, MOUNT_NONE,
+    NEV, arm_offset, dynamics, normal_force, tip_offset, unpack,
 )
 from .friction import REVERSAL_DEADBAND
 from .kernel_layout import (  # noqa: F401  (re-exported: the integrator's status codes)
@@ -59,8 +60,51 @@ def _dense_coefficients(y, ynew, h, k1, k3, k4, k5, k6, k7, coef):
 
 
 @njit(cache=True)
+def event_values(y, aux, sv, eref, mdl, g, arm=None):
+    """Event function values into g (NEV): the contact points' (events_from_aux) from a
+    dynamics evaluation's aux, then the armature's (armature_events) from the state y and
+    what that evaluation left in its scratch vector ``sv`` (the dynamics' work[22]); 1 (never
+    crossing) without an armature (arm None: kernel.dynamics)."""
+    events_from_aux(aux, eref, mdl, g)
+    if arm is not None:
+        armature_events(y, sv, mdl, arm, g)
+    else:
+        for k in range(2 * NEV_TIP, NEV):
+            g[k] = 1.0
+
+
+@njit(cache=True)
+def armature_events(y, sv, mdl, arm, g):
+    """The armature's event functions into g[2 NEV_TIP:], each positive while open (1 where
+    the model has none of it, never crossing): the rest stop q, the pole stop travel - q
+    (-1 while seated on it: held closed), the card's gap to the bar (m); while a stop is
+    closed and the armature not seated, its speed (a turn); while seated, the force
+    pressing it onto its stop. The card's penetration and the force on the armature are
+    those the dynamics evaluation of state y left in sv (kernel._armature_on_bar; seated
+    at a stop's surface, the stop itself adds nothing to the force). (Only sv is passed,
+    not the dynamics' whole work tuple: a compiled call takes a tuple's arrays one by one.)"""
+    ipar = mdl[1]
+    apar, _, closed = arm
+    base = 2 * NEV_TIP
+    for k in range(base, NEV):
+        g[k] = 1.0
+    off = arm_offset(ipar[I_N], ipar[I_PLANAR], ipar[I_MOUNT])
+    qa = y[off]
+    seated = closed[EA_SEAT] != 0.0
+    g[base + EA_REST] = -1.0 if seated and closed[EA_REST] != 0.0 else qa
+    g[base + EA_POLE] = -1.0 if seated and closed[EA_POLE] != 0.0 else apar[AP_TRAVEL] - qa
+    if seated:
+        g[base + EA_SEAT] = sv[6] if closed[EA_POLE] != 0.0 else -sv[6]
+    elif closed[EA_REST] != 0.0 or closed[EA_POLE] != 0.0:
+        g[base + EA_TURN] = y[off + 1]
+    if ipar[I_ARM_CARD] >= 0:
+        g[base + EA_CARD] = -sv[10]
+
+
+@njit(cache=True)
 def events_from_aux(aux, eref, mdl, g):
-    """Event function values (see kernel.event_values) from a dynamics evaluation's aux."""
+    """The contact points' event function values into g[:2 NEV_TIP] from a dynamics
+    evaluation's aux."""
     beta = mdl[0][F_BETA]
     vres = mdl[0][F_VREG]
     cpar = mdl[9]
@@ -82,6 +126,8 @@ def events_from_aux(aux, eref, mdl, g):
 @njit(cache=True)
 def _active(k, g_old, g_new, regime, fmodel):
     """Whether event k is watched in a step with end values g_old, g_new."""
+    if k >= 2 * NEV_TIP:
+        return True  # the armature's: its stops and card, always (constant where absent)
     i = k // NEV_TIP
     kind = k % NEV_TIP
     if kind == EV_CONTACT:
@@ -97,33 +143,47 @@ def _active(k, g_old, g_new, regime, fmodel):
 
 
 @njit(cache=True)
+def armature_step_bound(arm, hcap):
+    """The step bound (s) with the armature's stop or card closed and the armature not seated:
+    within the explicit method's accurate range, AP_HMAX = 1 / their highest rate (beyond
+    |lambda h| ~ 1 its steps amplify the contact's ringing, which the error estimate then
+    holds only at ~100 times the tolerance: a pressed armature lifted off spuriously)."""
+    apar, _, closed = arm
+    if closed[EA_SEAT] == 0.0 and (closed[EA_REST] != 0.0 or closed[EA_POLE] != 0.0 or closed[EA_CARD] != 0.0):
+        if hcap > apar[AP_HMAX]:
+            return apar[AP_HMAX]
+    return hcap
+
+
+@njit(cache=True)
 def _rk_stages(t, y, h, k1, k2, k3, k4, k5, k6, k7, ytmp, ynew, mdl,
-               regime, eref, aux_stage, aux_new, work):
+               regime, eref, aux_stage, aux_new, work, arm):
     """One Dormand-Prince step of size h from (t, y) with k1 = f(t, y): ynew and the stages;
     k7 = f(t + h, ynew) with its aux in aux_new (first-same-as-last)."""
     N = y.shape[0]
     for i in range(N):
         ytmp[i] = y[i] + h * A21 * k1[i]
-    dynamics(t + C2 * h, ytmp, mdl, regime, eref, k2, aux_stage, work)
+    dynamics(t + C2 * h, ytmp, mdl, regime, eref, k2, aux_stage, work, arm)
     for i in range(N):
         ytmp[i] = y[i] + h * (A31 * k1[i] + A32 * k2[i])
-    dynamics(t + C3 * h, ytmp, mdl, regime, eref, k3, aux_stage, work)
+    dynamics(t + C3 * h, ytmp, mdl, regime, eref, k3, aux_stage, work, arm)
     for i in range(N):
         ytmp[i] = y[i] + h * (A41 * k1[i] + A42 * k2[i] + A43 * k3[i])
-    dynamics(t + C4 * h, ytmp, mdl, regime, eref, k4, aux_stage, work)
+    dynamics(t + C4 * h, ytmp, mdl, regime, eref, k4, aux_stage, work, arm)
     for i in range(N):
         ytmp[i] = y[i] + h * (A51 * k1[i] + A52 * k2[i] + A53 * k3[i] + A54 * k4[i])
-    dynamics(t + C5 * h, ytmp, mdl, regime, eref, k5, aux_stage, work)
+    dynamics(t + C5 * h, ytmp, mdl, regime, eref, k5, aux_stage, work, arm)
     for i in range(N):
         ytmp[i] = y[i] + h * (A61 * k1[i] + A62 * k2[i] + A63 * k3[i] + A64 * k4[i] + A65 * k5[i])
-    dynamics(t + h, ytmp, mdl, regime, eref, k6, aux_stage, work)
+    dynamics(t + h, ytmp, mdl, regime, eref, k6, aux_stage, work, arm)
     for i in range(N):
         ynew[i] = y[i] + h * (A71 * k1[i] + A73 * k3[i] + A74 * k4[i] + A75 * k5[i] + A76 * k6[i])
-    dynamics(t + h, ynew, mdl, regime, eref, k7, aux_new, work)
+    dynamics(t + h, ynew, mdl, regime, eref, k7, aux_new, work, arm)
 
 
 @njit(cache=True)
-def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, store_dense, max_steps, work, stats):
+def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, store_dense, max_steps, work, stats,
+              arm=None):
     """Advance y (in place) from t (s) towards t_stop (s), starting with step h (s; 0: choose).
 
     tol: (hmax s, rtol, atol per component, relmask per component: 1 where rtol applies).
@@ -137,14 +197,17 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
     (time, state, per-tip aux and the largest normal force seen at the step's ends and
     three interior points); with store_dense, also the step's dense-output coefficients.
     stats (int64[4]) accumulates: accepted steps, rejected steps, rhs evaluations, events.
+    arm: None, or the armature's arrays (kernel.dynamics: an argument of its own, so that a
+    model without an armature runs code compiled without it).
     """
     hmax, rtol, atol, relmask = tol
     rec_t, rec_y, rec_aux, rec_fmax = rec
     dense_t0, dense_h, dense_coef = dense
     N = y.shape[0]
-    nev = 2 * NEV_TIP
+    nev = NEV
     fpar = mdl[0]
     fmodel = mdl[1][I_FRICTION]
+    sv = work[22]  # (the dynamics' scratch vector: what the armature's events read)
     k1 = np.empty(N)
     k2 = np.empty(N)
     k3 = np.empty(N)
@@ -166,9 +229,9 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
     n_rec = 0
     facold = 1e-4
 
-    dynamics(t, y, mdl, regime, eref, k1, aux_old, work)
+    dynamics(t, y, mdl, regime, eref, k1, aux_old, work, arm)
     stats[2] += 1
-    events_from_aux(aux_old, eref, mdl, g_old)
+    event_values(y, aux_old, sv, eref, mdl, g_old, arm)
     if h <= 0.0:  # initial step from the derivative scale (Hairer's heuristic, simplified)
         d0 = 0.0
         d1 = 0.0
@@ -199,6 +262,8 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
         hcap = hmax
         if gap > 0.0 and 0.5 * gap / fpar[F_VBOUND] > hmax:
             hcap = 0.5 * gap / fpar[F_VBOUND]
+        if arm is not None:
+            hcap = armature_step_bound(arm, hcap)
         if h > hcap:
             h = hcap
         last = False
@@ -208,7 +273,7 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
             last = True
         if not last and (h < 1e-15 * max(1.0, abs(t)) or h < 1e-18):
             return STEP_TOO_SMALL, t, h, n_rec, -1  # (a last step clipped to t_stop may be tiny)
-        _rk_stages(t, y, h, k1, k2, k3, k4, k5, k6, k7, ytmp, ynew, mdl, regime, eref, aux_stage, aux_new, work)
+        _rk_stages(t, y, h, k1, k2, k3, k4, k5, k6, k7, ytmp, ynew, mdl, regime, eref, aux_stage, aux_new, work, arm)
         stats[2] += 6
         err = 0.0
         finite = True
@@ -240,7 +305,7 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
             continue
         # accepted: events
         facold = max(err, 1e-4)
-        events_from_aux(aux_new, eref, mdl, g_new)
+        event_values(ynew, aux_new, sv, eref, mdl, g_new, arm)
         _dense_coefficients(y, ynew, h, k1, k3, k4, k5, k6, k7, coef)
         first_k = -1
         h_continue = h
@@ -266,9 +331,9 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
                 if not (a < tc < b):
                     tc = 0.5 * (a + b)
                 dense_eval(coef, tc, ymid)
-                dynamics(t + tc * h, ymid, mdl, regime, eref, ytmp, aux_stage, work)
+                dynamics(t + tc * h, ymid, mdl, regime, eref, ytmp, aux_stage, work, arm)
                 stats[2] += 1
-                events_from_aux(aux_stage, eref, mdl, g_mid)
+                event_values(ymid, aux_stage, sv, eref, mdl, g_mid, arm)
                 gc = g_mid[k]
                 if s * gc > 0.0:
                     a = tc
@@ -308,9 +373,9 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
                 found = False
                 for _ in range(40):
                     _rk_stages(t, y, trial * h, k1, k2, k3, k4, k5, k6, k7, ytmp, ymid, mdl,
-                               regime, eref, aux_stage, aux_new, work)
+                               regime, eref, aux_stage, aux_new, work, arm)
                     stats[2] += 6
-                    events_from_aux(aux_new, eref, mdl, g_mid)
+                    event_values(ymid, aux_new, sv, eref, mdl, g_mid, arm)
                     gt = g_mid[first_k]
                     if s_ev * gt < 0.0:
                         hi = trial
@@ -335,7 +400,7 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
                         trial = 0.5 * (lo + hi)
                 if not found:  # the last trial ended on the old side: retake at hi
                     _rk_stages(t, y, hi * h, k1, k2, k3, k4, k5, k6, k7, ytmp, ymid, mdl,
-                               regime, eref, aux_stage, aux_new, work)
+                               regime, eref, aux_stage, aux_new, work, arm)
                     stats[2] += 6
                 hh = hi * h
                 h_continue = h
@@ -343,7 +408,7 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
                 _dense_coefficients(y, ymid, hh, k1, k3, k4, k5, k6, k7, coef)
                 h = hh
                 first_theta = 1.0
-            dynamics(tev, ymid, mdl, regime, eref, ytmp, aux_new, work)
+            dynamics(tev, ymid, mdl, regime, eref, ytmp, aux_new, work, arm)
             stats[2] += 1
             _record(n_rec, t, h, tev, ymid, aux_new, aux_old, coef, rec, dense, store_dense, mdl, first_theta)
             n_rec += 1
@@ -411,7 +476,7 @@ def _record(n_rec, t_start, h, t_end, y_end, aux_end, aux_start, coef, rec, dens
 
 @njit(cache=True)
 def dense_contact(times, t_valid, dense_t0, dense_h, dense_coef, regimes, mdl,
-                  eref, work, out):
+                  eref, work, out, arm=None):
     """Per tip penetration (m), rate (m/s) and normal force (N) at sorted ``times`` from the
     stored dense output; out has shape (len(times), 2, 3)."""
     N = dense_coef.shape[2]
@@ -425,7 +490,7 @@ def dense_contact(times, t_valid, dense_t0, dense_h, dense_coef, regimes, mdl,
         while k < n - 1 and t_valid[k] < t:
             k += 1
         dense_eval(dense_coef[k], (t - dense_t0[k]) / dense_h[k], y)
-        dynamics(t, y, mdl, regimes[k], eref, dy, aux, work)
+        dynamics(t, y, mdl, regimes[k], eref, dy, aux, work, arm)
         for i in range(2):
             out[m, i, 0] = aux[i, A_Y]
             out[m, i, 1] = aux[i, A_YDOT]
@@ -461,6 +526,13 @@ def tip_forces(y, mdl, out):
     kinematics alone (the normal force follows the penetration and its rate; no
     accelerations, so a fraction of a right-hand side's cost)."""
     fpar, ipar, psi, xc, cpar = mdl[0], mdl[1], mdl[6], mdl[8], mdl[9]
+    if ipar[I_MOUNT] == MOUNT_NONE:  # no bar: no contact point
+        out[0] = 0.0
+        out[1] = 0.0
+        out[2] = 1e300
+        out[3] = -1e3
+        out[4] = -1e3
+        return
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
     r = np.empty(3)

@@ -1,7 +1,9 @@
 """Compiled right-hand side of the floating-frame bar with tip contact and friction.
 
-State layout (3D):     r(3) quat(4) q(n) | V(3) w(3) eta(n) | quadratures(NQ)
-State layout (planar): x z phi q(n)      | vx vz wy eta(n)  | quadratures(NQ)
+State layout (3D):     r(3) quat(4) q(n) | V(3) w(3) eta(n) | [armature] | quadratures(NQ)
+State layout (planar): x z phi q(n)      | vx vz wy eta(n)  | [armature] | quadratures(NQ)
+[armature]: its travel q_a (m or rad) and rate, in models that have one (mech/armature.py);
+a model without a bar (an armature alone) is q_a, dq_a/dt | quadratures.
 r, V: centre of mass in the world frame (z up, m, m/s); quat: body->world (scalar
 first); phi: rotation about world y; w: body angular velocity (rad/s); q, eta: modal
 coordinates (m) and speeds (m/s). Quadratures integrate dissipation and contact work
@@ -25,7 +27,7 @@ import math
 
 import numpy as np
 
-from . import contact_laws as _contact_laws, friction as _friction, rotations as _rotations
+from . import armature as _armature, contact_laws as _contact_laws, friction as _friction, rotations as _rotations
 from .jit import njit
 from .inertia import inertia_matrix, inertia_terms, inertia_terms_sparse, schur_complement
 from .kernel_layout import (  # noqa: F401  (re-exported: the kernel's own names)
@@ -37,17 +39,24 @@ from .kernel_layout import (  # noqa: F401  (re-exported: the kernel's own names
     L_DY, L_DZ, L_T0, L_TN, L_AX, L_AY, L_AZ, L_K, L_C, L_L0, N_LOAD, FREE, SLIP, STICK,
     Q_DNORMAL, Q_DFRICTION, Q_DMODAL, Q_WCOMP, Q_IMPULSE, Q_WIN, Q_DLOAD, NQ_FREE, NQ, A_Y,
     A_YDOT, A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_MARGIN, NAUX, EV_CONTACT, EV_CLIP, EV_SLIP,
-    EV_STICK, EV_COMPRESSION, NEV_TIP,
-    state_sizes,
+    EV_STICK, EV_COMPRESSION, NEV_TIP, NEV, EA_REST, EA_POLE, EA_CARD, EA_SEAT, MOUNT_NONE, I_ARMATURE,
+    I_ARM_DRIVE,
+    I_ARM_CARD, I_ARM_NGAIN, AP_MASS, AP_TRAVEL, AP_RATE, AP_PRELOAD, AP_STOP_K, AP_STOP_C, AP_DAMPING, AP_LEVER,
+    AP_FREE, AP_CARD_K, AP_CARD_C, AP_CARD_Z0, AP_HMAX, N_ARM, NEV_ARM, EA_TURN,
+    state_sizes, armature_offset,
 )
 
 # the pure-Python laws and layout, compiled for the loop (their modules stay numba-free)
 layout = njit(cache=True)(state_sizes)
+arm_offset = njit(cache=True)(armature_offset)
 normal_force = njit(cache=True)(_contact_laws.normal_force)
 friction_limit = njit(cache=True)(_friction.friction_limit)
 regularized_scale = njit(cache=True)(_friction.regularized_scale)
 slip_direction = njit(cache=True)(_friction.slip_direction)
 scaled_rebound = njit(cache=True)(_contact_laws.scaled_rebound)  # the damping calibration's impact
+stop_force = njit(cache=True)(_armature.stop_force)
+return_force = njit(cache=True)(_armature.return_force)
+gain_at = njit(cache=True)(_armature.gain_at)
 
 
 quat_to_matrix = njit(cache=True)(_rotations.quat_to_matrix)
@@ -105,7 +114,7 @@ def make_work(n):
         np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3)),  # s_tip sdot_tip theta_dot_tip (body)
         np.zeros((2, 3)),  # vP world
         np.zeros((4, 3)), np.zeros((4, n)), np.zeros((4, 3)),  # unit responses: wdot etadot Vdot
-        np.zeros(12), np.zeros((3, 3)),  # small vectors, Schur complement
+        np.zeros(12), np.zeros((3, 3)),  # small vectors (an armature's terms at 6-10), Schur complement
     )
 
 
@@ -354,16 +363,183 @@ def _tip_accel(k, R, s_tip, psi, theta, n, Rtip, Vdot, wdot, etadot, out):
 
 
 @njit(cache=True)
-def dynamics(t, y, mdl, regime, eref, dy, aux, work):
+def armature_terms(t, qa, va, pen_card, pen_card_rate, ipar, apar, again, closed, drive, out):
+    """The armature's generalized force and powers, into out (4,): the force along q (N, or
+    N m for a clapper: the drive times the gain table, the return spring, the viscous
+    damping, the stops and the card's reaction), the card's force on the bar (N, >= 0,
+    along world -z at its point), the drive's power (W) and the power the dashpots of the
+    stops and card and the viscous damping dissipate (W).
+
+    qa, va: q (m or rad) and its rate; pen_card (m): how far the card has pressed past the
+    bar's point, and its rate (m/s) (0 without a card). closed (3,): 1.0 for each of the
+    rest stop, pole stop and card (kernel_layout EA_*) the solver has found closed; an
+    open one exerts nothing, whatever its penetration inside a step."""
+    row = ipar[I_ARM_DRIVE]
+    f_drive = drive_at(t, drive, row) * gain_at(qa, again, ipar[I_ARM_NGAIN])
+    c_v = apar[AP_DAMPING]
+    f = f_drive - return_force(qa, apar[AP_RATE], apar[AP_PRELOAD]) - c_v * va
+    d = c_v * va * va
+    k = apar[AP_STOP_K]
+    if closed[EA_REST] != 0.0 and qa < 0.0:  # on the rest stop, penetration -q
+        fs = stop_force(-qa, -va, k, apar[AP_STOP_C])
+        f += fs
+        d += (fs + k * qa) * (-va)
+    pen = qa - apar[AP_TRAVEL]
+    if closed[EA_POLE] != 0.0 and pen > 0.0:  # on the pole stop
+        fs = stop_force(pen, va, k, apar[AP_STOP_C])
+        f -= fs
+        d += (fs - k * pen) * va
+    fc = 0.0
+    if ipar[I_ARM_CARD] >= 0 and closed[EA_CARD] != 0.0 and pen_card > 0.0:
+        kc = apar[AP_CARD_K]
+        fc = stop_force(pen_card, pen_card_rate, kc, apar[AP_CARD_C])
+        f -= apar[AP_LEVER] * fc
+        d += (fc - kc * pen_card) * pen_card_rate
+    out[0] = f
+    out[1] = fc
+    out[2] = f_drive * va
+    out[3] = d
+
+
+@njit(cache=True)
+def armature_force(t, y, mdl, arm):
+    """N (N m for a clapper): the force on the armature along q at t (s) in state y, of
+    everything but its stops: the drive times the gain, the return spring, the viscous
+    damping and the card's reaction. Seated on a stop, this presses it there (towards the
+    pole: the pole stop; its negative: the rest stop). arm: the model's armature arrays."""
+    ipar, psi, xc, drive = mdl[1], mdl[6], mdl[8], mdl[14]
+    apar, again, aclosed = arm
+    n = ipar[I_N]
+    planar = ipar[I_PLANAR]
+    off = arm_offset(n, planar, ipar[I_MOUNT])
+    qa = y[off]
+    va = y[off + 1]
+    pen_c = 0.0
+    rate_c = 0.0
+    pc = ipar[I_ARM_CARD]
+    if pc >= 0:
+        r = np.empty(3)
+        R = np.empty((3, 3))
+        q = np.empty(n)
+        V = np.empty(3)
+        w = np.empty(3)
+        eta = np.empty(n)
+        x = np.empty(3)
+        v = np.empty(3)
+        unpack(y, n, planar, r, R, q, V, w, eta)
+        load_point_motion(pc, xc, psi, r, R, q, V, w, eta, n, x, v)
+        pen_c, rate_c = card_penetration(qa, va, x[2], v[2], apar)
+    open_stops = np.zeros(NEV_ARM)
+    open_stops[EA_CARD] = aclosed[EA_CARD]
+    terms = np.empty(4)
+    armature_terms(t, qa, va, pen_c, rate_c, ipar, apar, again, open_stops, drive, terms)
+    return terms[0]
+
+
+@njit(cache=True)
+def card_penetration(qa, va, z, vz, apar):
+    """(m, m/s): how far the card has pressed past the bar's card point, and its rate. The card
+    hangs card_free_travel above the point's height at the start (AP_CARD_Z0) when q = 0
+    and moves down (world -z) by lever x q; z, vz: the point's world height (m) and rate."""
+    return apar[AP_LEVER] * qa - apar[AP_FREE] - (apar[AP_CARD_Z0] - z), apar[AP_LEVER] * va + vz
+
+
+@njit(cache=True)
+def _armature_alone(t, y, ipar, arm, drive, dy, aux, sv):
+    """dynamics of a model without a bar: the armature's two states, its quadratures (the
+    drive's work, the dissipation), its terms into sv[6:11] as beside a bar
+    (_armature_on_bar), and the two contact rows of aux switched off."""
+    apar, again, closed = arm
+    for i in range(2):
+        for c_ in range(NAUX):
+            aux[i, c_] = 0.0
+        aux[i, A_Y] = -1e3
+    terms = sv[6:10]
+    armature_terms(t, y[0], y[1], 0.0, 0.0, ipar, apar, again, closed, drive, terms)
+    sv[10] = 0.0
+    if closed[EA_SEAT] != 0.0:  # seated on its stop: held there
+        dy[0] = 0.0
+        dy[1] = 0.0
+    else:
+        dy[0] = y[1]
+        dy[1] = terms[0] / apar[AP_MASS]
+    for k in range(N_ARM, dy.shape[0]):
+        dy[k] = 0.0
+    dy[N_ARM + Q_WIN] = terms[2]
+    dy[N_ARM + Q_DLOAD] = terms[3]
+
+
+@njit(cache=True)
+def _armature_on_bar(t, y, n, planar, mount, ipar, arm, drive, xc, psi, theta,
+                     r, R, q, V, w, eta, F, f_r, f_e, Fw, Mw, sv):
+    """The armature beside a bar (dynamics): its terms into sv[6:10] (armature_terms) and the
+    card's penetration into sv[10] (for the events: mech.integrator.armature_events), its
+    card's force on the bar's point (down, world -z) into the bar's generalized forces.
+    Returns (the drive's power, the dissipated power), W."""
+    apar, again, aclosed = arm
+    off = arm_offset(n, planar, mount)
+    qa = y[off]
+    va = y[off + 1]
+    pc = ipar[I_ARM_CARD]
+    pen_c = 0.0
+    pen_c_rate = 0.0
+    s0 = 0.0
+    s1 = 0.0
+    s2 = 0.0
+    if pc >= 0:
+        xcard = np.empty(3)
+        vcard = np.empty(3)
+        s0, s1, s2 = load_point_motion(pc, xc, psi, r, R, q, V, w, eta, n, xcard, vcard)
+        pen_c, pen_c_rate = card_penetration(qa, va, xcard[2], vcard[2], apar)
+    terms = sv[6:10]
+    armature_terms(t, qa, va, pen_c, pen_c_rate, ipar, apar, again, aclosed, drive, terms)
+    sv[10] = pen_c
+    if terms[1] > 0.0:
+        Fw[0] = 0.0
+        Fw[1] = 0.0
+        Fw[2] = -terms[1]
+        Mw[0] = 0.0
+        Mw[1] = 0.0
+        Mw[2] = 0.0
+        _add_force_at(pc, s0, s1, s2, Fw, Mw, R, psi, theta, n, F, f_r, f_e)
+    return terms[2], terms[3]
+
+
+@njit(cache=True)
+def _armature_rates(y, base, arm, sv, dy):
+    """The armature's two rates into dy[base:base + 2] (its force in sv[6], _armature_on_bar);
+    held while seated."""
+    apar, _, aclosed = arm
+    if aclosed[EA_SEAT] != 0.0:
+        dy[base] = 0.0
+        dy[base + 1] = 0.0
+    else:
+        dy[base] = y[base + 1]
+        dy[base + 1] = sv[6] / apar[AP_MASS]
+
+
+@njit(cache=True)
+def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
     """Time derivative of the state into ``dy``; per-contact-point quantities into ``aux`` (2, NAUX).
 
     mdl: the model arrays and, last, the drive (model.BarModel.kernel_arrays: each contact
-    point's friction coefficient and repulsion over time, set by the caller, found through
-    the model's index array cdrive; the model's arrays never change). regime: (2,) FREE/SLIP/STICK per
+    point's friction coefficient and repulsion and the armature's force over time, set by
+    the caller, found through the model's index array cdrive and ipar[I_ARM_DRIVE]; the
+    model's arrays never change). regime: (2,) FREE/SLIP/STICK per
     contact point (friction bookkeeping; the normal force always follows the
     penetration). eref: (2, 2) reference slip direction per contact point.
+    arm: None, or the armature's arrays (model.BarModel.kernel_armature: its parameters
+    AP_*, its gain table, its contacts' states EA_*). An argument of its own, not in mdl:
+    numba compiles the kernel once for None, where every armature branch is removed
+    before the code is generated, so a model without an armature runs the code it ran
+    before the armature existed (measured: in mdl, the same branches, never taken, made
+    the default scene's run 10 % slower).
     """
     fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs, cdrive, drive = mdl
+    if arm is not None:
+        if ipar[I_MOUNT] == MOUNT_NONE:
+            _armature_alone(t, y, ipar, arm, drive, dy, aux, work[22])
+            return
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
     fmodel = ipar[I_FRICTION]
@@ -543,6 +719,12 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work):
         w_in += w_in_l
         d_load += d_l
 
+    if arm is not None:
+        w_arm, d_arm = _armature_on_bar(t, y, n, planar, mount, ipar, arm, drive, xc, psi, theta,
+                                        r, R, q, V, w, eta, F, f_r, f_e, Fw, Mw, sv)
+        w_in += w_arm
+        d_load += d_arm
+
     _solve_mounted(mount, F, f_r, f_e, Ainv, B, m, n, Vdot, wdot, etadot)
 
     if n_stick > 0:
@@ -590,6 +772,9 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work):
         for j in range(n):
             dy[13 + n + j] = etadot[j]
     base = npos + nvel
+    if arm is not None:
+        _armature_rates(y, base, arm, sv, dy)
+        base += N_ARM
     dy[base + Q_DNORMAL] = d_normal
     dy[base + Q_DFRICTION] = d_friction
     dy[base + Q_DMODAL] = d_modal
@@ -820,7 +1005,7 @@ def _apply_stick(fpar, n, planar, mount, R, w, eta, s_tip, sd_tip, th_tip, vP, r
 
 
 @njit(cache=True)
-def project_to_stick(t, y, mdl, regime, eref, aux, work):
+def project_to_stick(t, y, mdl, regime, eref, aux, work, arm=None):
     """Remove the slip velocity of every sticking tip by the smallest change of the speeds
     in the kinetic-energy metric: du = -M^-1 G^T (G M^-1 G^T)^-1 v_t, in the directions a
     slip at rest can be removed in (_rest_projection_solve). Returns the kinetic energy
@@ -830,7 +1015,7 @@ def project_to_stick(t, y, mdl, regime, eref, aux, work):
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
     dy = np.empty(y.shape[0])
-    dynamics(t, y, mdl, regime, eref, dy, aux, work)
+    dynamics(t, y, mdl, regime, eref, dy, aux, work, arm)
     (r, R, q, V, w, eta, Jm, B, Ainv, f_r, f_e, F, wdot, etadot, Vdot,
      s_tip, sd_tip, th_tip, vP, u_wdot, u_etadot, u_Vdot, sv, Amat) = work
     tips, ns = _sticking_tips(regime, aux)
@@ -874,9 +1059,27 @@ def project_to_stick(t, y, mdl, regime, eref, aux, work):
 
 
 @njit(cache=True)
-def energies(y, mdl, work, out):
+def armature_energy(qa, va, pen_card, apar, has_card):
+    """(kinetic, stored) energy of the armature (J): 1/2 m v^2; the return spring's
+    preload q + rate q^2 / 2, the stops' and the card's k pen^2 / 2."""
+    k = apar[AP_STOP_K]
+    stored = apar[AP_PRELOAD] * qa + 0.5 * apar[AP_RATE] * qa * qa
+    if qa < 0.0:
+        stored += 0.5 * k * qa * qa
+    pen = qa - apar[AP_TRAVEL]
+    if pen > 0.0:
+        stored += 0.5 * k * pen * pen
+    if has_card and pen_card > 0.0:
+        stored += 0.5 * apar[AP_CARD_K] * pen_card * pen_card
+    return 0.5 * apar[AP_MASS] * va * va, stored
+
+
+@njit(cache=True)
+def energies(y, mdl, work, out, arm=None):
     """out = (kinetic, elastic strain, gravity potential, stored Hertz energy, stored
-    energy of springs and the pivot's torsion spring incl. its preload), all J.
+    energy of springs and the pivot's torsion spring incl. its preload), all J; an
+    armature's kinetic energy counts in the first, its return spring's, stops' and card's
+    stored energy in the last.
 
     Kinetic energy about a frame origin that is not the centroid (held bars):
     1/2 m V.V + V . R (w x (c + L q) + L eta) + 1/2 w J w + w B eta + 1/2 m eta.eta.
@@ -884,6 +1087,14 @@ def energies(y, mdl, work, out):
     fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs, cdrive, drive = mdl
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
+    if arm is not None and ipar[I_MOUNT] == MOUNT_NONE:
+        kin, stored = armature_energy(y[0], y[1], 0.0, arm[0], False)
+        out[0] = kin
+        out[1] = 0.0
+        out[2] = 0.0
+        out[3] = 0.0
+        out[4] = stored
+        return
     r, R, q, V, w, eta, Jm, B = work[0], work[1], work[2], work[3], work[4], work[5], work[6], work[7]
     unpack(y, n, planar, r, R, q, V, w, eta)
     m = fpar[F_MASS]
@@ -948,6 +1159,17 @@ def energies(y, mdl, work, out):
     if ipar[I_MOUNT] == MOUNT_PIVOT:
         th = fpar[F_PIV_SIGN] * (y[2] - fpar[F_PIV_PHI0])
         sp += 0.5 * fpar[F_PIV_K] * th * th - fpar[F_PIV_T0] * th
+    if arm is not None:
+        apar = arm[0]
+        off = arm_offset(n, planar, ipar[I_MOUNT])
+        pc = ipar[I_ARM_CARD]
+        pen_c = 0.0
+        if pc >= 0:
+            load_point_motion(pc, xc, psi, r, R, q, V, w, eta, n, x, v)
+            pen_c, _ = card_penetration(y[off], y[off + 1], x[2], v[2], apar)
+        ka, ua = armature_energy(y[off], y[off + 1], pen_c, apar, pc >= 0)
+        kin += ka
+        sp += ua
     out[0] = kin
     out[1] = el
     out[2] = fpar[F_G] * (m * r[2] + R[2, 0] * cq[0] + R[2, 1] * cq[1] + R[2, 2] * cq[2])
@@ -956,13 +1178,52 @@ def energies(y, mdl, work, out):
 
 
 @njit(cache=True)
-def energy_table(Y, mdl):
+def armature_table(Y, mdl, arm):
+    """(records, 6) of the state history Y: the armature's q (m or rad), its rate, the
+    card's force on the bar (N), the stops' force on the armature (N or N m, positive
+    towards the pole: the rest stop's push), the card's penetration past the bar's point
+    (m) and its rate (m/s) (0 without a card)."""
+    fpar, ipar, J0, sp_ptr, sp_idx, sp_val, psi, theta, xc, cpar, cL, load, tabs, cdrive, _ = mdl
+    apar = arm[0]
+    n = ipar[I_N]
+    planar = ipar[I_PLANAR]
+    mount = ipar[I_MOUNT]
+    off = arm_offset(n, planar, mount)
+    work = make_work(n)
+    r, R, q, V, w, eta = work[0], work[1], work[2], work[3], work[4], work[5]
+    x = np.empty(3)
+    v = np.empty(3)
+    out = np.zeros((Y.shape[0], 6))
+    pc = ipar[I_ARM_CARD]
+    k = apar[AP_STOP_K]
+    c = apar[AP_STOP_C]
+    for rec in range(Y.shape[0]):
+        y = Y[rec]
+        qa = y[off]
+        va = y[off + 1]
+        fc = 0.0
+        if pc >= 0:
+            unpack(y, n, planar, r, R, q, V, w, eta)
+            load_point_motion(pc, xc, psi, r, R, q, V, w, eta, n, x, v)
+            pen_c, rate_c = card_penetration(qa, va, x[2], v[2], apar)
+            fc = stop_force(pen_c, rate_c, apar[AP_CARD_K], apar[AP_CARD_C])
+            out[rec, 4] = pen_c
+            out[rec, 5] = rate_c
+        out[rec, 0] = qa
+        out[rec, 1] = va
+        out[rec, 2] = fc
+        out[rec, 3] = stop_force(-qa, -va, k, c) - stop_force(qa - apar[AP_TRAVEL], va, k, c)
+    return out
+
+
+@njit(cache=True)
+def energy_table(Y, mdl, arm=None):
     """(records, 5): ``energies`` of every row of the state history Y."""
     n = mdl[1][0]
     work = make_work(n)
     out = np.empty((Y.shape[0], 5))
     e = np.empty(5)
     for k in range(Y.shape[0]):
-        energies(Y[k], mdl, work, e)
+        energies(Y[k], mdl, work, e, arm)
         out[k] = e
     return out

@@ -13,6 +13,11 @@ from __future__ import annotations
 (F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MAX_RATIO, F_RTIP, F_VREG, F_BAUM,
  F_VBOUND, F_BLOCK_Z, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN) = range(17)
 N_FPAR = 17
+# the armature's one-sided contacts (its rest stop, pole stop and card, EA_* below) that
+# the solver has found closed at its events (1.0) or open (0.0), and whether it is seated:
+# their forces act only while closed, so a step never integrates across the jump c v of a
+# dashpot's force at touchdown (the solver's own array, beside the drive in the kernel's
+# model tuple).
 # the drive: what the caller changes during a run, passed beside the model's arrays (the
 # last element of the kernel's model tuple) so that the model itself never changes. One
 # row per named channel (mech.model.BarModel.drive_names), each linear in time within a
@@ -26,15 +31,18 @@ N_DRIVE = 3
 # rows through cdrive only, never by name
 K_MU, K_REPULSION = range(2)
 CONTACT_DRIVES = ("mu", "repulsion")
-# ipar indices
-I_N, I_PLANAR, I_FRICTION, I_MOUNT, I_NLOAD, I_INERTIA = range(6)
-N_IPAR = 6
+# ipar indices; the armature's (mech/armature.py): 1 when the model has one, the drive
+# row of "armature.force", the card's point row (in psi/theta/xc, after the loads; -1:
+# no card), the number of knots of its gain table (0: gain 1)
+I_N, I_PLANAR, I_FRICTION, I_MOUNT, I_NLOAD, I_INERTIA, I_ARMATURE, I_ARM_DRIVE, I_ARM_CARD, I_ARM_NGAIN = range(10)
+N_IPAR = 10
 # inertia route (mech/inertia.py): Gram products (analytic free-free basis) or sparse list
 INERTIA_GRAM, INERTIA_SPARSE = 0, 1
 FRICTION_NONE, FRICTION_EXACT, FRICTION_REGULARIZED = 0, 1, 2
 # how the bar is held: free (6 rigid degrees of freedom), clamped at a base that moves
-# with a piecewise-constant velocity (none), pivoted about body y (rotation only, planar)
-MOUNT_FREE, MOUNT_CLAMP, MOUNT_PIVOT = 0, 1, 2
+# with a piecewise-constant velocity (none), pivoted about body y (rotation only, planar);
+# MOUNT_NONE: no bar at all, an armature alone (its state only)
+MOUNT_FREE, MOUNT_CLAMP, MOUNT_PIVOT, MOUNT_NONE = 0, 1, 2, 3
 # per contact point (cpar rows 0, 1): Hertz stiffness N/m^1.5, damping c, cap radius m,
 # 1.0 when the point exists
 C_K, C_C, C_R, C_ON = range(4)
@@ -43,6 +51,16 @@ C_K, C_C, C_R, C_ON = range(4)
 LOAD_FORCE, LOAD_SPRING = 0, 1
 (L_KIND, L_POINT, L_BODY, L_DX, L_DY, L_DZ, L_T0, L_TN, L_AX, L_AY, L_AZ, L_K, L_C, L_L0) = range(14)
 N_LOAD = 14
+# the armature (mech/armature.py): a rigid body with one coordinate q (m or rad, the travel
+# from its rest stop), its parameters in ``apar`` (SI: kg or kg m^2; m or rad; N/m or
+# N m/rad; N or N m; N s/m or N m s/rad; the card's lever m per unit q, free travel m,
+# stiffness N/m, damping N s/m, and the world height of the bar's card point at the
+# start, m). Its two states (q, dq/dt) follow the bar's positions and speeds, before
+# the quadratures. Gain table ``again`` (3, knots): positions, gains, PCHIP slopes.
+(AP_MASS, AP_TRAVEL, AP_RATE, AP_PRELOAD, AP_STOP_K, AP_STOP_C, AP_DAMPING,
+ AP_LEVER, AP_FREE, AP_CARD_K, AP_CARD_C, AP_CARD_Z0, AP_HMAX) = range(13)
+N_APAR = 13  # AP_HMAX: s, the longest step while a stop or the card is closed (1 / their highest rate)
+N_ARM = 2  # its states
 # regimes of a tip
 FREE, SLIP, STICK = 0, 1, 2
 # quadratures: dissipations; per tip i, compression work at Q_WCOMP + 2i, restitution
@@ -60,6 +78,16 @@ NAUX = 8
 # turn (dy/dt = 0: splits the normal work into compression and restitution exactly)
 EV_CONTACT, EV_CLIP, EV_SLIP, EV_STICK, EV_COMPRESSION = range(5)
 NEV_TIP = 5
+# the armature's events, after the tips' (index 2 NEV_TIP + EA_*): the rest stop (q), the
+# pole stop (travel - q) and the card (its gap to the bar), each positive while open; the
+# turn (its speed, watched while a stop is closed and it is not seated) and the seat (the
+# force pressing it onto the stop it is seated on, watched while seated). The same indices
+# in the solver's array of the contacts' states (``aclosed``): 1.0 where the rest stop,
+# pole stop, card is closed; at EA_SEAT, 1.0 while the armature is seated on its closed
+# stop (held there, its stop's force the reaction; docs/mechanics.md, "The armature")
+EA_REST, EA_POLE, EA_CARD, EA_TURN, EA_SEAT = range(5)
+NEV_ARM = 5
+NEV = 2 * NEV_TIP + NEV_ARM
 
 
 # what one call of the integrator ended with (mech.integrator.integrate)
@@ -68,7 +96,14 @@ STATUS_TEXT = ("done", "event", "buffer full", "step size too small", "non-finit
 
 
 def state_sizes(n: int, planar: bool) -> tuple[int, int]:
-    """(position size, velocity size) of the state for n modes (see mech.kernel's layout)."""
+    """(position size, velocity size) of the bar's state for n modes (see mech.kernel's layout)."""
     if planar:
         return 3 + n, 3 + n
     return 7 + n, 6 + n
+
+
+def armature_offset(n: int, planar: bool, mount: int) -> int:
+    """Index of the armature's q in the state: after the bar's positions and speeds (0: no bar)."""
+    if mount == MOUNT_NONE:
+        return 0
+    return 6 + 2 * n if planar else 13 + 2 * n  # (state_sizes, written out: compiled alone)

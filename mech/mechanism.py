@@ -44,9 +44,10 @@ class ContactPoint:
 
 
 def needs_mechanism(scene: MechScene) -> bool:
-    """True when the scene is more than the free bar on its two end caps."""
+    """True when the scene is more than the free bar on its two end caps (an armature's card
+    is a load point on the bar)."""
     return bool(scene.mount.held or scene.rivets or scene.forces or scene.springs
-                or scene.block.shape != "plane")
+                or scene.block.shape != "plane" or scene.armature.has_card)
 
 
 def contact_points(scene: MechScene) -> list[ContactPoint]:
@@ -93,6 +94,7 @@ class MechanismArrays:
     load: np.ndarray  # (n_loads, N_LOAD)
     tables: np.ndarray  # (2, k)
     spring_points: list  # (load row, spring) for the rest-length set-up
+    card_row: int = -1  # the armature card's point row (-1: no card)
 
 
 def build_arrays(scene: MechScene, planar: bool) -> MechanismArrays:
@@ -113,6 +115,9 @@ def build_arrays(scene: MechScene, planar: bool) -> MechanismArrays:
     loads = list(scene.forces) + list(scene.springs)
     s_pts += [ld.position for ld in loads]
     h_pts += [0.0 for _ in loads]
+    if scene.armature.has_card:  # the card's point on the axis, after the loads'
+        s_pts.append(scene.armature.card_position)
+        h_pts.append(0.0)
     # two contact rows always; a missing second contact is a switched-off dummy row
     if len(cps) < 2:
         s_pts.insert(len(cps), s_pts[0] if s_pts else 0.0)
@@ -162,7 +167,8 @@ def build_arrays(scene: MechScene, planar: bool) -> MechanismArrays:
         psi_tip=psi[:2], theta_tip=theta[:2], x_centre=xc[:2, 0].copy(),
     )
     springs = [(len(scene.forces) + k, sp) for k, sp in enumerate(scene.springs)]
-    return MechanismArrays(basis, x0, (psi, theta, xc), cps, first, load, tables, springs)
+    card = 2 + len(loads) if scene.armature.has_card else -1
+    return MechanismArrays(basis, x0, (psi, theta, xc), cps, first, load, tables, springs, card)
 
 
 def contact_parameters(cps, block, stiffness_override, dampings) -> np.ndarray:

@@ -10,17 +10,22 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .armature import gain_table
 from .beam_fe import beam_modes
 from .contact_laws import damping_formula, hertz_impact, hertz_stiffness
 from .damping_calibration import calibrate_damping
-from .drives import DriveKind, kind_of
+from .drives import ARMATURE_DRIVE, DriveKind, kind_of
 from .kernel_layout import (
     CONTACT_DRIVES, D_VALUE, F_BAUM, F_BETA, F_C, F_G, F_GAMMA, F_VBOUND, F_K, F_MASS, F_MAX_RATIO, F_RTIP,
-    N_DRIVE,
+    N_DRIVE, AP_CARD_C, AP_CARD_K, AP_CARD_Z0, AP_DAMPING, AP_FREE, AP_LEVER, AP_MASS, AP_PRELOAD, AP_RATE,
+    AP_HMAX, AP_STOP_C, AP_STOP_K, AP_TRAVEL, I_ARMATURE, I_ARM_CARD, I_ARM_DRIVE, I_ARM_NGAIN, MOUNT_NONE, N_APAR,
+    N_ARM,
+    NEV_ARM,
+    armature_offset,
     F_VREG, FRICTION_EXACT, FRICTION_NONE, FRICTION_REGULARIZED, I_FRICTION, I_N,
     I_PLANAR, I_MOUNT, I_NLOAD, MOUNT_CLAMP, MOUNT_FREE, MOUNT_PIVOT, N_FPAR,
     F_PIV_C, F_PIV_K, F_PIV_PHI0, F_PIV_SIGN, F_PIV_T0, L_L0, I_INERTIA, INERTIA_GRAM, INERTIA_SPARSE, N_IPAR, N_LOAD, NQ, NQ_FREE, C_C, C_K, C_ON, C_R, state_sizes,
@@ -370,15 +375,90 @@ def _spring_rest_lengths(model: "BarModel") -> np.ndarray:
     return load
 
 
-def state_slices(n: int, planar: bool, nq: int) -> dict:
-    """Named slices of the state vector for n modes and nq quadratures."""
+def state_slices(n: int, planar: bool, nq: int, armature: bool = False, bar: bool = True) -> dict:
+    """Named slices of the state vector for n modes and nq quadratures; with an armature,
+    "armature" (its q and rate) between the bar's speeds and the quadratures; without a
+    bar, only "armature" and "quad"."""
+    if not bar:
+        return {"armature": slice(0, N_ARM), "quad": slice(N_ARM, N_ARM + nq)}
     if planar:
-        return {"pos": slice(0, 2), "angle": slice(2, 3), "q": slice(3, 3 + n),
-                "vel": slice(3 + n, 5 + n), "omega": slice(5 + n, 6 + n),
-                "eta": slice(6 + n, 6 + 2 * n), "quad": slice(6 + 2 * n, 6 + 2 * n + nq)}
-    return {"pos": slice(0, 3), "quat": slice(3, 7), "q": slice(7, 7 + n),
-            "vel": slice(7 + n, 10 + n), "omega": slice(10 + n, 13 + n),
-            "eta": slice(13 + n, 13 + 2 * n), "quad": slice(13 + 2 * n, 13 + 2 * n + nq)}
+        out = {"pos": slice(0, 2), "angle": slice(2, 3), "q": slice(3, 3 + n),
+               "vel": slice(3 + n, 5 + n), "omega": slice(5 + n, 6 + n),
+               "eta": slice(6 + n, 6 + 2 * n), "quad": slice(6 + 2 * n, 6 + 2 * n + nq)}
+    else:
+        out = {"pos": slice(0, 3), "quat": slice(3, 7), "q": slice(7, 7 + n),
+               "vel": slice(7 + n, 10 + n), "omega": slice(10 + n, 13 + n),
+               "eta": slice(13 + n, 13 + 2 * n), "quad": slice(13 + 2 * n, 13 + 2 * n + nq)}
+    if armature:
+        a0 = out["quad"].start
+        out["armature"] = slice(a0, a0 + N_ARM)
+        out["quad"] = slice(a0 + N_ARM, a0 + N_ARM + nq)
+    return out
+
+
+# the armature's speed scale where nothing else sets one (no return spring, no initial
+# speed): its travel in this time. A relay's armature or a small solenoid closes in
+# milliseconds; the error control needs only the order of magnitude (it is relative to the
+# armature's own q and speed once it moves; this scale sets their absolute floor)
+ARMATURE_TIME_SCALE = 1e-3  # s
+
+
+@dataclass(frozen=True)
+class ArmatureScales:
+    """The armature's scales (SI; m or rad for a clapper): its reference speed, the stops'
+    penetration at that speed, an energy, and the shortest contact time of its stops and
+    card (the undamped half period on the armature's mass)."""
+
+    speed: float
+    penetration: float
+    energy: float
+    contact_time: float
+
+
+def armature_scales(arm) -> ArmatureScales:
+    """Scales of the armature (a present mech.parameters.Armature) for the error control and
+    the step after a stop or card contact starts: the reference speed is the largest of the
+    speed the return spring's energy over the travel gives (the least the drive must put in
+    to close it, preload d + rate d^2 / 2), the initial speed and travel / ARMATURE_TIME_SCALE."""
+    m = arm.inertia_value
+    d = arm.travel
+    w_spring = arm.spring_preload * d + 0.5 * arm.spring_rate * d * d
+    speed = max(math.sqrt(2.0 * w_spring / m), abs(arm.initial_speed), d / ARMATURE_TIME_SCALE)
+    k = arm.stop_stiffness
+    if arm.has_card:
+        k = max(k, arm.card_lever ** 2 * arm.card_stiffness)  # the card's stiffness along q
+    return ArmatureScales(speed=speed, penetration=speed * math.sqrt(m / arm.stop_stiffness),
+                          energy=0.5 * m * speed * speed, contact_time=math.pi * math.sqrt(m / k))
+
+
+def armature_parameters(arm, card_z0: float = 0.0, card_mobility: float = 0.0) -> np.ndarray:
+    """The kernel's apar (kernel_layout AP_*) of an armature (zeros if none); card_z0: the
+    world height (m) of the bar's card point at the start; card_mobility (1/kg): that
+    point's, along z (model.point_mobility). The step bound while a stop or the card is
+    closed, AP_HMAX, is 1 / their highest rate: sqrt(k_stop / m) and, for the card between
+    the armature and the bar's point, sqrt(k_card (lever^2 / m + card_mobility))."""
+    apar = np.zeros(N_APAR)
+    if not arm.present:
+        return apar
+    m = arm.inertia_value
+    rate2 = arm.stop_stiffness / m
+    if arm.has_card:
+        rate2 = max(rate2, arm.card_stiffness * (arm.card_lever ** 2 / m + card_mobility))
+    apar[AP_HMAX] = 1.0 / math.sqrt(rate2)
+    apar[AP_MASS] = arm.inertia_value
+    apar[AP_TRAVEL] = arm.travel
+    apar[AP_RATE] = arm.spring_rate
+    apar[AP_PRELOAD] = arm.spring_preload
+    apar[AP_STOP_K] = arm.stop_stiffness
+    apar[AP_STOP_C] = arm.stop_damping
+    apar[AP_DAMPING] = arm.damping
+    if arm.has_card:
+        apar[AP_LEVER] = arm.card_lever
+        apar[AP_FREE] = arm.card_free_travel
+        apar[AP_CARD_K] = arm.card_stiffness
+        apar[AP_CARD_C] = arm.card_damping
+        apar[AP_CARD_Z0] = card_z0
+    return apar
 
 
 @dataclass(frozen=True)
@@ -414,6 +494,9 @@ class BarModel:
     drive_names: tuple = ()
     cdrive: np.ndarray = None
     input_work: bool = False  # the input-work quadrature kept although nothing of the scene needs it
+    # the armature (kernel_layout AP_*; zeros without one) and its gain table (3, knots)
+    apar: np.ndarray = field(default_factory=lambda: np.zeros(N_APAR))
+    again: np.ndarray = field(default_factory=lambda: np.zeros((3, 0)))
 
     @property
     def n(self) -> int:
@@ -457,10 +540,40 @@ class BarModel:
         return (self.fpar, self.ipar, b.J0, ptr, idx, val, psi, theta, xc, self.cpar,
                 self.first_moments, self.load, self.tables, self.cdrive, drive)
 
+    def kernel_armature(self, closed: np.ndarray):
+        """The kernel's armature argument (kernel.dynamics: ``arm``): None without an
+        armature, else (apar, again, closed) with ``closed`` (float64[NEV_ARM], kernel_layout
+        EA_*) the states of its stops and card that the solver keeps."""
+        if not self.has_armature:
+            return None
+        return (self.apar, self.again, closed)
+
+    @functools.cached_property
+    def armature_arrays(self):
+        """``kernel_armature`` with every stop and the card open, the same tuple on every call
+        (for what follows from the state alone: energies, the armature's table)."""
+        return self.kernel_armature(np.zeros(NEV_ARM))
+
+    @property
+    def has_bar(self) -> bool:
+        """False for an armature alone (no bar, no contact point)."""
+        return int(self.ipar[I_MOUNT]) != MOUNT_NONE
+
+    @property
+    def has_armature(self) -> bool:
+        return bool(self.ipar[I_ARMATURE])
+
+    @property
+    def armature_index(self) -> int:
+        """The armature's q in the state (its rate follows); -1 without an armature."""
+        if not self.has_armature:
+            return -1
+        return armature_offset(self.n, self.planar, int(self.ipar[I_MOUNT]))
+
     @property
     def state_size(self) -> int:
-        npos, nvel = state_sizes(self.n, self.planar)
-        return npos + nvel + self.nq
+        npos, nvel = state_sizes(self.n, self.planar) if self.has_bar else (0, 0)
+        return npos + nvel + (N_ARM if self.has_armature else 0) + self.nq
 
     @property
     def cap_axes(self) -> list:
@@ -485,6 +598,8 @@ class BarModel:
         """s: how long a contact must stay quiet before the solver holds it at rest: two
         periods of the slowest oscillation it could still hide (the lowest elastic mode,
         the contact's own rebound on its reference mass, a pivot's torsion spring)."""
+        if not self.has_bar:
+            return 0.0  # an armature alone is never held (docs/mechanics.md, "The armature")
         cs = self.contact
         k_lin = 1.5 * cs.stiffness * math.sqrt(cs.penetration_scale)
         periods = [2.0 * math.pi * math.sqrt(cs.reference_mass / k_lin)]
@@ -494,6 +609,8 @@ class BarModel:
         mnt = self.scene.mount
         if mnt.kind == "pivot" and mnt.stiffness > 0.0:
             periods.append(2.0 * math.pi * math.sqrt(self.basis.J0[1, 1] / mnt.stiffness))
+        # (an armature is watched only while a stop or its card holds it, where its own
+        # periods are those of these stiff contacts: mech.solver, _watch_rest)
         return 2.0 * max(periods)
 
     @property
@@ -548,7 +665,12 @@ class BarModel:
 
     def slices(self) -> dict:
         """Named slices of the state vector."""
-        return state_slices(self.n, self.planar, self.nq)
+        return state_slices(self.n, self.planar, self.nq, self.has_armature, self.has_bar)
+
+    @property
+    def armature_drive_row(self) -> int:
+        """The drive row of "armature.force" (-1: no armature)."""
+        return int(self.ipar[I_ARM_DRIVE]) if self.has_armature else -1
 
     def _resting(self, R0: np.ndarray) -> tuple[float, np.ndarray]:
         """Centre height (m) and modal coordinates (m) of the bar resting on the block.
@@ -579,6 +701,18 @@ class BarModel:
         return z0, q
 
     def initial_state(self) -> np.ndarray:
+        if not self.has_bar:
+            y = np.zeros(self.state_size)
+            arm = self.scene.armature
+            y[self.slices()["armature"]] = (arm.start_position, arm.initial_speed)
+            return y
+        y = self._bar_initial_state()
+        if self.has_armature:
+            arm = self.scene.armature
+            y[self.slices()["armature"]] = (arm.start_position, arm.initial_speed)
+        return y
+
+    def _bar_initial_state(self) -> np.ndarray:
         ini, bar = self.scene.initial, self.scene.bar
         theta = math.radians(ini.angle_deg)
         a = 0.5 * bar.length - bar.tip_radius
@@ -611,10 +745,10 @@ class BarModel:
 
 
 def quadrature_count(ipar: np.ndarray, input_work: bool) -> int:
-    """NQ with the input-work and load-dissipation quadratures (a mount, loads, or asked
-    for: a driven force on a free bar), NQ_FREE without them (a plain free bar keeps the
-    state and error norm it always had)."""
-    held = ipar[I_MOUNT] != MOUNT_FREE or ipar[I_NLOAD] > 0
+    """NQ with the input-work and load-dissipation quadratures (a mount, loads, an armature,
+    or asked for: a driven force on a free bar), NQ_FREE without them (a plain free bar
+    keeps the state and error norm it always had)."""
+    held = ipar[I_MOUNT] != MOUNT_FREE or ipar[I_NLOAD] > 0 or ipar[I_ARMATURE] != 0
     return NQ if held or input_work else NQ_FREE
 
 
@@ -635,6 +769,8 @@ def build_model(scene: MechScene, *, input_work: bool = False) -> BarModel:
     input_work: keep the input-work quadrature (``work_in`` of the energy audit) even for
     a free bar without loads, so that a driven force (``repulsion.<i>``) may act on it.
     """
+    if scene.bar is None:
+        return armature_model(scene)
     scene, mode_count = resolve_auto_modes(scene)
     mode = scene.solver.model
     planar_ok = is_planar(scene)
@@ -681,6 +817,13 @@ def build_model(scene: MechScene, *, input_work: bool = False) -> BarModel:
     if arr is not None:
         ipar[I_MOUNT] = {"free": MOUNT_FREE, "clamp": MOUNT_CLAMP, "pivot": MOUNT_PIVOT}[scene.mount.kind]
         ipar[I_NLOAD] = len(arr.load)
+    arm = scene.armature
+    n_points = 2 if arr is None else len(arr.contacts)
+    if arm.present:
+        ipar[I_ARMATURE] = 1
+        ipar[I_ARM_DRIVE] = 2 * n_points  # after the contact points' channels
+        ipar[I_ARM_CARD] = arr.card_row if arr is not None else -1
+        ipar[I_ARM_NGAIN] = len(arm.force_gain["position"]) if arm.force_gain else 0
 
     # Error scales: positions and angles absolutely, against the Hertz penetration, so
     # the contact geometry is resolved at every height; speeds and energies relatively.
@@ -690,9 +833,9 @@ def build_model(scene: MechScene, *, input_work: bool = False) -> BarModel:
     vstar = cs.reference_speed
     npos, nvel = state_sizes(n, planar)
     nq = quadrature_count(ipar, input_work)
-    atol = np.empty(npos + nvel + nq)
+    atol = np.empty(npos + nvel + (N_ARM if arm.present else 0) + nq)
     rel = np.zeros_like(atol)
-    sl = state_slices(n, planar, nq)
+    sl = state_slices(n, planar, nq, arm.present)
     atol[sl["pos"]] = rtol * dstar
     atol[sl["angle" if planar else "quat"]] = rtol * dstar / L
     atol[sl["q"]] = rtol * dstar
@@ -705,6 +848,12 @@ def build_model(scene: MechScene, *, input_work: bool = False) -> BarModel:
     rel[sl["omega"]] = 1.0
     rel[sl["eta"]] = 1.0
     rel[sl["quad"]] = 1.0
+    if arm.present:
+        # the armature's energy belongs to the scene's scale (its drive's work is most of it)
+        ascales = armature_scales(arm)
+        cs = replace(cs, energy_scale=cs.energy_scale + ascales.energy)
+        _armature_tolerances(atol, rel, sl["armature"], ascales, rtol)
+        atol[sl["quad"]] = rtol * cs.energy_scale
     # Quadrature of the impulse is in N s, not J: scale it by the reference momentum.
     quad0 = sl["quad"].start
     atol[quad0 + 7: quad0 + 9] = rtol * cs.reference_mass * vstar
@@ -727,8 +876,12 @@ def build_model(scene: MechScene, *, input_work: bool = False) -> BarModel:
         parts = dict(points=arr.points, mechanism=arr, first_moments=arr.first_moments, load=arr.load.copy(),
                      tables=arr.tables,
                      cpar=contact_parameters(arr.contacts, scene.block, scene.contact.stiffness, cs.dampings))
-    n_points = 2 if arr is None else len(arr.contacts)
     names, cdrive = contact_drives(n_points, len(parts["cpar"]))
+    if arm.present:
+        names += (ARMATURE_DRIVE,)
+        parts.update(apar=armature_parameters(arm),
+                     again=gain_table(*(arm.force_gain[k] for k in ("position", "gain"))) if arm.force_gain
+                     else gain_table(None, None))
     model = BarModel(scene, planar, basis, cs, fpar, ipar, math.radians(scene.initial.azimuth_deg), atol, rel,
                      max_step, sparse_invariants(basis), mode_count=mode_count, drive_names=names, cdrive=cdrive,
                      input_work=input_work, **parts)
@@ -736,7 +889,92 @@ def build_model(scene: MechScene, *, input_work: bool = False) -> BarModel:
         # the springs' rest lengths are measured on the initial state, which the other
         # arrays define: a second, complete model with them
         model = replace(model, load=_spring_rest_lengths(model))
+    if arm.has_card:
+        # so is the height of the bar's card point, which places the card
+        card = int(model.ipar[I_ARM_CARD])
+        model = replace(model, apar=armature_parameters(arm, _card_height(model), point_mobility(model, card)))
     return model
+
+
+def point_mobility(model: "BarModel", p: int) -> float:
+    """1/kg: how a point (row p of the model's points) of the bar at rest answers an impulse
+    along world z, sum_j (Psi_j . z)^2 / m over the modes, with the rigid motions a free bar
+    or a pivot allows (1/m and r^2/I about the centroid, r^2/I about the hinge)."""
+    psi, _, xc = model.points
+    b = model.basis
+    mobility = float(np.sum(psi[p, :, 2] ** 2)) / b.mass if model.n else 0.0
+    mount = int(model.ipar[I_MOUNT])
+    if mount in (MOUNT_FREE, MOUNT_PIVOT):
+        mobility += xc[p, 0] ** 2 / b.J0[1, 1]
+    if mount == MOUNT_FREE:
+        mobility += 1.0 / b.mass
+    return mobility
+
+
+def _armature_tolerances(atol: np.ndarray, rel: np.ndarray, where: slice, scales: "ArmatureScales",
+                         rtol: float) -> None:
+    """The armature's error scales: q absolutely, to rtol x the stops' penetration at the
+    reference speed (so a stop's contact is resolved at either end of the travel, as the
+    bar's positions are against the Hertz penetration); its speed to rtol x the reference
+    speed and rtol x itself."""
+    atol[where] = (rtol * scales.penetration, rtol * scales.speed)
+    rel[where] = (0.0, 1.0)
+
+
+def _card_height(model: "BarModel") -> float:
+    """m: world z of the bar's card point in the model's initial state (modal deflection included)."""
+    y = model.initial_state()
+    sl = model.slices()
+    psi, _, xc = model.points
+    p = int(model.ipar[I_ARM_CARD])
+    s_body = xc[p] + (psi[p].T @ y[sl["q"]] if model.n else 0.0)
+    z0 = float(y[sl["pos"]][-1])
+    return z0 + float(model.rotation(y)[2] @ s_body)
+
+
+def armature_model(scene: MechScene) -> BarModel:
+    """The model of an armature alone (no bar): the same kernel and solver with a bar-less
+    model (kernel_layout MOUNT_NONE: no bar states, no contact point, the armature's two
+    states and the quadratures). Its ContactScales are the armature's stops' (stiffness
+    N/m or N m/rad, the reference speed, the stops' penetration and contact time, its
+    energy scale); no step bound but solver.max_step (no contact point to step over: the
+    events find the stops, the error control their stiffness)."""
+    arm = scene.armature
+    sc = armature_scales(arm)
+    rtol = scene.solver.rtol
+    basis = ModalBasis(families=(), orders=(), frequencies=np.zeros(0), mass=0.0, J0=np.zeros((3, 3)),
+                       J1=np.zeros((0, 3, 3)), J2=np.zeros((0, 3, 3)), S=np.zeros((0, 0, 3)),
+                       stiffness=np.zeros((0, 0)), damping=np.zeros((0, 0)), psi_tip=np.zeros((2, 0, 3)),
+                       theta_tip=np.zeros((2, 0, 3)), x_centre=np.zeros(2))
+    cs = ContactScales(stiffness=arm.stop_stiffness, damping=arm.stop_damping, beta=1.0, reference_speed=sc.speed,
+                       reference_mass=arm.inertia_value, penetration_scale=sc.penetration,
+                       shortest_contact=sc.contact_time, energy_scale=sc.energy, speed_bound=sc.speed)
+    fpar = np.zeros(N_FPAR)
+    fpar[F_VBOUND] = sc.speed
+    fpar[F_VREG] = scene.solver.stick_velocity_tol
+    fpar[F_BAUM] = 1.0 / sc.contact_time
+    ipar = np.zeros(N_IPAR, dtype=np.int64)
+    ipar[I_PLANAR] = 1
+    ipar[I_FRICTION] = FRICTION_NONE
+    ipar[I_INERTIA] = INERTIA_SPARSE
+    ipar[I_MOUNT] = MOUNT_NONE
+    ipar[I_ARMATURE] = 1
+    ipar[I_ARM_DRIVE] = 0
+    ipar[I_ARM_CARD] = -1
+    ipar[I_ARM_NGAIN] = len(arm.force_gain["position"]) if arm.force_gain else 0
+    sl = state_slices(0, True, NQ, True, False)
+    atol = np.empty(N_ARM + NQ)
+    rel = np.ones_like(atol)
+    _armature_tolerances(atol, rel, sl["armature"], sc, rtol)
+    atol[sl["quad"]] = rtol * sc.energy
+    max_step = scene.solver.max_step if scene.solver.max_step is not None else math.inf
+    again = (gain_table(arm.force_gain["position"], arm.force_gain["gain"]) if arm.force_gain
+             else gain_table(None, None))
+    return BarModel(scene, True, basis, cs, fpar, ipar, 0.0, atol, rel, max_step, sparse_invariants(basis),
+                    points=(np.zeros((2, 0, 3)), np.zeros((2, 0, 3)), np.zeros((2, 3))), cpar=np.zeros((2, 4)),
+                    first_moments=np.zeros((3, 1)), load=np.zeros((0, N_LOAD)), tables=np.zeros((2, 1)),
+                    drive_names=(ARMATURE_DRIVE,), cdrive=np.full((2, len(CONTACT_DRIVES)), -1, dtype=np.int64),
+                    apar=armature_parameters(arm), again=again)
 
 
 # --- bar.modes = "auto" (issue 9): counts from the contact time -----------------------

@@ -8,6 +8,7 @@ the scene keys (docs/scene_keys.md, tested against it).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Callable, Literal, Union
@@ -527,11 +528,165 @@ class Rivet:
             check_range(f"{n}.poisson_ratio", self.poisson_ratio, -1.0, 0.5)
 
 
+ARMATURE_KINDS = ("none", "plunger", "clapper")
+
+
+@dataclass(frozen=True)
+class Armature:
+    """The relay's armature: a rigid body on one coordinate q, its travel from the rest stop
+    (m for a plunger, rad for a clapper; 0 <= q <= travel between its stops), driven by the
+    drive channel "armature.force" times ``force_gain(q)``, positive towards the pole.
+
+    kind: "none" (no armature: the default), "plunger" (translation) or "clapper" (rotation
+    about its hinge). mass: kg (plunger); inertia: kg m^2 about the hinge (clapper).
+    travel: m or rad, from the rest stop to the pole stop (> 0).
+    spring_rate: N/m or N m/rad (>= 0) and spring_preload: N or N m (>= 0) of the return
+    spring, which pushes towards the rest stop with preload + rate q (a preload > 0 holds
+    the armature on its rest stop). stop_stiffness (N/m or N m/rad, > 0) and stop_damping
+    (N s/m or N m s/rad) of both stops: linear spring-dashpots that only push (k pen +
+    c dpen/dt clipped at 0), so the armature bounces on them. damping: viscous, N s/m or
+    N m s/rad. initial_position: q at the start (m or rad, in [0, travel]; None: 0, on the
+    rest stop); initial_speed: m/s or rad/s. At rest on a stop it is pressed onto, the
+    armature starts seated there (mech.solver).
+    The card, which pushes the contact spring (needs a [bar]): card_position, m along the
+    bar from tip 0 (None: no card); card_lever, m of card travel per unit of q (> 0);
+    card_free_travel, m of card travel before it touches the bar at rest (>= 0);
+    card_stiffness, N/m (> 0); card_damping, N s/m: a one-sided spring-dashpot like the
+    stops, pressing the bar's point towards the fixed contact (world -z), its reaction on
+    the armature. force_gain: {position = [...] (m or rad, strictly increasing, covering
+    [0, travel]), gain = [...]}, interpolated by monotone cubics (PCHIP); None: gain 1.
+    """
+
+    kind: str = "none"
+    mass: float | None = None
+    inertia: float | None = None
+    travel: float | None = None
+    spring_rate: float = 0.0
+    spring_preload: float = 0.0
+    stop_stiffness: float | None = None
+    stop_damping: float = 0.0
+    damping: float = 0.0
+    initial_position: float | None = None
+    initial_speed: float = 0.0
+    card_position: float | None = None
+    card_lever: float | None = None
+    card_free_travel: float = 0.0
+    card_stiffness: float | None = None
+    card_damping: float = 0.0
+    force_gain: dict | None = None
+
+    def __post_init__(self):
+        check_choice("armature.kind", self.kind, ARMATURE_KINDS)
+        if self.kind == "none":
+            for f in dataclasses.fields(self):
+                if f.name != "kind" and getattr(self, f.name) != f.default:
+                    raise ValueError(f"armature.{f.name}: an armature needs armature.kind = 'plunger' "
+                                     "(translation) or 'clapper' (rotation about a hinge)")
+            return
+        own, other = ("mass", "inertia") if self.kind == "plunger" else ("inertia", "mass")
+        if getattr(self, other) is not None:
+            has = "a mass (kg)" if own == "mass" else "an inertia (kg m^2)"
+            raise ValueError(f"armature.{other}: a {self.kind} has {has}; give armature.{own} instead")
+        if getattr(self, own) is None:
+            raise ValueError(f"armature.{own}: needed for armature.kind = {self.kind!r} "
+                             f"({'kg' if own == 'mass' else 'kg m^2 about the hinge'})")
+        check_positive(f"armature.{own}", getattr(self, own))
+        if self.travel is None:
+            raise ValueError("armature.travel: needed (m or rad, from the rest stop to the pole stop)")
+        travel = check_positive("armature.travel", self.travel)
+        check_nonnegative("armature.spring_rate", self.spring_rate)
+        check_nonnegative("armature.spring_preload", self.spring_preload)
+        if self.stop_stiffness is None:
+            raise ValueError("armature.stop_stiffness: needed (N/m or N m/rad, the stops' contact stiffness)")
+        check_positive("armature.stop_stiffness", self.stop_stiffness)
+        check_nonnegative("armature.stop_damping", self.stop_damping)
+        check_nonnegative("armature.damping", self.damping)
+        if self.initial_position is not None:
+            q0 = check_finite("armature.initial_position", self.initial_position)
+            if not 0.0 <= q0 <= travel:
+                raise ValueError(f"armature.initial_position = {q0!r}: must lie between the rest stop (0) and "
+                                 f"the pole stop (armature.travel = {travel!r})")
+        check_finite("armature.initial_speed", self.initial_speed)
+        self._check_card(travel)
+        if self.force_gain is not None:
+            object.__setattr__(self, "force_gain", _gain_table(self.force_gain, travel))
+
+    def _check_card(self, travel: float) -> None:
+        card = {"card_lever": None, "card_free_travel": 0.0, "card_stiffness": None, "card_damping": 0.0}
+        if self.card_position is None:
+            for key, default in card.items():
+                if getattr(self, key) != default:
+                    raise ValueError(f"armature.{key}: a card needs armature.card_position "
+                                     "(m along the bar from tip 0)")
+            return
+        check_finite("armature.card_position", self.card_position)
+        for key in ("card_lever", "card_stiffness"):
+            if getattr(self, key) is None:
+                raise ValueError(f"armature.{key}: needed with armature.card_position "
+                                 f"({'m of card travel per unit of q' if key == 'card_lever' else 'N/m'})")
+        lever = check_positive("armature.card_lever", self.card_lever)
+        free = check_nonnegative("armature.card_free_travel", self.card_free_travel)
+        check_positive("armature.card_stiffness", self.card_stiffness)
+        check_nonnegative("armature.card_damping", self.card_damping)
+        if free >= lever * travel:
+            raise ValueError(f"armature.card_free_travel = {free!r}: the card would never reach the bar; it must "
+                             f"be less than card_lever x travel = {lever * travel!r} m")
+
+    @property
+    def present(self) -> bool:
+        return self.kind != "none"
+
+    @property
+    def has_card(self) -> bool:
+        return self.card_position is not None
+
+    @property
+    def inertia_value(self) -> float:
+        """kg (plunger) or kg m^2 (clapper): what the drive accelerates."""
+        return self.mass if self.kind == "plunger" else self.inertia
+
+    @property
+    def start_position(self) -> float:
+        """m or rad: q at the start (on the rest stop, unless given)."""
+        return 0.0 if self.initial_position is None else float(self.initial_position)
+
+
+def _gain_table(table, travel: float) -> dict:
+    """armature.force_gain checked: {position: tuple, gain: tuple}, at least two points,
+    positions strictly increasing and covering [0, travel] (to 1e-9 of it), finite gains."""
+    name = "armature.force_gain"
+    if not isinstance(table, dict) or set(table) != {"position", "gain"}:
+        raise ValueError(f"{name} = {table!r}: expected {{position = [...], gain = [...]}}")
+    out = {}
+    for key in ("position", "gain"):
+        items = table[key]
+        if isinstance(items, (str, dict)) or not hasattr(items, "__iter__"):
+            raise ValueError(f"{name}.{key} = {items!r}: expected a list of numbers")
+        out[key] = tuple(check_finite(f"{name}.{key}[{k}]", v) for k, v in enumerate(items))
+    xs, gs = out["position"], out["gain"]
+    if len(xs) < 2:
+        raise ValueError(f"{name}.position: {len(xs)} point(s); give at least two")
+    if len(gs) != len(xs):
+        raise ValueError(f"{name}.gain: {len(gs)} gains for {len(xs)} positions; give one gain per position")
+    for k in range(1, len(xs)):
+        if xs[k] <= xs[k - 1]:
+            raise ValueError(f"{name}.position[{k}] = {xs[k]!r}: positions must increase strictly "
+                             f"(previous {xs[k - 1]!r})")
+    slack = 1e-9 * travel
+    if xs[0] > slack or xs[-1] < travel - slack:
+        raise ValueError(f"{name}.position = [{xs[0]!r} ... {xs[-1]!r}]: must cover the travel, from 0 to "
+                         f"armature.travel = {travel!r}")
+    return out
+
+
 @dataclass(frozen=True)
 class MechScene:
-    """Everything the impact solver needs. gravity: m/s^2 (>= 0), acting along -z."""
+    """Everything the impact solver needs. gravity: m/s^2 (>= 0), acting along -z.
 
-    bar: Bar = field(default_factory=Bar)
+    bar: None is an armature alone (no contact spring, no contact): then ``armature`` is
+    given and no mount, force, spring or rivet."""
+
+    bar: Bar | None = field(default_factory=Bar)
     block: Block = field(default_factory=Block)
     contact: Contact = field(default_factory=Contact)
     friction: Friction = field(default_factory=Friction)
@@ -542,13 +697,14 @@ class MechScene:
     forces: tuple = ()
     springs: tuple = ()
     rivets: tuple = ()
+    armature: Armature = field(default_factory=Armature)
 
     def __post_init__(self):
         check_nonnegative("environment.gravity", self.gravity, high=GRAVITY_MAX)
         for name, cls in (("bar", Bar), ("block", Block), ("contact", Contact),
                           ("friction", Friction), ("initial", Initial), ("solver", SolverOptions),
-                          ("mount", Mount)):
-            if not isinstance(getattr(self, name), cls):
+                          ("mount", Mount), ("armature", Armature)):
+            if not isinstance(getattr(self, name), cls) and not (name == "bar" and self.bar is None):
                 raise ValueError(f"{name}: expected a {cls.__name__}, got {type(getattr(self, name)).__name__}")
         for name, cls in (("forces", PointForce), ("springs", Spring), ("rivets", Rivet)):
             items = tuple(getattr(self, name))
@@ -559,7 +715,34 @@ class MechScene:
         if len(self.forces) + len(self.springs) > LOADS_MAX:
             raise ValueError(f"[[force]], [[spring]]: {len(self.forces)} forces and {len(self.springs)} springs; "
                              f"at most {LOADS_MAX} together")
+        if self.bar is None:
+            self._check_armature_alone()
+            return
         self._check_mechanism()
+        arm = self.armature
+        if arm.has_card:
+            check_position("armature.card_position", arm.card_position, self.bar.length)
+            if self.initial.resting:
+                raise ValueError("initial.resting: the resting start is for the free bar on its tips; "
+                                 "this scene has an armature card")
+
+    def _check_armature_alone(self) -> None:
+        """A scene without a bar: an armature alone, nothing that needs a bar."""
+        if not self.armature.present:
+            raise ValueError("bar: a scene without a bar is an armature alone; give [armature] with "
+                             "kind = 'plunger' or 'clapper', or a [bar]")
+        for name in ("forces", "springs", "rivets"):
+            if getattr(self, name):
+                raise ValueError(f"[[{name[:-1]}]]: acts on the bar, and this scene has none (an armature alone)")
+        if self.mount.held:
+            raise ValueError("mount.kind: holds the bar, and this scene has none (an armature alone)")
+        if self.armature.has_card:
+            raise ValueError("armature.card_position: the card pushes the contact spring, and this scene has "
+                             "no [bar] (an armature alone); add the [bar] or remove the card keys")
+
+    @property
+    def has_bar(self) -> bool:
+        return self.bar is not None
 
     def _check_mechanism(self) -> None:
         """Cross-section checks: points on the bar, held bars in one plane, rivets apart."""

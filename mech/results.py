@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .compiled import energy_table
+from .compiled import armature_table, energy_table
 from .kernel_layout import (
     A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_Y, A_YDOT, Q_DFRICTION, Q_DMODAL, Q_DNORMAL,
     Q_DLOAD, Q_IMPULSE, Q_WCOMP, Q_WIN, C_ON, C_R,
@@ -116,7 +116,7 @@ class ImpactResult:
         normal/friction/modal dissipation, spring_stored, load_dissipation, work_in, residual (J)."""
         if "energy_columns" not in self._cache:
             m = self.model
-            E = energy_table(self.states, m.arrays)
+            E = energy_table(self.states, m.arrays, m.armature_arrays)
             qd = self.states[:, m.slices()["quad"]]
             c = {"time": self.t, **audit_terms(E, qd, E[0])}
             c["residual"] = audit_residual(E, qd, E[0]) + self._projection_series()
@@ -135,6 +135,16 @@ class ImpactResult:
         # so the residual measures integration error only. Spread as a step at the end.
         out = np.zeros(len(self.t))
         out[-1:] = self.projection_energy
+        return out + self._seat_series()
+
+    def _seat_series(self) -> np.ndarray:
+        """J per record: the energy of the armature's ringing removed where it was seated on a
+        stop (its "armature_seat" events), credited from then on (the record at that time
+        holds the state before: its step ended at the turn where the armature was seated)."""
+        out = np.zeros(len(self.t))
+        for ev in self.events:
+            if ev["kind"] == "armature_seat" and ev["energy"] != 0.0:
+                out[self.t > ev["time"]] += ev["energy"]
         return out
 
     @property
@@ -143,6 +153,11 @@ class ImpactResult:
         regime_i columns hold REGIME_NAMES codes."""
         if "history_columns" not in self._cache:
             m = self.model
+            if not m.has_bar:  # an armature alone
+                data = {"time": self.t, **self._armature_columns()}
+                data.update({col: v for col, v in list(self.energy_columns.items())[1:]})
+                self._cache["history_columns"] = data
+                return data
             pos, quat, vel, omega = self._world()
             data = {"time": self.t,
                     "x": pos[:, 0], "y": pos[:, 1], "z": pos[:, 2],
@@ -167,11 +182,48 @@ class ImpactResult:
                 data[f"slip_vy_{i}"] = vs[:, 1]
                 data[f"slip_speed_{i}"] = np.hypot(vs[:, 0], vs[:, 1])
                 data[f"regime_{i}"] = self.regimes[:, i]
+            if m.has_armature:
+                data.update(self._armature_columns())
             en = self.energy_columns
             for col in list(en)[1:]:
                 data[col] = en[col]
             self._cache["history_columns"] = data
         return self._cache["history_columns"]
+
+    def _armature_columns(self) -> dict:
+        """The armature's history columns: armature_position (q: m, or rad for a clapper, the
+        travel from the rest stop), armature_velocity (m/s or rad/s), armature_stop_force
+        (N or N m on the armature, + the rest stop's push, - the pole stop's) and, with a
+        card, card_force (N, its push on the bar)."""
+        a = armature_table(self.states, self.model.arrays, self.model.armature_arrays)
+        out = {"armature_position": a[:, 0], "armature_velocity": a[:, 1], "armature_stop_force": a[:, 3]}
+        if self.model.scene.armature.has_card:
+            out["card_force"] = a[:, 2]
+        return out
+
+    @property
+    def armature(self) -> dict | None:
+        """The armature's motion as the run found it (None without an armature), from its
+        pole-stop events: first_arrival (s, the first time it reached the pole stop),
+        arrival_speed (m/s or rad/s, then), pole_bounces (how often it left the pole stop
+        and came back), last_arrival (s, the last time it reached the pole stop), left_pole
+        (s, when it left the pole stop after that; None if still on it at the end); the
+        times None where the run does not reach them."""
+        if not self.model.has_armature:
+            return None
+        pole = [e for e in self.events if e.get("stop") == "pole"]
+        starts = [e for e in pole if e["kind"] == "armature_stop_start"]
+        ends = [e for e in pole if e["kind"] == "armature_stop_end"]
+        first = starts[0] if starts else None
+        last = starts[-1] if starts else None
+        left = [e["time"] for e in ends if last is not None and e["time"] >= last["time"]]
+        return {
+            "first_arrival": first["time"] if first else None,
+            "arrival_speed": first["armature_velocity"] if first else None,
+            "pole_bounces": max(len(starts) - 1, 0),
+            "last_arrival": last["time"] if last else None,
+            "left_pole": left[0] if left else None,
+        }
 
     @property
     def history(self):
@@ -346,11 +398,11 @@ class ImpactResult:
         - W_all, also bounded from the scene, what every load can do (the actuator forces
           at their largest too), and the springs' energy: a run that gains energy by error
           does not enlarge its yardstick beyond it. A moving clamp and a free bar's forces
-          have no such bound: their work is what the run measured."""
+          have no such bound, nor has an armature's drive: their work is what the run measured."""
         en = self.energy_columns
         m = self.model
-        z0 = float(self.states[0, m.slices()["pos"]][-1])  # centre height, z up (planar: x, z)
-        scene = m.scene
+        # the centre's height, z up (planar: x, z); an armature alone has no bar to fall
+        z0 = float(self.states[0, m.slices()["pos"]][-1]) if m.has_bar else 0.0
         s0 = float(en["spring_stored"][0])
         e_in = float(en["kinetic"][0] + en["elastic"][0] + en["contact_stored"][0]) + s0
         if "scene_bounds" not in self._cache:
@@ -364,14 +416,16 @@ class ImpactResult:
         """(W_rest, W_all) of ``energy_scale``, J, from the scene alone."""
         m = self.model
         scene = m.scene
+        if not m.has_bar:  # an armature alone: its drive's work is what the run measured
+            return 0.0, math.inf
         if not scene.mount.held:  # a free bar can drop its centre to the tip radius
             w_rest = m.basis.mass * scene.gravity * max(z0 - scene.bar.tip_radius, 0.0)
             return w_rest, (math.inf if scene.forces else w_rest)
         from .model import load_work_bound
 
         w_rest = load_work_bound(m, e_in, forces=False)
-        if scene.mount.base_motion is not None:
-            return w_rest, math.inf
+        if scene.mount.base_motion is not None or scene.armature.present:
+            return w_rest, math.inf  # a moving clamp's or an armature drive's work: what the run measured
         return w_rest, (load_work_bound(m, e_in) if scene.forces else w_rest)
 
     @property
@@ -431,7 +485,10 @@ class ImpactResult:
     def to_summary(self) -> dict:
         """The JSON summary: contacts, restitution, energy, solver, flags."""
         c = self.contact_columns
+        arm = {"armature": {k: _num(v) if isinstance(v, float) else v for k, v in self.armature.items()}} \
+            if self.model.has_armature else {}
         return {
+            **arm,
             "contacts": [
                 {k: (int(c[k][j]) if k == "tip" else (bool(c[k][j]) if k == "complete" else _num(c[k][j])))
                  for k in CONTACT_COLUMNS}

@@ -12,6 +12,10 @@ default listed in docs/scene_keys.md; ``DEFAULT_SCENE_TOML`` is one scene, not t
     [[force]]   position, direction [3], frame ("world" | "body"), magnitude | (time, value)
     [[spring]]  anchor [3], position, stiffness, preload | rest_length, damping
     [[rivet]]   position, offset, radius, mass, youngs_modulus, poisson_ratio
+    [armature]  kind ("none" | "plunger" | "clapper"), mass | inertia, travel, spring_rate,
+                spring_preload, stop_stiffness, stop_damping, damping, initial_position,
+                initial_speed, card_position, card_lever, card_free_travel, card_stiffness,
+                card_damping, force_gain {position, gain}
     [initial]   height, angle_deg, azimuth_deg, velocity [3], angular_velocity [3]
     [contact]   law, restitution | damping, reference_speed, calibration, stiffness
     [friction]  mu, gamma, model, max_ratio, regularization_speed
@@ -20,8 +24,9 @@ default listed in docs/scene_keys.md; ``DEFAULT_SCENE_TOML`` is one scene, not t
     [environment] gravity
 
 Unknown sections or keys are errors that name them (a typo must not silently fall back
-to a default). Other packages (coupling) add their own sections and pass them through
-``extra_sections``. This module only maps the TOML structure onto the dataclasses of
+to a default). A scene with an [armature] and no [bar] is an armature alone (no contact
+spring, no contact): the sections that belong to the bar are then errors. Other packages
+(coupling) add their own sections and pass them through ``extra_sections``. This module only maps the TOML structure onto the dataclasses of
 mech/parameters.py, 1:1 (``bar.modes`` is the one key that sets two fields); the values are
 checked by the dataclasses (mech/validation.py), and their errors are reported with the
 file and the key as the scene wrote it.
@@ -33,7 +38,9 @@ import dataclasses
 import math
 import tomllib
 
-from .parameters import Bar, Block, Contact, Friction, Initial, MechScene, Mount, PointForce, Rivet, SolverOptions, Spring
+from .parameters import (
+    Armature, Bar, Block, Contact, Friction, Initial, MechScene, Mount, PointForce, Rivet, SolverOptions, Spring,
+)
 from .validation import check_file, check_keys
 
 SECTIONS = {
@@ -44,6 +51,7 @@ SECTIONS = {
     "friction": Friction,
     "solver": SolverOptions,
     "mount": Mount,
+    "armature": Armature,
 }
 # arrays of tables ([[force]] ...): TOML name -> (MechScene field, dataclass)
 LIST_SECTIONS = {
@@ -52,6 +60,8 @@ LIST_SECTIONS = {
     "rivet": ("rivets", Rivet),
 }
 ENVIRONMENT_KEYS = ("gravity",)
+# what an armature alone (an [armature] and no [bar]) may not have: they belong to the bar
+BAR_SECTIONS = ("block", "initial", "contact", "friction", "mount", "force", "spring", "rivet")
 # every top-level name a mechanics scene may hold (tables and arrays of tables)
 SCENE_SECTIONS = tuple(SECTIONS) + tuple(LIST_SECTIONS) + ("environment",)
 
@@ -148,6 +158,13 @@ def scene_from_dict(doc: dict, *, where: str = "scene", extra_sections=()) -> Me
     doc = _held_defaults(doc)
     parts = {name: _section(name, cls, doc.get(name, {}), where) for name, cls in SECTIONS.items()
              if name in doc}
+    if "armature" in doc and "bar" not in doc:
+        for name in BAR_SECTIONS:
+            if name in doc:
+                shown = f"[[{name}]]" if name in LIST_SECTIONS else f"[{name}]"
+                raise ValueError(f"{where}: {shown}: this scene has an [armature] and no [bar], an armature alone "
+                                 f"without a contact; add the [bar] or remove {shown}")
+        parts["bar"] = None
     for name, (fld, cls) in LIST_SECTIONS.items():
         if name not in doc:
             continue
@@ -235,6 +252,8 @@ def scene_to_dict(scene: MechScene) -> dict:
     out = {}
     for name, cls in SECTIONS.items():
         part = getattr(scene, name)
+        if part is None or (scene.bar is None and name in BAR_SECTIONS):
+            continue  # an armature alone: no bar, nor what belongs to it
         table = {}
         for f in dataclasses.fields(cls):
             value = getattr(part, f.name)
@@ -246,10 +265,14 @@ def scene_to_dict(scene: MechScene) -> dict:
                 value = list(value)
             if isinstance(value, float) and math.isinf(value):
                 value = "inf"
+            if isinstance(value, dict):  # armature.force_gain
+                value = {k: list(v) for k, v in value.items()}
             table[f.name] = value
         out[name] = table
     out["environment"] = {"gravity": scene.gravity}
-    if not scene.mount.held:
+    if not scene.armature.present:
+        del out["armature"]
+    if not scene.mount.held and "mount" in out:
         del out["mount"]
     elif scene.mount.base_motion is not None:
         bm = scene.mount.base_motion

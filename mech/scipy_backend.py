@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .compiled import dynamics, events_from_aux
+from .compiled import dynamics, event_values
 from .kernel_layout import (
     A_FN, A_Y, A_YDOT, D_VALUE, DONE, EV_CLIP, EV_COMPRESSION, EV_SLIP, EV_STICK, EVENT, FREE, FRICTION_EXACT,
-    I_FRICTION, NAUX, NEV_TIP, NOT_FINITE, SLIP, STICK,
+    I_FRICTION, NAUX, NEV, NEV_TIP, NOT_FINITE, SLIP, STICK,
 )
 
 from .stepping import Outcome
@@ -44,6 +44,7 @@ def scipy_segment(solver, t_target: float, method: str):
 
     m = solver.model
     arrays = solver.arrays
+    arm = solver.arm
     drive = solver.drive
     mu_rows = m.drive_rows("mu")  # a coupled model's friction coefficient is every contact point's
     regime = solver.regime.copy()
@@ -52,7 +53,7 @@ def scipy_segment(solver, t_target: float, method: str):
     rec = solver.recorder
     aux = np.empty((2, NAUX))
     aux_mid = np.empty((2, NAUX))
-    g = np.empty(2 * NEV_TIP)
+    g = np.empty(NEV)
     N = m.state_size
     counter = {"nfev": 0}
     coupled = solver.coupled
@@ -62,7 +63,7 @@ def scipy_segment(solver, t_target: float, method: str):
         dy = np.empty(N + n_ext)
         if coupled is not None:
             drive[mu_rows, D_VALUE] = coupled.friction_coefficient(t, y[N:])
-        dynamics(t, y[:N], arrays, regime, eref, dy[:N], aux, work)
+        dynamics(t, y[:N], arrays, regime, eref, dy[:N], aux, work, arm)
         if coupled is not None:
             dy[N:] = coupled.rhs(t, y[N:], aux[:, [A_Y, A_YDOT, A_FN]])
         counter["nfev"] += 1
@@ -73,7 +74,8 @@ def scipy_segment(solver, t_target: float, method: str):
     fexact = m.ipar[I_FRICTION] == FRICTION_EXACT
 
     def make_event(k):
-        i, kind = divmod(k, NEV_TIP)
+        # the contact points' events (tip i, kind), then the armature's (always watched)
+        i, kind = divmod(k, NEV_TIP) if k < 2 * NEV_TIP else (-1, -1)
         seen = {}  # t -> value at the last few times asked (see below)
 
         def ev(t, y):
@@ -96,9 +98,9 @@ def scipy_segment(solver, t_target: float, method: str):
             dy = np.empty(N)
             if coupled is not None:
                 drive[mu_rows, D_VALUE] = coupled.friction_coefficient(t, y[N:])
-            dynamics(t, y[:N], arrays, regime, eref, dy, aux, work)
+            dynamics(t, y[:N], arrays, regime, eref, dy, aux, work, arm)
             counter_events["nfev"] += 1
-            events_from_aux(aux, eref, arrays, g)
+            event_values(y[:N], aux, work[22], eref, arrays, g, arm)
             if kind == EV_SLIP and not (fexact and regime[i] == SLIP):
                 return solver.ev_sign[k]
             if kind == EV_STICK and not (fexact and regime[i] == STICK):
@@ -122,7 +124,7 @@ def scipy_segment(solver, t_target: float, method: str):
         return ev
 
     t_start = solver.t
-    events = [make_event(k) for k in range(2 * NEV_TIP)]
+    events = [make_event(k) for k in range(NEV)]
     rtol = solver.scene.solver.rtol
     # solve_ivp's error test is |err| <= atol + rtol |y| for every component, so positions
     # also get a relative share (the compiled loop holds them to atol alone): the baseline
@@ -168,7 +170,7 @@ def scipy_segment(solver, t_target: float, method: str):
         if coupled is not None:
             drive[mu_rows, D_VALUE] = coupled.friction_coefficient(sol.t[k], sol.y[N:, k])
             rec.ext[n0 + k - 1] = sol.y[N:, k]
-        dynamics(sol.t[k], y, arrays, regime, eref, dy, aux, work)
+        dynamics(sol.t[k], y, arrays, regime, eref, dy, aux, work, arm)
         r = n0 + k - 1
         rec.t[r] = sol.t[k]
         rec.y[r] = y
@@ -186,7 +188,7 @@ def scipy_segment(solver, t_target: float, method: str):
             samples[4] = aux[:, A_FN]
             for j, f in enumerate((0.25, 0.5, 0.75), start=1):
                 dynamics(sol.t[k - 1] + f * h, sol.sol(sol.t[k - 1] + f * h)[:N], arrays, regime, eref, dy,
-                         aux_mid, work)
+                         aux_mid, work, arm)
                 samples[j] = aux_mid[:, A_FN]
             peak = samples.max(axis=0)
             for tip in range(2):
@@ -195,7 +197,7 @@ def scipy_segment(solver, t_target: float, method: str):
                 if curvature < 0.0:
                     shift = 0.5 * (samples[j - 1, tip] - samples[j + 1, tip]) / curvature
                     tm = sol.t[k - 1] + 0.25 * (j + shift) * h
-                    dynamics(tm, sol.sol(tm)[:N], arrays, regime, eref, dy, aux_mid, work)
+                    dynamics(tm, sol.sol(tm)[:N], arrays, regime, eref, dy, aux_mid, work, arm)
                     peak[tip] = max(peak[tip], aux_mid[tip, A_FN])
             rec.fmax[r] = np.maximum(rec.fmax[r], peak)
     solver.stats[0] += n_new

@@ -28,19 +28,19 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .compiled import (
-    dense_contact, dense_eval, dense_tip_forces, dynamics, energies, energy_table, events_from_aux, make_work,
-    project_to_stick,
+    armature_force, armature_table, dense_contact, dense_eval, dense_tip_forces, dynamics, energies, energy_table,
+    event_values, make_work, project_to_stick,
 )
 from .kernel_layout import (
     A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, BUFFER_FULL, C_ON, C_R, DONE, EV_CLIP, EV_COMPRESSION,
-    D_SLOPE, D_VALUE, EV_CONTACT, EV_SLIP, EV_STICK, EVENT, F_MASS, FREE, FRICTION_EXACT,
-    I_FRICTION, NAUX, NEV_TIP, Q_WIN, SLIP, STATUS_TEXT, STICK, state_sizes,
+    D_SLOPE, D_VALUE, EA_CARD, EA_POLE, EA_REST, EA_SEAT, EA_TURN, EV_CONTACT, EV_SLIP, EV_STICK, EVENT, F_MASS, FREE,
+    FRICTION_EXACT, I_FRICTION, NAUX, NEV, NEV_TIP, Q_WIN, SLIP, STATUS_TEXT, STICK, state_sizes,
 )
 from .contact_laws import hertz_impact
 from .drives import set_step, step_targets, values_at
 from .friction import REVERSAL_DEADBAND
 from .mechanism import base_velocity_jumps
-from .model import BarModel, build_model
+from .model import BarModel, armature_scales, build_model
 from .parameters import MechScene
 from .recorder import MEMORY_LIMIT, Recorder, history_memory
 from .results import ImpactResult
@@ -49,6 +49,7 @@ from .stepping import CompiledStepper, Stepper
 
 REGIME_NAMES = ("free", "slip", "stick")
 EVENT_KINDS = ("contact", "clip", "slip", "stick", "compression")
+ARMATURE_EVENTS = {EA_REST: ("armature_stop", "rest"), EA_POLE: ("armature_stop", "pole"), EA_CARD: ("card", "")}
 CHATTER_LIMIT = 200  # events at one instant (within round-off) before the run is stopped
 
 
@@ -104,10 +105,13 @@ class Segment:
     _regime: np.ndarray
     _eref: np.ndarray
     _arrays: tuple = field(repr=False)  # the kernel's arguments with the drive of the segment
+    _arm: tuple = field(repr=False, default=None)  # and its armature's (kernel.dynamics), or None
     _work: tuple = field(repr=False, default=None)
     _out: np.ndarray = field(repr=False, default_factory=lambda: np.empty(5))
     _last_t: float = field(repr=False, default=float("nan"))
     _last_forces: tuple = field(repr=False, default=(0.0, 0.0, 0.0, 0.0, 0.0))
+    _arm_t: float = field(repr=False, default=float("nan"))
+    _arm_last: tuple = field(repr=False, default=(0.0, 0.0))
 
     def state(self, t: float) -> np.ndarray:
         """State vector at time t (s) in [t_start, t_end] (4th-order dense output)."""
@@ -131,12 +135,40 @@ class Segment:
         k = int(np.searchsorted(self._t_valid, t)) if len(self._t_valid) else 0
         k = min(k, max(len(self._regime) - 1, 0))
         regime = self._regime[k] if len(self._regime) else np.zeros(2, np.int64)
-        dynamics(t, y, self._arrays, regime, self._eref, dy, aux, self._work)
+        dynamics(t, y, self._arrays, regime, self._eref, dy, aux, self._work, self._arm)
         return aux[:, [A_Y, A_YDOT, A_FN]].copy()
 
     def normal_force(self, t: float) -> float:
         """N: total normal force of both tips at t."""
         return float(self.contact(t)[:, 2].sum())
+
+    def armature(self, t: float) -> tuple[float, float]:
+        """(q, dq/dt) of the armature at t (s) in [t_start, t_end] from the dense output (4th
+        order): its travel from the rest stop, m and m/s (plunger) or rad and rad/s
+        (clapper). Needs ``ImpactSolver(scene, keep_dense=True)`` unless t is the start.
+        Repeated calls at the same t are cached."""
+        if t == self._arm_t:
+            return self._arm_last
+        a = self._model.armature_index
+        if a < 0:
+            raise ValueError("Segment.armature: this model has no armature (the scene has no [armature])")
+        if not (self.t_start - 1e-15 <= t <= self.t_end + 1e-15):
+            raise ValueError(f"t = {t!r}: outside the segment [{self.t_start!r}, {self.t_end!r}] s")
+        if len(self._t_valid) == 0 or t <= self.t_start:
+            out = (float(self._start_state[a]), float(self._start_state[a + 1]))
+        else:
+            if not len(self._coef):
+                raise ValueError("Segment.armature: the dense output is kept only with "
+                                 "ImpactSolver(scene, keep_dense=True)")
+            k = min(int(np.searchsorted(self._t_valid, t)), len(self._t_valid) - 1)
+            c = self._coef[k]
+            th = (t - self._t0[k]) / self._h[k]
+            t1 = 1.0 - th
+            # (mech.integrator.dense_eval on the armature's two components only)
+            out = tuple(float(c[0, i] + th * (c[1, i] + t1 * (c[2, i] + th * (c[3, i] + t1 * c[4, i]))))
+                        for i in (a, a + 1))
+        self._arm_t, self._arm_last = t, out
+        return out
 
     def tip_forces(self, t: float) -> tuple[float, float, float, float, float]:
         """(F_0, F_1, gap, y_0, y_1) at t: each tip's normal force (N), the nearer tip's
@@ -189,7 +221,7 @@ class ImpactSolver:
         self.regime = np.zeros(2, dtype=np.int64)
         self.eref = np.zeros((2, 2))
         self.eref[:, 0] = 1.0
-        self.ev_sign = np.zeros(2 * NEV_TIP)
+        self.ev_sign = np.zeros(NEV)
         self.stats = np.zeros(4, dtype=np.int64)
         self.events: list[dict] = []
         self._last_event_time = -1.0
@@ -204,7 +236,11 @@ class ImpactSolver:
         self.drive = m.initial_drive()
         if coupled is not None:
             self.drive[m.drive_rows("mu"), D_VALUE] = coupled.friction_coefficient(0.0, self.z)
+        # which of the armature's stops and card are closed (kernel_layout EA_*): set at its
+        # events from the watched sides (_armature_signs), read by the kernel
+        self.armature_closed = np.zeros(NEV - 2 * NEV_TIP)
         self.arrays = m.kernel_arrays(self.drive)
+        self.arm = m.kernel_armature(self.armature_closed)  # (None without an armature)
         rows = scene.solver.history_rows
         if history_memory(m.state_size, rows, len(self.z)) > MEMORY_LIMIT:
             raise ValueError(
@@ -229,9 +265,18 @@ class ImpactSolver:
         if self._jumps and self._jumps[0][0] == 0.0:
             self._apply_base_jump(resolve=False)
         self._initial_state = self.y.copy()
-        hz = hertz_impact(m.contact.reference_mass, m.contact.stiffness, m.contact.reference_speed)
-        self._onset_step = hz.contact_time * scene.solver.rtol ** (2.0 / 7.0)
+        if m.has_bar:
+            hz = hertz_impact(m.contact.reference_mass, m.contact.stiffness, m.contact.reference_speed)
+            self._onset_step = hz.contact_time * scene.solver.rtol ** (2.0 / 7.0)
+        else:
+            self._onset_step = math.inf
+        # the step after the armature's stop or card closes: a tenth of their shortest half
+        # period (model.armature_scales), where its first step would otherwise be the free
+        # flight's and be rejected down to it
+        self._armature_onset = 0.1 * armature_scales(scene.armature).contact_time if m.has_armature else math.inf
         self._resolve(triggered=None)
+        if m.has_armature:
+            self._seat(start=True)  # at rest on a stop it is pressed onto: seated from the start
         self._record_point()
 
     # --- public API -------------------------------------------------------------------
@@ -243,8 +288,17 @@ class ImpactSolver:
     @property
     def drive_names(self) -> tuple[str, ...]:
         """The drive channels of this model, which ``advance`` takes: "mu.<i>" and
-        "repulsion.<i>" of each contact point i (mech.drives)."""
+        "repulsion.<i>" of each contact point i, and "armature.force" with an armature
+        (mech.drives)."""
         return self.model.drive_names
+
+    def armature_now(self) -> tuple[float, float]:
+        """(q, dq/dt) of the armature now: its travel from the rest stop, m and m/s (plunger)
+        or rad and rad/s (clapper)."""
+        a = self.model.armature_index
+        if a < 0:
+            raise ValueError("armature_now: this model has no armature (the scene has no [armature])")
+        return float(self.y[a]), float(self.y[a + 1])
 
     def drives_now(self) -> dict[str, float]:
         """Each drive channel's value at the current time (mu as given, before the kernel
@@ -268,11 +322,15 @@ class ImpactSolver:
         zero it acts as zero), and "repulsion.<i>" (N, >= 0), a force on contact point i
         along the block's normal, away from it, acting while the point touches -- Holm's
         electrodynamic repulsion of the constriction; its work counts as work put in
-        (``work_in``). A channel not given holds the value it ended the previous step
-        with. mu: a number or pair for every "mu.<i>" at once.
+        (``work_in``); "armature.force", the armature's drive: its force along q is this
+        value times the scene's gain table at q (N, or N m for a clapper, with no table;
+        positive towards the pole; its work is work put in too). A channel not given holds
+        the value it ended the previous step with. mu: a number or pair for every "mu.<i>"
+        at once.
 
         A new mu that changes what can stick re-resolves the regimes; a hold at rest ends
-        when a channel that moves the static equilibrium (a repulsion) changes.
+        when a channel that moves the static equilibrium (a repulsion, the armature's
+        drive) changes.
 
         stop_at_switch: return at the first contact start or end (make/break) after the
         current time instead, the segment ending there (a co-simulation step in free flight
@@ -361,7 +419,8 @@ class ImpactSolver:
         return Segment(t_start, self.t, self.events[ev_first:], m, t0, hh,
                        rec.t[n_first:n_last].copy(), coef, start_state,
                        rec.regime[n_first:n_last].copy(), self.eref.copy(),
-                       _arrays=m.kernel_arrays(self.drive.copy()))
+                       _arrays=m.kernel_arrays(self.drive.copy()),
+                       _arm=m.kernel_armature(self.armature_closed.copy()))
 
     def run(self):
         """Integrate to ``solver.t_end`` and return the ``ImpactResult``.
@@ -516,8 +575,8 @@ class ImpactSolver:
 
     def start_from(self, **parts) -> None:
         """Overwrite named parts of the initial state before integrating: any key of
-        ``model.slices()`` except "quad" (pos, angle or quat, q, vel, omega, eta; SI, the
-        solver's frame). For what a scene cannot say: a modal initial condition, a start
+        ``model.slices()`` except "quad" (pos, angle or quat, q, vel, omega, eta, armature;
+        SI, the solver's frame). For what a scene cannot say: a modal initial condition, a start
         already in contact. The run's first record and the regimes are redone."""
         if self.t != 0.0 or self.recorder.n != 1:
             raise ValueError("start_from: only before the first advance")
@@ -533,7 +592,10 @@ class ImpactSolver:
             self.y[sl[name]] = arr
         self._initial_state = self.y.copy()
         self.recorder.truncate(0)
+        self.armature_closed[:] = 0.0
         self._resolve(triggered=None)
+        if self.model.has_armature:
+            self._seat(start=True)
         self._record_point()
 
     def checkpoint(self) -> dict:
@@ -542,7 +604,7 @@ class ImpactSolver:
                     eref=self.eref.copy(), ev_sign=self.ev_sign.copy(), stats=self.stats.copy(),
                     n=self.recorder.n, thinned=self.thinning["rows_dropped"],
                     n_events=len(self.events), projection_energy=self.projection_energy,
-                    drive=self.drive.copy(), jump_index=self._jump_index,
+                    drive=self.drive.copy(), jump_index=self._jump_index, armature=self.armature_closed.copy(),
                     rest=(self._hold_until, self._hold_regime.copy(), self._rest_t0, self._rest_ke,
                           [list(h) for h in self.holds]))
 
@@ -557,6 +619,7 @@ class ImpactSolver:
         self.regime[:] = cp["regime"]
         self.eref[:] = cp["eref"]
         self.ev_sign[:] = cp["ev_sign"]
+        self.armature_closed[:] = cp["armature"]
         self.stats[:] = cp["stats"]
         self.recorder.truncate(cp["n"])
         del self.events[cp["n_events"]:]
@@ -583,7 +646,7 @@ class ImpactSolver:
                              + (" (the dense output before was released)" if b else ""))
         out = np.empty((len(times), 2, 3))
         dense_contact(times[order], rec.t[b:n], rec.dense_t0[:n - b], rec.dense_h[:n - b], rec.dense_coef[:n - b],
-                      rec.regime[b:n], self.arrays, self.eref, self.work, out)
+                      rec.regime[b:n], self.arrays, self.eref, self.work, out, self.arm)
         result = np.empty_like(out)
         result[order] = out
         return result
@@ -645,6 +708,8 @@ class ImpactSolver:
         changed = set_step(self.drive, kinds, targets, self.t, t_end)
         if not changed:
             return
+        if self.armature_closed[EA_SEAT] and self._seat_state()[2] <= 0.0:
+            self._unseat()  # the new drive no longer presses the seated armature on its stop
         if m.ipar[I_FRICTION] == FRICTION_EXACT and any(kinds[row].friction for row in changed):
             self._resolve(triggered=None)  # a new mu may change what can stick
         if any(kinds[row].moves_equilibrium for row in changed):
@@ -659,7 +724,7 @@ class ImpactSolver:
                    for row, kind in enumerate(self.model.drive_kinds))
 
     def _evaluate(self) -> np.ndarray:
-        dynamics(self.t, self.y, self.arrays, self.regime, self.eref, self._dy, self._aux, self.work)
+        dynamics(self.t, self.y, self.arrays, self.regime, self.eref, self._dy, self._aux, self.work, self.arm)
         return self._aux
 
     # --- contacts at rest ------------------------------------------------------------
@@ -702,7 +767,8 @@ class ImpactSolver:
             self._restart_rest_window()
             return
         if n_rec:  # the largest kinetic energy of the new records, in one compiled call
-            self._rest_ke = max(self._rest_ke, float(energy_table(rec.y[n0:n0 + n_rec], self.arrays)[:, 0].max()))
+            kinetic = energy_table(rec.y[n0:n0 + n_rec], self.arrays, self.arm)[:, 0]
+            self._rest_ke = max(self._rest_ke, float(kinetic.max()))
         if self.t - self._rest_t0 < self.model.rest_window * (1.0 - 1e-12):
             return
         # closed throughout: a window that began in flight (a segment ending at touchdown
@@ -720,8 +786,11 @@ class ImpactSolver:
                        for i in range(2))
         # a force on a ramp is not a constant load, however slowly the bar follows it
         # (nor is a driven force on a ramp: a repulsion that grows within the step)
-        if (quiet and not slipping and not self.model.loads_ramping(self.t) and not self._drives_ramping()
-                and self._settle_at_mean()):
+        # an armature between its stops with its card open is not held: it floats on its
+        # return spring, whose slow swing the window is not made to see
+        floating = self.model.has_armature and not np.any(self.armature_closed[[EA_REST, EA_POLE, EA_CARD]])
+        if (quiet and not slipping and not floating and not self.model.loads_ramping(self.t)
+                and not self._drives_ramping() and self._settle_at_mean()):
             later = [t for t in self.model.load_change_times if t > self.t]
             later += [t for t, _ in self._jumps[self._jump_index:] if t > self.t]
             self._hold_until = min(later) if later else math.inf
@@ -742,25 +811,29 @@ class ImpactSolver:
         t = rec.t[first:n]
         if len(t) < 2 or t[-1] <= t[0]:
             return False
-        npos, nvel = state_sizes(m.n, m.planar)
-        saved = (self.y.copy(), self.regime.copy(), self.eref.copy(), self.ev_sign.copy(), self.projection_energy)
+        pos, vel = self._rest_coordinates()
+        saved = (self.y.copy(), self.regime.copy(), self.eref.copy(), self.ev_sign.copy(), self.projection_energy,
+                 self.armature_closed.copy())
         e = self._rest_e
-        energies(self.y, self.arrays, self.work, e)
+        energies(self.y, self.arrays, self.work, e, self.arm)
         before = float(e.sum())
-        self.y[:npos] = np.trapezoid(rec.y[first:n, :npos], t, axis=0) / (t[-1] - t[0])
-        self.y[npos:npos + nvel] = 0.0
+        self.y[pos] = np.trapezoid(rec.y[first:n][:, pos], t, axis=0) / (t[-1] - t[0])
+        self.y[vel] = 0.0
         self._normalize_attitude()
         regime = self.regime.copy()
         self._resolve(triggered=None)
-        found = self._static_equilibrium(npos, nvel)
+        found = self._static_equilibrium(pos, vel)
         if found:
             self._resolve(triggered=None)
-        # (a contact that stuck must still stick: at zero speed it would otherwise slide)
+        # (a contact that stuck must still stick: at zero speed it would otherwise slide; and
+        # the armature's stops and card keep their states)
         if (not found or np.any((regime == FREE) != (self.regime == FREE))
-                or np.any((regime == STICK) & (self.regime == SLIP))):
-            self.y[:], self.regime[:], self.eref[:], self.ev_sign[:], self.projection_energy = saved
+                or np.any((regime == STICK) & (self.regime == SLIP))
+                or np.any(saved[5] != self.armature_closed)):
+            (self.y[:], self.regime[:], self.eref[:], self.ev_sign[:], self.projection_energy,
+             self.armature_closed[:]) = saved
             return False
-        energies(self.y, self.arrays, self.work, e)
+        energies(self.y, self.arrays, self.work, e, self.arm)
         self.projection_energy += float(e.sum()) - before
         return True
 
@@ -769,25 +842,43 @@ class ImpactSolver:
             quat = self.model.slices()["quat"]
             self.y[quat] /= np.linalg.norm(self.y[quat])
 
-    def _static_equilibrium(self, npos: int, nvel: int) -> bool:
+    def _rest_coordinates(self) -> tuple:
+        """Where in the state the positions and the speeds a hold at rest settles are: the
+        bar's (two slices) and, with an armature, its q and rate too (two index arrays;
+        one speed coordinate per position rate). (Slices without an armature: numpy sums a
+        strided view in another order than a copy, and the held state stays the one
+        the solver gave before the armature.)"""
+        m = self.model
+        npos, nvel = state_sizes(m.n, m.planar)
+        a = m.armature_index
+        if a < 0:
+            return slice(0, npos), slice(npos, npos + nvel)
+        return np.append(np.arange(npos), a), np.append(np.arange(npos, npos + nvel), a + 1)
+
+    def _static_equilibrium(self, pos, vel) -> bool:
         """Newton's method on the accelerations at zero speed, in the speed coordinates (a
         displacement du moves the positions by the state's own rates for speeds du), with
         the regimes held: stuck contacts keep their points (their holding forces adjust) and
         the directions nothing restores (sliding along a frictionless block, turning about a
         stuck pair of points) get no displacement (minimum-norm steps). Converged when a
         step moves no coordinate by more than rtol x the Hertz penetration scale (angles:
-        over the bar's length). The finite-difference steps are 1e-6 of that scale."""
+        over the bar's length; an armature's q: rtol x its stops' penetration scale, its
+        error control's). The finite-difference steps are 1e-6 of that scale. pos, vel: the
+        state indices of the positions and speeds (_rest_coordinates)."""
         m = self.model
-        vel = slice(npos, npos + nvel)
+        npos, nvel = state_sizes(m.n, m.planar)
         # each speed coordinate's length scale: penetration (m) or penetration / length (rad)
-        atol_v = m.atol[vel]
+        atol_v = m.atol[npos:npos + nvel]
         scale = m.contact.penetration_scale * atol_v / np.max(atol_v)
         rtol = self.scene.solver.rtol
+        if m.has_armature:  # the armature's q (its error scale is rtol x that length)
+            scale = np.append(scale, m.atol[m.armature_index] / rtol)
+            nvel += 1
 
         def displaced(du):
             self.y[vel] = du
             self._evaluate()
-            rate = self._dy[:npos].copy()
+            rate = self._dy[pos].copy()
             self.y[vel] = 0.0
             return rate
 
@@ -802,12 +893,12 @@ class ImpactSolver:
             for j in range(nvel):
                 du = np.zeros(nvel)
                 du[j] = 1e-6 * scale[j]
-                self.y[:npos] += displaced(du)
+                self.y[pos] += displaced(du)
                 J[:, j] = (accel() - a0) / du[j]
                 self.y[:] = base
             # columns in units of their scale: the least-squares cut-off then compares like with like
             step = np.linalg.lstsq(J * scale, -a0, rcond=1e-10)[0] * scale
-            self.y[:npos] += displaced(step)
+            self.y[pos] += displaced(step)
             self._normalize_attitude()
             if np.all(np.abs(step) <= rtol * scale):
                 return True
@@ -824,13 +915,13 @@ class ImpactSolver:
         sl = m.slices()
         n = m.n
         e = np.empty(5)
-        energies(self.y, self.arrays, self.work, e)
+        energies(self.y, self.arrays, self.work, e, self.arm)
         ke_before = e[0]
         R = m.rotation(self.y)
         self.y[sl["vel"]] += (dv[0], dv[2]) if m.planar else dv
         L = m.first_moments[:, 1:n + 1]
         self.y[sl["eta"]] -= (L.T @ (R.T @ dv)) / m.fpar[F_MASS]
-        energies(self.y, self.arrays, self.work, e)
+        energies(self.y, self.arrays, self.work, e, self.arm)
         if resolve:  # (a jump at t = 0 comes before the first record: the audit starts after it)
             self.y[sl["quad"].start + Q_WIN] += e[0] - ke_before
             self._resolve(triggered=None)
@@ -845,10 +936,15 @@ class ImpactSolver:
         self._chatter = self._chatter + 1 if same_instant else 0
         self._last_event_time = self.t
         if self._chatter > CHATTER_LIMIT:
+            last = (f"armature {ARMATURE_EVENTS[ev - 2 * NEV_TIP]}" if ev >= 2 * NEV_TIP
+                    else f"tip {tip} {EVENT_KINDS[kind]}")
             raise MechSolverError(
                 f"regime switching does not settle at t = {self.t!r} s: {self._chatter} events at one "
-                f"instant (last: tip {tip} {EVENT_KINDS[kind]}, regimes "
+                f"instant (last: {last}, regimes "
                 f"{[REGIME_NAMES[r] for r in self.regime]})", self.t, self.named_state(), partial=self.result())
+        if ev >= 2 * NEV_TIP:
+            self._armature_event(ev - 2 * NEV_TIP)
+            return
         if kind == EV_COMPRESSION:
             # a restart for the work split only (the time of maximum compression is in the
             # history): no regime changes, the watched sign turns; a contact chattering at
@@ -892,6 +988,138 @@ class ImpactSolver:
                 self._check_cap(other)
                 self.h = min(self.h, self._onset_step)
             self._log(other, "contact_start" if old[other] == FREE else "contact_end", old[other], aux)
+
+    def _armature_signs(self, g: np.ndarray, triggered: int | None) -> None:
+        """The watched side of each of the armature's events (g: every event function at the
+        current state): the triggered one is now on its new side, the others on the side
+        their value says (at a stop, not pressed: open); and so which of its stops and card
+        are closed (the seat is set by _seat and _unseat alone). The turn and the seat are
+        watched by which stops are closed: their values are taken again once that is set."""
+        base = 2 * NEV_TIP
+        for k in range(base, NEV):
+            if triggered == k:
+                self.ev_sign[k] = -self.ev_sign[k]
+            else:
+                self.ev_sign[k] = 1.0 if g[k] >= 0.0 else -1.0
+        closed = self.armature_closed.copy()
+        for k in (EA_REST, EA_POLE, EA_CARD):
+            self.armature_closed[k] = 1.0 if self.ev_sign[base + k] < 0.0 else 0.0
+        if np.any(closed != self.armature_closed):
+            event_values(self.y, self._evaluate(), self.work[22], self.eref, self.arrays, g, self.arm)
+            for k in (base + EA_TURN, base + EA_SEAT):
+                if triggered != k:
+                    self.ev_sign[k] = 1.0 if g[k] >= 0.0 else -1.0
+
+    def _armature_resolve(self, triggered: int | None = None) -> None:
+        """The armature's event signs and contact states for the current state."""
+        if not self.model.has_armature:
+            return
+        g = np.empty(NEV)
+        event_values(self.y, self._evaluate(), self.work[22], self.eref, self.arrays, g, self.arm)
+        self._armature_signs(g, triggered)
+
+    def _armature_event(self, k: int) -> None:
+        """The armature's event k (kernel_layout EA_*): a stop or the card closed or opened
+        (logged; a closing one starts with a step of its own time scale), a turn on a stop
+        (where it may be seated), or a seated armature's press vanishing (it leaves the
+        stop). The regimes of the contact points do not change: the card's force on the
+        bar is a load like the others."""
+        ev = 2 * NEV_TIP + k
+        if k == EA_TURN:
+            self.ev_sign[ev] = -self.ev_sign[ev]
+            self._seat()
+            return
+        if k == EA_SEAT:
+            self._unseat()
+            return
+        opened = self.ev_sign[ev] < 0.0  # it was closed (g < 0)
+        self._armature_resolve(ev)
+        if not opened:
+            self.h = min(self.h, self._armature_onset)
+        self._log_armature(k, "end" if opened else "start")
+        self._restart_rest_window()
+
+    def _seat_state(self) -> tuple[int, float, float]:
+        """(the closed stop EA_REST or EA_POLE, or -1; its penetration m or rad; the force
+        pressing the armature onto it, N or N m)."""
+        a = self.model.armature_index
+        arm = self.scene.armature
+        force = float(armature_force(self.t, self.y, self.arrays, self.arm))
+        if self.armature_closed[EA_POLE]:
+            return EA_POLE, float(self.y[a]) - arm.travel, force
+        if self.armature_closed[EA_REST]:
+            return EA_REST, -float(self.y[a]), -force
+        return -1, 0.0, 0.0
+
+    def _seat(self, start: bool = False) -> None:
+        """Seat the armature on its closed stop if it will stay there: at a turn (its speed
+        zero) with a force pressing it on, its stop's spring within that force of the
+        press, |k pen - R| <= R (its ringing then never lifts it off while R holds). Seated,
+        it is held at the stop's surface with zero speed, the stop's force the reaction R,
+        until R vanishes (the event EA_SEAT); the stop's stiffness then costs no steps (an
+        explicit method on a stop of 1e11 N/m kept ringing at ~100 times its tolerance and
+        lifted a pressed armature off spuriously: 5929 contact events in 10 ms of the
+        solenoid pressed with 5 N at rtol 1e-6). The energy this removes (the ringing's,
+        at most R^2 / (2 k)) is credited to the audit at that time: the event
+        "armature_seat" carries it (``energy``, J; mech.results).
+        start: at the start of the run, at the stop's surface and at rest (no ringing)."""
+        a = self.model.armature_index
+        arm = self.scene.armature
+        if start:
+            q, v = float(self.y[a]), float(self.y[a + 1])
+            at = EA_REST if q == 0.0 else EA_POLE if q == arm.travel else -1
+            if at < 0 or v != 0.0:
+                return
+            self.armature_closed[at] = 1.0
+            stop, pen, press = self._seat_state()
+            if press <= 0.0:
+                self.armature_closed[at] = 0.0
+                return
+        else:
+            stop, pen, press = self._seat_state()
+            k_stop = arm.stop_stiffness
+            if stop < 0 or press <= 0.0 or abs(k_stop * pen - press) > press:
+                return
+        e = self._rest_e
+        energies(self.y, self.arrays, self.work, e, self.arm)
+        before = float(e.sum())
+        self.y[a] = 0.0 if stop == EA_REST else arm.travel
+        self.y[a + 1] = 0.0
+        self.armature_closed[EA_SEAT] = 1.0
+        energies(self.y, self.arrays, self.work, e, self.arm)
+        self._armature_resolve()
+        self._log_armature(stop, "seat", energy=float(e.sum()) - before, press=press)
+
+    def _unseat(self) -> None:
+        """The press of the seated armature has vanished: it leaves its stop (at the surface,
+        at rest: the stop opens at once)."""
+        stop = EA_POLE if self.armature_closed[EA_POLE] else EA_REST
+        self.armature_closed[EA_SEAT] = 0.0
+        self._armature_resolve()
+        self._log_armature(stop, "end")
+        self._restart_rest_window()
+
+    def _log_armature(self, k: int, edge: str, **extra) -> None:
+        """Log the armature's stop or card event k (EA_*) as "<name>_<edge>" (start, end), or its
+        seat on stop k ("armature_seat", with the energy credited to the audit, J, and the
+        press, N or N m); ``extra``: more fields of the event."""
+        name, stop = ARMATURE_EVENTS[k]
+        if edge == "seat":
+            name, edge = "armature", "seat"
+        q, v, card, _, pen_card, pen_card_rate = armature_table(self.y[None, :], self.arrays, self.arm)[0]
+        travel = self.scene.armature.travel
+        if k == EA_CARD:
+            pen, rate, force = pen_card, pen_card_rate, card
+        elif k == EA_REST:
+            pen, rate, force = -q, -v, self.scene.armature.stop_stiffness * max(0.0, -q)
+        else:
+            pen, rate, force = q - travel, v, self.scene.armature.stop_stiffness * max(0.0, q - travel)
+        self.events.append(dict(
+            time=self.t, tip=-1, kind=f"{name}_{edge}", stop=stop,
+            regime_before="", regime_after="", penetration=float(pen), penetration_rate=float(rate),
+            normal_force=float(force), slip_speed=0.0, armature_position=float(q), armature_velocity=float(v),
+            **extra,
+        ))
 
     def _log(self, tip: int, kind: str, before: int, aux: np.ndarray) -> None:
         self.events.append(dict(
@@ -963,7 +1191,7 @@ class ImpactSolver:
                 rest[i] = SLIP  # (not at rest: left out of the projection)
         if any_rest:
             self.projection_energy += project_to_stick(
-                self.t, self.y, self.arrays, rest, self.eref, self._aux, self.work)
+                self.t, self.y, self.arrays, rest, self.eref, self._aux, self.work, self.arm)
 
     def _slip_reference(self, i: int, aux: np.ndarray, resisted: np.ndarray) -> np.ndarray:
         """Reference direction of a slip that starts at tip i from (near) rest: the direction
@@ -1052,8 +1280,9 @@ class ImpactSolver:
                 break
         self.regime[:] = new
         aux = self._evaluate()
-        g = np.empty(2 * NEV_TIP)
-        events_from_aux(aux, self.eref, self.arrays, g)
+        g = np.empty(NEV)
+        event_values(self.y, aux, self.work[22], self.eref, self.arrays, g, self.arm)
+        self._armature_signs(g, triggered)
         for i in range(2):
             b = NEV_TIP * i
             self.ev_sign[b + EV_CONTACT] = -1.0 if new[i] == FREE else 1.0

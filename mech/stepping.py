@@ -10,7 +10,8 @@ the same right-hand side, events and history rows; only how the steps are taken 
   LSODA), the independent routes of the tests and the accuracy study.
 
 The integration state a stepper reads: ``t`` (s), ``h`` (s, the step in use; 0 to choose),
-``regime``, ``eref``, ``model``, ``arrays`` (``model.kernel_arrays(drive)``), ``drive``,
+``regime``, ``eref``, ``model``, ``arrays`` (``model.kernel_arrays(drive)``), ``arm``
+(``model.kernel_armature(armature_closed)``: None without an armature), ``drive``,
 ``coupled`` (None or mech.solver.CoupledStates), ``work`` (kernel scratch), ``scene``; what
 it writes: ``y`` (and ``z``, the coupled extra states) in place to the state at the end,
 ``ev_sign``, ``stats`` (accumulated), the rows from ``recorder.n`` on (not committed: the
@@ -52,5 +53,5 @@ class CompiledStepper:
         return Outcome(*integrate(
             state.t, state.y, t_goal, state.h, (m.max_step, solver.rtol, m.atol, m.relmask), state.arrays,
             state.regime, state.eref, state.ev_sign, rows, dense, rec.keep_dense, solver.max_steps,
-            state.work, state.stats,
+            state.work, state.stats, state.arm,
         ))

@@ -138,6 +138,11 @@ def test_the_drive_channels_take_the_ahead_of_time_route():
     model = kinds["dynamics"][2]
     assert model[0] == "tuple"
     assert model[1][-2:] == [["array", "int64", 2, "C"], ["array", "float64", 2, "C"]]  # cdrive, drive
+    # the armature's arrays are an argument of their own: None (no armature), or its
+    # parameters, gain table and contact states in the "_armature" export
+    assert kinds["dynamics"][-1] == ["scalar", "none"]
+    assert kinds["dynamics_armature"][-1] == ["tuple", [["array", "float64", 1, "C"], ["array", "float64", 2, "C"],
+                                                        ["array", "float64", 1, "C"]]]
     steel = dict(youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0)
     free = {"bar": dict(length=0.1, diameter=0.006, tip_radius=0.003, modes=2, **steel),
             "initial": dict(height=1e-4, angle_deg=30.0, velocity=[0.3, 0.1, -1.0]),
@@ -165,6 +170,20 @@ def test_the_drive_channels_take_the_ahead_of_time_route():
             result = solver.result()
             assert len(result.contacts) >= 1
             assert np.isfinite(result.energy_table.residual.to_numpy()).all()
+        # the armature: alone (a bar-less model) and through its card on the blade
+        arm = dict(kind="plunger", mass=0.005, travel=2e-4, stop_stiffness=1e9, stop_damping=300.0,
+                   spring_preload=0.1, force_gain=dict(position=[0.0, 1e-4, 2e-4], gain=[1.0, 1.2, 2.0]))
+        card = dict(arm, card_position=0.01, card_lever=1.0, card_stiffness=1e5, card_damping=0.5)
+        for doc in ({"armature": arm, "solver": dict(t_end=2e-3)},
+                    dict(blade, armature=card, force=[], initial=dict(height=1e-4))):
+            solver = ImpactSolver(scene_from_dict(doc), keep_dense=True)
+            seg = solver.advance(1e-3, {"armature.force": (0.0, 3.0)})
+            seg.armature(0.5e-3)
+            solver.armature_now()
+            solver.advance(2e-3)
+            result = solver.result()
+            assert result.armature["first_arrival"] is not None
+            assert np.isfinite(result.history_columns["armature_position"]).all()
 
 
 def _fake_build(calls, delay=0.2):
