@@ -72,15 +72,16 @@ def main() -> None:
     report, wall = study(scene, args.operations, args.every)
     runs = [r["wall_time"] for r in report.rows]
     per_sample = wall / len(report.rows)
+    grown = (report.rows[-1]["gap"] - report.rows[0]["gap"]) * 1e9
     lines = [f"`{command_line()}`", "",
              f"- a single run of relay_cycle (median of 3): {single:.3f} s;",
              f"- {args.operations} operations sampled every {args.every}: {len(report.rows)} runs in {wall:.1f} s "
-             f"(end: {report.end_note}); the runs' own time {sum(runs):.1f} s (median {statistics.median(runs):.3f} s);",
+             f"(end: {report.end_note}); the runs' own time {sum(runs):.1f} s "
+             f"(median {statistics.median(runs):.3f} s);",
              f"- per sample {per_sample:.3f} s = {per_sample / single:.2f} x the single run; per simulated operation "
              f"{wall / report.operations_done * 1e3:.1f} ms (target <= 500 ms);",
              f"- worn after {report.operations_done} operations: {report.worn[0]:.3g} m^3 (moving), "
-             f"{report.worn[1]:.3g} m^3 (fixed); the gap grew by {(report.rows[-1]['gap'] - report.rows[0]['gap']) * 1e9:.3g} nm "
-             "by the last sample."]
+             f"{report.worn[1]:.3g} m^3 (fixed); the gap grew by {grown:.3g} nm by the last sample."]
     if args.convergence:
         # no end criterion: the studies must reach the same operation count to compare
         fast = scene.update({"duty.erosion_coefficient": 2e-10, "duty.life": {

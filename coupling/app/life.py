@@ -40,7 +40,6 @@ import copy
 import dataclasses
 import hashlib
 import json
-import math
 import os
 import sys
 import time
@@ -468,6 +467,7 @@ def plot_life(rows: list[dict]):
             y = np.array([np.nan if r.get(column) is None else r[column] for r in rows], float) * scale
             ax.plot(x, y, "o-", ms=3, label=column.replace("_", " "))
         ax.set_ylabel(f"{name} ({unit})")
+        ax.ticklabel_format(axis="y", useOffset=False)  # a slow wear shows as digits, not as an offset
         ax.grid(alpha=0.3)
         if len(columns) > 1:
             ax.legend(fontsize=7)

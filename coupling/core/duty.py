@@ -141,8 +141,8 @@ class DutySettings:
                              "\"possible\", >= 1 \"likely\")")
         check_positive("duty.melt_fraction", self.melt_fraction, high=1.0)
         heights = _pair_of("duty.cap_height", self.cap_height)
-        object.__setattr__(self, "cap_height", tuple(
-            None if h is None else check_positive(f"duty.cap_height[{i}]", h, high=10.0) for i, h in enumerate(heights)))
+        object.__setattr__(self, "cap_height", tuple(None if h is None else check_positive(
+            f"duty.cap_height[{i}]", h, high=10.0) for i, h in enumerate(heights)))
         if self.life is not None and not isinstance(self.life, LifeLimits):
             raise ValueError(f"duty.life = {self.life!r}: expected a table of keys")
         # every datum a model will read, named with its model now rather than after the run

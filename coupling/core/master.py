@@ -289,7 +289,8 @@ class CoSimulation:
         mu = link.mu(i_now)
         inputs = link.held_inputs(mech.contact_now(), stepper.uses_gap)
         tick = time.perf_counter()
-        mech.advance(t_next, link.drives(mech, mu, mu) | link.repulsion(mech, self.scene.duty, lambda s: i_now, t, t_next))
+        mech.advance(t_next, link.drives(mech, mu, mu)
+                     | link.repulsion(mech, self.scene.duty, lambda s: i_now, t, t_next))
         self.stats["mech_seconds"] += time.perf_counter() - tick
         link.mu_log.append((t, t_next, mu, mu))
         tick = time.perf_counter()

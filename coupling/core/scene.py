@@ -386,7 +386,8 @@ def circuit_key_names(ck) -> dict:
     names.update({f"ContactSchedule.{name}": f"circuit.schedule.{'make/break' if name == 'intervals' else key}"
                   for key, name in _SCHEDULE.items()})
     names["SwitchCircuit.load"] = "circuit.template"
-    names.update({f"ShortCircuit.{k.split('.', 1)[1]}": v for k, v in list(names.items()) if k.startswith("SwitchCircuit.")})
+    names.update({f"ShortCircuit.{k.split('.', 1)[1]}": v for k, v in list(names.items())
+                  if k.startswith("SwitchCircuit.")})  # a ShortCircuit is a SwitchCircuit
     names["CircuitSpec.probes"] = "circuit.probes"  # what to record, beside the circuit itself
     return names
 

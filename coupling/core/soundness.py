@@ -27,8 +27,8 @@ the rows it thinned away (``mech.ImpactResult.thinning``)):
   about that fraction;
 - circuit (template circuits): the loop current through the load is at most
   2 V / (R_source + R_wiring + R_load) (A): the supply across the series loop, plus one
-  full overshoot of the loop's ringing (a short_circuit template: R_load || R_fault). A netlist circuit's topology is not known: no
-  current bound.
+  full overshoot of the loop's ringing (a short_circuit template: R_load || R_fault). A
+  netlist circuit's topology is not known: no current bound.
 
 Bounds are compared with a relative margin (BOUND_MARGIN) for round-off and the
 integration error the energy check already limits.

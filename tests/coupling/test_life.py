@@ -105,6 +105,9 @@ def test_the_worn_volume_is_each_samples_erosion_times_the_operations_it_stands_
     table = pd.read_parquet(out / "life.parquet")
     assert list(table.operation) == [0, 2, 4] and list(table.columns) == list(life.LIFE_COLUMNS)
     assert (out / "life.png").is_file() and (out / "life.csv").is_file()
+    from plot_checks import assert_every_axis_has_a_unit
+
+    assert assert_every_axis_has_a_unit(life.plot_life(rows), "plot_life")
 
 
 def test_resume_after_an_interrupt_loses_no_sampled_operation(relay, whole, tmp_path, monkeypatch):
