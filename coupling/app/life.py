@@ -19,7 +19,7 @@ contact between them:
   ``cap_height`` (the worn heights) and ``conductor_radius`` (pinned at the first sample's:
   the cap's base, where the current lines run parallel, does not wear);
 - it stops at N operations or at the first end criterion of [duty.life] (coupling.core.duty.
-  LifeLimits): the gap out of its range, the held contact force below its least, the
+  LifeLimits): the gap out of its range, the held normal force below its least, the
   held contact resistance above its largest, a make's weld risk at ``stop_on_weld``, or a
   cap worn through.
 
@@ -344,7 +344,7 @@ def _row_end(row: dict, limits: dict) -> tuple[str, str] | None:
 
     force, resistance, risk = row.get("held_force"), row.get("contact_resistance"), row.get("weld_risk")
     if limits["min_force"] is not None and force is not None and force < limits["min_force"]:
-        return "force", f"held contact force {force:.4g} N below duty.life.min_force {limits['min_force']:.4g} N"
+        return "force", f"held normal force {force:.4g} N below duty.life.min_force {limits['min_force']:.4g} N"
     if limits["max_resistance"] is not None and resistance is not None and resistance > limits["max_resistance"]:
         return "resistance", (f"held contact resistance {resistance:.4g} ohm above duty.life.max_resistance "
                               f"{limits['max_resistance']:.4g} ohm")
@@ -448,7 +448,7 @@ PANELS = (
     (("make_arc_energy", "break_arc_energy"), "arc energy", "mJ", 1e3),
     (("moving_worn_volume", "fixed_worn_volume"), "worn volume", "mm^3", 1e9),
     (("contact_resistance",), "held contact resistance", "mohm", 1e3),
-    (("held_force",), "held contact force", "N", 1.0),
+    (("held_force",), "held normal force", "N", 1.0),
     (("gap",), "contact gap", "mm", 1e3),
 )
 

@@ -94,7 +94,7 @@ _SUMMARY = {
                   "max_load_current": ("largest load current", "A"),
                   "load_current_bound": ("load current bound", "A")},
     "duty": {"conductor_radius": ("conductor radius", "m"), "blow_off_current": ("blow-off current", "A"),
-             "held_force": ("held contact force", "N"), "contact_resistance": ("held contact resistance", "ohm"),
+             "held_force": ("held normal force", "N"), "contact_resistance": ("held contact resistance", "ohm"),
              "arc_energy": ("arc energy by stage", "J"),
              **{f"{side}_{k}": (f"{side} contact's {w}", u) for side in ("moving", "fixed") for k, w, u in (
                  ("anodic_energy", "anodic-stage arc energy", "J"),
@@ -107,7 +107,7 @@ _SUMMARY = {
              "fixed_worn_volume": ("fixed contact's worn volume", "m^3"),
              "moving_cap_height": ("moving cap height", "m"), "moving_cap_radius": ("moving cap radius", "m"),
              "fixed_cap_height": ("fixed cap height", "m"), "fixed_cap_radius": ("fixed cap radius", "m"),
-             "gap": ("contact gap", "m"), "held_force": ("held contact force", "N"),
+             "gap": ("contact gap", "m"), "held_force": ("held normal force", "N"),
              "contact_resistance": ("held contact resistance", "ohm"), "bounce_time": ("bounce time", "s"),
              "gap_low": ("least gap", "m"), "gap_high": ("largest gap", "m"), "min_force": ("least held force", "N"),
              "max_resistance": ("largest held resistance", "ohm")},

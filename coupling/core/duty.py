@@ -54,7 +54,7 @@ class LifeLimits:
     """[duty.life]: when `switchsim life` stops before its operation count (SI).
 
     gap_range: m, [low, high] of the contact gap (None: 0.5 and 1.5 x the scene's gap);
-    min_force: N, the least held contact force (None: 0.5 x the first sampled operation's);
+    min_force: N, the least held normal force (None: 0.5 x the first sampled operation's);
     max_resistance: ohm, the largest held contact resistance (None: 10 x the first sampled
     operation's); stop_on_weld: stop at a make whose weld risk reaches "likely" (default),
     "possible", or "never".
@@ -344,7 +344,7 @@ def operation_duty(result, ops: list[dict]) -> list[dict]:
 def _held(duty: DutySettings, t, i_contact, force, resistance, span) -> dict | None:
     """The held closure's figures (None without a held closure).
 
-    force: the closure's median contact force in time (N: half of the closure at a force
+    force: the closure's median normal force in time (N: half of the closure at a force
     below it, half above: what the contact is held at, whatever impacts at its start or a
     ramp of the actuator do); contact_resistance: R_c at that force, the closure's median in
     time (ohm); contact_voltage: the largest |contact current| of the closure times that R_c

@@ -1,12 +1,12 @@
 """Holm's repulsion acting on the motion in a coupled run, against closed forms.
 
 The contact is a rigid steel arm hinged at one end under a constant preload torque (a
-statically determinate support: the contact force plus the repulsion balance the same
+statically determinate support: the normal force plus the repulsion balance the same
 moments), its tip on a silver pair (Holm's plastic law), switching a supply whose load is
 shorted at a time (the short_circuit template):
 
 - before the fault the contact carries the preload P = (T0 + m g L / 2) / (L - R_tip);
-- under a steady fault current I the mechanics' contact force is F = P - mu0 I^2 / (4 pi)
+- under a steady fault current I the mechanics' normal force is F = P - mu0 I^2 / (4 pi)
   ln(R / a(F)), the a-spot a = sqrt(F / (pi H)) at the force it carries, and the current is
   the template's closed form E / (R_source + R_c + R_fault || R_load);
 - with the fault current ramped slowly, the force follows that equilibrium until it has
