@@ -115,6 +115,32 @@ class ContactLink:
         names = mech.drive_names
         return {f"mu.{i}": (mu_start, mu_end) for i in self.points if f"mu.{i}" in names}
 
+    def repulsion(self, mech, duty, current_at, t: float, t_end: float) -> dict:
+        """The drives ``repulsion.<i>`` of its contact points over the step [t, t_end] (N at the
+        step's start and end), empty without [duty] repulsion (``duty``: the scene's
+        coupling.core.duty.DutySettings or None).
+
+        Holm's force of each point's share of the loop current ``current_at(s)`` (A, extrapolated
+        as mu's is), at the plastic a-spot of the point's normal force at the step's start; the
+        current split between the points by their conductances then. A point open at the step's
+        start gets 0 for the step (it has no spot): a point that makes within a step feels its
+        repulsion from the next one on, which also ends the chatter a repulsion above the
+        closing force would keep up at an open contact (docs/mechanics.md, "Drive channels")."""
+        if duty is None or not duty.repulsion:
+            return {}
+        names = mech.drive_names
+        contact = mech.contact_now()
+        law = self.laws.resistance_law.scalar_force_conductance
+        g = {i: law(contact[i, 2]) * conduction_onset(contact[i, 0], self.onset) for i in self.points}
+        total = sum(g.values())
+        ends = (current_at(t), current_at(t_end))
+        out = {}
+        for i in self.points:
+            if f"repulsion.{i}" in names:
+                share = g[i] / total if total > 0.0 else 0.0
+                out[f"repulsion.{i}"] = tuple(duty.repulsion_force(share * current, contact[i, 2]) for current in ends)
+        return out
+
     # -- into the circuit --
 
     def inputs(self, seg, touching_at_start, gap_wanted: bool) -> dict:

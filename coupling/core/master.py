@@ -163,7 +163,7 @@ class CoSimulation:
         policy = self.policy
         t_end = sc.t_end
         tick = time.perf_counter()
-        mech = ImpactSolver(sc.mech, keep_dense=True)
+        mech = ImpactSolver(sc.mech, keep_dense=True, input_work=sc.duty is not None and sc.duty.repulsion)
         try:
             stepper = Stepper(sc.circuit.circuit, t_end, sc.circuit.options)
         except ValueError:  # the netlist is bad input (ngspice refused it): an input error, exit 2
@@ -250,7 +250,8 @@ class CoSimulation:
         # being redone there with the current extrapolated to that end: the mechanics stop
         # at it (instead of integrating the bounces beyond and returning to it).
         in_flight = cp is not None and not np.any(touching)
-        seg = mech.advance(t_next, link.drives(mech, mu0, link.mu(current_at(t_next))), stop_at_switch=in_flight)
+        seg = mech.advance(t_next, link.drives(mech, mu0, link.mu(current_at(t_next)))
+                           | link.repulsion(mech, self.scene.duty, current_at, t, t_next), stop_at_switch=in_flight)
         switching = [e["time"] for e in seg.events if e["kind"] in CONTACT_EVENTS]
         aligned = False
         if cp is not None and switching:
@@ -264,7 +265,8 @@ class CoSimulation:
                 # stopped flight step is redone in full)
                 t_next = t_next if end is None else end
                 mech.restore(cp)
-                seg = mech.advance(t_next, link.drives(mech, mu0, link.mu(current_at(t_next))))
+                seg = mech.advance(t_next, link.drives(mech, mu0, link.mu(current_at(t_next)))
+                                   | link.repulsion(mech, self.scene.duty, current_at, t, t_next))
                 self.stats["aligned_steps"] += int(end is not None)
                 switching = [e["time"] for e in seg.events if e["kind"] in CONTACT_EVENTS]
                 aligned = end is not None
@@ -287,7 +289,8 @@ class CoSimulation:
         mu = link.mu(i_now)
         inputs = link.held_inputs(mech.contact_now(), stepper.uses_gap)
         tick = time.perf_counter()
-        mech.advance(t_next, link.drives(mech, mu, mu))
+        mech.advance(t_next, link.drives(mech, mu, mu)
+                     | link.repulsion(mech, self.scene.duty, lambda s: i_now, t, t_next))
         self.stats["mech_seconds"] += time.perf_counter() - tick
         link.mu_log.append((t, t_next, mu, mu))
         tick = time.perf_counter()

@@ -175,6 +175,10 @@ class CoupledResult:
                 ops = _operations(self.closed_intervals, self.scene.t_end, w["time"], w["contact_voltage"], loop,
                                   w["contact_current"], arc, settings,
                                   min_arc_current=None if model is None else model.min_current)
+                if getattr(self.scene, "duty", None) is not None:  # what each did to the contact
+                    from coupling.core.duty import operation_duty
+
+                    ops = operation_duty(self, ops)
             self._cache["operations"] = ops
         return self._cache["operations"]
 
@@ -219,6 +223,10 @@ class CoupledResult:
         if self.scene.circuit is not None:
             out["bounce"] = _jsonable(self.bounce)
             out["operations"] = _jsonable(self.operations)
+            if getattr(self.scene, "duty", None) is not None:
+                from coupling.core.duty import duty_totals
+
+                out["duty"] = _jsonable(duty_totals(self.scene.duty, self.operations))
             if self.logic is not None:
                 out["logic"] = _jsonable(self.logic)
         if self.scene.tribology is not None:

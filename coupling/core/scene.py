@@ -11,6 +11,7 @@ A scene names only what it needs, and only that is built:
     [circuit]     template = "resistive" | "inductive" | "capacitive" | "current_source" | "netlist"
                   | "mcu_input" (voltage, pull, pull_resistance, series_resistance,
                   input_capacitance, logic_low, logic_high, contact_capacitance, leakage_conductance)
+                  | "short_circuit" (resistive, shorted at fault_time: fault_resistance, fault_rise)
                   voltage, source_resistance (voltage templates) | current, compliance_voltage,
                   output_capacitance, output_resistance (current_source), wiring_resistance,
                   wiring_inductance, load_resistance, load_inductance, load_capacitance,
@@ -28,6 +29,10 @@ A scene names only what it needs, and only that is built:
                   history_max_rows
     [metrics]     settle_window (s), make_guard (s), arc_toggle_limit (coupling.core.metrics),
                   logic = { node = "v(pin)", low, high } (V; coupling.core.logic)
+    [duty]        materials = ["moving", "fixed"], moving_node, repulsion, conductor_radius,
+                  transition_gap, transfer_fraction, erosion_coefficient, weld_margin,
+                  melt_fraction, cap_height, life = {gap_range, min_force, max_resistance,
+                  stop_on_weld} (coupling.core.duty; docs/contact_duty.md)
 
 SI units everywhere. File paths are relative to the scene file. Every error names the
 file, the section and key as written and says what is allowed, before any solver starts.
@@ -58,7 +63,7 @@ from mech.validation import (
     check_bool, check_choice, check_file, check_keys, check_nonnegative, check_positive, check_whole,
 )
 
-COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output", "metrics")
+COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output", "metrics", "duty")
 # macro steps a coupled run may take at most (t_end / macro_step, every step in contact):
 # each costs a mechanics advance and an ngspice step (~0.1-1 ms), so 1e6 is minutes to an
 # hour; a 1e-9 s macro step over 5 ms (5e6) is refused before it starts
@@ -70,7 +75,7 @@ POINTS_PER_MACRO_STEP = 4
 WAVE_COPIES = 3
 MECH_WAVE_COLUMNS = 8  # normal_force_0/1, penetration_0/1, normal_force, gap, mu (+1 spare)
 MACRO_STEP_LOG_BYTES = 152  # the friction coefficient's log, one entry per macro step
-TEMPLATES = ("resistive", "inductive", "capacitive", "current_source", "netlist", "mcu_input")
+TEMPLATES = ("resistive", "inductive", "capacitive", "current_source", "netlist", "mcu_input", "short_circuit")
 SCHEMES = ("mechanics_first", "jacobi")
 
 
@@ -186,6 +191,7 @@ class Scene:
     output: OutputOptions = field(default_factory=OutputOptions)
     name: str = "scene"
     metrics: Any = None  # coupling.core.metrics.MetricSettings
+    duty: Any = None  # coupling.core.duty.DutySettings, when the scene has [duty]
 
     @property
     def kind(self) -> str:
@@ -338,7 +344,9 @@ _LOADS = {
     "capacitive": {"load_resistance": "resistance", "load_capacitance": "capacitance",
                    "bleed_resistance": "bleed_resistance"},
     "current_source": {"load_resistance": "resistance"},
+    "short_circuit": {"load_resistance": "resistance"},
 }
+_FAULT = {"fault_time": "fault_time", "fault_resistance": "fault_resistance", "fault_rise": "fault_rise"}
 _TEMPLATE_CIRCUIT = {"contact_capacitance": "contact_capacitance", "leakage_conductance": "leakage_conductance"}
 _NETLIST = {"netlist": None, "load_probe": "load_probe", "leakage_conductance": "leakage_conductance"}
 _PARTS = ("snubber", "flyback", "arc")
@@ -356,7 +364,8 @@ def template_keys(template: str) -> set:
     if template == "mcu_input":
         return set(_MCU_INPUT)
     source = _CURRENT_SOURCE if template == "current_source" else _VOLTAGE_SOURCE
-    return set(source) | set(_WIRING) | set(_LOADS[template]) | set(_TEMPLATE_CIRCUIT) | set(_PARTS)
+    fault = set(_FAULT) if template == "short_circuit" else set()
+    return set(source) | set(_WIRING) | set(_LOADS[template]) | set(_TEMPLATE_CIRCUIT) | set(_PARTS) | fault
 
 
 CIRCUIT_KEYS = frozenset({"template", "schedule", "probes", *_OPTION_KEYS}.union(*(template_keys(t) for t in TEMPLATES)))
@@ -368,7 +377,7 @@ def circuit_key_names(ck) -> dict:
     for cls, keys in ((ck.DCSource, _VOLTAGE_SOURCE), (ck.CurrentSource, _CURRENT_SOURCE), (ck.Wiring, _WIRING),
                       (ck.ResistiveLoad, _LOADS["resistive"]), (ck.InductiveLoad, _LOADS["inductive"]),
                       (ck.CapacitiveLoad, _LOADS["capacitive"]), (ck.SwitchCircuit, _TEMPLATE_CIRCUIT),
-                      (ck.NetlistCircuit, _NETLIST), (ck.McuInput, _MCU_INPUT)):
+                      (ck.NetlistCircuit, _NETLIST), (ck.McuInput, _MCU_INPUT), (ck.ShortCircuit, _FAULT)):
         names.update({f"{cls.__name__}.{name}": f"circuit.{key}" for key, name in keys.items() if name})
     for part, cls in zip(_PARTS, (ck.Snubber, ck.FlybackDiode, ck.ArcModel)):
         names[f"SwitchCircuit.{part}"] = names[f"NetlistCircuit.{part}"] = f"circuit.{part}"
@@ -377,6 +386,8 @@ def circuit_key_names(ck) -> dict:
     names.update({f"ContactSchedule.{name}": f"circuit.schedule.{'make/break' if name == 'intervals' else key}"
                   for key, name in _SCHEDULE.items()})
     names["SwitchCircuit.load"] = "circuit.template"
+    names.update({f"ShortCircuit.{k.split('.', 1)[1]}": v for k, v in list(names.items())
+                  if k.startswith("SwitchCircuit.")})  # a ShortCircuit is a SwitchCircuit
     names["CircuitSpec.probes"] = "circuit.probes"  # what to record, beside the circuit itself
     return names
 
@@ -447,12 +458,13 @@ def _circuit(table: dict, base_dir: Path, current_factor: str | None):
                 load = ck.ResistiveLoad(**_fields(table, _LOADS[template]))
             else:
                 source = ck.DCSource(**_fields(table, _VOLTAGE_SOURCE))
-                load = {"resistive": ck.ResistiveLoad, "inductive": ck.InductiveLoad,
-                        "capacitive": ck.CapacitiveLoad}[template](**_fields(table, _LOADS[template]))
-            circ = ck.SwitchCircuit(source=source, load=load, wiring=ck.Wiring(**_fields(table, _WIRING)),
-                                    snubber=_part(table, "snubber", ck.Snubber),
-                                    flyback=_part(table, "flyback", ck.FlybackDiode), arc=arc,
-                                    contact_current_factor=current_factor, **_fields(table, _TEMPLATE_CIRCUIT))
+                load = {"resistive": ck.ResistiveLoad, "inductive": ck.InductiveLoad, "capacitive": ck.CapacitiveLoad,
+                        "short_circuit": ck.ResistiveLoad}[template](**_fields(table, _LOADS[template]))
+            cls, fault = (ck.ShortCircuit, _fields(table, _FAULT)) if template == "short_circuit" else (
+                ck.SwitchCircuit, {})
+            circ = cls(source=source, load=load, wiring=ck.Wiring(**_fields(table, _WIRING)),
+                       snubber=_part(table, "snubber", ck.Snubber), flyback=_part(table, "flyback", ck.FlybackDiode),
+                       arc=arc, contact_current_factor=current_factor, **_fields(table, _TEMPLATE_CIRCUIT), **fault)
         schedule = None
         if "schedule" in table:
             st = check_keys("circuit.schedule", _table("circuit.schedule", table["schedule"]), _SCHEDULE)
@@ -537,8 +549,9 @@ def _build(doc: dict, base_dir: Path, name: str) -> Scene:
     coupling, output = (_section(doc, section, cls) for section, cls in (
         ("coupling", CouplingOptions), ("output", OutputOptions)))
     metrics, circuit = _metrics(doc, circuit)
+    duty = _duty(doc, mech, tribology, circuit)
     scene = Scene(raw=copy.deepcopy(doc), base_dir=base_dir, mech=mech, tribology=tribology, circuit=circuit,
-                  coupling=coupling, output=output, name=name, metrics=metrics)
+                  coupling=coupling, output=output, name=name, metrics=metrics, duty=duty)
     check_work(scene)
     return scene
 
@@ -647,6 +660,15 @@ def _metrics(doc: dict, circuit: CircuitSpec | None):
     probe, circuit = _recorded(logic.node, circuit, "metrics.logic.node")
     table["logic"] = dataclasses.replace(logic, node=probe.text)
     return MetricSettings(**table), circuit
+
+
+def _duty(doc: dict, mech: MechScene | None, tribology: TribologySpec | None, circuit: CircuitSpec | None):
+    """[duty] as coupling.core.duty.DutySettings (its defaults from the other sections), or None."""
+    if "duty" not in doc:
+        return None
+    from coupling.core.duty import duty_from_table
+
+    return duty_from_table(_table("[duty]", doc["duty"]), mech, tribology, circuit)
 
 
 def _recorded(text: str, spec: CircuitSpec, where: str):

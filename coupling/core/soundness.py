@@ -27,8 +27,8 @@ the rows it thinned away (``mech.ImpactResult.thinning``)):
   about that fraction;
 - circuit (template circuits): the loop current through the load is at most
   2 V / (R_source + R_wiring + R_load) (A): the supply across the series loop, plus one
-  full overshoot of the loop's ringing. A netlist circuit's topology is not known: no
-  current bound.
+  full overshoot of the loop's ringing (a short_circuit template: R_load || R_fault). A
+  netlist circuit's topology is not known: no current bound.
 
 Bounds are compared with a relative margin (BOUND_MARGIN) for round-off and the
 integration error the energy check already limits.
@@ -181,7 +181,11 @@ def _circuit_current_bound(scene) -> float | None:
     circ = getattr(spec, "circuit", None)
     try:
         voltage = circ.source.voltage
-        series = circ.source.internal_resistance + circ.wiring.resistance + circ.load.resistance
+        load = circ.load.resistance
+        series = circ.source.internal_resistance + circ.wiring.resistance + load
     except AttributeError:  # a netlist circuit: its topology is the user's
         return None
+    fault = getattr(circ, "fault_resistance", None)  # circuit.ShortCircuit: the load shorted by it
+    if fault is not None:
+        series += load * fault / (load + fault) - load
     return loop_current_bound(voltage, series) if series > 0 else None
