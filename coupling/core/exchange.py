@@ -17,11 +17,14 @@ point's height, for an arc that grows with it) and, back, mu(I) from the loop cu
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from coupling.core.policy import TAIL_POINTS, end_rate
 
 CONTACT_EVENTS = ("contact_start", "contact_end")
+FLUX_FLOOR = 1e-6  # Wb: floor of |psi| in the flux linkage's cautious time scale (the step rules')
 
 
 def conduction_onset(penetration: float, onset: float) -> float:
@@ -245,9 +248,17 @@ class CoilLink:
         self.magnet = magnet
         self.rest_gap = float(rest_gap)
         self.lever = float(lever)
-        self.separable = bool(getattr(magnet, "separable", False))
+        from coupling.laws.magnet import FluxTubeMagnet
+
+        # a flux-tube magnet's iron carries the whole coil flux: W = W_iron(psi) + psi^2 R(g) / (2 N^2)
+        self.separable = isinstance(magnet, FluxTubeMagnet)
         self.tail = Tail()
-        self.drive_log: list[tuple[float, float, float, float]] = []
+        # the flux linkage at the last step's end (Wb), its rate (Wb/s), time scale (s) and the
+        # slope the step rules chose to extrapolate it with
+        self.psi, self.rate, self.scale, self.slope = 0.0, 0.0, math.inf, 0.0
+        self.q_times: list[np.ndarray] = []  # the circuit's points ...
+        self.q: list[np.ndarray] = []  # ... and the armature's travel there (m or rad)
+        self._sampled = False
 
     def gap(self, q: float) -> float:
         """m: the working air gap at the armature's position q."""
@@ -269,6 +280,14 @@ class CoilLink:
         return (self.lever * float(self.magnet.force(psi_start, g0)),
                 self.lever * float(self.magnet.force(psi_end, g1)))
 
+    def drives(self, t: float, end: float, arm: tuple[float, float], policy) -> dict:
+        """The armature's drive over [t, end]: the flux linkage extrapolated from the circuit's
+        last points by the step rules (``policy.extrapolate`` with this link's slope and time
+        scale), the armature's (q, q_dot) at t in ``arm``."""
+        psi0 = policy.extrapolate(self.psi, self.slope, 0.0, self.scale)
+        psi1 = policy.extrapolate(self.psi, self.slope, end - t, self.scale)
+        return {"armature.force": self.drive(psi0, psi1, arm[0], arm[1], end - t)}
+
     def inputs(self, seg) -> dict:
         """The coil's gap channel over the segment, from the armature's dense output."""
         lo, hi = seg.t_start, seg.t_end
@@ -283,6 +302,32 @@ class CoilLink:
         """Wb: the coil's flux linkage at the step's end."""
         return float(step.values["coil_flux_linkage" + self.label[len("coil"):]])
 
-    def observe(self, step, jumped: bool = False) -> None:
-        """Keep the circuit's last points of the flux linkage (its rate and time scale)."""
-        self.tail.observe(step.reader("time"), step.reader("coil_flux_linkage" + self.label[len("coil"):]), jumped)
+    def observe(self, step, seg, span: float) -> None:
+        """After a step: the flux linkage at its end, its rate and time scale from the circuit's
+        last points (differences over at least 1e-3 of ``span``, s), and the armature's travel
+        at the step's circuit points (for the result's columns)."""
+        times = step.reader("time")
+        self.tail.observe(times, step.reader("coil_flux_linkage" + self.label[len("coil"):]), False)
+        self.psi = self.flux(step)
+        self.rate, self.scale = self.tail.rate(span)
+        new = times[1:] if self._sampled else times
+        self._sampled = True
+        lo, hi = seg.t_start, seg.t_end
+        self.q_times.append(new)
+        self.q.append(np.array([seg.armature(min(max(s, lo), hi))[0] for s in new]))
+
+    def columns(self, waves: dict) -> dict:
+        """The result's coil columns beside the circuit's (coil_current, coil_voltage,
+        coil_flux_linkage): ``armature_position`` (m, the pole face's travel from rest,
+        lever x q), ``working_gap`` (m) and ``magnetic_force`` (N, F(psi, g) at the pole)."""
+        q = self.travel_series(waves["time"])
+        gap = np.maximum(self.gap(q), 0.0)
+        psi = waves["coil_flux_linkage" + self.label[len("coil"):]]
+        return {"armature_position": self.lever * q, "working_gap": gap,
+                "magnetic_force": np.asarray(self.magnet.force(psi, gap), dtype=float)}
+
+    def travel_series(self, times: np.ndarray) -> np.ndarray:
+        """m or rad: the armature's travel at ``times`` (s), from its samples at the circuit's points."""
+        if not self.q_times:
+            return np.zeros(len(times))
+        return np.interp(times, np.concatenate(self.q_times), np.concatenate(self.q))

@@ -63,7 +63,7 @@ from mech.validation import (
     check_bool, check_choice, check_file, check_keys, check_nonnegative, check_positive, check_whole,
 )
 
-COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output", "metrics", "duty")
+COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output", "metrics", "duty", "coil", "magnet")
 # macro steps a coupled run may take at most (t_end / macro_step, every step in contact):
 # each costs a mechanics advance and an ngspice step (~0.1-1 ms), so 1e6 is minutes to an
 # hour; a 1e-9 s macro step over 5 ms (5e6) is refused before it starts
@@ -423,7 +423,9 @@ def _part(table: dict, name: str, cls):
     return cls(**value)
 
 
-def _circuit(table: dict, base_dir: Path, current_factor: str | None):
+def _circuit(table: dict, base_dir: Path, current_factor: str | None, device=None):
+    """[circuit] as its CircuitSpec; with the relay's ``device`` ([coil], [magnet]) the coil
+    and its drive join the template's circuit (a netlist places it with an XCOIL line)."""
     import circuit as ck
 
     table = check_keys("[circuit]", _table("[circuit]", table), CIRCUIT_KEYS)
@@ -448,9 +450,14 @@ def _circuit(table: dict, base_dir: Path, current_factor: str | None):
             if "netlist" not in table:
                 raise ValueError("template \"netlist\" needs netlist = \"file.cir\" (with one 'XCONTACT a b' line)")
             path = _input_file("circuit.netlist", table["netlist"], base_dir)
+            coil = {} if device is None else dict(coil_resistance=device.resistance,
+                                                  coil_current=device.current_law())
             circ = ck.NetlistCircuit.from_file(path, arc=arc, contact_current_factor=current_factor,
-                                               **_fields(table, _NETLIST))
+                                               **_fields(table, _NETLIST), **coil)
         elif template == "mcu_input":
+            if device is not None:
+                raise ValueError("[coil] with circuit.template = \"mcu_input\": the coil's drive joins a switch "
+                                 "template (resistive, inductive, capacitive, current_source) or a netlist")
             circ = ck.McuInput(contact_current_factor=current_factor, **_fields(table, _MCU_INPUT))
         else:
             if template == "current_source":
@@ -464,7 +471,8 @@ def _circuit(table: dict, base_dir: Path, current_factor: str | None):
                 ck.SwitchCircuit, {})
             circ = cls(source=source, load=load, wiring=ck.Wiring(**_fields(table, _WIRING)),
                        snubber=_part(table, "snubber", ck.Snubber), flyback=_part(table, "flyback", ck.FlybackDiode),
-                       arc=arc, contact_current_factor=current_factor, **_fields(table, _TEMPLATE_CIRCUIT), **fault)
+                       arc=arc, contact_current_factor=current_factor, coil=None if device is None else device.drive(),
+                       **_fields(table, _TEMPLATE_CIRCUIT), **fault)
         schedule = None
         if "schedule" in table:
             st = check_keys("circuit.schedule", _table("circuit.schedule", table["schedule"]), _SCHEDULE)
@@ -507,9 +515,16 @@ def _build(doc: dict, base_dir: Path, name: str) -> Scene:
         raise ValueError("[circuit.schedule] prescribes the contact, so the scene runs no mechanics; "
                          f"remove [{'], ['.join(mech_given or ['solver'])}] (only [solver] t_end may stay) "
                          "or remove [circuit.schedule]")
-    if "coupling" in doc and (circuit_table is None or schedule_given):
-        raise ValueError("[coupling] settings need mechanics and a [circuit] to couple")
-    if circuit_table is not None and not schedule_given and "tribology" not in doc:
+    if "coupling" in doc and ((circuit_table is None and "coil" not in doc) or schedule_given):
+        raise ValueError("[coupling] settings need mechanics and a [circuit] (or a [coil]) to couple")
+    from coupling.core.device import device as relay_device
+
+    device = relay_device(doc)
+    if device is not None and ("armature" not in doc or schedule_given):
+        raise ValueError("[coil] and [magnet] drive an armature: add [armature] (its kind, mass or inertia and "
+                         "travel; docs/mechanics.md section 10)")
+    contact_spring = "bar" in doc or "block" in doc or "rivet" in doc
+    if circuit_table is not None and not schedule_given and "tribology" not in doc and contact_spring:
         raise ValueError("a coupled scene needs [tribology] for R_c(F_n, I) and mu(I): "
                          "source = \"illustrative\" (the shipped, not measured, fit), fit = \"fit.json\" "
                          "or data = \"data.csv\"")
@@ -539,12 +554,18 @@ def _build(doc: dict, base_dir: Path, name: str) -> Scene:
                                 model=fr.model, max_ratio=fr.max_ratio,
                                 regularization_speed=fr.regularization_speed)
             mech = dataclasses.replace(mech, friction=friction)  # every other section as the scene says
+        if device is not None:
+            mech = _armature_of(mech, device)
 
     circuit = None
     if circuit_table is not None:
         # R_c(F, I) = g(|I|)/G_F(F): the current factor goes into ngspice (solved without lag)
         factor = tribology.laws.resistance_law.current_factor_expression("I") if tribology is not None else None
-        circuit = _circuit(circuit_table, base_dir, factor)
+        circuit = _circuit(circuit_table, base_dir, factor, device)
+    elif device is not None:  # an actuator: the coil's drive is the whole circuit
+        import circuit as ck
+
+        circuit = CircuitSpec(device.drive(), ck.SimulationOptions(), template="coil")
 
     coupling, output = (_section(doc, section, cls) for section, cls in (
         ("coupling", CouplingOptions), ("output", OutputOptions)))
@@ -602,12 +623,15 @@ def _largest_state(mech: MechScene) -> int:
     from mech.model import is_planar
 
     bar = mech.bar
+    extra = 8 if mech.armature.present else 0  # the armature's coordinate, speed and quadratures (bounded)
+    if bar is None:  # an armature alone
+        return extra + NQ
     planar = mech.mount.held or (mech.solver.model != "3d" and is_planar(mech))
     axial = CAP if bar.axial_modes == "auto" else bar.axial_modes
     bending = CAP if bar.bending_modes == "auto" else bar.bending_modes
     n = axial + bending * (1 if planar else 2)
     npos, nvel = state_sizes(n, planar)
-    return npos + nvel + (NQ if (mech.mount.held or mech.forces or mech.springs) else NQ_FREE)
+    return npos + nvel + extra + (NQ if (mech.mount.held or mech.forces or mech.springs) else NQ_FREE)
 
 
 def check_work(scene: Scene) -> None:
@@ -635,6 +659,32 @@ def check_work(scene: Scene) -> None:
     raise ValueError(f"{key}: the run could take {est['total'] / 2**30:.3g} GiB (history "
                      f"{est['history'] / 2**30:.3g}, waveforms {est['waveforms'] / 2**30:.3g}), more than the "
                      f"{MEMORY_LIMIT / 2**30:g} GiB a run may take; {fix}")
+
+
+def _armature_of(mech: MechScene, device) -> MechScene:
+    """The mechanics' armature driven by the magnet: a magnet whose force separates as
+    psi^2 h(g) gives the armature its gain table lever h(g(q)) over the travel (the
+    coupling then drives it with psi^2, coupling.core.exchange.CoilLink); its gap must stay
+    open over the whole travel."""
+    from coupling.core.exchange import CoilLink
+
+    arm = mech.armature
+    if not arm.present:
+        raise ValueError("[coil] and [magnet] drive an armature: give [armature] kind = \"plunger\" or \"clapper\"")
+    link = CoilLink("coil", device.magnet, device.rest_gap, device.lever)
+    closed = link.gap(arm.travel)
+    if not closed > 0.0:
+        raise ValueError(f"magnet.rest_gap = {device.rest_gap!r} m with magnet.lever = {device.lever!r} and "
+                         f"armature.travel = {arm.travel!r}: the working gap would close to {closed:.3g} m at the pole "
+                         "stop; the gap must stay > 0 over the travel (a residual gap: the pole stop before the pole)")
+    if not link.separable:
+        return mech
+    if arm.force_gain is not None:
+        raise ValueError("armature.force_gain: the magnet gives the armature its gain (h(g) of its flux-tube "
+                         "model); remove armature.force_gain")
+    q, gain = link.gain_table(arm.travel)
+    return dataclasses.replace(mech, armature=dataclasses.replace(
+        arm, force_gain={"position": [float(x) for x in q], "gain": [float(g) for g in gain]}))
 
 
 def _metrics(doc: dict, circuit: CircuitSpec | None):

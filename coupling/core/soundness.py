@@ -152,18 +152,20 @@ def assess(result) -> dict:
         # from the records themselves and the extremes of those a long run thinned away
         # (mech.ImpactResult.thinning), not from the history table
         residual = mres.max_abs_residual
-        speed = mres.max_speed
-        pen = mres.deepest_penetration
-        v_max = speed_bound(scale, scene.bar.mass)
-        y_max = penetration_bound(scale, float(mres.solver["stiffness"]), scene.bar.mass * scene.gravity)
         kinetic = mres.max_kinetic
         out.update(energy_scale=scale, relative_residual=residual / scale if scale > 0 else None,
-                   max_kinetic=kinetic, max_speed=speed, speed_bound=v_max, max_penetration=pen,
-                   penetration_bound=y_max)
+                   max_kinetic=kinetic)
         problems += [p for p in (energy_problem(residual, scale, scene.solver.energy_tolerance),
-                                 kinetic_problem(kinetic, scale), speed_problem(speed, v_max),
-                                 penetration_problem(pen, y_max, scene.bar.tip_radius)) if p]
-        problems += [p for p in (hertz_problem(y, r, name) for name, y, r in mres.contact_depths) if p]
+                                 kinetic_problem(kinetic, scale)) if p]
+        if scene.bar is not None:  # (an armature alone has no bar to speed or to sink into a contact)
+            speed = mres.max_speed
+            pen = mres.deepest_penetration
+            v_max = speed_bound(scale, scene.bar.mass)
+            y_max = penetration_bound(scale, float(mres.solver["stiffness"]), scene.bar.mass * scene.gravity)
+            out.update(max_speed=speed, speed_bound=v_max, max_penetration=pen, penetration_bound=y_max)
+            problems += [p for p in (speed_problem(speed, v_max),
+                                     penetration_problem(pen, y_max, scene.bar.tip_radius)) if p]
+            problems += [p for p in (hertz_problem(y, r, name) for name, y, r in mres.contact_depths) if p]
     bound = _circuit_current_bound(result.scene)
     waves = result.waveform_columns
     if bound is not None and waves is not None and len(waves["time"]) and "load_current" in waves:
