@@ -24,7 +24,10 @@ import numpy as np
 from coupling.core.policy import TAIL_POINTS, end_rate
 
 CONTACT_EVENTS = ("contact_start", "contact_end")
-FLUX_FLOOR = 1e-6  # Wb: floor of |psi| in the flux linkage's cautious time scale (the step rules')
+# the step rules' floor of the coil's signal (psi^2 or psi), as a fraction of its value at the
+# coil's rated current: changes far below the rated force do not shorten the steps (the
+# coil's ringing after an unsuppressed release, at a thousandth of its rated flux)
+FLUX_FLOOR = 1.0
 
 
 def conduction_onset(penetration: float, onset: float) -> float:
@@ -243,8 +246,11 @@ class CoilLink:
     ends, the gap at the end predicted from the armature's speed.
     """
 
-    def __init__(self, label: str, magnet, rest_gap: float, lever: float = 1.0):
+    def __init__(self, label: str, magnet, rest_gap: float, lever: float = 1.0, switch_times=(),
+                 floor: float = 0.0):
         self.label = label
+        self.floor = float(floor)  # Wb^2 or Wb: the signal's floor in the step rules (FLUX_FLOOR of the rated)
+        self.switch_times = tuple(sorted(float(s) for s in switch_times))
         self.magnet = magnet
         self.rest_gap = float(rest_gap)
         self.lever = float(lever)
@@ -253,12 +259,19 @@ class CoilLink:
         # a flux-tube magnet's iron carries the whole coil flux: W = W_iron(psi) + psi^2 R(g) / (2 N^2)
         self.separable = isinstance(magnet, FluxTubeMagnet)
         self.tail = Tail()
-        # the flux linkage at the last step's end (Wb), its rate (Wb/s), time scale (s) and the
-        # slope the step rules chose to extrapolate it with
-        self.psi, self.rate, self.scale, self.slope = 0.0, 0.0, math.inf, 0.0
+        # the watched signal (``signal``: psi^2 or psi) at the last step's end, its rate (per s),
+        # time scale (s) and the slope the step rules chose to extrapolate it with
+        self.value, self.rate, self.scale, self.slope = 0.0, 0.0, math.inf, 0.0
         self.q_times: list[np.ndarray] = []  # the circuit's points ...
         self.q: list[np.ndarray] = []  # ... and the armature's travel there (m or rad)
         self._sampled = False
+
+    def next_switch(self, t: float) -> float:
+        """s: the coil drive's next switching instant after t (its driver's PWL vertices: on,
+        off and their edges), inf without one. The coil's voltage jumps there, which the
+        flux linkage's extrapolation cannot see: a macro step ends at each."""
+        later = [s for s in self.switch_times if s > t * (1.0 + 1e-12) + 1e-15]
+        return min(later) if later else math.inf
 
     def gap(self, q: float) -> float:
         """m: the working air gap at the armature's position q."""
@@ -272,21 +285,26 @@ class CoilLink:
         q = np.sort((self.rest_gap - gaps) / self.lever)
         return q, self.lever * np.asarray(self.magnet.force(1.0, self.rest_gap - self.lever * q), dtype=float)
 
-    def drive(self, psi_start: float, psi_end: float, q: float, q_dot: float, span: float) -> tuple[float, float]:
-        """The armature drive's values at the step's start and end (see the class docstring)."""
-        if self.separable:
-            return psi_start * psi_start, psi_end * psi_end
-        g0, g1 = self.gap(q), self.gap(q + q_dot * span)
-        return (self.lever * float(self.magnet.force(psi_start, g0)),
-                self.lever * float(self.magnet.force(psi_end, g1)))
+    def signal(self, psi):
+        """What the step rules watch and extrapolate: the drive's flux part, psi^2 (Wb^2) for a
+        separable magnet (the force itself up to the gain: a clamped coil's flux falling
+        through zero, or ringing at a thousandth of its rated value, moves it by nothing),
+        psi (Wb) otherwise."""
+        return psi * psi if self.separable else psi
 
     def drives(self, t: float, end: float, arm: tuple[float, float], policy) -> dict:
-        """The armature's drive over [t, end]: the flux linkage extrapolated from the circuit's
-        last points by the step rules (``policy.extrapolate`` with this link's slope and time
-        scale), the armature's (q, q_dot) at t in ``arm``."""
-        psi0 = policy.extrapolate(self.psi, self.slope, 0.0, self.scale)
-        psi1 = policy.extrapolate(self.psi, self.slope, end - t, self.scale)
-        return {"armature.force": self.drive(psi0, psi1, arm[0], arm[1], end - t)}
+        """The armature's drive over [t, end], its flux part extrapolated from the circuit's last
+        points by the step rules (``policy.extrapolate`` with this link's slope and time scale;
+        psi^2 kept >= 0); the armature's (q, q_dot) at t in ``arm`` (a table magnet's gap at the
+        end predicted from them)."""
+        s0 = policy.extrapolate(self.value, self.slope, 0.0, self.scale)
+        s1 = policy.extrapolate(self.value, self.slope, end - t, self.scale)
+        if self.separable:
+            return {"armature.force": (max(s0, 0.0), max(s1, 0.0))}
+        q, q_dot = arm
+        g0, g1 = self.gap(q), self.gap(q + q_dot * (end - t))
+        return {"armature.force": (self.lever * float(self.magnet.force(s0, g0)),
+                                   self.lever * float(self.magnet.force(s1, g1)))}
 
     def inputs(self, seg) -> dict:
         """The coil's gap channel over the segment, from the armature's dense output."""
@@ -307,9 +325,13 @@ class CoilLink:
         last points (differences over at least 1e-3 of ``span``, s), and the armature's travel
         at the step's circuit points (for the result's columns)."""
         times = step.reader("time")
-        self.tail.observe(times, step.reader("coil_flux_linkage" + self.label[len("coil"):]), False)
-        self.psi = self.flux(step)
+        self.tail.observe(times, self.signal(step.reader("coil_flux_linkage" + self.label[len("coil"):])), False)
+        self.value = self.signal(self.flux(step))
         self.rate, self.scale = self.tail.rate(span)
+        if self.rate != 0.0:
+            # not beyond the time it takes to change by its own size (plus the floor): a signal
+            # falling linearly to zero (a clamped coil's release) has no curvature
+            self.scale = min(self.scale, (abs(self.value) + self.floor) / abs(self.rate))
         new = times[1:] if self._sampled else times
         self._sampled = True
         lo, hi = seg.t_start, seg.t_end
