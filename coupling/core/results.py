@@ -203,8 +203,8 @@ class CoupledResult:
             spec = device(self.scene.raw)
             circ = self.scene.circuit.circuit
             drive = circ if isinstance(circ, CoilDrive) else getattr(circ, "coil", None)  # None: a netlist's
-            travel = spec.lever * self.scene.mech.armature.travel
-            self._cache["relay"] = relay_metrics(w, self.operations, drive, spec.magnet, travel, spec.resistance)
+            self._cache["relay"] = relay_metrics(w, self.operations, drive, spec.magnet, self.mechanics.events,
+                                                 spec.resistance)
         return self._cache["relay"]
 
     @property
