@@ -112,7 +112,7 @@ poisson_ratio = { value = 0.37, range = [0.3, 0.4], source = "s" }
     monkeypatch.setitem(MATERIALS, "X", load_materials(text)["X"])
 
 
-RELAY = "coupling/scenes/default.toml"
+RELAY = "coupling/scenes/relay_force.toml"
 
 
 @pytest.mark.parametrize("duty, match", [

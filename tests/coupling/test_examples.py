@@ -717,9 +717,12 @@ def test_solenoid_current_dips_while_the_armature_flies_and_then_rises_to_v_over
     w = pd.read_csv(out / "waveforms.csv")
     # the back-EMF i dL/dt of the closing gap: the current falls towards the arrival
     assert numbers["current_at_arrival"] < 0.6 * numbers["peak_current_before_arrival"]
-    # the arrival is where the travel first reaches the stop at the pole
-    k = int(np.argmax(w.armature_position.to_numpy() >= numbers["travel"] * (1 - 1e-3)))
-    assert w.time[k] == pytest.approx(numbers["arrival"], abs=1e-9)
+    # the arrival (the mechanics' located stop event) is where the travel first reaches the
+    # pole: short of it at every sample before, at it (within the stop's 1e11 N/m) just after
+    x, t = w.armature_position.to_numpy(), w.time.to_numpy()
+    travel, arrival = numbers["travel"], numbers["arrival"]
+    assert x[t < arrival].max() < travel
+    assert x[np.searchsorted(t, arrival)] == pytest.approx(travel, rel=1e-3)
     # below V / R while the gap only closes (the back-EMF opposes the supply); the armature
     # rebounds from the nearly elastic stop (e = 0.99 from its 1e11 N/m and 400 N s/m), and
     # while the gap opens again the trapped flux drives the current above V / R
@@ -775,5 +778,7 @@ def test_a_diode_slows_the_release_and_lengthens_the_break_arc(suppression):
     # a slow opening keeps the gap short while the current is still large: a longer arc
     assert arc["diode"] > max(arc["none"], arc["zener"], arc["rc"])
     assert rows["diode"]["arc_energy"] > max(rows[k]["arc_energy"] for k in ("none", "zener", "rc"))
-    # the make is the same in all four (the suppression acts at switch-off only)
-    assert len({round(r["operate_time"], 9) for r in rows.values()}) == 1
+    # the make is nearly the same in all four: while the coil is on the diodes are reverse
+    # biased and the RC only charges (measured 4.4517-4.4537 ms)
+    operate = [r["operate_time"] for r in rows.values()]
+    assert max(operate) - min(operate) < 1e-3 * min(operate)

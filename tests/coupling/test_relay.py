@@ -105,3 +105,40 @@ def test_the_coil_energy_balance_closes_at_second_order_in_the_macro_step():
     orders = np.log(np.array(residuals[:-1]) / residuals[1:]) / np.log(np.array(steps[:-1]) / steps[1:])
     assert np.all(orders > 1.7), (residuals, orders)
     assert residuals[-1] < 1e-4
+
+
+def _without(doc: dict, section: str, key: str) -> dict:
+    doc = copy.deepcopy(doc)
+    doc[section].pop(key)
+    return doc
+
+
+def _with(doc: dict, section: str, key: str, value) -> dict:
+    doc = copy.deepcopy(doc)
+    doc[section][key] = value
+    return doc
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda d: _without(d, "coil", "resistance"), "[coil] needs resistance (ohm, the winding) with magnet.model = "
+                                                  "'flux_tubes'"),
+    (lambda d: _without(d, "coil", "turns"), "[coil] needs turns"),
+    (lambda d: _without(d, "magnet", "rest_gap"), "[magnet] needs rest_gap (m)"),
+    (lambda d: _with(d, "coil", "turns", -4500), "coil.turns = -4500"),
+    (lambda d: _with(d, "coil", "suppression", "varistor"), "coil.suppression = 'varistor': allowed values are"),
+    (lambda d: _with(d, "coil", "off_time", 5e-4), "coil.off_time = 0.0005 s: must come after on_time"),
+    (lambda d: _with(d, "coil", "voltage", 200.0), "coil.switch_breakdown = 100 V: must exceed the supply"),
+    (lambda d: _with(d, "magnet", "model", "horseshoe"), "magnet.model"),
+    (lambda d: {k: v for k, v in d.items() if k != "magnet"}, "[coil] needs [magnet]"),
+])
+def test_bad_coil_and_magnet_keys_are_one_line_naming_the_key(change, message):
+    doc = change(default_scene().raw)
+    with pytest.raises(ValueError) as err:
+        scene_from_dict(doc, name="relay.toml")
+    text = str(err.value)
+    assert message in text and "\n" not in text, text
+
+
+def test_the_suppression_is_a_scene_key():
+    scene = default_scene().set("coil.suppression", "diode")
+    assert scene.circuit.circuit.coil.suppression == "diode"
