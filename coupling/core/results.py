@@ -242,6 +242,10 @@ class CoupledResult:
             out["stopped_at"] = self.stopped_at
         if self.mechanics is not None:
             out.update(self.mechanics.to_summary())
+            refined = self.stats.get("modes_refined")
+            if refined and "solver" in out:  # run again with the count its impacts asked for
+                out["solver"] = dict(out["solver"], modes_rule=refined["rule"] + " (refined after a first run: "
+                                     + refined["first"] + ")")
             flag = jacobi_step_flag(self)
             if flag:
                 out["flags"] = list(out.get("flags", [])) + [flag]
