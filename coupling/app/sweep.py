@@ -255,17 +255,11 @@ class Sweep:
 
 
 def apply_changes(raw: dict, changes: dict) -> dict:
-    """A copy of a scene document with "section.key" (or "section.sub.key") values set."""
-    doc = copy.deepcopy(raw)
-    for key, value in changes.items():
-        parts = key.split(".")
-        node = doc
-        for part in parts[:-1]:
-            node = node.setdefault(part, {})
-            if not isinstance(node, dict):
-                raise ValueError(f"sweep parameter {key!r}: {part!r} is not a table in the base scene")
-        node[parts[-1]] = list(value) if isinstance(value, tuple) else value
-    return doc
+    """A copy of a scene document with scene keys set as ``Scene.set`` sets them
+    ("section.key", "rivet[0].mass", "circuit.params.RF": coupling.core.scene.set_keys)."""
+    from coupling.core.scene import set_keys
+
+    return set_keys(raw, changes, "sweep parameter")
 
 
 def _flatten_keys(table: dict, prefix: str = "", leaf=lambda v: False) -> dict:
@@ -281,10 +275,13 @@ def _flatten_keys(table: dict, prefix: str = "", leaf=lambda v: False) -> dict:
 
 
 def _check_params(params: dict, where: str) -> None:
+    from coupling.core.scene import key_steps
+
     for key in params:
-        parts = key.split(".")
-        if len(parts) < 2 or not all(parts):
-            raise ValueError(f"sweep {where}: key {key!r}: expected a scene key 'section.key', e.g. 'initial.angle_deg'")
+        try:
+            key_steps(key)
+        except ValueError as err:
+            raise ValueError(f"sweep {where}: {err}") from None
         if key in RESERVED:
             raise ValueError(f"sweep {where}: key {key!r} is reserved for the results table")
 
