@@ -277,8 +277,9 @@ def _with_params(lines: list[NetlistLine], params: tuple[tuple[str, float], ...]
             from difflib import get_close_matches
 
             names = sorted(dict.fromkeys(defined[::-1]), key=str.lower)
-            close = get_close_matches(key, [n.lower() for n in names], n=1)
-            hint = f"; did you mean {close[0]!r}?" if close else ""
+            lowered = {n.lower(): n for n in names}
+            close = get_close_matches(key, list(lowered), n=1, cutoff=0.5)
+            hint = f"; did you mean {lowered[close[0]]!r}?" if close else ""
             raise ValueError(f"NetlistCircuit.params.{name} = {value!r}: the netlist has no '.param {name}' at its "
                              f"top level{hint} (its parameters: {', '.join(names) or 'none'})")
     return out

@@ -824,7 +824,8 @@ def _walk(raw: dict, key: str, where: str, *, create: bool = True) -> tuple:
                 raise ValueError(f"{where}: key {key!r}: {_shown(steps[:k])} is not a list")
             if step >= len(node):
                 entries = f"{len(node)} entr{'y' if len(node) == 1 else 'ies'}"
-                span = f" ({_shown(steps[:k])}[0] to [{len(node) - 1}])" if node else ""
+                at = _shown(steps[:k])
+                span = f" (only {at}[0])" if len(node) == 1 else f" ({at}[0] to {at}[{len(node) - 1}])" if node else ""
                 raise ValueError(f"{where}: key {key!r}: index [{step}] is beyond {_shown(steps[:k])}, which has "
                                  f"{entries}{span}")
         if k == len(steps) - 1:
