@@ -6,7 +6,9 @@ scene key, as ``Scene.set`` takes them), built from one design:
 - ``grid``: every combination of the listed values;
 - ``cases``: a list of runs, each optionally named;
 - ``random`` / ``lhs``: ``samples`` seeded draws (uniform, or Latin hypercube through
-  scipy.stats.qmc) inside [low, high] per parameter, log-uniform with ``log = true``.
+  scipy.stats.qmc) inside [low, high] per parameter, log-uniform with ``log = true``;
+- ``tolerance``: ``samples`` seeded draws around the base scene's values, normal or
+  uniform per key (coupling.app.tolerance), and DIR/statistics.json of the metrics.
 
 Every run's scene is built and validated in the client before anything starts (and the
 design's size, MAX_RUNS, before it is built). Runs go to dask.distributed workers (a
@@ -33,9 +35,9 @@ Sweep file (TOML, SI units)::
 
     [sweep]
     scene = "base.toml"          # relative to this file; omitted: the built-in default scene
-    design = "grid"              # grid | cases | random | lhs
-    samples = 20                 # random, lhs
-    seed = 1                     # random, lhs
+    design = "grid"              # grid | cases | random | lhs | tolerance
+    samples = 20                 # random, lhs, tolerance
+    seed = 1                     # random, lhs, tolerance
     waveforms = false            # true, or a list of columns to keep
     set = { "output.plots" = false }     # applied to every run (optional)
 
@@ -49,6 +51,10 @@ Sweep file (TOML, SI units)::
 
     [sweep.ranges]               # design = "random" / "lhs": [low, high] or {low, high, log}
     "initial.angle_deg" = [10.0, 80.0]
+
+    [sweep.tolerances]           # design = "tolerance" (coupling.app.tolerance)
+    "rivet[0].mass" = { tolerance = 2e-6, distribution = "normal" }    # T = 3 sigma
+    # [sweep] limits = { "bounce.total_bounce_time" = 4e-3 }: the fraction beyond, in statistics.json
 """
 
 from __future__ import annotations
@@ -68,8 +74,9 @@ import uuid
 from pathlib import Path
 from typing import Any
 
-DESIGNS = ("grid", "cases", "random", "lhs")
-_SWEEP_KEYS = {"scene", "design", "samples", "seed", "waveforms", "set", "grid", "cases", "ranges"}
+DESIGNS = ("grid", "cases", "random", "lhs", "tolerance")
+_SWEEP_KEYS = {"scene", "design", "samples", "seed", "waveforms", "set", "grid", "cases", "ranges", "tolerances",
+               "limits"}
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,99}$")
 RESERVED = ("run_id", "name", "status", "error", "wall_time", "session", "finished_at")
 
@@ -114,6 +121,7 @@ class Sweep:
     waveforms: bool | tuple[str, ...] = False
     common: dict = dataclasses.field(default_factory=dict)
     life: dict | None = None  # a life study per run: {"operations": N, "every": K} (coupling.app.life)
+    study: dict | None = None  # a tolerance study: {tolerances, limits, samples, seed} (coupling.app.tolerance)
     checked: bool = dataclasses.field(default=False, init=False, compare=False, repr=False)  # set by check()
 
     # constructors ----------------------------------------------------------------------
@@ -178,6 +186,34 @@ class Sweep:
                 case[key] = float(value)
             rows.append((None, case))
         return cls._of(base, rows, **kw)
+
+    @classmethod
+    def tolerance(cls, base, tolerances: dict, *, samples: int, seed: int = 0, limits: dict | None = None,
+                  **kw) -> "Sweep":
+        """A tolerance study: ``samples`` seeded draws of the keys of ``tolerances`` ({key:
+        {tolerance, distribution = "normal" | "uniform", relative}}) around the values the
+        base scene (with ``common``) gives them; ``limits`` {metric: limit} (SI). After the
+        runs, run_sweep writes DIR/statistics.json (coupling.app.tolerance)."""
+        from coupling.app.tolerance import check_limits, check_tolerances, draw
+
+        if not isinstance(samples, int) or isinstance(samples, bool) or samples < 2:
+            raise ValueError(f"sweep samples = {samples!r}: expected an integer >= 2")
+        _check_size(samples, "sweep samples")
+        if not isinstance(seed, int) or isinstance(seed, bool):
+            raise ValueError(f"sweep seed = {seed!r}: expected an integer")
+        if not isinstance(tolerances, dict):
+            raise ValueError(f"sweep.tolerances = {tolerances!r:.200}: expected a table of 'key' = {{ tolerance, "
+                             "distribution }")
+        tolerances = _flatten_keys(tolerances, leaf=lambda v: isinstance(v, dict) and "tolerance" in v)
+        _check_params(tolerances, "tolerances")
+        common = _flatten_keys(dict(kw.get("common") or {}))
+        raw = base.raw if hasattr(base, "raw") else base
+        checked = check_tolerances(tolerances, apply_changes(raw, common) if isinstance(raw, dict) else raw)
+        limits = check_limits(limits)
+        sweep = cls._of(base, [(None, values) for values in draw(checked, samples, seed)], **kw)
+        study = dict(tolerances={k: dict(v) for k, v in tolerances.items()}, limits=limits, samples=samples,
+                     seed=seed, base_values={k: v[0] for k, v in checked.items()})
+        return dataclasses.replace(sweep, study=study)
 
     @classmethod
     def _of(cls, base, rows, *, waveforms=False, common: dict | None = None) -> "Sweep":
@@ -251,6 +287,8 @@ class Sweep:
                    runs=[(r.run_id, r.params) for r in self.runs])
         if self.life is not None:
             doc["life"] = self.life
+        if self.study is not None:
+            doc["study"] = self.study
         return hashlib.sha256(json.dumps(doc, sort_keys=True, default=repr).encode()).hexdigest()[:16]
 
 
@@ -384,15 +422,17 @@ def load_sweep(path) -> Sweep:
     design = table.get("design")
     if design not in DESIGNS:
         raise ValueError(f"{path}: sweep.design = {design!r}: allowed values are {', '.join(map(repr, DESIGNS))}")
-    need = {"grid": "grid", "cases": "cases", "random": "ranges", "lhs": "ranges"}[design]
+    need = {"grid": "grid", "cases": "cases", "random": "ranges", "lhs": "ranges", "tolerance": "tolerances"}[design]
     if need not in table:
         raise ValueError(f"{path}: sweep.design = {design!r} needs sweep.{need}")
-    for other in {"grid", "cases", "ranges"} - {need}:
+    for other in sorted({"grid", "cases", "ranges", "tolerances"} - {need}):
         if other in table:
             raise ValueError(f"{path}: sweep.{other} is unused with sweep.design = {design!r}; remove it")
     for key in ("samples", "seed"):
-        if key in table and design not in ("random", "lhs"):
+        if key in table and design not in ("random", "lhs", "tolerance"):
             raise ValueError(f"{path}: sweep.{key} is unused with sweep.design = {design!r}; remove it")
+    if "limits" in table and design != "tolerance":
+        raise ValueError(f"{path}: sweep.limits is used by sweep.design = \"tolerance\" only; remove it")
     from coupling.core.scene import default_scene, load_scene
 
     scene_key = table.get("scene")
@@ -413,6 +453,11 @@ def load_sweep(path) -> Sweep:
         sweep = Sweep.grid(base, _flatten_keys(grid), **kw)
     elif design == "cases":
         sweep = Sweep.cases(base, table["cases"], **kw)
+    elif design == "tolerance":
+        if "samples" not in table:
+            raise ValueError(f"{path}: sweep.design = \"tolerance\" needs sweep.samples (the number of runs)")
+        sweep = Sweep.tolerance(base, table["tolerances"], samples=table["samples"], seed=table.get("seed", 0),
+                                limits=table.get("limits"), **kw)
     else:
         if "samples" not in table:
             raise ValueError(f"{path}: sweep.design = {design!r} needs sweep.samples (the number of runs)")
@@ -658,6 +703,7 @@ class SweepReport:
     interrupted: bool = False
     out_dir: str = ""
     rerun: int = 0  # runs that had a failed row and were run again (resume)
+    statistics: str | None = None  # a tolerance study's DIR/statistics.json, once every run has a row
 
     @property
     def complete(self) -> bool:
@@ -936,7 +982,13 @@ def run_sweep(sweep: Sweep, out_dir, *, workers: int | None = None, scheduler: s
         sweep.check()
     out = _sweep_folder(out_dir)
     with _FolderLock(out):
-        return _run_locked(sweep, out, workers, scheduler, client, resume, progress, window)
+        report = _run_locked(sweep, out, workers, scheduler, client, resume, progress, window)
+        if sweep.study is not None and report.complete:
+            from coupling.app.tolerance import write_statistics
+
+            write_statistics(out, sweep.study)
+            report.statistics = str(out / "statistics.json")
+        return report
 
 
 def _run_locked(sweep, out: Path, workers, scheduler, client, resume, progress, window) -> SweepReport:
@@ -1107,5 +1159,6 @@ def sweep_command(path: str, out_dir: str, *, workers: int | None = None, schedu
     if not quiet:
         print(f"switchsim sweep: {report.done} run(s) now ({report.rerun} of them failed before), "
               f"{report.skipped} already done, {report.failed} failed, {report.seconds:.1f} s; results in "
-              f"{out_dir}/results (coupling.app.sweep.read_results)", file=sys.stderr)
+              f"{out_dir}/results (coupling.app.sweep.read_results)"
+              + (f"; statistics in {report.statistics}" if report.statistics else ""), file=sys.stderr)
     return 1 if report.failed else 0

@@ -858,6 +858,15 @@ def _walk(raw: dict, key: str, where: str, *, create: bool = True) -> tuple:
     raise AssertionError("unreachable")
 
 
+def key_value(raw: dict, key: str, where: str):
+    """The value a scene document gives ``key`` (any key Scene.set takes), None when it gives
+    none; a key that cannot be in a scene is an error as for Scene.set."""
+    node, last = _walk(raw, key, where, create=False)
+    if node is None:
+        return None
+    return node[last] if isinstance(node, list) else node.get(last)
+
+
 def set_keys(raw: dict, changes: dict, where: str) -> dict:
     """A copy of a scene document with each key of ``changes`` ("section.key",
     "rivet[0].mass", "circuit.params.RF", ...) set to its value (tuples as lists)."""
