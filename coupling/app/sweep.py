@@ -76,7 +76,7 @@ from typing import Any
 
 DESIGNS = ("grid", "cases", "random", "lhs", "tolerance")
 _SWEEP_KEYS = {"scene", "design", "samples", "seed", "waveforms", "set", "grid", "cases", "ranges", "tolerances",
-               "limits"}
+               "limits", "check"}
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,99}$")
 RESERVED = ("run_id", "name", "status", "error", "wall_time", "session", "finished_at")
 
@@ -189,11 +189,13 @@ class Sweep:
 
     @classmethod
     def tolerance(cls, base, tolerances: dict, *, samples: int, seed: int = 0, limits: dict | None = None,
-                  **kw) -> "Sweep":
+                  check: int = 0, **kw) -> "Sweep":
         """A tolerance study: ``samples`` seeded draws of the keys of ``tolerances`` ({key:
         {tolerance, distribution = "normal" | "uniform", relative}}) around the values the
         base scene (with ``common``) gives them; ``limits`` {metric: limit} (SI). After the
-        runs, run_sweep writes DIR/statistics.json (coupling.app.tolerance)."""
+        runs, run_sweep writes DIR/statistics.json (coupling.app.tolerance). ``check``: how
+        many of the runs (the first) are also rerun refined, as ``run --check`` does, to set
+        the numerical error beside the scatter."""
         from coupling.app.tolerance import check_limits, check_tolerances, draw
 
         if not isinstance(samples, int) or isinstance(samples, bool) or samples < 2:
@@ -210,9 +212,12 @@ class Sweep:
         raw = base.raw if hasattr(base, "raw") else base
         checked = check_tolerances(tolerances, apply_changes(raw, common) if isinstance(raw, dict) else raw)
         limits = check_limits(limits)
+        if not isinstance(check, int) or isinstance(check, bool) or not 0 <= check <= samples:
+            raise ValueError(f"sweep check = {check!r}: expected a whole number of runs, 0 to samples = {samples}")
         sweep = cls._of(base, [(None, values) for values in draw(checked, samples, seed)], **kw)
         study = dict(tolerances={k: dict(v) for k, v in tolerances.items()}, limits=limits, samples=samples,
-                     seed=seed, base_values={k: v[0] for k, v in checked.items()})
+                     seed=seed, base_values={k: v[0] for k, v in checked.items()}, check=check,
+                     check_runs=[r.run_id for r in sweep.runs[:check]])
         return dataclasses.replace(sweep, study=study)
 
     @classmethod
@@ -431,8 +436,9 @@ def load_sweep(path) -> Sweep:
     for key in ("samples", "seed"):
         if key in table and design not in ("random", "lhs", "tolerance"):
             raise ValueError(f"{path}: sweep.{key} is unused with sweep.design = {design!r}; remove it")
-    if "limits" in table and design != "tolerance":
-        raise ValueError(f"{path}: sweep.limits is used by sweep.design = \"tolerance\" only; remove it")
+    for key in ("limits", "check"):
+        if key in table and design != "tolerance":
+            raise ValueError(f"{path}: sweep.{key} is used by sweep.design = \"tolerance\" only; remove it")
     from coupling.core.scene import default_scene, load_scene
 
     scene_key = table.get("scene")
@@ -457,7 +463,7 @@ def load_sweep(path) -> Sweep:
         if "samples" not in table:
             raise ValueError(f"{path}: sweep.design = \"tolerance\" needs sweep.samples (the number of runs)")
         sweep = Sweep.tolerance(base, table["tolerances"], samples=table["samples"], seed=table.get("seed", 0),
-                                limits=table.get("limits"), **kw)
+                                limits=table.get("limits"), check=table.get("check", 0), **kw)
     else:
         if "samples" not in table:
             raise ValueError(f"{path}: sweep.design = {design!r} needs sweep.samples (the number of runs)")
@@ -505,6 +511,7 @@ def execute(sweep_doc: dict, run_doc: dict, wave_dir: str | None) -> dict:
     row = {"run_id": run_doc["run_id"], "name": run_doc["name"]}
     params = run_doc["params"]
     summary = None
+    numerical: dict = {}
     status, error = "ok", None
     with _RUN_LOCK:
         worker = _worker_address()
@@ -520,6 +527,14 @@ def execute(sweep_doc: dict, run_doc: dict, wave_dir: str | None) -> dict:
             summary = result.summary
             waveforms = result.waveforms
             status, error = result.status.value, result.message or None  # judged where it was made
+            if run_doc["run_id"] in sweep_doc.get("check_runs", ()) and status == "ok":
+                from coupling.app.accuracy import check as accuracy_check
+                from coupling.app.tolerance import numerical_changes
+
+                try:
+                    numerical = numerical_changes(accuracy_check(scene, result, sensitivity=False))
+                except Exception as err:  # noqa: BLE001 - the run stands; only its check failed
+                    numerical = {"numerical.status": f"check failed: {type(err).__name__}: {_one_line(err)}"}
         except CoupledRunError as err:
             status, error = "failed", _one_line(err)
             summary = err.partial.summary if err.partial is not None else None
@@ -538,6 +553,7 @@ def execute(sweep_doc: dict, run_doc: dict, wave_dir: str | None) -> dict:
             if key == "status":
                 continue
             row[f"summary.{key}" if key in row or key in RESERVED else key] = value
+    row.update(numerical)
     row.update(status=status, error=error, wall_time=time.perf_counter() - tick)
     if worker is not None and _ngspice_exited():
         row["_restart"] = worker  # this run ended ngspice ("cannot recover"): the worker needs a new process
@@ -824,7 +840,8 @@ def _manifest(sweep: Sweep, out: Path, resume: bool, write: bool = True) -> None
         return
     doc = dict(fingerprint=fingerprint, base_name=sweep.base_name, base_dir=sweep.base_dir, base=sweep.base,
                common=sweep.common, waveforms=sweep.waveforms, parameters=sweep.parameters,
-               runs=[dataclasses.asdict(r) for r in sweep.runs], **({} if sweep.life is None else {"life": sweep.life}))
+               runs=[dataclasses.asdict(r) for r in sweep.runs], **({} if sweep.life is None else {"life": sweep.life}),
+               **({} if sweep.study is None else {"study": sweep.study}))
     tmp = path.with_suffix(".json.tmp")
     tmp.write_text(json.dumps(doc, indent=1, default=repr))
     os.replace(tmp, path)
@@ -1013,7 +1030,8 @@ def _run_locked(sweep, out: Path, workers, scheduler, client, resume, progress, 
     session = f"{time.strftime('%Y%m%dT%H%M%S')}-{uuid.uuid4().hex[:6]}"
     sweep_doc = dict(base=sweep.base, base_dir=str(Path(sweep.base_dir).resolve()), base_name=sweep.base_name,
                      common=sweep.common, waveforms=sweep.waveforms,
-                     life=None if sweep.life is None else dict(sweep.life, folder=str((out / "life").resolve())))
+                     life=None if sweep.life is None else dict(sweep.life, folder=str((out / "life").resolve())),
+                     check_runs=_check_runs(sweep))
     cluster = None
     own_client = client is None
     started = None
@@ -1123,11 +1141,16 @@ def _submit(client, sweep_doc: dict, run: Run, wave_dir):
                          pure=False, retries=0)
 
 
+def _check_runs(sweep: Sweep) -> list[str]:
+    """The run_ids a tolerance study reruns refined (``check``)."""
+    return list(sweep.study.get("check_runs", ())) if sweep.study is not None else []
+
+
 def run_sweep_inline(sweep: Sweep) -> list[dict]:
     """Every run of the sweep in this process, one after the other, rows returned (no Dask,
     no files): for small studies and for comparing against the Dask path."""
     doc = dict(base=sweep.base, base_dir=sweep.base_dir, base_name=sweep.base_name, common=sweep.common,
-               waveforms=False)
+               waveforms=False, check_runs=_check_runs(sweep))
     return [execute(doc, dict(run_id=r.run_id, name=r.name, params=r.params), None) for r in sweep.runs]
 
 

@@ -31,7 +31,12 @@ column name): per scalar metric mean, std, p50, p95, p99, each with a confidence
   at 95 %);
 - a limit: the fraction of runs beyond it (metric > limit) with Wilson's score interval;
 - sensitivity: Spearman's rank correlation of each toleranced key with the metric (and its
-  p-value): which tolerance drives the spread.
+  p-value): which tolerance drives the spread;
+- numerical: with ``[sweep] check = N`` the first N runs (a random subset: the draws are
+  random) are also rerun refined as ``switchsim run --check`` does (coupling.app.accuracy,
+  without its input perturbations), and each metric the check knows gets the largest change
+  a refinement made, against the study's std: a ratio well below 1 says the scatter is the
+  tolerances', not numerical noise.
 """
 
 from __future__ import annotations
@@ -43,6 +48,11 @@ import numpy as np
 DISTRIBUTIONS = ("normal", "uniform")
 CONFIDENCE = 0.95
 _SPEC_KEYS = ("tolerance", "distribution", "relative")
+#: The metrics ``run --check`` judges (coupling.app.accuracy.metrics_of) by their row columns.
+CHECKED_METRICS = {f"bounce.{k}": k for k in ("first_make", "last_make", "bounces", "total_bounce_time",
+                                               "peak_contact_voltage", "arc_energy")}
+#: A metric's numerical change below this fraction of its std: the scatter is the tolerances'.
+NUMERICAL_FRACTION = 0.1
 #: Row columns that are never metrics (the run's bookkeeping).
 _NOT_METRICS = ("run_id", "name", "status", "error", "session", "finished_at", "wall_time")
 
@@ -144,6 +154,18 @@ def check_limits(limits, where: str = "sweep.limits") -> dict:
     return out
 
 
+def numerical_changes(accuracy: dict) -> dict:
+    """{"numerical.<metric column>": the largest |change| any refinement that ran made} of a
+    run's ``run --check`` verdict (coupling.app.accuracy.check), and "numerical.status"."""
+    out: dict = {"numerical.status": accuracy.get("status")}
+    for column, name in CHECKED_METRICS.items():
+        changes = [abs(entry["metrics"][name]["change"]) for entry in accuracy.get("refinements", [])
+                   if entry.get("status") == "ok" and entry.get("metrics", {}).get(name, {}).get("change") is not None]
+        if changes:
+            out[f"numerical.{column}"] = float(max(changes))
+    return out
+
+
 # --- the statistics -----------------------------------------------------------------------
 
 
@@ -202,7 +224,8 @@ def metric_columns(df, parameters) -> list[str]:
 
     out = []
     for column in df.columns:
-        if column in parameters or column in _NOT_METRICS or column.startswith("summary.") and column[8:] in parameters:
+        if (column in parameters or column in _NOT_METRICS or column.startswith("numerical.")
+                or column.startswith("summary.") and column[8:] in parameters):
             continue
         series = df[column]
         if pd.api.types.is_bool_dtype(series) or not pd.api.types.is_numeric_dtype(series):
@@ -249,6 +272,18 @@ def statistics(df, parameters, limits: dict | None = None, confidence: float = C
             rho, pv = stats.spearmanr(p, x)
             sens[key] = {"spearman": _num(float(rho)), "p_value": _num(float(pv))}
         entry["sensitivity"] = sens
+        if f"numerical.{column}" in ok.columns:
+            changes = ok[f"numerical.{column}"].to_numpy(float)
+            changes = changes[np.isfinite(changes)]
+            if len(changes):
+                std = float(np.std(x, ddof=1))
+                worst = float(np.max(changes))
+                ratio = worst / std if std > 0 else None
+                entry["numerical"] = {
+                    "checked_runs": int(len(changes)), "max_change": worst, "ratio_to_std": _num(ratio),
+                    "verdict": ("scatter from the tolerances" if ratio is not None and ratio < NUMERICAL_FRACTION
+                                else "numerical error is a sizeable part of the spread: refine the scene "
+                                     "(switchsim run --check names the setting)")}
         out[column] = entry
     for metric in limits:
         if metric not in out:
@@ -275,6 +310,7 @@ def write_statistics(out_dir, study: dict, *, plots: bool = True) -> dict:
     metrics = statistics(df, parameters, study.get("limits"), study.get("confidence", CONFIDENCE))
     failed = int((df["status"] != "ok").sum()) if "status" in df.columns else 0
     doc = {"_study": {"samples": study.get("samples"), "seed": study.get("seed"), "rows": int(len(df)),
+                      "checked_runs": study.get("check", 0),
                       "failed": failed, "confidence": study.get("confidence", CONFIDENCE),
                       "tolerances": study["tolerances"], "limits": study.get("limits") or {},
                       "intervals": INTERVALS},

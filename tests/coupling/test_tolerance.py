@@ -164,6 +164,9 @@ def test_the_same_seed_gives_the_same_runs(tmp_path):
     ('design = "tolerance"\nsamples = 4\n[sweep.tolerances]\n"circuit.input_capacitance" = { tolerance = -1.0 }\n',
      ["tolerance = -1.0", "> 0"]),
     ('design = "tolerance"\n' + TOLERANCE, ["needs sweep.samples"]),
+    ('design = "tolerance"\nsamples = 4\ncheck = 5\n' + TOLERANCE, ["sweep check = 5", "0 to samples = 4"]),
+    ('design = "lhs"\nsamples = 4\ncheck = 1\n[sweep.ranges]\n"circuit.input_capacitance" = [1e-9, 2e-9]\n',
+     ["sweep.check", "tolerance\" only"]),
     ('design = "lhs"\nsamples = 4\nlimits = { "logic.first_edge" = 1e-5 }\n[sweep.ranges]\n'
      '"circuit.input_capacitance" = [1e-9, 2e-9]\n', ["sweep.limits", "tolerance\" only"]),
     ('design = "tolerance"\nsamples = 4\n[sweep.tolerances]\n"circuit.input_capacitance" = '
@@ -195,3 +198,36 @@ def test_a_study_on_dask_writes_statistics_and_plots(tmp_path):
     assert edge["limit"]["beyond"] == int((df["logic.first_edge"] > 32.5e-6).sum())
     assert doc["_study"]["seed"] == 1 and doc["_study"]["intervals"]["fraction_beyond"] == "Wilson score interval"
     assert (tmp_path / "out" / "plots" / "tolerance_logic.first_edge.png").stat().st_size > 10_000
+
+
+def test_free_drop_first_make_under_a_height_tolerance_with_the_numerical_check():
+    """The built-in free drop, coupled: the bar falls freely (no rotation) from height h at
+    v = 1 m/s down, so its first make is at t(h) = (sqrt(v^2 + 2 g h) - v) / g. A normal
+    tolerance on h (T = 3 sigma = 5 %) gives t's std = t'(h0) sigma_h and mean
+    t(h0) + t''(h0) sigma_h^2 / 2 (to O(sigma^4): 1e-13 s here); the fraction beyond
+    t(h0) + t'(h0) sigma_h is 1 - Phi(1) = 0.159. Two runs are rerun refined (check = 2):
+    their numerical change is far below the spread."""
+    from coupling import builtin_scene
+
+    g, v, h0 = 9.80665, 1.0, 1e-3
+    sigma_h = 0.05 * h0 / 3.0
+    root = math.sqrt(v * v + 2 * g * h0)
+    t0, slope, curvature = (root - v) / g, 1.0 / root, -g / root ** 3
+    base = builtin_scene("free_drop").set("solver.t_end", 1.3e-3)
+    assert base.raw["initial"]["velocity"][2] == -v and base.raw["initial"]["height"] == h0
+    sweep = Sweep.tolerance(base, {"initial.height": {"tolerance": 0.05, "distribution": "normal",
+                                                      "relative": True}},
+                            samples=40, seed=4, check=2, limits={"bounce.first_make": t0 + slope * sigma_h})
+    df = pd.DataFrame(run_sweep_inline(sweep))
+    h = df["initial.height"].to_numpy()
+    # each sample's event time against free fall: the mechanics locates the touchdown to 1e-12 s
+    assert np.max(np.abs(df["bounce.first_make"] - (np.sqrt(v * v + 2 * g * h) - v) / g)) < 1e-12
+    out = tol.statistics(df, ["initial.height"], sweep.study["limits"])["bounce.first_make"]
+    _inside(out["mean"], t0 + curvature * sigma_h ** 2 / 2.0, "mean")
+    _inside(out["std"], slope * sigma_h, "std")
+    _inside(out["p50"], t0, "p50")
+    _inside(out["limit"]["fraction"], 1.0 - stats.norm.cdf(1.0), "fraction beyond")
+    numerical = out["numerical"]
+    assert numerical["checked_runs"] == 2 and numerical["ratio_to_std"] < tol.NUMERICAL_FRACTION
+    assert numerical["verdict"] == "scatter from the tolerances"
+    assert df["numerical.status"].notna().sum() == 2  # the first two runs alone were checked
