@@ -285,11 +285,6 @@ def statistics(df, parameters, limits: dict | None = None, confidence: float = C
                                 else "numerical error is a sizeable part of the spread: refine the scene "
                                      "(switchsim run --check names the setting)")}
         out[column] = entry
-    for metric in limits:
-        if metric not in out:
-            raise ValueError(f"sweep.limits: {metric!r}: no run reported this metric (the scene's kind does not "
-                             "compute it, or every run failed); the metrics reported: "
-                             f"{', '.join(sorted(out)) or 'none'}")
     return out
 
 
@@ -313,7 +308,10 @@ def write_statistics(out_dir, study: dict, *, plots: bool = True) -> dict:
                       "checked_runs": study.get("check", 0),
                       "failed": failed, "confidence": study.get("confidence", CONFIDENCE),
                       "tolerances": study["tolerances"], "limits": study.get("limits") or {},
-                      "intervals": INTERVALS},
+                      "intervals": INTERVALS,
+                      # a limit's metric that no run reported (the scene's kind does not compute it, or
+                      # fewer than two runs had it): said here rather than silently left out
+                      "limits_not_reported": sorted(set(study.get("limits") or {}) - set(metrics))},
            **metrics}
     path = out / "statistics.json"
     tmp = path.with_name(f".{path.name}.tmp")
@@ -365,8 +363,8 @@ def plot_distribution(df, metric: str, limit: float | None = None, stats: dict |
             ax.axvline(limit, color="C3", lw=1.2, label="limit")
         if stats is not None and "limit" in stats:
             frac = stats["limit"]["fraction"]
-            cdf.set_title(f"beyond the limit: {frac['value']:.3g} ({frac['interval'][0]:.3g} to "
-                          f"{frac['interval'][1]:.3g})", fontsize=9)
+            cdf.set_title(f"runs beyond the limit: {100 * frac['value']:.3g} % ({100 * CONFIDENCE:g} % Wilson interval "
+                          f"{100 * frac['interval'][0]:.3g} to {100 * frac['interval'][1]:.3g} %)", fontsize=9)
     name = label(metric)
     hist.set_xlabel(name)
     hist.set_ylabel(f"probability density (1/{_unit_of(metric)})")
