@@ -18,6 +18,7 @@ A scene names only what it needs, and only that is built:
                   bleed_resistance, contact_capacitance, leakage_conductance,
                   snubber = {resistance, capacitance} (both), flyback = true | {...},
                   arc = true | false | {min_voltage, min_current, ...}, netlist = "file.cir",
+                  params = {NAME = number} (new values of the netlist's .param definitions),
                   load_probe, max_step, reltol, abstol, vntol, chgtol, method, temperature,
                   wall_timeout (each key one dataclass field; omitted: that field's default),
                   probes = ["v(node)", "v(n1,n2)", "i(element)"] (recorded as waveform columns)
