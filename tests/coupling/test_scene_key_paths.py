@@ -285,6 +285,11 @@ EXAMPLES = {
     "duty.materials": ["Ag", "AgNi10"], "duty.erosion_coefficient": 1e-12, "duty.cap_height": 1e-4,
     "duty.conductor_radius": 2e-3, "duty.life.stop_on_weld": "never", "duty.life.min_force": 0.1,
     "duty.life.max_resistance": 0.1, "duty.life.gap_range": [1e-4, 2e-3],
+    "coil.on_time": 2e-4, "coil.off_time": 1e-3, "coil.suppression": "diode", "coil.resistance": 50.0,
+    "coil.turns": 1000, "magnet.rest_gap": 2e-3, "magnet.working_gap": {"area": 5e-5},
+    "magnet.pole_leakage": {"width": 0.03, "radius": 1e-3},
+    "magnet.iron": [{"shape": "prism", "length": 0.02, "area": 5e-5, "material": "9SMnPb28"}],
+    "magnet.fixed_gap": [{"tube": [{"shape": "axial", "length": 1e-4, "area": 2e-5}]}],
 }
 RC_PLAIN = "net\n.param RS=1\nV1 a 0 24\nXCONTACT a b\nVLOAD b c 0\nR1 c 0 {RS}\n"
 COUPLED = {"tribology": {"source": "illustrative"}, "circuit": {}, "solver": {"t_end": 1e-3}}
@@ -334,6 +339,8 @@ def _base_and_key(section: str, key: str) -> tuple[dict, str]:
     if section.startswith("duty"):
         life = {"life": {}} if section == "duty.life" else {}
         return {**json.loads(json.dumps(DUTY)), "duty": life}, f"{section}.{key}"
+    if section in ("coil", "magnet"):  # an actuator: a flux-tube magnet, its armature, the coil's drive
+        return json.loads(json.dumps(MAGNET)), f"{section}.{key}"
     table = {"schedule": dict(SCHEDULE)}
     if section == "circuit":
         templates = [t for t in cs.TEMPLATES if key in cs.template_keys(t)] or ["resistive"]
@@ -379,7 +386,10 @@ NEEDS_COMPANIONS = {"bar.width", "bar.thickness", "mount.base_motion", "force.ti
                     "tribology.fit", "tribology.data", "tribology.mu", "tribology.resistance",
                     "circuit.schedule", "circuit.snubber", "circuit.flyback", "circuit.arc", "metrics.logic",
                     "duty.life", "contact.damping", "block.shape", "armature.kind", "tribology.source",
-                    "circuit.arc.ayrton_c", "contact.calibration"}
+                    "circuit.arc.ayrton_c", "contact.calibration",
+                    # a table magnet's keys in a flux-tube scene, and the choice between them
+                    "magnet.model", "magnet.currents", "magnet.gaps", "magnet.flux_linkages", "magnet.forces",
+                    "magnet.force_tolerance"}
 
 
 @pytest.mark.parametrize("section, key, default", _doc_rows(), ids=[f"{s}.{k}" for s, k, _ in _doc_rows()])
