@@ -50,9 +50,9 @@ WAVEFORM = {
     "coil_current": Quantity("coil current", "A"),
     "coil_voltage": Quantity("coil voltage", "V"),
     "coil_flux_linkage": Quantity("coil flux linkage", "Wb"),
-    "armature_position": Quantity("armature travel at the pole", "m"),
+    "armature_position": Quantity("armature travel", "m"),
     "working_gap": Quantity("working air gap", "m"),
-    "magnetic_force": Quantity("magnetic force at the pole", "N"),
+    "magnetic_force": Quantity("magnetic force", "N"),
 }
 
 # summary.json scalars, flattened with dots as a sweep's results rows hold them
