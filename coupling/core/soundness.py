@@ -174,7 +174,43 @@ def assess(result) -> dict:
         problem = current_problem(current, bound)
         if problem:
             problems.append(problem)
+    if mres is None and waves is not None and len(waves["time"]) and "contact_resistance" in waves:
+        problems += schedule_contact_problems(result.scene, waves)
     out["problems"] = problems
+    return out
+
+
+BOILING_VOLTAGE_BOUND = 1.5  # V across a closed metallic contact: above every contact metal's boiling voltage
+OPEN_VOLTAGE_BOUND = 3e5  # V across an open contact: air's ~3 MV/m across 0.1 m, a gap no switch has
+
+
+def schedule_contact_problems(scene, waves: dict) -> list[str]:
+    """A prescribed contact (no mechanics, no gap unless opening_speed is given) that its
+    circuit drives beyond what a contact can be: closed, a voltage above BOILING_VOLTAGE_BOUND
+    (Holm's boiling voltage of the a-spot: Ag 0.67 V, Cu 0.79 V, W 1.1 V; above it the spot
+    boils and no metallic contact, whatever its resistance, carries the current); open, a
+    voltage above OPEN_VOLTAGE_BOUND (air breaks down across any gap shorter than V / 3 MV/m;
+    with opening_speed the breakdown warning judges the gap itself)."""
+    r = np.asarray(waves["contact_resistance"], dtype=float)
+    v = np.abs(np.asarray(waves["contact_voltage"], dtype=float))
+    t = np.asarray(waves["time"], dtype=float)
+    schedule = getattr(getattr(scene, "circuit", None), "schedule", None)
+    closed_r = getattr(schedule, "closed_resistance", None)
+    out = []
+    if closed_r:
+        closed = np.isfinite(r) & (r <= 2.0 * closed_r)
+        if np.any(closed & (v > BOILING_VOLTAGE_BOUND)):
+            k = int(np.argmax(np.where(closed, v, -np.inf)))
+            current = v[k] / r[k]
+            out.append(f"contact: {v[k]:.3g} V across the closed contact at {t[k]:.6g} s ({current:.3g} A through "
+                       f"{r[k]:.3g} ohm), above the ~{BOILING_VOLTAGE_BOUND:g} V at which a contact spot boils "
+                       "(Holm: Ag 0.67 V, Cu 0.79 V, W 1.1 V): no metallic contact carries that; lower the "
+                       "source or raise the loop's resistance")
+    open_ = ~np.isfinite(r)
+    if np.any(open_ & (v > OPEN_VOLTAGE_BOUND)):
+        k = int(np.argmax(np.where(open_, v, -np.inf)))
+        out.append(f"contact: {v[k]:.3g} V across the open contact at {t[k]:.6g} s: air breaks down across any gap "
+                   f"shorter than {v[k] / 3e6:.3g} m (~3 MV/m), far beyond a switch's; lower the source")
     return out
 
 

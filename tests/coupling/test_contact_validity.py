@@ -72,3 +72,26 @@ def test_an_arc_model_without_breakdown_voltage_is_warned_of_with_the_setting_to
     lines = [w for w in res.warnings if "exceeds air breakdown" in w]
     assert len(lines) == 1
     assert "without [circuit.arc] breakdown_voltage" in lines[0] and "add the arc model" not in lines[0]
+
+
+def schedule_scene(voltage: float, load: float):
+    from coupling.core.soundness import BOILING_VOLTAGE_BOUND  # noqa: F401  (the bound judged)
+
+    return scene_from_dict({"circuit": {"template": "resistive", "voltage": voltage, "load_resistance": load,
+                                        "source_resistance": 0.0, "schedule": {"make": [1e-4], "break": []}},
+                            "solver": {"t_end": 1e-3}}, name="schedule")
+
+
+def test_a_prescribed_contact_driven_past_its_boiling_voltage_is_unsound():
+    """The audit's case: 100 kV into 1 uohm through a prescribed contact (closed 10 mohm) ran
+    'ok' with 5e6 A. Closed, the contact's voltage I R_closed = 50 kV is far above the ~1 V at
+    which any contact spot boils; 24 V into 10 ohm leaves it at 24 mV and sound."""
+    from coupling.core.soundness import BOILING_VOLTAGE_BOUND
+
+    bad = run(schedule_scene(100e3, 1e-6))
+    assert bad.status.value == "unsound"
+    assert any("across the closed contact" in p for p in bad.problems)
+    good = run(schedule_scene(24.0, 10.0))
+    assert good.status.value == "ok", good.message
+    closed_voltage = 24.0 * 0.01 / (10.0 + 0.01)  # the divider with the default closed resistance
+    assert closed_voltage < BOILING_VOLTAGE_BOUND
