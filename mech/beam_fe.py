@@ -492,15 +492,27 @@ def _strain_integral(family: str, nodes: np.ndarray, full: np.ndarray) -> np.nda
     return total
 
 
+def _one_blas_thread():
+    """A context in which BLAS and LAPACK run on one thread: their threaded kernels sum in
+    another order than the serial ones, so the FE modes, and through them a whole run, came
+    out different in the last digits with the thread count (the same scene gave 236 macro
+    steps from Python and 233 from the command line, which sets one thread). The FE
+    problems are a few hundred dof: one thread costs nothing measurable."""
+    from threadpoolctl import threadpool_limits
+
+    return threadpool_limits(1, user_api="blas")
+
+
 def _generalized_eigh(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Eigenpairs of a v = mu b v (a symmetric, b symmetric positive definite), mu ascending,
     v^T b v = 1: with b = L L^T, the standard problem of L^-1 a L^-T (numpy alone: scipy's
     eigh would cost scipy.linalg's import, ~0.13 s, on every held bar's first build)."""
-    low = np.linalg.cholesky(b)
-    inv = np.linalg.solve(low, np.eye(len(b)))
-    c = inv @ a @ inv.T
-    mu, w = np.linalg.eigh(0.5 * (c + c.T))
-    return mu, inv.T @ w
+    with _one_blas_thread():
+        low = np.linalg.cholesky(b)
+        inv = np.linalg.solve(low, np.eye(len(b)))
+        c = inv @ a @ inv.T
+        mu, w = np.linalg.eigh(0.5 * (c + c.T))
+        return mu, inv.T @ w
 
 
 def _solve(beam: FEBeam, system: FESystem, cond: str, count: int):
