@@ -43,6 +43,7 @@ from .templates import (
     McuInput,
     ResistiveLoad,
     Snubber,
+    ShortCircuit,
     SwitchCircuit,
     Wiring,
 )
@@ -76,6 +77,7 @@ __all__ = [
     "Snubber",
     "StepResult",
     "Stepper",
+    "ShortCircuit",
     "SwitchCircuit",
     "TimestepTooSmallError",
     "Wiring",

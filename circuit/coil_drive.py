@@ -15,8 +15,9 @@ Netlist (``CoilDrive.add_to``; nodes ``coil_supply``, ``coil_drv``)::
       "rc":    Rcoil_supp coil_supply coil_rc R ; Ccoil_supp coil_rc coil_drv C
       "none":  the driver's capacitance, then its avalanche clamp, take the coil's current
 
-The driver switches on at ``on_time`` and off at ``off_time`` (s), its conductance ramping
-linearly over ``edge_time`` between 1e-9 S and 1/``switch_resistance``. Known from relay
+The driver is off at t = 0 (the operating point has the coil unpowered), switches on at
+``on_time`` and off at ``off_time`` (s), its conductance ramping linearly over
+``edge_time`` between 1e-9 S and 1/``switch_resistance``. Known from relay
 application notes and reproduced here: a diode holds the coil current, which decays with
 the coil's L/R, so the armature releases late and slowly (and the contact's break arc
 burns longer); a zener (in series with a diode) clamps the coil at -(V_z + V_d), the
@@ -103,15 +104,16 @@ class CoilDrive:
                     low_open=True)
 
     def switch_vertices(self) -> list[tuple[float, float]]:
-        """(time s, conductance S) of the driver's PWL (it holds its last value after the last)."""
+        """(time s, conductance S) of the driver's PWL (it holds its last value after the last):
+        off at t = 0 (the circuit's operating point has the coil unpowered), switched on at
+        ``on_time`` (0: a step at the start) and off at ``off_time``, each over ``edge_time``."""
         on = 1.0 / self.switch_resistance
-        points = [(0.0, OFF_CONDUCTANCE if self.on_time > 0.0 else on)]
+        points = [(0.0, OFF_CONDUCTANCE)]
         if self.on_time > 0.0:
-            points += [(self.on_time, OFF_CONDUCTANCE), (self.on_time + self.edge_time, on)]
+            points.append((self.on_time, OFF_CONDUCTANCE))
+        points.append((self.on_time + self.edge_time, on))
         if self.off_time is not None:
             points += [(self.off_time, on), (self.off_time + self.edge_time, OFF_CONDUCTANCE)]
-        if len(points) == 1:
-            points.append((1.0, points[0][1]))  # a PWL needs two vertices
         return points
 
     @property

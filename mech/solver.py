@@ -269,6 +269,7 @@ class ImpactSolver:
         # what changes during the run besides the state: the named drive channels over time
         # (one row each, kernel_layout D_*), passed to the kernel beside the model's arrays
         self.drive = m.initial_drive()
+        self._step_end = 0.0  # s: the end of the step the drives were last set for
         if coupled is not None:
             self.drive[m.drive_rows("mu"), D_VALUE] = coupled.friction_coefficient(0.0, self.z)
         # which of the armature's stops and card are closed (kernel_layout EA_*): set at its
@@ -759,7 +760,8 @@ class ImpactSolver:
             self._unseat()  # the new drive no longer presses the seated armature on its stop
         if m.ipar[I_FRICTION] == FRICTION_EXACT and any(kinds[row].friction for row in changed):
             self._resolve(triggered=None)  # a new mu may change what can stick
-        if any(kinds[row].moves_equilibrium for row in changed):
+        self._step_end = t_end
+        if any(kinds[row].moves_equilibrium and not self._seated_through(row) for row in changed):
             if self._hold_until > self.t:
                 self._release_hold()
             else:
@@ -767,8 +769,22 @@ class ImpactSolver:
 
     def _drives_ramping(self) -> bool:
         """True if a channel that moves the static equilibrium changes during this step."""
-        return any(kind.moves_equilibrium and self.drive[row, D_SLOPE] != 0.0
+        return any(kind.moves_equilibrium and self.drive[row, D_SLOPE] != 0.0 and not self._seated_through(row)
                    for row, kind in enumerate(self.model.drive_kinds))
+
+    def _seated_through(self, row: int) -> bool:
+        """True if ``row`` is the armature's drive and the seated armature stays pressed on its
+        stop to the step's end: its press (linear in the drive while it sits still) positive
+        at both ends. Its drive then moves nothing the bar feels (the card and the bar see
+        the armature's position, which the stop holds), so a hold of the bar at rest goes on
+        while the coil's flux changes (the relay held closed while its coil current settles)."""
+        if row != self.model.armature_drive_row or not self.armature_closed[EA_SEAT]:
+            return False
+        stop, _, press = self._seat_state()
+        if press <= 0.0:
+            return False
+        end = float(armature_force(self._step_end, self.y, self.arrays, self.arm))
+        return (end if stop == EA_POLE else -end) > 0.0
 
     def _evaluate(self) -> np.ndarray:
         dynamics(self.t, self.y, self.arrays, self.regime, self.eref, self._dy, self._aux, self.work, self.arm)

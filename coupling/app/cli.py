@@ -1,5 +1,5 @@
 """The `switchsim` command line: `switchsim run [SCENE.toml] [--out DIR] [--overwrite] [--quiet] [--plots]`,
-`switchsim plot RESULT_DIR`, `switchsim fit DATA.csv --out DIR`, `switchsim sweep`. Exit codes:
+`switchsim plot RESULT_DIR`, `switchsim fit DATA.csv --out DIR`, `switchsim sweep`, `switchsim life`. Exit codes:
 coupling/app/commands.py."""
 
 from __future__ import annotations
@@ -52,6 +52,19 @@ def _build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--scheduler", default=None, help="address of an existing Dask scheduler, tcp://host:port")
     sweep.add_argument("--resume", action="store_true", help="continue the sweep in --out; finished runs are kept")
     sweep.add_argument("--quiet", action="store_true", help="no progress output")
+    # --- life: coupling/app/life.py ---
+    life = sub.add_parser("life", help="electrical life: the scene's operation sampled every K operations, the "
+                                       "contact worn in between (docs/contact_duty.md)")
+    life.add_argument("scene", nargs="?", default=None,
+                      help="scene TOML that makes and breaks once (default: the built-in relay_cycle), or a sweep "
+                           "TOML: a life study per design, on Dask")
+    life.add_argument("--operations", type=int, required=True, help="operations N to simulate (>= 1)")
+    life.add_argument("--every", type=int, default=1, help="sample every K-th operation (default 1)")
+    life.add_argument("--out", required=True, help="study folder (life.csv/.parquet, life.png, checkpoint.json)")
+    life.add_argument("--resume", action="store_true", help="continue the study in --out; sampled operations are kept")
+    life.add_argument("--workers", type=int, default=None, help="a sweep file's local worker processes")
+    life.add_argument("--scheduler", default=None, help="a sweep file's Dask scheduler, tcp://host:port")
+    life.add_argument("--quiet", action="store_true", help="no progress output")
     return parser
 
 
@@ -96,6 +109,11 @@ def _command(args) -> int:
 
             return sweep_command(args.sweep, args.out, workers=args.workers, scheduler=args.scheduler,
                                  resume=args.resume, quiet=args.quiet)
+        if args.command == "life":
+            from coupling.app.life import life_command
+
+            return life_command(args.scene, args.out, args.operations, args.every, resume=args.resume,
+                                quiet=args.quiet, workers=args.workers, scheduler=args.scheduler)
     except (ValueError, FileNotFoundError) as err:
         # Input errors: one clear line, no traceback.
         print(f"switchsim: error: {_one_line(err)}", file=sys.stderr)

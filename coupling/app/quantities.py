@@ -93,6 +93,24 @@ _SUMMARY = {
                   "penetration_bound": ("penetration bound", "m"),
                   "max_load_current": ("largest load current", "A"),
                   "load_current_bound": ("load current bound", "A")},
+    "duty": {"conductor_radius": ("conductor radius", "m"), "blow_off_current": ("blow-off current", "A"),
+             "held_force": ("held normal force", "N"), "contact_resistance": ("held contact resistance", "ohm"),
+             "arc_energy": ("arc energy by stage", "J"),
+             **{f"{side}_{k}": (f"{side} contact's {w}", u) for side in ("moving", "fixed") for k, w, u in (
+                 ("anodic_energy", "anodic-stage arc energy", "J"),
+                 ("cathodic_energy", "cathodic-stage arc energy", "J"),
+                 ("eroded_volume", "eroded volume", "m^3"), ("eroded_mass", "eroded mass", "kg"))}},
+    # a life study's outcome, as `switchsim life SWEEP.toml` rows hold it (coupling.app.life)
+    "life": {"operations": ("operations asked", "-"), "every": ("sampled every", "-"), "samples": ("samples", "-"),
+             "operations_done": ("operations done", "-"),
+             "moving_worn_volume": ("moving contact's worn volume", "m^3"),
+             "fixed_worn_volume": ("fixed contact's worn volume", "m^3"),
+             "moving_cap_height": ("moving cap height", "m"), "moving_cap_radius": ("moving cap radius", "m"),
+             "fixed_cap_height": ("fixed cap height", "m"), "fixed_cap_radius": ("fixed cap radius", "m"),
+             "gap": ("contact gap", "m"), "held_force": ("held normal force", "N"),
+             "contact_resistance": ("held contact resistance", "ohm"), "bounce_time": ("bounce time", "s"),
+             "gap_low": ("least gap", "m"), "gap_high": ("largest gap", "m"), "min_force": ("least held force", "N"),
+             "max_resistance": ("largest held resistance", "ohm")},
     # (the fitted laws' parameters: tribology_quantity, from the law families' own units)
     "tribology": {"laws.mu.gamma": ("friction exponent gamma", "-"),
                   "laws.resistance.spots": ("contact spots", "-"),
@@ -143,7 +161,8 @@ SCENE = {
                 "netlist": "path", "load_probe": "-", "probes": "-", "max_step": "s", "reltol": "-", "abstol": "A",
                 "vntol": "V", "chgtol": "C", "temperature": "degC", "method": "-", "wall_timeout": "s",
                 "schedule": "-", "pull": "-", "pull_resistance": "ohm", "series_resistance": "ohm",
-                "input_capacitance": "F", "logic_low": "V", "logic_high": "V"},
+                "input_capacitance": "F", "logic_low": "V", "logic_high": "V", "fault_time": "s",
+                "fault_resistance": "ohm", "fault_rise": "s"},
     "circuit.snubber": {"resistance": "ohm", "capacitance": "F"},
     "circuit.flyback": {"saturation_current": "A", "emission_coefficient": "-", "series_resistance": "ohm"},
     "circuit.arc": {"min_voltage": "V", "min_current": "A", "resistance": "ohm", "formation_time": "s",
@@ -156,6 +175,10 @@ SCENE = {
     "output": {"csv": "-", "parquet": "-", "plots": "-", "history": "-", "html": "-", "history_resolution": "s",
                "history_max_rows": "-"},
     "metrics": {"settle_window": "s", "make_guard": "s", "arc_toggle_limit": "-", "logic": "-"},
+    "duty": {"materials": "-", "moving_node": "-", "repulsion": "-", "conductor_radius": "m", "transition_gap": "m",
+             "transfer_fraction": "-", "erosion_coefficient": "m^3/J", "weld_margin": "-", "melt_fraction": "-",
+             "cap_height": "m", "life": "-"},
+    "duty.life": {"gap_range": "m", "min_force": "N", "max_resistance": "ohm", "stop_on_weld": "-"},
 }
 
 

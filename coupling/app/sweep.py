@@ -113,6 +113,7 @@ class Sweep:
     base_name: str = "scene"
     waveforms: bool | tuple[str, ...] = False
     common: dict = dataclasses.field(default_factory=dict)
+    life: dict | None = None  # a life study per run: {"operations": N, "every": K} (coupling.app.life)
     checked: bool = dataclasses.field(default=False, init=False, compare=False, repr=False)  # set by check()
 
     # constructors ----------------------------------------------------------------------
@@ -248,6 +249,8 @@ class Sweep:
         must continue the same sweep."""
         doc = dict(base=self.base, base_dir=self.base_dir, common=self.common, waveforms=self.waveforms,
                    runs=[(r.run_id, r.params) for r in self.runs])
+        if self.life is not None:
+            doc["life"] = self.life
         return hashlib.sha256(json.dumps(doc, sort_keys=True, default=repr).encode()).hexdigest()[:16]
 
 
@@ -471,7 +474,7 @@ def execute(sweep_doc: dict, run_doc: dict, wave_dir: str | None) -> dict:
             doc = apply_changes(sweep_doc["base"], {**sweep_doc["common"], **params})
             scene = scene_from_dict(doc, base_dir=sweep_doc["base_dir"], name=f"{sweep_doc['base_name']} "
                                                                            f"[{run_doc['run_id']}]")
-            result = run(scene)
+            result = run(scene) if sweep_doc.get("life") is None else _life(scene, sweep_doc["life"], run_doc)
             summary = result.summary
             waveforms = result.waveforms
             status, error = result.status.value, result.message or None  # judged where it was made
@@ -497,6 +500,13 @@ def execute(sweep_doc: dict, run_doc: dict, wave_dir: str | None) -> dict:
     if worker is not None and _ngspice_exited():
         row["_restart"] = worker  # this run ended ngspice ("cannot recover"): the worker needs a new process
     return row
+
+
+def _life(scene, life: dict, run_doc: dict):
+    """A life study of one run's scene (coupling.app.life.design_life), in place of its run."""
+    from coupling.app.life import design_life
+
+    return design_life(scene, life, run_doc["run_id"])
 
 
 def _worker_address() -> str | None:
@@ -771,7 +781,7 @@ def _manifest(sweep: Sweep, out: Path, resume: bool, write: bool = True) -> None
         return
     doc = dict(fingerprint=fingerprint, base_name=sweep.base_name, base_dir=sweep.base_dir, base=sweep.base,
                common=sweep.common, waveforms=sweep.waveforms, parameters=sweep.parameters,
-               runs=[dataclasses.asdict(r) for r in sweep.runs])
+               runs=[dataclasses.asdict(r) for r in sweep.runs], **({} if sweep.life is None else {"life": sweep.life}))
     tmp = path.with_suffix(".json.tmp")
     tmp.write_text(json.dumps(doc, indent=1, default=repr))
     os.replace(tmp, path)
@@ -953,7 +963,8 @@ def _run_locked(sweep, out: Path, workers, scheduler, client, resume, progress, 
     tick = time.monotonic()
     session = f"{time.strftime('%Y%m%dT%H%M%S')}-{uuid.uuid4().hex[:6]}"
     sweep_doc = dict(base=sweep.base, base_dir=str(Path(sweep.base_dir).resolve()), base_name=sweep.base_name,
-                     common=sweep.common, waveforms=sweep.waveforms)
+                     common=sweep.common, waveforms=sweep.waveforms,
+                     life=None if sweep.life is None else dict(sweep.life, folder=str((out / "life").resolve())))
     cluster = None
     own_client = client is None
     started = None

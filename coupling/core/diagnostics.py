@@ -164,7 +164,7 @@ def run_warnings(result) -> list[str]:
     if result.mechanics is not None:
         out += hertz_warnings(result.mechanics)
     w = result.waveform_columns
-    if w is not None and len(w["time"]):
+    if w is not None and len(w["time"]) and "contact_voltage" in w:  # (an actuator's coil drive has no contact)
         t = w["time"]
         v = w["contact_voltage"]
         i_arc = w["arc_current"] if "arc_current" in w else np.zeros_like(t)

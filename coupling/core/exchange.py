@@ -17,11 +17,17 @@ point's height, for an arc that grows with it) and, back, mu(I) from the loop cu
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from coupling.core.policy import TAIL_POINTS, end_rate
 
 CONTACT_EVENTS = ("contact_start", "contact_end")
+# the step rules' floor of the coil's signal (psi^2 or psi), as a fraction of its value at the
+# coil's rated current: changes far below the rated force do not shorten the steps (the
+# coil's ringing after an unsuppressed release, at a thousandth of its rated flux)
+FLUX_FLOOR = 1.0
 
 
 def conduction_onset(penetration: float, onset: float) -> float:
@@ -114,6 +120,32 @@ class ContactLink:
         points the model has (N^gamma, at the step's start and end)."""
         names = mech.drive_names
         return {f"mu.{i}": (mu_start, mu_end) for i in self.points if f"mu.{i}" in names}
+
+    def repulsion(self, mech, duty, current_at, t: float, t_end: float) -> dict:
+        """The drives ``repulsion.<i>`` of its contact points over the step [t, t_end] (N at the
+        step's start and end), empty without [duty] repulsion (``duty``: the scene's
+        coupling.core.duty.DutySettings or None).
+
+        Holm's force of each point's share of the loop current ``current_at(s)`` (A, extrapolated
+        as mu's is), at the plastic a-spot of the point's normal force at the step's start; the
+        current split between the points by their conductances then. A point open at the step's
+        start gets 0 for the step (it has no spot): a point that makes within a step feels its
+        repulsion from the next one on, which also ends the chatter a repulsion above the
+        closing force would keep up at an open contact (docs/mechanics.md, "Drive channels")."""
+        if duty is None or not duty.repulsion:
+            return {}
+        names = mech.drive_names
+        contact = mech.contact_now()
+        law = self.laws.resistance_law.scalar_force_conductance
+        g = {i: law(contact[i, 2]) * conduction_onset(contact[i, 0], self.onset) for i in self.points}
+        total = sum(g.values())
+        ends = (current_at(t), current_at(t_end))
+        out = {}
+        for i in self.points:
+            if f"repulsion.{i}" in names:
+                share = g[i] / total if total > 0.0 else 0.0
+                out[f"repulsion.{i}"] = tuple(duty.repulsion_force(share * current, contact[i, 2]) for current in ends)
+        return out
 
     # -- into the circuit --
 
@@ -214,14 +246,32 @@ class CoilLink:
     ends, the gap at the end predicted from the armature's speed.
     """
 
-    def __init__(self, label: str, magnet, rest_gap: float, lever: float = 1.0):
+    def __init__(self, label: str, magnet, rest_gap: float, lever: float = 1.0, switch_times=(),
+                 floor: float = 0.0):
         self.label = label
+        self.floor = float(floor)  # Wb^2 or Wb: the signal's floor in the step rules (FLUX_FLOOR of the rated)
+        self.switch_times = tuple(sorted(float(s) for s in switch_times))
         self.magnet = magnet
         self.rest_gap = float(rest_gap)
         self.lever = float(lever)
-        self.separable = bool(getattr(magnet, "separable", False))
+        from coupling.laws.magnet import FluxTubeMagnet
+
+        # a flux-tube magnet's iron carries the whole coil flux: W = W_iron(psi) + psi^2 R(g) / (2 N^2)
+        self.separable = isinstance(magnet, FluxTubeMagnet)
         self.tail = Tail()
-        self.drive_log: list[tuple[float, float, float, float]] = []
+        # the watched signal (``signal``: psi^2 or psi) at the last step's end, its rate (per s),
+        # time scale (s) and the slope the step rules chose to extrapolate it with
+        self.value, self.rate, self.scale, self.slope = 0.0, 0.0, math.inf, 0.0
+        self.q_times: list[np.ndarray] = []  # the circuit's points ...
+        self.q: list[np.ndarray] = []  # ... and the armature's travel there (m or rad)
+        self._sampled = False
+
+    def next_switch(self, t: float) -> float:
+        """s: the coil drive's next switching instant after t (its driver's PWL vertices: on,
+        off and their edges), inf without one. The coil's voltage jumps there, which the
+        flux linkage's extrapolation cannot see: a macro step ends at each."""
+        later = [s for s in self.switch_times if s > t * (1.0 + 1e-12) + 1e-15]
+        return min(later) if later else math.inf
 
     def gap(self, q: float) -> float:
         """m: the working air gap at the armature's position q."""
@@ -235,13 +285,26 @@ class CoilLink:
         q = np.sort((self.rest_gap - gaps) / self.lever)
         return q, self.lever * np.asarray(self.magnet.force(1.0, self.rest_gap - self.lever * q), dtype=float)
 
-    def drive(self, psi_start: float, psi_end: float, q: float, q_dot: float, span: float) -> tuple[float, float]:
-        """The armature drive's values at the step's start and end (see the class docstring)."""
+    def signal(self, psi):
+        """What the step rules watch and extrapolate: the drive's flux part, psi^2 (Wb^2) for a
+        separable magnet (the force itself up to the gain: a clamped coil's flux falling
+        through zero, or ringing at a thousandth of its rated value, moves it by nothing),
+        psi (Wb) otherwise."""
+        return psi * psi if self.separable else psi
+
+    def drives(self, t: float, end: float, arm: tuple[float, float], policy) -> dict:
+        """The armature's drive over [t, end], its flux part extrapolated from the circuit's last
+        points by the step rules (``policy.extrapolate`` with this link's slope and time scale;
+        psi^2 kept >= 0); the armature's (q, q_dot) at t in ``arm`` (a table magnet's gap at the
+        end predicted from them)."""
+        s0 = policy.extrapolate(self.value, self.slope, 0.0, self.scale)
+        s1 = policy.extrapolate(self.value, self.slope, end - t, self.scale)
         if self.separable:
-            return psi_start * psi_start, psi_end * psi_end
-        g0, g1 = self.gap(q), self.gap(q + q_dot * span)
-        return (self.lever * float(self.magnet.force(psi_start, g0)),
-                self.lever * float(self.magnet.force(psi_end, g1)))
+            return {"armature.force": (max(s0, 0.0), max(s1, 0.0))}
+        q, q_dot = arm
+        g0, g1 = self.gap(q), self.gap(q + q_dot * (end - t))
+        return {"armature.force": (self.lever * float(self.magnet.force(s0, g0)),
+                                   self.lever * float(self.magnet.force(s1, g1)))}
 
     def inputs(self, seg) -> dict:
         """The coil's gap channel over the segment, from the armature's dense output."""
@@ -257,6 +320,36 @@ class CoilLink:
         """Wb: the coil's flux linkage at the step's end."""
         return float(step.values["coil_flux_linkage" + self.label[len("coil"):]])
 
-    def observe(self, step, jumped: bool = False) -> None:
-        """Keep the circuit's last points of the flux linkage (its rate and time scale)."""
-        self.tail.observe(step.reader("time"), step.reader("coil_flux_linkage" + self.label[len("coil"):]), jumped)
+    def observe(self, step, seg, span: float) -> None:
+        """After a step: the flux linkage at its end, its rate and time scale from the circuit's
+        last points (differences over at least 1e-3 of ``span``, s), and the armature's travel
+        at the step's circuit points (for the result's columns)."""
+        times = step.reader("time")
+        self.tail.observe(times, self.signal(step.reader("coil_flux_linkage" + self.label[len("coil"):])), False)
+        self.value = self.signal(self.flux(step))
+        self.rate, self.scale = self.tail.rate(span)
+        if self.rate != 0.0:
+            # not beyond the time it takes to change by its own size (plus the floor): a signal
+            # falling linearly to zero (a clamped coil's release) has no curvature
+            self.scale = min(self.scale, (abs(self.value) + self.floor) / abs(self.rate))
+        new = times[1:] if self._sampled else times
+        self._sampled = True
+        lo, hi = seg.t_start, seg.t_end
+        self.q_times.append(new)
+        self.q.append(np.array([seg.armature(min(max(s, lo), hi))[0] for s in new]))
+
+    def columns(self, waves: dict) -> dict:
+        """The result's coil columns beside the circuit's (coil_current, coil_voltage,
+        coil_flux_linkage): ``armature_position`` (m, the pole face's travel from rest,
+        lever x q), ``working_gap`` (m) and ``magnetic_force`` (N, F(psi, g) at the pole)."""
+        q = self.travel_series(waves["time"])
+        gap = np.maximum(self.gap(q), 0.0)
+        psi = waves["coil_flux_linkage" + self.label[len("coil"):]]
+        return {"armature_position": self.lever * q, "working_gap": gap,
+                "magnetic_force": np.asarray(self.magnet.force(psi, gap), dtype=float)}
+
+    def travel_series(self, times: np.ndarray) -> np.ndarray:
+        """m or rad: the armature's travel at ``times`` (s), from its samples at the circuit's points."""
+        if not self.q_times:
+            return np.zeros(len(times))
+        return np.interp(times, np.concatenate(self.q_times), np.concatenate(self.q))

@@ -132,8 +132,13 @@ class CoupledResult:
         return bool(self.scene.circuit.schedule.is_closed(self.scene.t_end))
 
     @property
+    def has_contact(self) -> bool:
+        """True when the circuit holds a contact (an actuator's coil drive alone holds none)."""
+        return self.scene.circuit is not None and bool(getattr(self.scene.circuit.circuit, "contacts", (1,)))
+
+    @property
     def bounce(self) -> dict:
-        if self.scene.circuit is None:
+        if not self.has_contact:
             return {}
         key = "bounce"
         if key not in self._cache:
@@ -159,7 +164,7 @@ class CoupledResult:
     def operations(self) -> list[dict]:
         """The run as a sequence of operations, each a ``make`` and/or a ``break``
         (coupling.core.metrics.operations; summary.json ``operations``, docs/coupling.md)."""
-        if self.scene.circuit is None:
+        if not self.has_contact:
             return []
         if "operations" not in self._cache:
             w = self.waveform_columns
@@ -175,8 +180,32 @@ class CoupledResult:
                 ops = _operations(self.closed_intervals, self.scene.t_end, w["time"], w["contact_voltage"], loop,
                                   w["contact_current"], arc, settings,
                                   min_arc_current=None if model is None else model.min_current)
+                if getattr(self.scene, "duty", None) is not None:  # what each did to the contact
+                    from coupling.core.duty import operation_duty
+
+                    ops = operation_duty(self, ops)
             self._cache["operations"] = ops
         return self._cache["operations"]
+
+    @property
+    def relay(self) -> dict | None:
+        """What the relay's coil and armature did (coupling.core.relay; summary.json ``relay``),
+        None without a coil."""
+        w = self.waveform_columns
+        if w is None or "magnetic_force" not in w or not len(w["time"]):
+            return None
+        if "relay" not in self._cache:
+            from coupling.core.device import device
+            from coupling.core.relay import relay_metrics
+
+            from circuit.coil_drive import CoilDrive
+
+            spec = device(self.scene.raw)
+            circ = self.scene.circuit.circuit
+            drive = circ if isinstance(circ, CoilDrive) else getattr(circ, "coil", None)  # None: a netlist's
+            travel = spec.lever * self.scene.mech.armature.travel
+            self._cache["relay"] = relay_metrics(w, self.operations, drive, spec.magnet, travel, spec.resistance)
+        return self._cache["relay"]
 
     @property
     def opening_columns(self) -> dict:
@@ -216,9 +245,16 @@ class CoupledResult:
             flag = jacobi_step_flag(self)
             if flag:
                 out["flags"] = list(out.get("flags", [])) + [flag]
-        if self.scene.circuit is not None:
+        if self.has_contact:
             out["bounce"] = _jsonable(self.bounce)
             out["operations"] = _jsonable(self.operations)
+        if self.scene.circuit is not None:
+            if self.relay is not None:
+                out["relay"] = _jsonable(self.relay)
+            if getattr(self.scene, "duty", None) is not None:
+                from coupling.core.duty import duty_totals
+
+                out["duty"] = _jsonable(duty_totals(self.scene.duty, self.operations))
             if self.logic is not None:
                 out["logic"] = _jsonable(self.logic)
         if self.scene.tribology is not None:

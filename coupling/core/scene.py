@@ -11,6 +11,7 @@ A scene names only what it needs, and only that is built:
     [circuit]     template = "resistive" | "inductive" | "capacitive" | "current_source" | "netlist"
                   | "mcu_input" (voltage, pull, pull_resistance, series_resistance,
                   input_capacitance, logic_low, logic_high, contact_capacitance, leakage_conductance)
+                  | "short_circuit" (resistive, shorted at fault_time: fault_resistance, fault_rise)
                   voltage, source_resistance (voltage templates) | current, compliance_voltage,
                   output_capacitance, output_resistance (current_source), wiring_resistance,
                   wiring_inductance, load_resistance, load_inductance, load_capacitance,
@@ -28,6 +29,10 @@ A scene names only what it needs, and only that is built:
                   history_max_rows
     [metrics]     settle_window (s), make_guard (s), arc_toggle_limit (coupling.core.metrics),
                   logic = { node = "v(pin)", low, high } (V; coupling.core.logic)
+    [duty]        materials = ["moving", "fixed"], moving_node, repulsion, conductor_radius,
+                  transition_gap, transfer_fraction, erosion_coefficient, weld_margin,
+                  melt_fraction, cap_height, life = {gap_range, min_force, max_resistance,
+                  stop_on_weld} (coupling.core.duty; docs/contact_duty.md)
 
 SI units everywhere. File paths are relative to the scene file. Every error names the
 file, the section and key as written and says what is allowed, before any solver starts.
@@ -58,7 +63,7 @@ from mech.validation import (
     check_bool, check_choice, check_file, check_keys, check_nonnegative, check_positive, check_whole,
 )
 
-COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output", "metrics")
+COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output", "metrics", "duty", "coil", "magnet")
 # macro steps a coupled run may take at most (t_end / macro_step, every step in contact):
 # each costs a mechanics advance and an ngspice step (~0.1-1 ms), so 1e6 is minutes to an
 # hour; a 1e-9 s macro step over 5 ms (5e6) is refused before it starts
@@ -70,7 +75,7 @@ POINTS_PER_MACRO_STEP = 4
 WAVE_COPIES = 3
 MECH_WAVE_COLUMNS = 8  # normal_force_0/1, penetration_0/1, normal_force, gap, mu (+1 spare)
 MACRO_STEP_LOG_BYTES = 152  # the friction coefficient's log, one entry per macro step
-TEMPLATES = ("resistive", "inductive", "capacitive", "current_source", "netlist", "mcu_input")
+TEMPLATES = ("resistive", "inductive", "capacitive", "current_source", "netlist", "mcu_input", "short_circuit")
 SCHEMES = ("mechanics_first", "jacobi")
 
 
@@ -186,6 +191,7 @@ class Scene:
     output: OutputOptions = field(default_factory=OutputOptions)
     name: str = "scene"
     metrics: Any = None  # coupling.core.metrics.MetricSettings
+    duty: Any = None  # coupling.core.duty.DutySettings, when the scene has [duty]
 
     @property
     def kind(self) -> str:
@@ -338,7 +344,9 @@ _LOADS = {
     "capacitive": {"load_resistance": "resistance", "load_capacitance": "capacitance",
                    "bleed_resistance": "bleed_resistance"},
     "current_source": {"load_resistance": "resistance"},
+    "short_circuit": {"load_resistance": "resistance"},
 }
+_FAULT = {"fault_time": "fault_time", "fault_resistance": "fault_resistance", "fault_rise": "fault_rise"}
 _TEMPLATE_CIRCUIT = {"contact_capacitance": "contact_capacitance", "leakage_conductance": "leakage_conductance"}
 _NETLIST = {"netlist": None, "load_probe": "load_probe", "leakage_conductance": "leakage_conductance"}
 _PARTS = ("snubber", "flyback", "arc")
@@ -356,7 +364,8 @@ def template_keys(template: str) -> set:
     if template == "mcu_input":
         return set(_MCU_INPUT)
     source = _CURRENT_SOURCE if template == "current_source" else _VOLTAGE_SOURCE
-    return set(source) | set(_WIRING) | set(_LOADS[template]) | set(_TEMPLATE_CIRCUIT) | set(_PARTS)
+    fault = set(_FAULT) if template == "short_circuit" else set()
+    return set(source) | set(_WIRING) | set(_LOADS[template]) | set(_TEMPLATE_CIRCUIT) | set(_PARTS) | fault
 
 
 CIRCUIT_KEYS = frozenset({"template", "schedule", "probes", *_OPTION_KEYS}.union(*(template_keys(t) for t in TEMPLATES)))
@@ -368,7 +377,7 @@ def circuit_key_names(ck) -> dict:
     for cls, keys in ((ck.DCSource, _VOLTAGE_SOURCE), (ck.CurrentSource, _CURRENT_SOURCE), (ck.Wiring, _WIRING),
                       (ck.ResistiveLoad, _LOADS["resistive"]), (ck.InductiveLoad, _LOADS["inductive"]),
                       (ck.CapacitiveLoad, _LOADS["capacitive"]), (ck.SwitchCircuit, _TEMPLATE_CIRCUIT),
-                      (ck.NetlistCircuit, _NETLIST), (ck.McuInput, _MCU_INPUT)):
+                      (ck.NetlistCircuit, _NETLIST), (ck.McuInput, _MCU_INPUT), (ck.ShortCircuit, _FAULT)):
         names.update({f"{cls.__name__}.{name}": f"circuit.{key}" for key, name in keys.items() if name})
     for part, cls in zip(_PARTS, (ck.Snubber, ck.FlybackDiode, ck.ArcModel)):
         names[f"SwitchCircuit.{part}"] = names[f"NetlistCircuit.{part}"] = f"circuit.{part}"
@@ -377,6 +386,8 @@ def circuit_key_names(ck) -> dict:
     names.update({f"ContactSchedule.{name}": f"circuit.schedule.{'make/break' if name == 'intervals' else key}"
                   for key, name in _SCHEDULE.items()})
     names["SwitchCircuit.load"] = "circuit.template"
+    names.update({f"ShortCircuit.{k.split('.', 1)[1]}": v for k, v in list(names.items())
+                  if k.startswith("SwitchCircuit.")})  # a ShortCircuit is a SwitchCircuit
     names["CircuitSpec.probes"] = "circuit.probes"  # what to record, beside the circuit itself
     return names
 
@@ -412,7 +423,9 @@ def _part(table: dict, name: str, cls):
     return cls(**value)
 
 
-def _circuit(table: dict, base_dir: Path, current_factor: str | None):
+def _circuit(table: dict, base_dir: Path, current_factor: str | None, device=None):
+    """[circuit] as its CircuitSpec; with the relay's ``device`` ([coil], [magnet]) the coil
+    and its drive join the template's circuit (a netlist places it with an XCOIL line)."""
     import circuit as ck
 
     table = check_keys("[circuit]", _table("[circuit]", table), CIRCUIT_KEYS)
@@ -437,9 +450,14 @@ def _circuit(table: dict, base_dir: Path, current_factor: str | None):
             if "netlist" not in table:
                 raise ValueError("template \"netlist\" needs netlist = \"file.cir\" (with one 'XCONTACT a b' line)")
             path = _input_file("circuit.netlist", table["netlist"], base_dir)
+            coil = {} if device is None else dict(coil_resistance=device.resistance,
+                                                  coil_current=device.current_law())
             circ = ck.NetlistCircuit.from_file(path, arc=arc, contact_current_factor=current_factor,
-                                               **_fields(table, _NETLIST))
+                                               **_fields(table, _NETLIST), **coil)
         elif template == "mcu_input":
+            if device is not None:
+                raise ValueError("[coil] with circuit.template = \"mcu_input\": the coil's drive joins a switch "
+                                 "template (resistive, inductive, capacitive, current_source) or a netlist")
             circ = ck.McuInput(contact_current_factor=current_factor, **_fields(table, _MCU_INPUT))
         else:
             if template == "current_source":
@@ -447,12 +465,14 @@ def _circuit(table: dict, base_dir: Path, current_factor: str | None):
                 load = ck.ResistiveLoad(**_fields(table, _LOADS[template]))
             else:
                 source = ck.DCSource(**_fields(table, _VOLTAGE_SOURCE))
-                load = {"resistive": ck.ResistiveLoad, "inductive": ck.InductiveLoad,
-                        "capacitive": ck.CapacitiveLoad}[template](**_fields(table, _LOADS[template]))
-            circ = ck.SwitchCircuit(source=source, load=load, wiring=ck.Wiring(**_fields(table, _WIRING)),
-                                    snubber=_part(table, "snubber", ck.Snubber),
-                                    flyback=_part(table, "flyback", ck.FlybackDiode), arc=arc,
-                                    contact_current_factor=current_factor, **_fields(table, _TEMPLATE_CIRCUIT))
+                load = {"resistive": ck.ResistiveLoad, "inductive": ck.InductiveLoad, "capacitive": ck.CapacitiveLoad,
+                        "short_circuit": ck.ResistiveLoad}[template](**_fields(table, _LOADS[template]))
+            cls, fault = (ck.ShortCircuit, _fields(table, _FAULT)) if template == "short_circuit" else (
+                ck.SwitchCircuit, {})
+            circ = cls(source=source, load=load, wiring=ck.Wiring(**_fields(table, _WIRING)),
+                       snubber=_part(table, "snubber", ck.Snubber), flyback=_part(table, "flyback", ck.FlybackDiode),
+                       arc=arc, contact_current_factor=current_factor, coil=None if device is None else device.drive(),
+                       **_fields(table, _TEMPLATE_CIRCUIT), **fault)
         schedule = None
         if "schedule" in table:
             st = check_keys("circuit.schedule", _table("circuit.schedule", table["schedule"]), _SCHEDULE)
@@ -495,9 +515,16 @@ def _build(doc: dict, base_dir: Path, name: str) -> Scene:
         raise ValueError("[circuit.schedule] prescribes the contact, so the scene runs no mechanics; "
                          f"remove [{'], ['.join(mech_given or ['solver'])}] (only [solver] t_end may stay) "
                          "or remove [circuit.schedule]")
-    if "coupling" in doc and (circuit_table is None or schedule_given):
-        raise ValueError("[coupling] settings need mechanics and a [circuit] to couple")
-    if circuit_table is not None and not schedule_given and "tribology" not in doc:
+    if "coupling" in doc and ((circuit_table is None and "coil" not in doc) or schedule_given):
+        raise ValueError("[coupling] settings need mechanics and a [circuit] (or a [coil]) to couple")
+    from coupling.core.device import device as relay_device
+
+    device = relay_device(doc)
+    if device is not None and ("armature" not in doc or schedule_given):
+        raise ValueError("[coil] and [magnet] drive an armature: add [armature] (its kind, mass or inertia and "
+                         "travel; docs/mechanics.md section 10)")
+    contact_spring = "bar" in doc or "block" in doc or "rivet" in doc
+    if circuit_table is not None and not schedule_given and "tribology" not in doc and contact_spring:
         raise ValueError("a coupled scene needs [tribology] for R_c(F_n, I) and mu(I): "
                          "source = \"illustrative\" (the shipped, not measured, fit), fit = \"fit.json\" "
                          "or data = \"data.csv\"")
@@ -527,18 +554,25 @@ def _build(doc: dict, base_dir: Path, name: str) -> Scene:
                                 model=fr.model, max_ratio=fr.max_ratio,
                                 regularization_speed=fr.regularization_speed)
             mech = dataclasses.replace(mech, friction=friction)  # every other section as the scene says
+        if device is not None:
+            mech = _armature_of(mech, device)
 
     circuit = None
     if circuit_table is not None:
         # R_c(F, I) = g(|I|)/G_F(F): the current factor goes into ngspice (solved without lag)
         factor = tribology.laws.resistance_law.current_factor_expression("I") if tribology is not None else None
-        circuit = _circuit(circuit_table, base_dir, factor)
+        circuit = _circuit(circuit_table, base_dir, factor, device)
+    elif device is not None:  # an actuator: the coil's drive is the whole circuit
+        import circuit as ck
+
+        circuit = CircuitSpec(device.drive(), ck.SimulationOptions(), template="coil")
 
     coupling, output = (_section(doc, section, cls) for section, cls in (
         ("coupling", CouplingOptions), ("output", OutputOptions)))
     metrics, circuit = _metrics(doc, circuit)
+    duty = _duty(doc, mech, tribology, circuit)
     scene = Scene(raw=copy.deepcopy(doc), base_dir=base_dir, mech=mech, tribology=tribology, circuit=circuit,
-                  coupling=coupling, output=output, name=name, metrics=metrics)
+                  coupling=coupling, output=output, name=name, metrics=metrics, duty=duty)
     check_work(scene)
     return scene
 
@@ -589,12 +623,15 @@ def _largest_state(mech: MechScene) -> int:
     from mech.model import is_planar
 
     bar = mech.bar
+    extra = 8 if mech.armature.present else 0  # the armature's coordinate, speed and quadratures (bounded)
+    if bar is None:  # an armature alone
+        return extra + NQ
     planar = mech.mount.held or (mech.solver.model != "3d" and is_planar(mech))
     axial = CAP if bar.axial_modes == "auto" else bar.axial_modes
     bending = CAP if bar.bending_modes == "auto" else bar.bending_modes
     n = axial + bending * (1 if planar else 2)
     npos, nvel = state_sizes(n, planar)
-    return npos + nvel + (NQ if (mech.mount.held or mech.forces or mech.springs) else NQ_FREE)
+    return npos + nvel + extra + (NQ if (mech.mount.held or mech.forces or mech.springs) else NQ_FREE)
 
 
 def check_work(scene: Scene) -> None:
@@ -624,6 +661,32 @@ def check_work(scene: Scene) -> None:
                      f"{MEMORY_LIMIT / 2**30:g} GiB a run may take; {fix}")
 
 
+def _armature_of(mech: MechScene, device) -> MechScene:
+    """The mechanics' armature driven by the magnet: a magnet whose force separates as
+    psi^2 h(g) gives the armature its gain table lever h(g(q)) over the travel (the
+    coupling then drives it with psi^2, coupling.core.exchange.CoilLink); its gap must stay
+    open over the whole travel."""
+    from coupling.core.exchange import CoilLink
+
+    arm = mech.armature
+    if not arm.present:
+        raise ValueError("[coil] and [magnet] drive an armature: give [armature] kind = \"plunger\" or \"clapper\"")
+    link = CoilLink("coil", device.magnet, device.rest_gap, device.lever)
+    closed = link.gap(arm.travel)
+    if not closed > 0.0:
+        raise ValueError(f"magnet.rest_gap = {device.rest_gap!r} m with magnet.lever = {device.lever!r} and "
+                         f"armature.travel = {arm.travel!r}: the working gap would close to {closed:.3g} m at the pole "
+                         "stop; the gap must stay > 0 over the travel (a residual gap: the pole stop before the pole)")
+    if not link.separable:
+        return mech
+    if arm.force_gain is not None:
+        raise ValueError("armature.force_gain: the magnet gives the armature its gain (h(g) of its flux-tube "
+                         "model); remove armature.force_gain")
+    q, gain = link.gain_table(arm.travel)
+    return dataclasses.replace(mech, armature=dataclasses.replace(
+        arm, force_gain={"position": [float(x) for x in q], "gain": [float(g) for g in gain]}))
+
+
 def _metrics(doc: dict, circuit: CircuitSpec | None):
     """([metrics] as MetricSettings, the circuit) with its ``logic`` input resolved: an
     mcu_input template gives its pin and thresholds by default, and the node read is added
@@ -647,6 +710,15 @@ def _metrics(doc: dict, circuit: CircuitSpec | None):
     probe, circuit = _recorded(logic.node, circuit, "metrics.logic.node")
     table["logic"] = dataclasses.replace(logic, node=probe.text)
     return MetricSettings(**table), circuit
+
+
+def _duty(doc: dict, mech: MechScene | None, tribology: TribologySpec | None, circuit: CircuitSpec | None):
+    """[duty] as coupling.core.duty.DutySettings (its defaults from the other sections), or None."""
+    if "duty" not in doc:
+        return None
+    from coupling.core.duty import duty_from_table
+
+    return duty_from_table(_table("[duty]", doc["duty"]), mech, tribology, circuit)
 
 
 def _recorded(text: str, spec: CircuitSpec, where: str):

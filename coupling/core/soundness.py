@@ -27,8 +27,8 @@ the rows it thinned away (``mech.ImpactResult.thinning``)):
   about that fraction;
 - circuit (template circuits): the loop current through the load is at most
   2 V / (R_source + R_wiring + R_load) (A): the supply across the series loop, plus one
-  full overshoot of the loop's ringing. A netlist circuit's topology is not known: no
-  current bound.
+  full overshoot of the loop's ringing (a short_circuit template: R_load || R_fault). A
+  netlist circuit's topology is not known: no current bound.
 
 Bounds are compared with a relative margin (BOUND_MARGIN) for round-off and the
 integration error the energy check already limits.
@@ -152,18 +152,20 @@ def assess(result) -> dict:
         # from the records themselves and the extremes of those a long run thinned away
         # (mech.ImpactResult.thinning), not from the history table
         residual = mres.max_abs_residual
-        speed = mres.max_speed
-        pen = mres.deepest_penetration
-        v_max = speed_bound(scale, scene.bar.mass)
-        y_max = penetration_bound(scale, float(mres.solver["stiffness"]), scene.bar.mass * scene.gravity)
         kinetic = mres.max_kinetic
         out.update(energy_scale=scale, relative_residual=residual / scale if scale > 0 else None,
-                   max_kinetic=kinetic, max_speed=speed, speed_bound=v_max, max_penetration=pen,
-                   penetration_bound=y_max)
+                   max_kinetic=kinetic)
         problems += [p for p in (energy_problem(residual, scale, scene.solver.energy_tolerance),
-                                 kinetic_problem(kinetic, scale), speed_problem(speed, v_max),
-                                 penetration_problem(pen, y_max, scene.bar.tip_radius)) if p]
-        problems += [p for p in (hertz_problem(y, r, name) for name, y, r in mres.contact_depths) if p]
+                                 kinetic_problem(kinetic, scale)) if p]
+        if scene.bar is not None:  # (an armature alone has no bar to speed or to sink into a contact)
+            speed = mres.max_speed
+            pen = mres.deepest_penetration
+            v_max = speed_bound(scale, scene.bar.mass)
+            y_max = penetration_bound(scale, float(mres.solver["stiffness"]), scene.bar.mass * scene.gravity)
+            out.update(max_speed=speed, speed_bound=v_max, max_penetration=pen, penetration_bound=y_max)
+            problems += [p for p in (speed_problem(speed, v_max),
+                                     penetration_problem(pen, y_max, scene.bar.tip_radius)) if p]
+            problems += [p for p in (hertz_problem(y, r, name) for name, y, r in mres.contact_depths) if p]
     bound = _circuit_current_bound(result.scene)
     waves = result.waveform_columns
     if bound is not None and waves is not None and len(waves["time"]) and "load_current" in waves:
@@ -181,7 +183,11 @@ def _circuit_current_bound(scene) -> float | None:
     circ = getattr(spec, "circuit", None)
     try:
         voltage = circ.source.voltage
-        series = circ.source.internal_resistance + circ.wiring.resistance + circ.load.resistance
+        load = circ.load.resistance
+        series = circ.source.internal_resistance + circ.wiring.resistance + load
     except AttributeError:  # a netlist circuit: its topology is the user's
         return None
+    fault = getattr(circ, "fault_resistance", None)  # circuit.ShortCircuit: the load shorted by it
+    if fault is not None:
+        series += load * fault / (load + fault) - load
     return loop_current_bound(voltage, series) if series > 0 else None

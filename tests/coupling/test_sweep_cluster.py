@@ -136,9 +136,18 @@ def test_two_invocations_on_one_folder_at_once_write_each_run_once(tmp_path):
     """Two `--resume` at once gave 16 rows for 8 runs; now the second is refused in one line."""
     sweep = netlist_sweep(tmp_path, ["good"] * 8)
     out = tmp_path / "out"
-    procs = [subprocess.Popen([sys.executable, "-m", "coupling", "sweep", str(sweep), "--out", str(out),
-                               "--workers", "1", "--resume", "--quiet"], env=ENV, stdout=subprocess.PIPE,
-                              stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    def start():
+        return subprocess.Popen([sys.executable, "-m", "coupling", "sweep", str(sweep), "--out", str(out),
+                                 "--workers", "1", "--resume", "--quiet"], env=ENV, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)
+
+    # the second starts once the first holds the folder (started together, a loaded machine
+    # let the first finish before the second looked: both exited 0)
+    procs = [start()]
+    deadline = time.monotonic() + 120
+    while not (out / ".sweep.lock").exists() and procs[0].poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    procs.append(start())
     results = [(p.wait(timeout=300), p.stderr.read()) for p in procs]
     codes = sorted(code for code, _ in results)
     assert codes == [0, 2], results
