@@ -54,14 +54,16 @@ def changeover(force: dict, **extra) -> dict:
     return doc
 
 
-def pressed_force(press: float) -> float:
+def pressed_force(press: float, stiffness: float = K_BLADE) -> float:
     """N: the NC contact's force R at rest under a net press ``press`` (N) up at the rivets.
-    The blade's deflection there, (press - R) / K_BLADE, is the Hertz compression (R /
-    K_HERTZ)^(2/3) (it starts touching, undeformed): R = press - K_BLADE (R / K_HERTZ)^(2/3),
-    solved by fixed-point iteration (a contraction: the correction is ~3e-4 of the press)."""
+    The blade's deflection there, (press - R) / stiffness, is the Hertz compression (R /
+    K_HERTZ)^(2/3) (it starts touching, undeformed): R = press - stiffness (R /
+    K_HERTZ)^(2/3), solved by fixed-point iteration (a contraction: the correction is ~3e-4
+    of the press). stiffness: N/m, what resists the lift at the rivets (the blade's, plus
+    a spring's pressing there)."""
     r = press
     for _ in range(60):
-        r = press - K_BLADE * (r / K_HERTZ) ** (2.0 / 3.0)
+        r = press - stiffness * (r / K_HERTZ) ** (2.0 / 3.0)
     return r
 
 
@@ -149,6 +151,31 @@ def test_a_changeover_at_rest_carries_the_preload_on_its_nc_contact(pressed):
     assert c[0, 2] == 0.0
     assert -c[0, 0] == pytest.approx(GAP_NO + (nc / K_HERTZ) ** (2.0 / 3.0), rel=1e-6)
     assert c[1, 0] == pytest.approx((nc / K_HERTZ) ** (2.0 / 3.0), rel=1e-6)
+
+
+K_SPRING = 100.0  # N/m: the preloading spring's rate (a seventh of the blade's)
+
+
+def test_a_blade_preloaded_by_a_spring_rests_on_its_nc_stop_with_the_preload():
+    """The issue's check: a changeover whose NC contact is a stop (electrical = false),
+    the blade preloaded against it by a spring pulling up at the rivets (its anchor
+    straight above them, 0.1 m away, pulling ``preload`` at the start, where the blade
+    just touches NC). At rest the stop carries the preload less what the lift of the
+    Hertz compression takes off: the blade's stiffness and the spring's (it shortens by
+    that lift), pressed_force with K_BLADE + K_SPRING (to the 1e-6 of the test above;
+    the spring's share alone is 4e-5 of the preload, so its rate is seen). The NO contact
+    carries nothing."""
+    doc = changeover(dict(magnitude=0.0), solver=dict(t_end=1.0))
+    del doc["force"]
+    doc["fixed"][1]["electrical"] = False
+    doc["spring"] = [dict(anchor=[-ARM, 0.0, 0.1], position=XR, stiffness=K_SPRING, preload=PRESS)]
+    solver = ImpactSolver(scene_from_dict(doc))
+    solver.advance(0.03)
+    assert solver.at_rest and not solver.pairs[1].electrical
+    c = solver.contact_now()
+    assert c[1, 2] == pytest.approx(pressed_force(PRESS, K_BLADE + K_SPRING), rel=1e-6)
+    assert c[1, 2] != pytest.approx(pressed_force(PRESS), rel=1e-6)  # (the spring's rate is resolved)
+    assert c[0, 2] == 0.0
 
 
 @pytest.mark.parametrize("repulsion", [0.1, 0.3])
