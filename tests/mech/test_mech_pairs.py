@@ -54,16 +54,16 @@ def changeover(force: dict, **extra) -> dict:
     return doc
 
 
-def pressed_force(press: float, stiffness: float = K_BLADE) -> float:
+def pressed_force(press: float, stiffness: float = K_BLADE, k_hertz: float = K_HERTZ) -> float:
     """N: the NC contact's force R at rest under a net press ``press`` (N) up at the rivets.
     The blade's deflection there, (press - R) / stiffness, is the Hertz compression (R /
     K_HERTZ)^(2/3) (it starts touching, undeformed): R = press - stiffness (R /
     K_HERTZ)^(2/3), solved by fixed-point iteration (a contraction: the correction is ~3e-4
     of the press). stiffness: N/m, what resists the lift at the rivets (the blade's, plus
-    a spring's pressing there)."""
+    a spring's pressing there); k_hertz: N/m^1.5, the Hertz stiffness of the rivet on NC."""
     r = press
     for _ in range(60):
-        r = press - stiffness * (r / K_HERTZ) ** (2.0 / 3.0)
+        r = press - stiffness * (r / k_hertz) ** (2.0 / 3.0)
     return r
 
 
@@ -154,6 +154,9 @@ def test_a_changeover_at_rest_carries_the_preload_on_its_nc_contact(pressed):
 
 
 K_SPRING = 100.0  # N/m: the preloading spring's rate (a seventh of the blade's)
+# the NC stop of that test: a copper-like rivet head of radius 3 mm (Hertz: the effective
+# radius of the two caps, the two materials)
+NC_R, NC_E, NC_NU = 0.003, 120e9, 0.34
 
 
 def test_a_blade_preloaded_by_a_spring_rests_on_its_nc_stop_with_the_preload():
@@ -163,18 +166,21 @@ def test_a_blade_preloaded_by_a_spring_rests_on_its_nc_stop_with_the_preload():
     just touches NC). At rest the stop carries the preload less what the lift of the
     Hertz compression takes off: the blade's stiffness and the spring's (it shortens by
     that lift), pressed_force with K_BLADE + K_SPRING (to the 1e-6 of the test above;
-    the spring's share alone is 4e-5 of the preload, so its rate is seen). The NO contact
-    carries nothing."""
+    the spring's share alone is 4e-5 of the preload, so its rate is seen). The stop is a
+    spherical rivet head of its own material: the Hertz stiffness of the two caps' effective
+    radius and the two materials (with the blade's steel on both sides the lift's share
+    differs by 1e-4 of the preload). The NO contact carries nothing."""
     doc = changeover(dict(magnitude=0.0), solver=dict(t_end=1.0))
     del doc["force"]
-    doc["fixed"][1]["electrical"] = False
+    doc["fixed"][1].update(electrical=False, shape="sphere", radius=NC_R, youngs_modulus=NC_E, poisson_ratio=NC_NU)
     doc["spring"] = [dict(anchor=[-ARM, 0.0, 0.1], position=XR, stiffness=K_SPRING, preload=PRESS)]
     solver = ImpactSolver(scene_from_dict(doc))
     solver.advance(0.03)
     assert solver.at_rest and not solver.pairs[1].electrical
     c = solver.contact_now()
-    assert c[1, 2] == pytest.approx(pressed_force(PRESS, K_BLADE + K_SPRING), rel=1e-6)
-    assert c[1, 2] != pytest.approx(pressed_force(PRESS), rel=1e-6)  # (the spring's rate is resolved)
+    k_hertz = hertz_stiffness(RR * NC_R / (RR + NC_R), E, NU, NC_E, NC_NU)
+    assert c[1, 2] == pytest.approx(pressed_force(PRESS, K_BLADE + K_SPRING, k_hertz), rel=1e-6)
+    assert c[1, 2] != pytest.approx(pressed_force(PRESS, K_BLADE, k_hertz), rel=1e-6)  # (the spring's rate is seen)
     assert c[0, 2] == 0.0
 
 
