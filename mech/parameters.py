@@ -593,9 +593,12 @@ class FixedContact:
                 raise ValueError(f"{n}.offset: shifts a spherical fixed contact's top; set {n}.shape = 'sphere'")
         check_magnitude(f"{n}.offset", self.offset, LENGTH_MAX)
         check_choice(f"{n}.facing", self.facing, FACINGS)
-        if (self.height is None) == (self.gap is None):
-            raise ValueError(f"{n}.height: give height (m, world z of its surface) or gap (m from its point at "
-                             "the start), one of them")
+        if self.height is None and self.gap is None:
+            raise ValueError(f"{n}.height: needed: give height (m, world z of its surface) or gap (m from its "
+                             "point at the start), one of them")
+        if self.height is not None and self.gap is not None:
+            raise ValueError(f"{n}.height = {self.height!r} and {n}.gap = {self.gap!r}: give height (m, world z of "
+                             "its surface) or gap (m from its point at the start), not both")
         if self.height is not None:
             check_magnitude(f"{n}.height", self.height, LENGTH_MAX)
         else:
