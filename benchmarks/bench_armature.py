@@ -12,7 +12,7 @@ measured in the same run (no timed tests):
     output on and the armature's position asked at every step's middle (as the coupling
     asks for the gap). Solver time = the solver's integration wall time; loop = the whole
     stepping loop in Python.
-(b) The default relay's make (coupling.builtin_scene("default") mechanics, 5 ms) with its
+(b) The default relay's make (coupling.builtin_scene("relay_force") mechanics, 5 ms) with its
     armature force table against the same blade closed by an armature: a plunger of 2 g,
     0.5 mm of travel (stops 1e9 N/m, 600 N s/m), return spring 0.3 N + 400 N/m, its card
     at the force's position (lever 1, 0.1 mm free travel, 1e5 N/m, 0.5 N s/m), driven by
@@ -99,7 +99,7 @@ def relay_scenes():
 
     from mech.parameters import Armature
 
-    table = builtin_scene("default").set("solver.t_end", T_END_B).mech
+    table = builtin_scene("relay_force").set("solver.t_end", T_END_B).mech
     force = table.forces[0]
     arm = Armature(kind="plunger", mass=2e-3, travel=5e-4, stop_stiffness=1e9, stop_damping=600.0,
                    spring_rate=400.0, spring_preload=0.3, card_position=force.position, card_lever=1.0,

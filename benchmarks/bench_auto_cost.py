@@ -6,7 +6,7 @@ Three scenes, each with bar.modes = "auto" and with its former count, in one pro
 of N warm runs (the machine is shared: other load only adds time):
 - the free drop, coupled (builtin_scene("free_drop"), the default scene when auto was
   introduced; issue 9's target: auto <= 1.5x its former 3 modes per family);
-- the relay, coupled (builtin_scene("default"), the default scene now; formerly 1 axial +
+- the relay, coupled (builtin_scene("relay_force"), the default scene until the coil relay; formerly 1 axial +
   6 bending modes, which run --check showed unconverged);
 - the mechanics default alone (mech.default_scene(), 50 ms), formerly 3 per family.
 Writes the block between the auto-cost markers of docs/benchmarks.md.
@@ -47,7 +47,7 @@ def main() -> None:
     args = ap.parse_args()
     rows = []
     coupled = (("free drop, coupled (10 ms)", coupling.builtin_scene("free_drop"), 3),
-               ("relay, coupled (the default, 5 ms)", coupling.builtin_scene("default"), {"axial": 1, "bending": 6}))
+               ("relay_force, coupled (5 ms)", coupling.builtin_scene("relay_force"), {"axial": 1, "bending": 6}))
     for name, base, former in coupled:
         for label, value in (("auto", "auto"), ("former", former)):
             sc = base.set("bar.modes", value)

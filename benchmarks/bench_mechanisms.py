@@ -18,7 +18,7 @@ Four measurements, each against a baseline measured in the same run (no timed te
     solver (no scene key; it is built in), so the cost without it is extrapolated from the
     cost per simulated ms of the settled contact over the last rest window before the hold
     starts (the same solver advanced to the window's start, then timed over the window).
-(c) The coupled relay closure: coupling.builtin_scene("default") with t_end = the start of
+(c) The coupled relay closure: coupling.builtin_scene("relay_force") with t_end = the start of
     the final closure + 2 ms (first make to 2 ms after settling); solver time =
     result.stats mech_seconds + circuit_seconds, median of --repeat runs. Target < 0.3 s.
     Next to it the mechanics alone over the same span, in one advance and in macro steps.
@@ -77,7 +77,7 @@ def relay_mech(**changes):
     """The relay default scene's mechanics (a MechScene), with "section.key" changes."""
     from coupling import builtin_scene
 
-    return builtin_scene("default").update(changes).mech if changes else builtin_scene("default").mech
+    return builtin_scene("relay_force").update(changes).mech if changes else builtin_scene("relay_force").mech
 
 
 def timed_run(scene, repeat: int, best: bool = False):
@@ -264,11 +264,11 @@ def part_d(repeat: int) -> list:
 def part_c(repeat: int) -> dict:
     from coupling import builtin_scene, run
 
-    probe = run(builtin_scene("default"))
+    probe = run(builtin_scene("relay_force"))
     bnc = probe.bounce
     first_make, final_start = bnc["first_make"], bnc["last_make"]
     t_end = final_start + 0.002
-    scene = builtin_scene("default").set("solver.t_end", t_end)
+    scene = builtin_scene("relay_force").set("solver.t_end", t_end)
     solver_s, walls, res = [], [], None
     for _ in range(repeat):
         res = run(scene)
@@ -405,7 +405,7 @@ def main() -> None:
     from mech import simulate
 
     simulate(relay_mech(**{"solver.t_end": 2e-4}))
-    run(builtin_scene("default").set("solver.t_end", 2e-4))
+    run(builtin_scene("relay_force").set("solver.t_end", 2e-4))
     base0 = baseline_import_numpy()
     a = part_a(args.repeat)
     b = part_b(args.repeat)

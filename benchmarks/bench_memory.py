@@ -61,7 +61,7 @@ def timed(fn) -> float:
 
 def speed_rows(repeat: int) -> list[str]:
     mech_default = coupling.scene_from_dict({"solver": {"t_end": 0.05}}, name="mechanics default")
-    scenes = (("relay, coupled (the default, 5 ms)", coupling.builtin_scene("default")),
+    scenes = (("relay_force, coupled (5 ms)", coupling.builtin_scene("relay_force")),
               ("free drop, coupled (10 ms)", coupling.builtin_scene("free_drop")),
               ("mechanics default alone (50 ms)", mech_default))
     rows = ["| scene | with / without (median of neighbouring pairs) | with, s (median) | without, s (median) |",

@@ -37,7 +37,7 @@ from coupling.core.scene import load_scene  # noqa: E402
 DOC = ROOT / "docs" / "accuracy-modes.md"
 BEGIN, END = "<!-- mode-count-mechanisms:begin -->", "<!-- mode-count-mechanisms:end -->"
 CASES = {
-    "default relay (clamped CuBe blade, 24 V / 10 ohm, arc)": lambda: builtin_scene("default"),
+    "default relay (clamped CuBe blade, 24 V / 10 ohm, arc)": lambda: builtin_scene("relay_force"),
     "pushbutton (pivoted steel lever, 5 V / 1 kohm)": lambda: load_scene(ROOT / "examples" / "pushbutton.toml"),
 }
 LADDER = [(1, 3), (1, 6), (3, 5), (3, 8), (3, 12), (3, 16), (5, 20)]

@@ -55,11 +55,11 @@ load_resistance = 12.0
 
 
 def coupled_sweep(runs: int):
-    """The default coupled scene, 3 ms, load resistance varied over `runs` values."""
-    from coupling.core.scene import default_scene
+    """The force-driven relay (relay_force), 3 ms, load resistance varied over `runs` values."""
+    from coupling.core.scene import builtin_scene
     from coupling.app.sweep import Sweep
 
-    base = default_scene().set("solver.t_end", 0.003)
+    base = builtin_scene("relay_force").set("solver.t_end", 0.003)
     return Sweep.grid(base, {"circuit.load_resistance": [6.0 + 0.5 * k for k in range(runs)]})
 
 
@@ -98,14 +98,14 @@ def on_cluster(sweep, workers: int, tmp: Path, repeat: int) -> float:
 
 
 def _timed_runs(n: int = 4) -> dict:
-    """n runs of the 3 ms default coupled scene in the calling process, after a warm-up,
+    """n runs of the 3 ms relay_force scene in the calling process, after a warm-up,
     each timed (s), and the process's resident memory after them (bytes)."""
     import psutil
 
     from coupling import run
-    from coupling.core.scene import default_scene
+    from coupling.core.scene import builtin_scene
 
-    scene = default_scene().set("solver.t_end", 0.003)
+    scene = builtin_scene("relay_force").set("solver.t_end", 0.003)
     run(scene)
     times = []
     for k in range(n):
@@ -196,7 +196,7 @@ def main() -> None:
     overhead = t1 / t_bare - 1.0
     lines = [f"`.venv/bin/python benchmarks/bench_sweep.py --runs {args.runs} --repeat {args.repeat}` "
              f"(load average {load:.1f} at the end; {os.cpu_count()} CPUs; best of {args.repeat} per route)", "",
-             f"Throughput: the default coupled scene at 3 ms, circuit.load_resistance over {args.runs} values, "
+             f"Throughput: the relay_force scene at 3 ms, circuit.load_resistance over {args.runs} values, "
              "on a started cluster whose workers have made one run each.", "",
              "| route | wall | runs/s |", "|---|---|---|",
              f"| bare `coupling.run`, one process, one after the other | {t_bare:.2f} s | {args.runs / t_bare:.2f} |",
@@ -205,7 +205,7 @@ def main() -> None:
              f"- 2 workers / 1 worker: **{speedup:.2f}x** (target >= 1.8x: {'met' if speedup >= 1.8 else 'not met'}).",
              f"- Overhead of the sweep machinery per run (1 worker against bare): **{100 * overhead:+.1f} %** "
              f"(target <= 10 %: {'met' if overhead <= 0.10 else 'not met'}).", "",
-             f"Worker settings (the same 3 ms default coupled run, {args.settings_runs} runs inside one Dask task "
+             f"Worker settings (the same 3 ms relay_force run, {args.settings_runs} runs inside one Dask task "
              "after a warm-up run; the worker's resident memory after them):", "",
              "| where | per run (median, range) | RSS after |", "|---|---|---|",
              *[f"| {label} | {1e3 * sorted(m['times'])[len(m['times']) // 2]:.0f} ms ({min(m['times']) * 1e3:.0f}-"

@@ -33,6 +33,9 @@ class ModeCount:
     safety: float
     capped: tuple[str, ...] = ()
     floored: tuple[str, ...] = ()
+    # Hz: the lowest frequency of each family left out (inf: none known, or capped): a
+    # faster impact than the estimate changes the count only once its cutoff passes one
+    next_frequencies: tuple[float, float] = (math.inf, math.inf)
 
     @property
     def reason(self) -> str:
@@ -64,7 +67,7 @@ def choose_mode_count(axial_frequencies, bending_frequencies, contact_time: floa
     if not safety > 0.0:
         raise ValueError(f"safety = {safety!r}: must be > 0")
     cutoff = safety / contact_time
-    counts, capped, floored = {}, [], []
+    counts, capped, floored, following = {}, [], [], []
     for fam, freqs in (("axial", axial_frequencies), ("bending", bending_frequencies)):
         k = count_below(freqs, cutoff)
         if k >= cap:
@@ -74,6 +77,8 @@ def choose_mode_count(axial_frequencies, bending_frequencies, contact_time: floa
             k = floor
             floored.append(fam)
         counts[fam] = k
+        f = np.asarray(freqs, dtype=float)
+        following.append(float(f[k]) if k < min(cap, len(f)) else math.inf)
     return ModeCount(axial=counts["axial"], bending=counts["bending"], cutoff=cutoff,
                      contact_time=contact_time, impact_speed=impact_speed, safety=safety,
-                     capped=tuple(capped), floored=tuple(floored))
+                     capped=tuple(capped), floored=tuple(floored), next_frequencies=tuple(following))

@@ -1046,22 +1046,28 @@ def family_frequencies(bar, count: int) -> tuple[np.ndarray, np.ndarray]:
     return axial, bend
 
 
-def resolve_auto_modes(scene: MechScene, safety: float | None = None):
+def resolve_auto_modes(scene: MechScene, safety: float | None = None, impact_speed: float | None = None):
     """(scene with explicit mode counts, ModeCount or None). "auto" counts are chosen by
     mech.mode_count.choose_mode_count from the Hertz contact time of the first impact
     (rigid-bar effective mass and impact speed of ``contact_scales``); safety: the
-    factor of f_cut = safety / t_c (None: mode_count.SAFETY)."""
+    factor of f_cut = safety / t_c (None: mode_count.SAFETY). impact_speed: m/s, an impact
+    speed known better than the scene's estimate (a run's own largest, see
+    refined_mode_count): t_c scales as v^(-1/5) on the same effective mass (Hertz)."""
     bar = scene.bar
     if bar.axial_modes != "auto" and bar.bending_modes != "auto":
         return scene, None
+    factor = SAFETY if safety is None else safety
     if needs_mechanism(scene):
-        axial, bend, t_c, speed = _mechanism_auto_inputs(scene, CAP, SAFETY if safety is None else safety)
-        cs = None
+        mass, stiffness, speed = _mechanism_impact(scene)
+        if impact_speed is not None:
+            speed = impact_speed
+        t_c = hertz_impact(mass, stiffness, speed).contact_time
+        axial, bend = _mechanism_frequencies(scene, CAP, factor / t_c)
     else:
         cs = contact_scales(scene, 0)
-        t_c = hertz_impact(cs.reference_mass, cs.stiffness, cs.reference_speed).contact_time
+        speed = cs.reference_speed if impact_speed is None else impact_speed
+        t_c = hertz_impact(cs.reference_mass, cs.stiffness, speed).contact_time
         axial, bend = family_frequencies(bar, CAP)
-        speed = cs.reference_speed
     choice = choose_mode_count(axial, bend, t_c, impact_speed=speed,
                                safety=SAFETY if safety is None else safety)
     bar = dataclasses.replace(
@@ -1072,23 +1078,48 @@ def resolve_auto_modes(scene: MechScene, safety: float | None = None):
     return dataclasses.replace(scene, bar=bar), choice
 
 
-def _mechanism_auto_inputs(scene: MechScene, cap: int, safety: float):
-    """(axial Hz, bending Hz, contact time s, impact speed m/s) for "auto" on a mechanism
-    scene: the frequencies of the bar as held (finite-element modes, rivets' masses on
-    it; bending in its more flexible plane), every one below f_cut = safety / t_c at least,
-    and the Hertz time t_c of the first contact point's impact on its effective mass
-    (mechanism_scales, from a small basis)."""
+def _mechanism_impact(scene: MechScene) -> tuple[float, float, float]:
+    """(effective mass kg, Hertz stiffness N/m^1.5, impact speed m/s) of a mechanism's first
+    contact point's impact (mechanism_scales, from a small basis)."""
     bar = scene.bar
     small = dataclasses.replace(scene, bar=dataclasses.replace(bar, axial_modes=1, bending_modes=3))
     arr = build_arrays(small, True)
     cs = mechanism_scales(small, arr, arr.basis.n)
-    t_c = hertz_impact(cs.reference_mass, cs.stiffness, cs.reference_speed).contact_time
+    return cs.reference_mass, cs.stiffness, cs.reference_speed
+
+
+def _mechanism_frequencies(scene: MechScene, cap: int, cutoff: float) -> tuple[np.ndarray, np.ndarray]:
+    """(axial Hz, bending Hz) of the bar as held (finite-element modes, rivets' masses on
+    it; bending in its more flexible plane), every one below ``cutoff`` (Hz) at least."""
     beam = fe_beam(scene)
-    i22, i33 = bar.second_moments
-    cutoff = safety / t_c
+    i22, i33 = scene.bar.second_moments
     axial = frequencies_below(beam, "axial", cutoff, cap)
     bend = frequencies_below(beam, "bend3" if i22 <= i33 else "bend2", cutoff, cap)
-    return axial, bend, t_c, cs.reference_speed
+    return axial, bend
+
+
+def refined_mode_count(scene: MechScene, chosen, impact_speeds) -> object | None:
+    """The "auto" count a run's own impacts ask for, or None when the chosen one holds.
+
+    scene: the MechScene as written (its "auto" families); chosen: the ModeCount the run
+    used (its estimate of the impact speed); impact_speeds: m/s, the normal speeds of the
+    run's impacts. The fastest impact is the shortest (t_c ~ v^(-1/5)) and so sets the
+    cutoff: where it was faster than the estimate and its count is larger in a family,
+    the run under-resolved its own impacts (a driven blade arriving at a few tenths of a
+    m/s where the estimate took a floor of 1 mm/s), and that count is returned."""
+    speeds = np.abs(np.asarray(impact_speeds, dtype=float))
+    speeds = speeds[np.isfinite(speeds)]
+    if chosen is None or not len(speeds) or not float(speeds.max()) > chosen.impact_speed:
+        return None
+    # the cutoff at the fastest impact (t_c ~ v^(-1/5)) against the first mode left out of
+    # each family: below both, the count holds (no eigen-solve needed to know it)
+    cutoff = chosen.cutoff * (float(speeds.max()) / chosen.impact_speed) ** 0.2
+    if cutoff < min(chosen.next_frequencies):
+        return None
+    _, refined = resolve_auto_modes(scene, safety=chosen.safety, impact_speed=float(speeds.max()))
+    if refined is None or (refined.axial <= chosen.axial and refined.bending <= chosen.bending):
+        return None
+    return refined
 
 
 def frequencies_below(beam, family: str, cutoff: float, cap: int, first: int = 8) -> np.ndarray:

@@ -97,6 +97,15 @@ PANELS = (
           "linear"),
     Panel("gap", WAVEFORM["gap"], (Trace("gap", "gap", "#8c564b"),), "linear", ("um", 1e6)),
     Panel("arc_power", WAVEFORM["arc_power"], (Trace("arc_power", "arc power", "#ff7f0e", "nonzero"),), "spikes"),
+    # the relay's coil and armature: the current with its dip at pull-in, the coil's voltage
+    # (its spike at switch-off, which the suppression sets), the force and the travel
+    Panel("coil_current", WAVEFORM["coil_current"], (Trace("coil_current", "coil current", "#17becf"),), "linear",
+          ("mA", 1e3)),
+    Panel("coil_voltage", WAVEFORM["coil_voltage"], (Trace("coil_voltage", "coil voltage", "#1f77b4"),), "linear"),
+    Panel("magnetic_force", WAVEFORM["magnetic_force"],
+          (Trace("magnetic_force", "magnetic force", "#e377c2"),), "linear"),
+    Panel("armature", WAVEFORM["armature_position"],
+          (Trace("armature_position", "armature travel", "#7f7f7f"),), "linear", ("mm", 1e3)),
     Panel("probe_voltage", WAVEFORM["probe_voltage"], (Trace("v(*"),), "linear"),
     Panel("probe_current", WAVEFORM["probe_current"], (Trace("i(*"),), "linear"),
 )

@@ -439,11 +439,36 @@ def run(scene: Scene, *, progress: bool = False, check: bool = False) -> Coupled
         from coupling.app.accuracy import run_checked
 
         return run_checked(scene, progress=progress)
+    if scene.kind == "circuit":
+        return _run_schedule(scene).judge()
+    result = _run_once(scene, progress)
+    refined = _refined_modes(scene, result)
+    if refined is not None:
+        # the run's own impacts were faster (shorter) than the estimate its "auto" count
+        # was chosen for: run again with the count they ask for (once: a faster impact still
+        # would only move the cutoff by v^(1/5))
+        first = result.mechanics.model.mode_count
+        modes = {"axial": refined.axial, "bending": refined.bending}
+        result = _run_once(scene.set("bar.modes", modes), progress)
+        result.stats["modes_refined"] = {"first": first.reason, "rule": refined.reason, "modes": modes}
+    return result.judge()
+
+
+def _run_once(scene: Scene, progress: bool) -> CoupledResult:
     if scene.kind == "coupled":
-        return CoSimulation(scene, progress=progress).run().judge()
-    if scene.kind == "mechanics":
-        return _run_mechanics(scene).judge()
-    return _run_schedule(scene).judge()
+        return CoSimulation(scene, progress=progress).run()
+    return _run_mechanics(scene)
+
+
+def _refined_modes(scene: Scene, result: CoupledResult):
+    """The mode count the finished run's own impacts ask for where "auto" chose fewer
+    (mech.model.refined_mode_count), else None."""
+    from mech.model import refined_mode_count
+
+    mech = result.mechanics
+    if mech is None or getattr(mech.model, "mode_count", None) is None or not len(mech.contact_columns["t_start"]):
+        return None
+    return refined_mode_count(scene.mech, mech.model.mode_count, mech.contact_columns["normal_speed_in"])
 
 
 def _run_mechanics(scene: Scene) -> CoupledResult:

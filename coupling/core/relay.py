@@ -8,7 +8,9 @@ armature_position, working_gap and magnetic_force), its operations and the coil'
   (the break of the contact's last operation); None where the run does not reach them;
 - ``pull_in_current`` (A): the coil current when the armature first leaves its rest stop;
   ``drop_out_current`` (A): the coil current when it leaves the pole after the coil is
-  switched off; ``armature_arrival`` (s): its first arrival at the pole;
+  switched off; ``armature_arrival`` (s): its first arrival at the pole; all three at the
+  mechanics' located stop events (the current interpolated between the circuit's points
+  there), not at samples of the travel, which a coarse step can miss;
 - ``energy``: the coil's energy balance, J: ``into_coil`` (integral of v i dt) =
   ``copper`` (integral of R i^2 dt) + ``magnetic_change`` (W(psi, g) at the end less at the
   start, the magnet's stored energy) + ``armature_work`` (integral of F d(g) along the
@@ -24,20 +26,22 @@ import numpy as np
 
 from coupling.core.metrics import trapezoid
 
-MOVED = 1e-3  # of the pole face's full travel: the armature has left a stop
+def stop_times(events: list[dict], stop: str, kind: str) -> list[float]:
+    """s: the times of the mechanics' armature stop events on ``stop`` ("rest" or "pole")
+    of ``kind`` ("start": it reached the stop, "end": it left it)."""
+    return [float(e["time"]) for e in events if e.get("stop") == stop and e["kind"] == f"armature_stop_{kind}"]
 
 
-def relay_metrics(waves: dict, operations: list[dict], drive, magnet, travel: float, resistance: float) -> dict:
+def relay_metrics(waves: dict, operations: list[dict], drive, magnet, events: list[dict], resistance: float) -> dict:
     """The ``relay`` block (module docstring). waves: the run's columns (SI); operations:
     the contact's (coupling.core.metrics.operations; [] without a contact); drive: the
     circuit's CoilDrive (its on_time and off_time), or None for a netlist's coil; magnet:
-    the coupling.laws.magnet magnet; travel: m, the pole face's full travel; resistance:
-    ohm, the coil's winding."""
+    the coupling.laws.magnet magnet; events: the mechanics' events (its armature's stop
+    events); resistance: ohm, the coil's winding."""
     t = np.asarray(waves["time"], float)
     i = np.asarray(waves["coil_current"], float)
     v = np.asarray(waves["coil_voltage"], float)
     psi = np.asarray(waves["coil_flux_linkage"], float)
-    x = np.asarray(waves["armature_position"], float)
     gap = np.asarray(waves["working_gap"], float)
     force = np.asarray(waves["magnetic_force"], float)
     on = drive.on_time if drive is not None else None
@@ -53,16 +57,16 @@ def relay_metrics(waves: dict, operations: list[dict], drive, magnet, travel: fl
         if after:
             out["release_time"] = after[0] - off
     if len(t):
-        moved = np.flatnonzero(x > MOVED * travel)
-        if len(moved):
-            out["pull_in_current"] = float(i[moved[0]])
-        closed = np.flatnonzero(x >= (1.0 - MOVED) * travel)
-        if len(closed):
-            out["armature_arrival"] = float(t[closed[0]])
-        if off is not None and len(closed):
-            left = np.flatnonzero((t >= off) & (x < (1.0 - MOVED) * travel))
-            if len(left):
-                out["drop_out_current"] = float(i[left[0]])
+        lifted = stop_times(events, "rest", "end")
+        if lifted:
+            out["pull_in_current"] = float(np.interp(lifted[0], t, i))
+        arrived = stop_times(events, "pole", "start")
+        if arrived:
+            out["armature_arrival"] = arrived[0]
+        if off is not None:
+            left = [s for s in stop_times(events, "pole", "end") if s >= off]
+            if left:
+                out["drop_out_current"] = float(np.interp(left[0], t, i))
         into = trapezoid(t, v * i)
         copper = trapezoid(t, resistance * i * i)
         stored = float(magnet.energy(psi[-1], gap[-1]) - magnet.energy(psi[0], gap[0]))

@@ -203,8 +203,8 @@ class CoupledResult:
             spec = device(self.scene.raw)
             circ = self.scene.circuit.circuit
             drive = circ if isinstance(circ, CoilDrive) else getattr(circ, "coil", None)  # None: a netlist's
-            travel = spec.lever * self.scene.mech.armature.travel
-            self._cache["relay"] = relay_metrics(w, self.operations, drive, spec.magnet, travel, spec.resistance)
+            self._cache["relay"] = relay_metrics(w, self.operations, drive, spec.magnet, self.mechanics.events,
+                                                 spec.resistance)
         return self._cache["relay"]
 
     @property
@@ -242,6 +242,10 @@ class CoupledResult:
             out["stopped_at"] = self.stopped_at
         if self.mechanics is not None:
             out.update(self.mechanics.to_summary())
+            refined = self.stats.get("modes_refined")
+            if refined and "solver" in out:  # run again with the count its impacts asked for
+                out["solver"] = dict(out["solver"], modes_rule=refined["rule"] + " (refined after a first run: "
+                                     + refined["first"] + ")")
             flag = jacobi_step_flag(self)
             if flag:
                 out["flags"] = list(out.get("flags", [])) + [flag]

@@ -799,12 +799,14 @@ def load_scene(path) -> Scene:
     return scene_from_dict(read_toml(path), base_dir=path.parent, name=str(path))
 
 
-BUILTIN_SCENES = ("default", "relay_cycle", "free_drop")
+BUILTIN_SCENES = ("default", "relay_force", "relay_cycle", "free_drop")
 
 
 def builtin_scene_text(name: str = "default") -> str:
-    """A built-in scene as TOML text: "default" (a relay contact closing), "relay_cycle"
-    (closing, held, opening) or "free_drop" (the source paper's bar dropped on a block)."""
+    """A built-in scene as TOML text: "default" (a relay operated by its coil: make, bounce,
+    hold, break), "relay_force" (its contact closed by a given force), "relay_cycle"
+    (closed, held and opened by given forces) or "free_drop" (the source paper's bar
+    dropped on a block)."""
     if name not in BUILTIN_SCENES:
         raise ValueError(f"built-in scene {name!r}: allowed: {', '.join(BUILTIN_SCENES)}")
     return resources.files("coupling").joinpath(f"scenes/{name}.toml").read_text()
@@ -817,7 +819,7 @@ def builtin_scene(name: str = "default") -> Scene:
 
 
 def default_scene_text() -> str:
-    """The built-in default coupled scene (a relay contact closing), as TOML text."""
+    """The built-in default coupled scene (a relay operated by its coil), as TOML text."""
     return builtin_scene_text("default")
 
 

@@ -208,9 +208,9 @@ def test_rigid_bar_has_no_mode_refinement():
 
 def test_short_coupled_scene_check_and_cli(tmp_path, capsys):
     from coupling.app.cli import main
-    from coupling.core.scene import default_scene_text
+    from coupling.core.scene import builtin_scene_text
 
-    text = default_scene_text().replace("height = 0.001", "height = 0.00002").replace(
+    text = builtin_scene_text("relay_force").replace("height = 0.001", "height = 0.00002").replace(
         "t_end = 0.01", "t_end = 0.0006").replace("plots = true", "plots = false").replace(
         "parquet = true", "parquet = false")
     path = tmp_path / "short.toml"
@@ -241,9 +241,9 @@ def test_jacobi_with_a_step_longer_than_the_contacts_is_flagged():
     # Jacobi holds the conductance of the step start over the step: with a 200 us step on
     # the default scene (contacts of tens of us) the arc energy came out ~1e-9 J instead of
     # the 0.02 J of mechanics_first (docs/accuracy.md, part 5). Such a result must say so.
-    from coupling import default_scene
+    from coupling import builtin_scene
 
-    base = default_scene().update({"initial.height": 2e-5, "solver.t_end": 6e-4, "coupling.macro_step": 2e-4})
+    base = builtin_scene("relay_force").update({"initial.height": 2e-5, "solver.t_end": 6e-4, "coupling.macro_step": 2e-4})
     jac = run(base.set("coupling.scheme", "jacobi"))
     mf = run(base)
     shortest = float((jac.mechanics.contacts.t_end - jac.mechanics.contacts.t_start)[jac.mechanics.contacts.complete].min())
@@ -261,9 +261,9 @@ def test_relay_at_auto_is_within_its_sensitivity_and_a_coarse_count_is_not():
     # change of the gap or the restitution does, and nothing else moves. One bending mode too
     # few per the table (1 axial + 3 bending) gets the peak force wrong, which no
     # such change explains.
-    from coupling import default_scene
+    from coupling import builtin_scene
 
-    scene = default_scene().update({"solver.t_end": 3e-3, "output.plots": False})
+    scene = builtin_scene("relay_force").update({"solver.t_end": 3e-3, "output.plots": False})
     result = run(scene, check=True)
     acc, base = result.accuracy, metrics_of(result)
     entries = {e["name"]: e for e in acc["refinements"]}

@@ -11,7 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from coupling import builtin_scene, default_scene, run
+from coupling import builtin_scene, run
 from coupling.app.cli import main
 from coupling.core.scene import scene_from_dict
 
@@ -22,9 +22,9 @@ WAVE_COLUMNS = {"time", "contact_voltage", "contact_current", "contact_resistanc
 
 def test_default_scene_runs_end_to_end_through_the_command(tmp_path, capsys):
     scene = tmp_path / "short_default.toml"
-    from coupling.core.scene import default_scene_text
+    from coupling.core.scene import builtin_scene_text
 
-    scene.write_text(default_scene_text().replace("t_end = 0.005", "t_end = 0.003"))
+    scene.write_text(builtin_scene_text("relay_force").replace("t_end = 0.005", "t_end = 0.003"))
     assert main(["run", str(scene), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     out = tmp_path / "out"
     summary = json.loads((out / "summary.json").read_text())
@@ -120,10 +120,10 @@ def test_planar_scene_uses_the_planar_model_and_zero_modes_the_rigid_bar():
 
 
 def test_a_failed_run_writes_what_it_has_and_says_why(tmp_path, capsys):
-    from coupling.core.scene import default_scene_text
+    from coupling.core.scene import builtin_scene_text
 
     scene = tmp_path / "fails.toml"
-    scene.write_text(default_scene_text().replace("t_end = 0.005", "t_end = 0.003\nmax_steps = 300"))
+    scene.write_text(builtin_scene_text("relay_force").replace("t_end = 0.005", "t_end = 0.003\nmax_steps = 300"))
     rc = main(["run", str(scene), "--out", str(tmp_path / "out"), "--quiet"])
     assert rc == 1
     err = capsys.readouterr().err

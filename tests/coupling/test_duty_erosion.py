@@ -112,7 +112,7 @@ poisson_ratio = { value = 0.37, range = [0.3, 0.4], source = "s" }
     monkeypatch.setitem(MATERIALS, "X", load_materials(text)["X"])
 
 
-RELAY = "coupling/scenes/default.toml"
+RELAY = "coupling/scenes/relay_force.toml"
 
 
 @pytest.mark.parametrize("duty, match", [
@@ -134,18 +134,18 @@ RELAY = "coupling/scenes/default.toml"
 ])
 def test_bad_duty_keys_are_one_line_errors_naming_the_key(monkeypatch, duty, match):
     _bare(monkeypatch)
-    from coupling import default_scene
+    from coupling import builtin_scene
 
-    doc = dict(default_scene().raw, duty=dict({"materials": ["Ag", "Ag"]}, **duty))
+    doc = dict(builtin_scene("relay_force").raw, duty=dict({"materials": ["Ag", "Ag"]}, **duty))
     with pytest.raises(ValueError, match=match) as err:
         scene_from_dict(doc, name="relay")
     assert "\n" not in str(err.value) and str(err.value).startswith("relay: ")
 
 
 def test_duty_needs_materials_a_circuit_and_a_gap():
-    from coupling import default_scene
+    from coupling import builtin_scene
 
-    relay = default_scene()
+    relay = builtin_scene("relay_force")
     fitted = dict(relay.raw, tribology={"source": "illustrative"}, duty={})
     with pytest.raises(ValueError, match=r"duty\.materials: missing: give the contact materials"):
         scene_from_dict(fitted, name="fitted")

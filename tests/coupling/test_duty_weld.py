@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pytest
 
-from coupling import default_scene, run
+from coupling import builtin_scene, run
 from coupling.laws.duty import ContactPair, hot_contact_voltage, welding_current
 
 LAMP = {"circuit.template": "capacitive", "circuit.voltage": 48.0, "circuit.load_resistance": 0.05,
@@ -26,7 +26,7 @@ LAMP = {"circuit.template": "capacitive", "circuit.voltage": 48.0, "circuit.load
 
 @pytest.fixture(scope="module")
 def lamp():
-    return run(default_scene().update(LAMP))
+    return run(builtin_scene("relay_force").update(LAMP))
 
 
 def test_welding_appears_at_the_first_bounce_separation_not_in_the_held_contact(lamp):
@@ -71,7 +71,7 @@ def test_the_held_criteria_are_the_runs_own_numbers(lamp):
 def test_a_resistive_make_of_the_same_relay_welds_nowhere_near_as_likely(lamp):
     """The same relay closing 24 V onto 10 ohm: 2.4 A through the bounces, a first-bounce weld
     ratio an order of magnitude below the lamp's, no criterion reached."""
-    res = run(default_scene().set("duty.materials", ["Ag", "Ag"]))
+    res = run(builtin_scene("relay_force").set("duty.materials", ["Ag", "Ag"]))
     (op,) = res.summary["operations"]
     ratios = op["make"]["weld"]["ratios"]
     assert max(ratios.values()) < 1.0 and op["make"]["weld_risk"] != "likely"

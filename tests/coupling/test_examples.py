@@ -689,3 +689,96 @@ def test_debounce_chosen_rc_bridges_the_longest_bounce_opening(debounce):
     # h^2 / (8 tau) = 80 ns (0.7 %; measured 0.6 %)
     assert chosen["latency"] == pytest.approx(r_series * chosen["input_capacitance"] * math.log(vcc / c["logic_low"]),
                                               rel=0.02)
+
+
+# --- plunger_solenoid: the issue's solenoid pulled in by a 12 V step ------------------------
+
+@pytest.fixture(scope="module")
+def solenoid(tmp_path_factory):
+    return _run(tmp_path_factory, "plunger_solenoid")
+
+
+def test_solenoid_current_rises_with_the_open_magnets_l_over_r(solenoid):
+    numbers, out = solenoid
+    coil = _toml("plunger_solenoid")["coil"]
+    assert numbers["status"] == "ok"
+    early = numbers["early"]
+    # before the armature has moved (travel below 1e-4 of its 4.75 mm) the coil is an R-L
+    # with the open magnet's unsaturated inductance
+    assert early["travel"] < 1e-4 * numbers["travel"]
+    tau = numbers["tau_open"]
+    assert early["current"] == pytest.approx(coil["voltage"] / coil["resistance"] * (1 - math.exp(-early["time"] / tau)),
+                                             rel=2e-3)
+
+
+def test_solenoid_current_dips_while_the_armature_flies_and_then_rises_to_v_over_r(solenoid):
+    numbers, out = solenoid
+    coil = _toml("plunger_solenoid")["coil"]
+    w = pd.read_csv(out / "waveforms.csv")
+    # the back-EMF i dL/dt of the closing gap: the current falls towards the arrival
+    assert numbers["current_at_arrival"] < 0.6 * numbers["peak_current_before_arrival"]
+    # the arrival (the mechanics' located stop event) is where the travel first reaches the
+    # pole: short of it at every sample before, at it (within the stop's 1e11 N/m) just after
+    x, t = w.armature_position.to_numpy(), w.time.to_numpy()
+    travel, arrival = numbers["travel"], numbers["arrival"]
+    assert x[t < arrival].max() < travel
+    assert x[np.searchsorted(t, arrival)] == pytest.approx(travel, rel=1e-3)
+    # below V / R while the gap only closes (the back-EMF opposes the supply); the armature
+    # rebounds from the nearly elastic stop (e = 0.99 from its 1e11 N/m and 400 N s/m), and
+    # while the gap opens again the trapped flux drives the current above V / R
+    before = w.time <= numbers["arrival"]
+    assert w.coil_current[before].max() < coil["voltage"] / coil["resistance"]
+    assert numbers["final_current"] > 0.95 * numbers["steady_current"]
+    # the force F = psi^2 h(g) grows as the gap closes
+    assert numbers["force_at_pole"] > 3 * numbers["force_at_peak_current"]
+
+
+def test_solenoid_coil_energy_balance_closes(solenoid):
+    numbers, _ = solenoid
+    e = numbers["energy"]
+    assert e["copper"] > 0 and e["magnetic_change"] > 0 and e["armature_work"] > 0
+    assert e["into_coil"] == pytest.approx(e["copper"] + e["magnetic_change"] + e["armature_work"], rel=2e-3)
+
+
+# --- relay_suppression: the default relay released with each coil suppression ---------------
+
+@pytest.fixture(scope="module")
+def suppression(tmp_path_factory):
+    return _run(tmp_path_factory, "relay_suppression")
+
+
+def test_suppression_clamps_the_coil_voltage_where_its_parts_say(suppression):
+    numbers, _ = suppression
+    import dataclasses
+
+    from circuit.coil_drive import CoilDrive
+
+    parts = {f.name: f.default for f in dataclasses.fields(CoilDrive)}
+    rows = numbers["suppressions"]
+    assert all(r["status"] == "ok" and r["break_complete"] for r in rows.values()), rows
+    supply = 12.0
+    # none: the driver avalanches, the coil sees supply - breakdown; a diode: one forward drop;
+    # diode + zener: -(V_z + V_d)
+    assert rows["none"]["coil_voltage_min"] == pytest.approx(supply - parts["switch_breakdown"], abs=1.0)
+    assert -1.2 < rows["diode"]["coil_voltage_min"] < -0.3
+    assert rows["zener"]["coil_voltage_min"] == pytest.approx(-parts["zener_voltage"] - 0.8, abs=0.7)
+    # the RC: the current's first jump into R (I R) and then the capacitor's swing, bounded
+    # by the coil's stored energy: C V^2 / 2 <= L I^2 / 2 (L from the closed magnet)
+    assert rows["none"]["coil_voltage_min"] < rows["rc"]["coil_voltage_min"] < -numbers["rc"]["resistance"] * 0.01
+
+
+def test_a_diode_slows_the_release_and_lengthens_the_break_arc(suppression):
+    numbers, _ = suppression
+    rows = numbers["suppressions"]
+    release = {k: r["release_time"] for k, r in rows.items()}
+    arc = {k: r["arc_duration"] for k, r in rows.items()}
+    # the higher the coil's clamp, the faster its flux (and the armature's hold) collapses
+    assert release["none"] < release["zener"] < release["diode"]
+    assert release["none"] < release["rc"] < release["diode"]
+    # a slow opening keeps the gap short while the current is still large: a longer arc
+    assert arc["diode"] > max(arc["none"], arc["zener"], arc["rc"])
+    assert rows["diode"]["arc_energy"] > max(rows[k]["arc_energy"] for k in ("none", "zener", "rc"))
+    # the make is nearly the same in all four: while the coil is on the diodes are reverse
+    # biased and the RC only charges (measured 4.4517-4.4537 ms)
+    operate = [r["operate_time"] for r in rows.values()]
+    assert max(operate) - min(operate) < 1e-3 * min(operate)

@@ -35,7 +35,7 @@ AUDIT_SCENES = {
     # a mechanics run to 1e300 s (grew 25 MB/s to a 4.25 GiB allocation traceback)
     "long.toml": "[solver]\nt_end = 1e300\n",
     # the relay with a 5.4 MN armature force (12 GB before)
-    "crush.toml": builtin_scene_text("default").replace("value = [0.0, 5.4]", "value = [0.0, 5.4e6]"),
+    "crush.toml": builtin_scene_text("relay_force").replace("value = [0.0, 5.4]", "value = [0.0, 5.4e6]"),
 }
 
 
@@ -110,7 +110,7 @@ def test_out_of_memory_in_the_api_and_a_coupled_run_raise_with_the_partial_resul
     assert "out of memory" in str(info.value) and info.value.partial.mechanics.t[-1] > 0.0
     # the coupled relay: its mechanics' history cannot grow past 2048 rows (it takes ~4 900)
     with OutOfMemory(2048), pytest.raises(CoupledRunError) as info:
-        run(coupling.builtin_scene("default"))
+        run(coupling.builtin_scene("relay_force"))
     partial = info.value.partial
     assert "MemoryError" in str(info.value) and "\n" not in str(info.value)
     assert partial is not None and partial.status == "failed" and partial.stopped_at is not None
@@ -131,13 +131,13 @@ def test_out_of_memory_in_a_sweep_is_a_failed_row_with_the_partial_summary():
 
 def test_a_macro_step_that_would_take_millions_of_steps_is_refused_before_it_runs():
     """The audit's case: a 1e-9 s macro step over 5 ms (5e6 steps) started without an estimate."""
-    text = builtin_scene_text("default").replace("macro_step = 5e-6", "macro_step = 1e-9")
+    text = builtin_scene_text("relay_force").replace("macro_step = 5e-6", "macro_step = 1e-9")
     with pytest.raises(ValueError) as info:
         scene_from_dict(tomllib.loads(text))
     message = str(info.value)
     assert "coupling.macro_step = 1e-09" in message and "5e+06 macro steps" in message and "\n" not in message
     # at the bound it is allowed
-    ok = builtin_scene_text("default").replace("macro_step = 5e-6", f"macro_step = {0.005 / MACRO_STEPS_MAX!r}")
+    ok = builtin_scene_text("relay_force").replace("macro_step = 5e-6", f"macro_step = {0.005 / MACRO_STEPS_MAX!r}")
     scene_from_dict(tomllib.loads(ok))
 
 
@@ -167,11 +167,11 @@ def test_the_memory_estimate_is_the_history_and_the_waveforms_and_refuses_above_
         scene_from_dict({"solver": {"history_rows": 10_000_000}})
     assert "solver.history_rows = 10000000" in str(info.value) and "GiB" in str(info.value)
     # an ngspice step of 1e-12 s over 5 ms: 5e9 points, refused naming the key
-    coupled = builtin_scene_text("default").replace("[circuit]\n", "[circuit]\nmax_step = 1e-12\n")
+    coupled = builtin_scene_text("relay_force").replace("[circuit]\n", "[circuit]\nmax_step = 1e-12\n")
     with pytest.raises(ValueError) as info:
         scene_from_dict(tomllib.loads(coupled))
     assert "circuit.max_step = 1e-12" in str(info.value)
-    assert memory_estimate(coupling.builtin_scene("default"))["total"] < MEMORY_LIMIT  # (auto modes at their cap)
+    assert memory_estimate(coupling.builtin_scene("relay_force"))["total"] < MEMORY_LIMIT  # (auto modes at their cap)
 
 
 def test_the_coupled_run_samples_its_contact_in_batches_and_releases_the_dense_output(monkeypatch):
@@ -182,7 +182,7 @@ def test_the_coupled_run_samples_its_contact_in_batches_and_releases_the_dense_o
 
     def relay(flush_rows):
         monkeypatch.setattr(master, "DENSE_FLUSH_ROWS", flush_rows)
-        sim = master.CoSimulation(coupling.builtin_scene("default"))
+        sim = master.CoSimulation(coupling.builtin_scene("relay_force"))
         return sim.run(), sim.mech
 
     batched, mech_batched = relay(256)

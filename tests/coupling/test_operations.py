@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from coupling import builtin_scene, default_scene, run
+from coupling import builtin_scene, run
 from coupling.core.metrics import MetricSettings, bounce_metrics, operations
 
 W = 1e-3  # s, the settle window
@@ -75,11 +75,11 @@ def test_episodes_split_where_the_contact_stays_open_a_settle_window():
     assert b["bounces"] == 0 and b["first_make"] == 1e-3 and b["settled"] and b["settle_time"] == 0.0
 
 
-def test_the_relay_cycle_makes_as_the_default_relay_does():
-    """relay_cycle is the default relay closed, held and opened: its make operation and its
-    top-level bounce keys equal the make-only default's (they were mixed with the break:
+def test_the_relay_cycle_makes_as_the_force_driven_relay_does():
+    """relay_cycle is relay_force closed, held and opened: its make operation and its
+    top-level bounce keys equal the make-only relay_force's (they were mixed with the break:
     7 bounces, 5.6 ms of 'bounce time')."""
-    make_only = run(default_scene())
+    make_only = run(builtin_scene("relay_force"))
     cycle = run(builtin_scene("relay_cycle"))
     (op,) = cycle.operations
     # the two force tables are the same up to the opening but written with other points,

@@ -142,15 +142,15 @@ def test_the_api_and_the_command_line_write_the_same_folder(tmp_path):
     files as the command line does."""
     import pytest
 
-    from coupling import default_scene, run
+    from coupling import builtin_scene, run
     from coupling.app.cli import main
     from coupling.app.output import DestinationError
 
-    from coupling.core.scene import default_scene_text
+    from coupling.core.scene import builtin_scene_text
 
-    scene = default_scene().set("solver.t_end", 1e-3)
+    scene = builtin_scene("relay_force").set("solver.t_end", 1e-3)
     path = tmp_path / "s.toml"
-    path.write_text(default_scene_text().replace("t_end = 0.005", "t_end = 0.001"))
+    path.write_text(builtin_scene_text("relay_force").replace("t_end = 0.005", "t_end = 0.001"))
     assert main(["run", str(path), "--out", str(tmp_path / "cli"), "--quiet"]) == 0
     run(scene).save(tmp_path / "api")
     names = sorted(p.name for p in (tmp_path / "cli").iterdir())

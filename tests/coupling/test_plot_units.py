@@ -69,10 +69,10 @@ def test_bounce_units_are_those_of_docs_coupling():
 def _summaries():
     """Summaries of a run of each kind: coupled with material laws (the default relay),
     coupled with fitted laws (their parameters), mechanics only, a prescribed schedule."""
-    from coupling import default_scene, load_scene, run
+    from coupling import builtin_scene, load_scene, run
     from coupling.core.scene import scene_from_dict
 
-    relay = default_scene().set("solver.t_end", 1e-3)
+    relay = builtin_scene("relay_force").set("solver.t_end", 1e-3)
     schedule = scene_from_dict({"solver": {"t_end": 2e-3}, "circuit": {
         "template": "resistive", "voltage": 24.0, "load_resistance": 12.0,
         "schedule": {"make": [2e-4], "break": [1e-3], "closed_resistance": 0.01}}}, name="schedule")
@@ -133,9 +133,9 @@ def test_sweep_plots_say_quantity_and_unit_on_every_axis(tmp_path):
     fig = plot_metric(df, "bounce_ms", "circuit.snubber.capacitance", labels={"bounce_ms": "bounce time (ms)"})
     assert fig.axes[0].get_ylabel() == "bounce time (ms)"
     # the overlay of kept waveforms: scaled and labelled as the run's own panel
-    from coupling import default_scene, run
+    from coupling import builtin_scene, run
 
-    res = run(default_scene().set("solver.t_end", 2e-3))
+    res = run(builtin_scene("relay_force").set("solver.t_end", 2e-3))
     (tmp_path / "waveforms").mkdir()
     res.waveforms.to_parquet(tmp_path / "waveforms" / "run0000.parquet")
     fig = plot_overlay(tmp_path, ["run0000"], "contact_resistance", label=["circuit.snubber.resistance"],

@@ -77,9 +77,9 @@ _RUN = {}
 def _relay():
     """The default scene to 2 ms: 6 bounces and the start of the closure (run once per module)."""
     if "res" not in _RUN:
-        from coupling import default_scene, run
+        from coupling import builtin_scene, run
 
-        _RUN["res"] = run(default_scene().set("solver.t_end", 2e-3))
+        _RUN["res"] = run(builtin_scene("relay_force").set("solver.t_end", 2e-3))
     return _RUN["res"]
 
 

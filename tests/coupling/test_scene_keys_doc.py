@@ -12,6 +12,7 @@ import pytest
 
 import circuit as ck
 from coupling.core import scene as cs
+from coupling.core.device import COIL_KEYS, FLUX_TUBE_KEYS, PLACEMENT_KEYS, TABLE_KEYS
 from coupling.core.duty import DUTY_KEYS, LIFE_KEYS
 from coupling.core.metrics import MetricSettings
 from mech.scene import ENVIRONMENT_KEYS, LIST_SECTIONS, SECTIONS, entry_keys
@@ -63,6 +64,8 @@ def test_every_accepted_key_is_documented_and_nothing_else():
     expected["metrics"] = _fields(MetricSettings)
     expected["duty"] = set(DUTY_KEYS)
     expected["duty.life"] = set(LIFE_KEYS)
+    expected["coil"] = set(COIL_KEYS)
+    expected["magnet"] = set(PLACEMENT_KEYS + FLUX_TUBE_KEYS + TABLE_KEYS)
     assert set(doc) == set(expected), "sections of docs/scene_keys.md differ from the scene's"
     for section, keys in expected.items():
         assert doc[section] == keys, f"[{section}]: missing {keys - doc[section]}, extra {doc[section] - keys}"
@@ -99,7 +102,14 @@ NO_FIELD = {("tribology", k) for k in ("source", "fit", "data", "mu", "resistanc
 # documented in words and checked where they are made (tests/coupling/test_duty_erosion.py,
 # test_duty_needs_materials_a_circuit_and_a_gap; tests/coupling/test_life.py, the limits)
 DERIVED = {("duty", k) for k in ("materials", "conductor_radius", "cap_height")} | {
-    ("duty.life", k) for k in ("gap_range", "min_force", "max_resistance")}
+    ("duty.life", k) for k in ("gap_range", "min_force", "max_resistance")} | {
+    # the winding and the magnet's model keys: needed or not by the model chosen (documented
+    # in words, checked in tests/coupling/test_relay.py, bad input)
+    ("coil", "resistance"), ("coil", "turns"), ("magnet", "model"), ("magnet", "rest_gap"),
+    ("magnet", "force_tolerance")} | {("magnet", k) for k in FLUX_TUBE_KEYS + TABLE_KEYS}
+# an actuator alone: the built-in solenoid's magnet, its armature, the coil's drive as the circuit
+ACTUATOR = {"armature": {"kind": "plunger", "mass": 0.026, "travel": 4.75e-3, "stop_stiffness": 1e11},
+            "magnet": {"model": "plunger_solenoid"}, "coil": {}}
 DUTY = {"tribology": {"resistance": {"law": "holm", "materials": ["Ag", "Ag"]}, "mu": 0.3}, "circuit": {}}
 OPTION_KEYS = {f.name for f in dataclasses.fields(ck.SimulationOptions)}
 CONTEXTS = {"initial": {"held bar": {"mount": {"kind": "clamp", "position": 0.3}}}}
@@ -172,6 +182,12 @@ def _field_without(section: str, key: str, patch: dict, folder: Path):
         return getattr(cs.scene_from_dict({**DUTY, "duty": {}}).duty, key)
     if section == "duty.life":
         return getattr(cs.scene_from_dict({**DUTY, "duty": {"life": {}}}).duty.life, key)
+    if section == "coil":
+        return getattr(cs.scene_from_dict(ACTUATOR).circuit.circuit, key)
+    if section == "magnet":
+        from coupling.core.device import device
+
+        return getattr(device(ACTUATOR), key)
     table = {"schedule": {"make": [1e-4], "break": []}, **patch}
     if table.get("template") == "netlist":
         (folder / "net.cir").write_text(NETLIST)

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from coupling.core.scene import builtin_scene
 from coupling.app.sweep import Sweep
 
-BASE = builtin_scene("default")  # a relay: clamped blade, rivets, force, materials' laws, circuit, arc
+BASE = builtin_scene("relay_force")  # a relay: clamped blade, rivets, force, materials' laws, circuit, arc
 
 # the dataclasses behind the scene, whose names an error must not show
 INTERNAL = re.compile(r"\b(DCSource|CurrentSource|Wiring|ResistiveLoad|InductiveLoad|CapacitiveLoad|Snubber|"
@@ -23,7 +23,7 @@ INTERNAL = re.compile(r"\b(DCSource|CurrentSource|Wiring|ResistiveLoad|Inductive
                       r"SolverOptions|Mount|PointForce|Spring|Rivet|HolmResistance|ConstantResistance)\b")
 SCENE_KEY = re.compile(r"\b[a-z_]+(\[\d+\])?\.[a-z_]+|\[[a-z_.]+\]")
 
-# values outside each key's allowed range (SI), on the default scene
+# values outside each key's allowed range (SI), on the relay_force scene
 OUT_OF_RANGE = {
     "bar.length": [0.0, -0.015], "bar.youngs_modulus": [0.0, -1e9], "bar.poisson_ratio": [0.5, -1.0],
     "bar.density": [0.0], "bar.modal_damping": [1.0, -0.1], "bar.modes": [-1, 41, 2.5, "some"],
@@ -72,7 +72,7 @@ def test_any_variation_is_a_scene_or_one_named_line(changes):
     try:
         BASE.update(changes)
     except ValueError as err:
-        assert check_message(err, changes.values()).startswith("default scene: ")
+        assert check_message(err, changes.values()).startswith("relay_force scene: ")
 
 
 @settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
@@ -87,7 +87,7 @@ def test_a_value_out_of_range_names_its_key_in_set_and_in_a_sweep(data):
         text = check_message(err)
     else:
         raise AssertionError(f"{key} = {value!r} was accepted")
-    assert text.startswith("default scene: ") and f"{key} = " in text, text
+    assert text.startswith("relay_force scene: ") and f"{key} = " in text, text
     values = [value] if good is None else [good, value]
     try:
         Sweep.grid(BASE, {key: values}).check()
@@ -99,7 +99,7 @@ def test_a_value_out_of_range_names_its_key_in_set_and_in_a_sweep(data):
 
 
 def _valid(key: str) -> list:
-    """A value of the key the default scene accepts (its own), to mix into a sweep."""
+    """A value of the key the relay_force scene accepts (its own), to mix into a sweep."""
     node = BASE.raw
     for part in key.split(".")[:-1]:
         node = node.get(part, {}) if isinstance(node, dict) else {}

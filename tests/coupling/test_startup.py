@@ -107,7 +107,7 @@ def test_coupled_scene_imports_pyspice_and_pyarrow_only(tmp_path):
 
 
 def test_default_scene_imports_pyspice_and_pyarrow_only_and_writes_its_documented_outputs(tmp_path):
-    """The built-in default scene (a held blade, inline laws) with its default outputs; the
+    """The built-in default scene (the coil-driven relay, inline laws) with its default outputs; the
     files are the ones README.md lists for it."""
     _requires_aot()
     assert _loaded(tmp_path, None) == {"PySpice", "pyarrow"}

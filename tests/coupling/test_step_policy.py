@@ -205,7 +205,7 @@ def test_growing_steps_in_a_closed_contact_change_no_checked_metric():
     from coupling import CoSimulation, builtin_scene
     from coupling.app.accuracy import compare, metrics_of, tip_intervals
 
-    scene = builtin_scene("default").update({"solver.t_end": 0.003})
+    scene = builtin_scene("relay_force").update({"solver.t_end": 0.003})
     runs = {}
     for cap in (1.0, 4.0):
         sim = CoSimulation(scene)

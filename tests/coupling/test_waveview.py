@@ -73,10 +73,10 @@ def _relay_page():
         import tempfile
         from pathlib import Path
 
-        from coupling import default_scene, run
+        from coupling import builtin_scene, run
         from coupling.app.waveview import write_waveform_html
 
-        res = run(default_scene().set("solver.t_end", 2e-3))
+        res = run(builtin_scene("relay_force").set("solver.t_end", 2e-3))
         with tempfile.TemporaryDirectory() as tmp:
             path = Path(tmp) / "waveforms.html"
             assert write_waveform_html(res, path) == "written"

@@ -333,7 +333,7 @@ def test_the_compiled_cache_folder_follows_the_mechanics_sources(tmp_path):
     assert changed != before and source_key(tmp_path) == before
 
 
-@pytest.mark.parametrize("name", ["free_drop", "default", "pushbutton"])
+@pytest.mark.parametrize("name", ["free_drop", "relay_force", "pushbutton"])
 def test_normal_forces_from_the_kinematics_equal_the_right_hand_sides(name):
     """The peak-force samples inside a step and the circuit's force callback evaluate only
     the contact kinematics (integrator.tip_forces); at every recorded state of a run (a free

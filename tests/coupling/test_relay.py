@@ -1,0 +1,144 @@
+"""The relay as a whole (the default scene): its coil, magnet and armature drive the contact.
+
+Physics checked against routes independent of the co-simulation: the static pull-in voltage
+from the magnet's force at the rest gap and the return spring's preload; operate time
+against coil voltage; the ordering every relay designer
+knows (a freewheeling diode slows the release and lengthens the break arc: checked on
+examples/relay_suppression.py's runs in test_examples.py); the coil's energy audit closing
+at the step rules' second order.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from coupling import default_scene, run, scene_from_dict
+from coupling.core.device import device
+
+CONTACT_SECTIONS = ("bar", "mount", "rivet", "block", "initial", "contact", "tribology", "circuit", "coupling")
+
+
+def armature_alone(voltage: float, t_end: float = 0.012):
+    """The default relay's coil, magnet and armature without the contact spring: an actuator
+    (the card's keys go with the blade it pushes)."""
+    doc = copy.deepcopy(default_scene().raw)
+    for key in CONTACT_SECTIONS:
+        doc.pop(key, None)
+    doc["armature"] = {k: v for k, v in doc["armature"].items() if not k.startswith("card_")}
+    doc["coil"].update(voltage=voltage, off_time=t_end)
+    doc["solver"] = {"t_end": t_end}
+    return scene_from_dict(doc, name="armature alone")
+
+
+def drive_defaults() -> dict:
+    """The coil drive's default parts (circuit.CoilDrive's fields), which the scene keeps."""
+    from circuit.coil_drive import CoilDrive
+
+    return {f.name: f.default for f in dataclasses.fields(CoilDrive)}
+
+
+def loop_resistance() -> float:
+    """ohm: the coil's winding and its driver switch (on) in series, the steady current's."""
+    return device(default_scene().raw).resistance + drive_defaults()["switch_resistance"]
+
+
+def static_pull_in_voltage() -> float:
+    """V at which the magnet's steady force at the rest gap (coil current V / R) holds the
+    return spring's preload: lever F(V / R, g_rest) = preload torque."""
+    raw = default_scene().raw
+    spec = device(raw)
+    arm, mag = raw["armature"], raw["magnet"]
+
+    def excess(v):
+        return mag["lever"] * float(spec.magnet.force_at_current(v / loop_resistance(), mag["rest_gap"])) \
+            - arm["spring_preload"]
+
+    return brentq(excess, 0.1, raw["coil"]["voltage"], xtol=1e-9)
+
+
+def test_below_the_static_pull_in_voltage_the_armature_stays_on_its_rest_stop():
+    v_pull = static_pull_in_voltage()
+    assert 0.5 < v_pull < 12.0  # the default coil (12 V) pulls in with margin
+    # 30 ms: ten of the open magnet's L / R (about 3 ms), the current steady at the end
+    below, above = run(armature_alone(0.97 * v_pull, 0.03)), run(armature_alone(1.03 * v_pull, 0.03))
+    for res in (below, above):
+        assert res.status.value == "ok", res.message
+    # 3 % under: the force never reaches the preload, nothing moves though the current
+    # reached its steady value (exp(-10) short of it)
+    assert below.relay["pull_in_current"] is None
+    assert float(np.max(below.waveforms.armature_position)) == 0.0
+    assert below.waveforms.coil_current.iloc[-1] == pytest.approx(0.97 * v_pull / loop_resistance(), rel=2e-4)
+    # 3 % over: it leaves the stop where the static balance says, and arrives at the pole
+    assert above.relay["armature_arrival"] is not None
+    assert above.mechanics.armature["first_arrival"] == above.relay["armature_arrival"]
+    # it lifts off (the mechanics' located event) at the static pull-in current: the force
+    # there is psi^2 extrapolated over a macro step and the current is interpolated between
+    # the circuit's points (measured 1.2e-5 apart)
+    assert above.relay["pull_in_current"] == pytest.approx(v_pull / loop_resistance(), rel=1e-4)
+
+
+def test_operate_time_falls_as_the_coil_voltage_rises():
+    times = []
+    for volts in (10.0, 12.0, 24.0):
+        res = run(default_scene().update({"coil.voltage": volts, "solver.t_end": 0.008}))
+        assert res.status.value == "ok", res.message
+        times.append(res.relay["operate_time"])
+    assert all(t is not None for t in times)
+    assert times[0] > times[1] > times[2] > 0.0
+
+
+def test_the_coil_energy_balance_closes_at_second_order_in_the_macro_step():
+    """into_coil = copper + magnetic_change + armature_work + residual; the residual is the
+    circuit's integration error on its points, second order in their spacing."""
+    residuals = []
+    steps = (1e-4, 3e-5, 1e-5)
+    for h in steps:
+        res = run(armature_alone(12.0).update({"coupling.macro_step": h, "coupling.max_macro_step": h}))
+        e = res.relay["energy"]
+        assert e["into_coil"] > 0 and e["copper"] > 0 and e["armature_work"] > 0
+        residuals.append(abs(e["residual"]) / e["into_coil"])
+    orders = np.log(np.array(residuals[:-1]) / residuals[1:]) / np.log(np.array(steps[:-1]) / steps[1:])
+    assert np.all(orders > 1.7), (residuals, orders)
+    assert residuals[-1] < 1e-4
+
+
+def _without(doc: dict, section: str, key: str) -> dict:
+    doc = copy.deepcopy(doc)
+    doc[section].pop(key)
+    return doc
+
+
+def _with(doc: dict, section: str, key: str, value) -> dict:
+    doc = copy.deepcopy(doc)
+    doc[section][key] = value
+    return doc
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda d: _without(d, "coil", "resistance"), "[coil] needs resistance (ohm, the winding) with magnet.model = "
+                                                  "'flux_tubes'"),
+    (lambda d: _without(d, "coil", "turns"), "[coil] needs turns"),
+    (lambda d: _without(d, "magnet", "rest_gap"), "[magnet] needs rest_gap (m)"),
+    (lambda d: _with(d, "coil", "turns", -4500), "coil.turns = -4500"),
+    (lambda d: _with(d, "coil", "suppression", "varistor"), "coil.suppression = 'varistor': allowed values are"),
+    (lambda d: _with(d, "coil", "off_time", 5e-4), "coil.off_time = 0.0005 s: must come after on_time"),
+    (lambda d: _with(d, "coil", "voltage", 200.0), "coil.switch_breakdown = 100 V: must exceed the supply"),
+    (lambda d: _with(d, "magnet", "model", "horseshoe"), "magnet.model"),
+    (lambda d: {k: v for k, v in d.items() if k != "magnet"}, "[coil] needs [magnet]"),
+])
+def test_bad_coil_and_magnet_keys_are_one_line_naming_the_key(change, message):
+    doc = change(default_scene().raw)
+    with pytest.raises(ValueError) as err:
+        scene_from_dict(doc, name="relay.toml")
+    text = str(err.value)
+    assert message in text and "\n" not in text, text
+
+
+def test_the_suppression_is_a_scene_key():
+    scene = default_scene().set("coil.suppression", "diode")
+    assert scene.circuit.circuit.coil.suppression == "diode"
