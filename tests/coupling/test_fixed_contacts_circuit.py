@@ -19,26 +19,26 @@ from coupling import builtin_scene, run
 from coupling.core.diagnostics import pairs_warning
 from coupling.core.scene import scene_from_dict
 
-T_END = 1.5e-3  # s: the default relay's first make (0.8 ms) and bounces
+T_END = 1.5e-3  # s: the force-driven relay's first make (0.8 ms) and bounces
 
 
-def default_doc() -> dict:
-    doc = copy.deepcopy(builtin_scene("default").raw)
+def relay_doc() -> dict:
+    doc = copy.deepcopy(builtin_scene("relay_force").raw)
     doc["solver"]["t_end"] = T_END
     return doc
 
 
 def as_fixed(doc: dict) -> dict:
-    """The default scene's [block] (a silver rivet head, its top at z = 0) as one [[fixed]] entry."""
+    """The force-driven relay's [block] (a silver rivet head, its top at z = 0) as one [[fixed]] entry."""
     doc = copy.deepcopy(doc)
     doc["fixed"] = [dict(point="rivet0", name="NO", height=0.0, **doc.pop("block"))]
     return doc
 
 
 def changeover(nc: dict | None = None) -> dict:
-    """The default relay with a second rivet on the blade's top and an NC contact above it,
+    """The force-driven relay with a second rivet on the blade's top and an NC contact above it,
     0.1 mm away (``nc`` patches the NC entry)."""
-    doc = as_fixed(default_doc())
+    doc = as_fixed(relay_doc())
     rivet = doc["rivet"][0]
     doc["rivet"].append(dict(rivet, offset=-rivet["offset"], mass=0.0, name="top"))
     doc["fixed"].append(dict(doc["fixed"][0], point="top", name="NC", facing="down", gap=1e-4, **(nc or {})))
@@ -48,14 +48,14 @@ def changeover(nc: dict | None = None) -> dict:
 
 @pytest.fixture(scope="module")
 def block_run():
-    return run(scene_from_dict(default_doc()))
+    return run(scene_from_dict(relay_doc()))
 
 
 def test_one_fixed_contact_runs_the_block_scene_in_the_circuit_too(block_run):
     """The same mechanics to the last bit gives ngspice the same inputs at the same times:
     every waveform column equal, bit for bit, the same bounce metrics, and no line about
     the contacts (one electrical fixed contact is what the circuit's contact stands for)."""
-    res = run(scene_from_dict(as_fixed(default_doc())))
+    res = run(scene_from_dict(as_fixed(relay_doc())))
     a, b = block_run.waveform_columns, res.waveform_columns
     assert block_run.summary["bounce"]["bounces"] > 0  # (a make with bounces, not an idle run)
     assert set(a) == set(b)
@@ -100,8 +100,8 @@ def test_an_electrical_contact_beyond_the_first_two_pairs_is_named():
 
 
 def test_one_electrical_contact_and_a_mechanics_alone_have_no_line():
-    assert pairs_warning(scene_from_dict(as_fixed(default_doc()))) is None
-    assert pairs_warning(scene_from_dict(default_doc())) is None  # ([block]: one fixed contact)
+    assert pairs_warning(scene_from_dict(as_fixed(relay_doc()))) is None
+    assert pairs_warning(scene_from_dict(relay_doc())) is None  # ([block]: one fixed contact)
     doc = changeover()
     del doc["tribology"]
     doc.pop("circuit", None)
