@@ -39,6 +39,7 @@ _geff), arc_*, xcoil_*.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -49,7 +50,7 @@ from .arc import ArcModel
 from .blocks import CoilBlock, ContactBlock
 from .contact import DEFAULT_LEAKAGE, check_current_factor
 from .errors import NetlistInputError
-from .netlist_check import DECK_TITLE, NetlistLine, check_lines, logical_lines, read_netlist
+from .netlist_check import DECK_TITLE, NetlistLine, check_lines, logical_lines, param_spans, read_netlist
 from .probes import Probes
 from .validation import check_range
 
@@ -70,6 +71,12 @@ class NetlistCircuit:
     leakage_conductance: open-contact conductance, S.
     contact_current_factor: optional ngspice expression g(I) of the contact current I (A);
         the contact conductance is then G(t)/g(I) (see contact.py).
+    params: new values of the netlist's own top-level ``.param`` definitions, {name: number}
+        or (name, number) pairs (None: the netlist's own values)
+        (names as SPICE reads them, case-insensitive; units as the netlist uses them, SI):
+        each definition's value is replaced by the number before the netlist is checked, so
+        the checks see the netlist as ngspice will. A name the netlist does not define at
+        its top level (outside ``.subckt``) is refused.
     coil_resistance, coil_current: the relay coil's copper resistance (ohm) and current law
         (an ngspice expression of PSI, Wb, and GAP, m: circuit.blocks.CoilBlock) for an
         ``XCOIL p n`` line; both or neither.
@@ -85,8 +92,10 @@ class NetlistCircuit:
     origins: tuple[tuple[str, int], ...] | None = field(default=None, compare=False, repr=False)
     coil_resistance: float | None = None
     coil_current: str | None = None
+    params: tuple[tuple[str, float], ...] | None = None
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "params", _param_values(self.params) if self.params else None)
         if not isinstance(self.text, str) or not self.text.strip():
             raise ValueError("NetlistCircuit.text: must be a non-empty netlist string")
         if self.arc is not None and not isinstance(self.arc, ArcModel):
@@ -111,13 +120,14 @@ class NetlistCircuit:
     def _lines(self) -> list[NetlistLine]:
         if self.origins is None:
             lines = logical_lines(self.text, "<text>")
-            check_lines(lines)
-            return lines
-        texts = self.text.split("\n")
-        if len(texts) != len(self.origins):
-            raise ValueError("NetlistCircuit.origins: one (file, line) per line of text")
-        lines = [NetlistLine(t, f, n) for t, (f, n) in zip(texts, self.origins)]
+        else:
+            texts = self.text.split("\n")
+            if len(texts) != len(self.origins):
+                raise ValueError("NetlistCircuit.origins: one (file, line) per line of text")
+            lines = [NetlistLine(t, f, n) for t, (f, n) in zip(texts, self.origins)]
+        lines = _with_params(lines, self.params)
         # the text was checked when read; checked again since the object may be built by hand
+        # and the parameters' values are new text
         check_lines(lines)
         return lines
 
@@ -208,3 +218,68 @@ class NetlistCircuit:
             texts[row] = "\n".join(line for line in str(scratch).splitlines()[1:] if line.strip())
         expanded = [DECK_TITLE] + texts[1:]
         return "\n".join(part for text in expanded for part in text.split("\n") if part.strip().lower() != ".end")
+
+
+def _param_values(params) -> tuple[tuple[str, float], ...]:
+    """``params`` ({name: number} or (name, number) pairs) as checked pairs."""
+    if isinstance(params, dict):
+        params = tuple(params.items())
+    if not isinstance(params, (tuple, list)) or not all(isinstance(p, (tuple, list)) and len(p) == 2 for p in params):
+        raise ValueError(f"NetlistCircuit.params = {params!r:.200}: expected a table of name = number")
+    out = []
+    for name, value in params:
+        if not (isinstance(name, str) and re.fullmatch(r"[A-Za-z_]\w*", name)):
+            raise ValueError(f"NetlistCircuit.params: {name!r:.60} is not a parameter name (a letter or _, then "
+                             "letters, digits, _)")
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+                or abs(value) > PARAM_MAX:
+            raise ValueError(f"NetlistCircuit.params.{name} = {value!r:.60}: expected a finite number, "
+                             f"|value| <= {PARAM_MAX:g}")
+        out.append((name, float(value)))
+    lowered = [name.lower() for name, _ in out]
+    for name in out:
+        if lowered.count(name[0].lower()) > 1:
+            raise ValueError(f"NetlistCircuit.params.{name[0]}: given twice (SPICE names ignore case)")
+    return tuple(out)
+
+
+#: Largest magnitude of a parameter value set from the scene (ngspice reads doubles; this
+#: keeps products of parameters finite).
+PARAM_MAX = 1e30
+
+
+def _with_params(lines: list[NetlistLine], params: tuple[tuple[str, float], ...] | None) -> list[NetlistLine]:
+    """The lines with each top-level ``.param`` definition of a name in ``params`` given the
+    new value (every definition of it: ngspice would take the last); a name the netlist does
+    not define at its top level is refused, naming it and the ones it defines."""
+    if not params:
+        return lines
+    wanted = {name.lower(): (name, value) for name, value in params}
+    seen: set[str] = set()
+    defined: list[str] = []
+    out = []
+    depth = 0
+    for k, line in enumerate(lines):
+        head = line.text.split(None, 1)[0].lower() if k and line.text.strip() else ""
+        depth += head == ".subckt"
+        depth -= head == ".ends" and depth > 0
+        spans = param_spans(line.text) if k and depth == 0 else []
+        text = line.text
+        for name, start, end in reversed(spans):
+            defined.append(name)
+            hit = wanted.get(name.lower())
+            if hit is not None:
+                seen.add(name.lower())
+                text = f"{text[:start]} {hit[1]!r} {text[end:].lstrip()}".rstrip()
+        out.append(line if text == line.text else NetlistLine(text, line.file, line.line))
+    for key, (name, value) in wanted.items():
+        if key not in seen:
+            from difflib import get_close_matches
+
+            names = sorted(dict.fromkeys(defined[::-1]), key=str.lower)
+            lowered = {n.lower(): n for n in names}
+            close = get_close_matches(key, list(lowered), n=1, cutoff=0.5)
+            hint = f"; did you mean {lowered[close[0]]!r}?" if close else ""
+            raise ValueError(f"NetlistCircuit.params.{name} = {value!r}: the netlist has no '.param {name}' at its "
+                             f"top level{hint} (its parameters: {', '.join(names) or 'none'})")
+    return out

@@ -387,6 +387,19 @@ def _assignments(text: str) -> list[tuple[str, str]]:
             for k, m in enumerate(found)]
 
 
+def param_spans(text: str) -> list[tuple[str, int, int]]:
+    """(name, start, end) of each ``name = value`` of a ``.param`` line: the value is
+    text[start:end] (braces and quotes masked, as in ``_assignments``); [] for any other line."""
+    head = text.split(None, 1)[0].lower() if text.strip() else ""
+    if head != ".param":
+        return []
+    masked = _MASKED.sub(lambda m: " " * len(m.group(0)), text)
+    offset = text.lower().index(".param") + len(".param")
+    found = [m for m in _ASSIGNED.finditer(masked, offset)]
+    return [(m.group(1), m.end(), found[k + 1].start() if k + 1 < len(found) else len(text))
+            for k, m in enumerate(found)]
+
+
 def _check_definitions(lines: list[NetlistLine]) -> None:
     """No '.func' or '.param' may depend on itself, directly or through others: ngspice
     expands a recursive function until its stack overflows (a segmentation fault that ends

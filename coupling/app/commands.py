@@ -149,7 +149,19 @@ def _result_lines(summary: dict) -> None:
         print(f"switchsim: first make {_ms(b.get('first_make'))}, last make {_ms(b.get('last_make'))}, "
               f"{b.get('bounces')} bounce(s), {settle}, "
               f"peak contact voltage {peak or 0:.3g} V, arc energy {b.get('arc_energy') or 0:.3g} J")
-    if "contacts" in summary:
+    relay = summary.get("relay")
+    if relay:
+        parts = [f"operate time {_ms(relay['operate_time'])}" if relay.get("operate_time") is not None else None,
+                 f"release time {_ms(relay['release_time'])}" if relay.get("release_time") is not None else None,
+                 f"armature at the pole {_ms(relay['armature_arrival'])}" if relay.get("armature_arrival") is not None
+                 else "armature never at the pole",
+                 f"pull-in at {relay['pull_in_current'] * 1e3:.4g} mA" if relay.get("pull_in_current") is not None
+                 else None]
+        energy = relay.get("energy") or {}
+        if energy.get("relative_residual") is not None:
+            parts.append(f"coil energy residual {energy['relative_residual']:.2g}")
+        print("switchsim: relay: " + ", ".join(p for p in parts if p))
+    if "contacts" in summary and not (relay and not summary["contacts"]):  # (an actuator alone has no contact)
         residual = summary.get("energy", {}).get("relative_residual")
         e = summary.get("restitution") or {}
         first = ", ".join(f"{v:.3g} ({k})" for k, v in e.items() if v is not None) or "none (no rebound)"

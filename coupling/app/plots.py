@@ -146,7 +146,7 @@ def plot_waveforms(result, whole_run: bool = False):
     against time over the bounce window (or the whole run); closed intervals shaded."""
     from coupling.app.panels import axis, columns_of, panels_for
 
-    b = result.bounce
+    b = result.bounce or {}  # (an actuator alone has no contact to bounce)
     cols = columns_of(result)
     t_s = cols["time"]
     t = t_s * 1e3
@@ -165,6 +165,10 @@ def plot_waveforms(result, whole_run: bool = False):
     axes[-1].set_xlim(*window)
     axes[-1].set_xlabel("time (ms)")
     title = "whole run" if whole_run else "bounce window"
+    if "contact_voltage" not in cols:
+        axes[0].set_title(f"{title}: coil and armature (no contact)", fontsize=9)
+        fig.tight_layout()
+        return fig
     peak = b.get("peak_bounce_voltage")
     final = b.get("peak_final_opening_voltage")
     settle = ("settled, settle time " + f"{b['settle_time'] * 1e3:.4g} ms") if b.get("settled") else (
@@ -351,12 +355,17 @@ def save_plots(result, out_dir) -> list[Path]:
     """Write the plots that apply to this run's kind into out_dir; returns their paths."""
     out = Path(out_dir)
     figures = []
-    if result.waveforms is not None and len(result.waveforms) > 1:  # (a run that failed before the circuit started has none)
+    waves = result.waveforms
+    # an actuator alone (a coil, its magnet and armature, no contact): its panels over the run
+    contact = waves is None or "contact_voltage" in waves.columns
+    if waves is not None and len(waves) > 1 and not contact:
+        figures.append(("waveforms.png", lambda r: plot_waveforms(r, whole_run=True)))
+    elif waves is not None and len(waves) > 1:  # (a run that failed before the circuit started has none)
         figures.append(("waveforms.png", plot_waveforms))
         figures.append(("waveforms_whole_run.png", lambda r: plot_waveforms(r, whole_run=True)))
         figures.append(("contact_voltage_log.png", plot_log_voltage))
         figures.append(("openings.png", plot_openings))
-    if result.mechanics is not None:
+    if result.mechanics is not None and contact:
         figures += [("normal_force.png", plot_normal_force), ("tip_heights.png", plot_tip_heights),
                     ("energy.png", plot_energy)]
     if (getattr(result, "accuracy", None) or {}).get("closed") is not None:

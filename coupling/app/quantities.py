@@ -50,9 +50,9 @@ WAVEFORM = {
     "coil_current": Quantity("coil current", "A"),
     "coil_voltage": Quantity("coil voltage", "V"),
     "coil_flux_linkage": Quantity("coil flux linkage", "Wb"),
-    "armature_position": Quantity("armature travel at the pole", "m"),
+    "armature_position": Quantity("armature travel", "m"),
     "working_gap": Quantity("working air gap", "m"),
-    "magnetic_force": Quantity("magnetic force at the pole", "N"),
+    "magnetic_force": Quantity("magnetic force", "N"),
 }
 
 # summary.json scalars, flattened with dots as a sweep's results rows hold them
@@ -182,7 +182,7 @@ SCENE = {
                 "vntol": "V", "chgtol": "C", "temperature": "degC", "method": "-", "wall_timeout": "s",
                 "schedule": "-", "pull": "-", "pull_resistance": "ohm", "series_resistance": "ohm",
                 "input_capacitance": "F", "logic_low": "V", "logic_high": "V", "fault_time": "s",
-                "fault_resistance": "ohm", "fault_rise": "s"},
+                "fault_resistance": "ohm", "fault_rise": "s", "params": "-"},
     "circuit.snubber": {"resistance": "ohm", "capacitance": "F"},
     "circuit.flyback": {"saturation_current": "A", "emission_coefficient": "-", "series_resistance": "ohm"},
     "circuit.arc": {"min_voltage": "V", "min_current": "A", "resistance": "ohm", "formation_time": "s",
@@ -206,7 +206,7 @@ def scene_quantity(key: str) -> Quantity | None:
     """A scene key as a sweep names it ("circuit.snubber.capacitance", "initial.angle_deg"):
     its words (the key's parts, a unit suffix dropped) and unit; None when the key is not in
     docs/scene_keys.md's table."""
-    section, _, last = key.rpartition(".")
+    section, _, last = re.sub(r"\[\d+\]", "", key).rpartition(".")  # rivet[0].mass: a [[rivet]] key
     unit = SCENE.get(section, {}).get(last)
     if unit is None:
         return None

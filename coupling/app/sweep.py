@@ -6,7 +6,9 @@ scene key, as ``Scene.set`` takes them), built from one design:
 - ``grid``: every combination of the listed values;
 - ``cases``: a list of runs, each optionally named;
 - ``random`` / ``lhs``: ``samples`` seeded draws (uniform, or Latin hypercube through
-  scipy.stats.qmc) inside [low, high] per parameter, log-uniform with ``log = true``.
+  scipy.stats.qmc) inside [low, high] per parameter, log-uniform with ``log = true``;
+- ``tolerance``: ``samples`` seeded draws around the base scene's values, normal or
+  uniform per key (coupling.app.tolerance), and DIR/statistics.json of the metrics.
 
 Every run's scene is built and validated in the client before anything starts (and the
 design's size, MAX_RUNS, before it is built). Runs go to dask.distributed workers (a
@@ -33,9 +35,9 @@ Sweep file (TOML, SI units)::
 
     [sweep]
     scene = "base.toml"          # relative to this file; omitted: the built-in default scene
-    design = "grid"              # grid | cases | random | lhs
-    samples = 20                 # random, lhs
-    seed = 1                     # random, lhs
+    design = "grid"              # grid | cases | random | lhs | tolerance
+    samples = 20                 # random, lhs, tolerance
+    seed = 1                     # random, lhs, tolerance
     waveforms = false            # true, or a list of columns to keep
     set = { "output.plots" = false }     # applied to every run (optional)
 
@@ -49,6 +51,10 @@ Sweep file (TOML, SI units)::
 
     [sweep.ranges]               # design = "random" / "lhs": [low, high] or {low, high, log}
     "initial.angle_deg" = [10.0, 80.0]
+
+    [sweep.tolerances]           # design = "tolerance" (coupling.app.tolerance)
+    "rivet[0].mass" = { tolerance = 2e-6, distribution = "normal" }    # T = 3 sigma
+    # [sweep] limits = { "bounce.total_bounce_time" = 4e-3 }: the fraction beyond, in statistics.json
 """
 
 from __future__ import annotations
@@ -68,8 +74,9 @@ import uuid
 from pathlib import Path
 from typing import Any
 
-DESIGNS = ("grid", "cases", "random", "lhs")
-_SWEEP_KEYS = {"scene", "design", "samples", "seed", "waveforms", "set", "grid", "cases", "ranges"}
+DESIGNS = ("grid", "cases", "random", "lhs", "tolerance")
+_SWEEP_KEYS = {"scene", "design", "samples", "seed", "waveforms", "set", "grid", "cases", "ranges", "tolerances",
+               "limits", "check"}
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,99}$")
 RESERVED = ("run_id", "name", "status", "error", "wall_time", "session", "finished_at")
 
@@ -114,6 +121,7 @@ class Sweep:
     waveforms: bool | tuple[str, ...] = False
     common: dict = dataclasses.field(default_factory=dict)
     life: dict | None = None  # a life study per run: {"operations": N, "every": K} (coupling.app.life)
+    study: dict | None = None  # a tolerance study: {tolerances, limits, samples, seed} (coupling.app.tolerance)
     checked: bool = dataclasses.field(default=False, init=False, compare=False, repr=False)  # set by check()
 
     # constructors ----------------------------------------------------------------------
@@ -178,6 +186,39 @@ class Sweep:
                 case[key] = float(value)
             rows.append((None, case))
         return cls._of(base, rows, **kw)
+
+    @classmethod
+    def tolerance(cls, base, tolerances: dict, *, samples: int, seed: int = 0, limits: dict | None = None,
+                  check: int = 0, **kw) -> "Sweep":
+        """A tolerance study: ``samples`` seeded draws of the keys of ``tolerances`` ({key:
+        {tolerance, distribution = "normal" | "uniform", relative}}) around the values the
+        base scene (with ``common``) gives them; ``limits`` {metric: limit} (SI). After the
+        runs, run_sweep writes DIR/statistics.json (coupling.app.tolerance). ``check``: how
+        many of the runs (the first) are also rerun refined, as ``run --check`` does, to set
+        the numerical error beside the scatter."""
+        from coupling.app.tolerance import check_limits, check_tolerances, draw
+
+        if not isinstance(samples, int) or isinstance(samples, bool) or samples < 2:
+            raise ValueError(f"sweep samples = {samples!r}: expected an integer >= 2")
+        _check_size(samples, "sweep samples")
+        if not isinstance(seed, int) or isinstance(seed, bool):
+            raise ValueError(f"sweep seed = {seed!r}: expected an integer")
+        if not isinstance(tolerances, dict):
+            raise ValueError(f"sweep.tolerances = {tolerances!r:.200}: expected a table of 'key' = {{ tolerance, "
+                             "distribution }")
+        tolerances = _flatten_keys(tolerances, leaf=lambda v: isinstance(v, dict) and "tolerance" in v)
+        _check_params(tolerances, "tolerances")
+        common = _flatten_keys(dict(kw.get("common") or {}))
+        raw = base.raw if hasattr(base, "raw") else base
+        checked = check_tolerances(tolerances, apply_changes(raw, common) if isinstance(raw, dict) else raw)
+        limits = check_limits(limits)
+        if not isinstance(check, int) or isinstance(check, bool) or not 0 <= check <= samples:
+            raise ValueError(f"sweep check = {check!r}: expected a whole number of runs, 0 to samples = {samples}")
+        sweep = cls._of(base, [(None, values) for values in draw(checked, samples, seed)], **kw)
+        study = dict(tolerances={k: dict(v) for k, v in tolerances.items()}, limits=limits, samples=samples,
+                     seed=seed, base_values={k: v[0] for k, v in checked.items()}, check=check,
+                     check_runs=[r.run_id for r in sweep.runs[:check]])
+        return dataclasses.replace(sweep, study=study)
 
     @classmethod
     def _of(cls, base, rows, *, waveforms=False, common: dict | None = None) -> "Sweep":
@@ -251,21 +292,17 @@ class Sweep:
                    runs=[(r.run_id, r.params) for r in self.runs])
         if self.life is not None:
             doc["life"] = self.life
+        if self.study is not None:
+            doc["study"] = self.study
         return hashlib.sha256(json.dumps(doc, sort_keys=True, default=repr).encode()).hexdigest()[:16]
 
 
 def apply_changes(raw: dict, changes: dict) -> dict:
-    """A copy of a scene document with "section.key" (or "section.sub.key") values set."""
-    doc = copy.deepcopy(raw)
-    for key, value in changes.items():
-        parts = key.split(".")
-        node = doc
-        for part in parts[:-1]:
-            node = node.setdefault(part, {})
-            if not isinstance(node, dict):
-                raise ValueError(f"sweep parameter {key!r}: {part!r} is not a table in the base scene")
-        node[parts[-1]] = list(value) if isinstance(value, tuple) else value
-    return doc
+    """A copy of a scene document with scene keys set as ``Scene.set`` sets them
+    ("section.key", "rivet[0].mass", "circuit.params.RF": coupling.core.scene.set_keys)."""
+    from coupling.core.scene import set_keys
+
+    return set_keys(raw, changes, "sweep parameter")
 
 
 def _flatten_keys(table: dict, prefix: str = "", leaf=lambda v: False) -> dict:
@@ -281,10 +318,13 @@ def _flatten_keys(table: dict, prefix: str = "", leaf=lambda v: False) -> dict:
 
 
 def _check_params(params: dict, where: str) -> None:
+    from coupling.core.scene import key_steps
+
     for key in params:
-        parts = key.split(".")
-        if len(parts) < 2 or not all(parts):
-            raise ValueError(f"sweep {where}: key {key!r}: expected a scene key 'section.key', e.g. 'initial.angle_deg'")
+        try:
+            key_steps(key)
+        except ValueError as err:
+            raise ValueError(f"sweep {where}: {err}") from None
         if key in RESERVED:
             raise ValueError(f"sweep {where}: key {key!r} is reserved for the results table")
 
@@ -387,15 +427,18 @@ def load_sweep(path) -> Sweep:
     design = table.get("design")
     if design not in DESIGNS:
         raise ValueError(f"{path}: sweep.design = {design!r}: allowed values are {', '.join(map(repr, DESIGNS))}")
-    need = {"grid": "grid", "cases": "cases", "random": "ranges", "lhs": "ranges"}[design]
+    need = {"grid": "grid", "cases": "cases", "random": "ranges", "lhs": "ranges", "tolerance": "tolerances"}[design]
     if need not in table:
         raise ValueError(f"{path}: sweep.design = {design!r} needs sweep.{need}")
-    for other in {"grid", "cases", "ranges"} - {need}:
+    for other in sorted({"grid", "cases", "ranges", "tolerances"} - {need}):
         if other in table:
             raise ValueError(f"{path}: sweep.{other} is unused with sweep.design = {design!r}; remove it")
     for key in ("samples", "seed"):
-        if key in table and design not in ("random", "lhs"):
+        if key in table and design not in ("random", "lhs", "tolerance"):
             raise ValueError(f"{path}: sweep.{key} is unused with sweep.design = {design!r}; remove it")
+    for key in ("limits", "check"):
+        if key in table and design != "tolerance":
+            raise ValueError(f"{path}: sweep.{key} is used by sweep.design = \"tolerance\" only; remove it")
     from coupling.core.scene import default_scene, load_scene
 
     scene_key = table.get("scene")
@@ -416,6 +459,11 @@ def load_sweep(path) -> Sweep:
         sweep = Sweep.grid(base, _flatten_keys(grid), **kw)
     elif design == "cases":
         sweep = Sweep.cases(base, table["cases"], **kw)
+    elif design == "tolerance":
+        if "samples" not in table:
+            raise ValueError(f"{path}: sweep.design = \"tolerance\" needs sweep.samples (the number of runs)")
+        sweep = Sweep.tolerance(base, table["tolerances"], samples=table["samples"], seed=table.get("seed", 0),
+                                limits=table.get("limits"), check=table.get("check", 0), **kw)
     else:
         if "samples" not in table:
             raise ValueError(f"{path}: sweep.design = {design!r} needs sweep.samples (the number of runs)")
@@ -463,6 +511,7 @@ def execute(sweep_doc: dict, run_doc: dict, wave_dir: str | None) -> dict:
     row = {"run_id": run_doc["run_id"], "name": run_doc["name"]}
     params = run_doc["params"]
     summary = None
+    numerical: dict = {}
     status, error = "ok", None
     with _RUN_LOCK:
         worker = _worker_address()
@@ -478,6 +527,14 @@ def execute(sweep_doc: dict, run_doc: dict, wave_dir: str | None) -> dict:
             summary = result.summary
             waveforms = result.waveforms
             status, error = result.status.value, result.message or None  # judged where it was made
+            if run_doc["run_id"] in sweep_doc.get("check_runs", ()) and status == "ok":
+                from coupling.app.accuracy import check as accuracy_check
+                from coupling.app.tolerance import numerical_changes
+
+                try:
+                    numerical = numerical_changes(accuracy_check(scene, result, sensitivity=False))
+                except Exception as err:  # noqa: BLE001 - the run stands; only its check failed
+                    numerical = {"numerical.status": f"check failed: {type(err).__name__}: {_one_line(err)}"}
         except CoupledRunError as err:
             status, error = "failed", _one_line(err)
             summary = err.partial.summary if err.partial is not None else None
@@ -496,6 +553,7 @@ def execute(sweep_doc: dict, run_doc: dict, wave_dir: str | None) -> dict:
             if key == "status":
                 continue
             row[f"summary.{key}" if key in row or key in RESERVED else key] = value
+    row.update(numerical)
     row.update(status=status, error=error, wall_time=time.perf_counter() - tick)
     if worker is not None and _ngspice_exited():
         row["_restart"] = worker  # this run ended ngspice ("cannot recover"): the worker needs a new process
@@ -661,6 +719,7 @@ class SweepReport:
     interrupted: bool = False
     out_dir: str = ""
     rerun: int = 0  # runs that had a failed row and were run again (resume)
+    statistics: str | None = None  # a tolerance study's DIR/statistics.json, once every run has a row
 
     @property
     def complete(self) -> bool:
@@ -781,7 +840,8 @@ def _manifest(sweep: Sweep, out: Path, resume: bool, write: bool = True) -> None
         return
     doc = dict(fingerprint=fingerprint, base_name=sweep.base_name, base_dir=sweep.base_dir, base=sweep.base,
                common=sweep.common, waveforms=sweep.waveforms, parameters=sweep.parameters,
-               runs=[dataclasses.asdict(r) for r in sweep.runs], **({} if sweep.life is None else {"life": sweep.life}))
+               runs=[dataclasses.asdict(r) for r in sweep.runs], **({} if sweep.life is None else {"life": sweep.life}),
+               **({} if sweep.study is None else {"study": sweep.study}))
     tmp = path.with_suffix(".json.tmp")
     tmp.write_text(json.dumps(doc, indent=1, default=repr))
     os.replace(tmp, path)
@@ -939,7 +999,13 @@ def run_sweep(sweep: Sweep, out_dir, *, workers: int | None = None, scheduler: s
         sweep.check()
     out = _sweep_folder(out_dir)
     with _FolderLock(out):
-        return _run_locked(sweep, out, workers, scheduler, client, resume, progress, window)
+        report = _run_locked(sweep, out, workers, scheduler, client, resume, progress, window)
+        if sweep.study is not None and report.complete:
+            from coupling.app.tolerance import write_statistics
+
+            write_statistics(out, sweep.study)
+            report.statistics = str(out / "statistics.json")
+        return report
 
 
 def _run_locked(sweep, out: Path, workers, scheduler, client, resume, progress, window) -> SweepReport:
@@ -964,7 +1030,8 @@ def _run_locked(sweep, out: Path, workers, scheduler, client, resume, progress, 
     session = f"{time.strftime('%Y%m%dT%H%M%S')}-{uuid.uuid4().hex[:6]}"
     sweep_doc = dict(base=sweep.base, base_dir=str(Path(sweep.base_dir).resolve()), base_name=sweep.base_name,
                      common=sweep.common, waveforms=sweep.waveforms,
-                     life=None if sweep.life is None else dict(sweep.life, folder=str((out / "life").resolve())))
+                     life=None if sweep.life is None else dict(sweep.life, folder=str((out / "life").resolve())),
+                     check_runs=_check_runs(sweep))
     cluster = None
     own_client = client is None
     started = None
@@ -1074,11 +1141,16 @@ def _submit(client, sweep_doc: dict, run: Run, wave_dir):
                          pure=False, retries=0)
 
 
+def _check_runs(sweep: Sweep) -> list[str]:
+    """The run_ids a tolerance study reruns refined (``check``)."""
+    return list(sweep.study.get("check_runs", ())) if sweep.study is not None else []
+
+
 def run_sweep_inline(sweep: Sweep) -> list[dict]:
     """Every run of the sweep in this process, one after the other, rows returned (no Dask,
     no files): for small studies and for comparing against the Dask path."""
     doc = dict(base=sweep.base, base_dir=sweep.base_dir, base_name=sweep.base_name, common=sweep.common,
-               waveforms=False)
+               waveforms=False, check_runs=_check_runs(sweep))
     return [execute(doc, dict(run_id=r.run_id, name=r.name, params=r.params), None) for r in sweep.runs]
 
 
@@ -1110,5 +1182,6 @@ def sweep_command(path: str, out_dir: str, *, workers: int | None = None, schedu
     if not quiet:
         print(f"switchsim sweep: {report.done} run(s) now ({report.rerun} of them failed before), "
               f"{report.skipped} already done, {report.failed} failed, {report.seconds:.1f} s; results in "
-              f"{out_dir}/results (coupling.app.sweep.read_results)", file=sys.stderr)
+              f"{out_dir}/results (coupling.app.sweep.read_results)"
+              + (f"; statistics in {report.statistics}" if report.statistics else ""), file=sys.stderr)
     return 1 if report.failed else 0

@@ -18,6 +18,7 @@ A scene names only what it needs, and only that is built:
                   bleed_resistance, contact_capacitance, leakage_conductance,
                   snubber = {resistance, capacitance} (both), flyback = true | {...},
                   arc = true | false | {min_voltage, min_current, ...}, netlist = "file.cir",
+                  params = {NAME = number} (new values of the netlist's .param definitions),
                   load_probe, max_step, reltol, abstol, vntol, chgtol, method, temperature,
                   wall_timeout (each key one dataclass field; omitted: that field's default),
                   probes = ["v(node)", "v(n1,n2)", "i(element)"] (recorded as waveform columns)
@@ -210,7 +211,10 @@ class Scene:
         return SolverOptions(**self.raw.get("solver", {})).t_end  # a schedule scene: [solver] t_end alone
 
     def set(self, key: str, value) -> "Scene":
-        """A new scene with ``key`` ("section.key" or "section.sub.key") set to value, re-validated.
+        """A new scene with ``key`` set to value, re-validated: "section.key",
+        "section.sub.key", an entry of a list by its index ("rivet[0].mass", "force[1].value",
+        "magnet.iron[1].length", "initial.velocity[2]"), a netlist's parameter
+        ("circuit.params.RF"). An index names an entry the scene has (no entry is added).
 
         Example: ``scene.set("initial.angle_deg", 45).set("circuit.load_resistance", 6.0)``.
         """
@@ -224,10 +228,7 @@ class Scene:
         they are set in the same call): ``update({"bar.width": 0.02, "bar.thickness": 3e-4})``
         turns a round bar (bar.diameter) into a rectangular one in one call; likewise
         bar.diameter back, and tribology.source / fit / data (ALTERNATIVES)."""
-        raw = copy.deepcopy(self.raw)
-        for key, value in changes.items():
-            node, last = _walk(raw, key, self.name)
-            node[last] = list(value) if isinstance(value, tuple) else value
+        raw = set_keys(self.raw, changes, self.name)
         _drop_replaced_alternatives(raw, changes)
         return scene_from_dict(raw, base_dir=self.base_dir, name=self.name)
 
@@ -235,8 +236,11 @@ class Scene:
         """A new scene without these "section.key" entries (their defaults apply), validated."""
         raw = copy.deepcopy(self.raw)
         for key in keys:
-            node, last = _walk(raw, key, self.name)
-            node.pop(last, None)
+            node, last = _walk(raw, key, self.name, create=False)
+            if isinstance(node, list):
+                node.pop(last)  # "rivet[1]": the entry goes, the ones after it move up
+            elif node is not None:
+                node.pop(last, None)
         return scene_from_dict(raw, base_dir=self.base_dir, name=self.name)
 
     def __reduce__(self):
@@ -348,7 +352,8 @@ _LOADS = {
 }
 _FAULT = {"fault_time": "fault_time", "fault_resistance": "fault_resistance", "fault_rise": "fault_rise"}
 _TEMPLATE_CIRCUIT = {"contact_capacitance": "contact_capacitance", "leakage_conductance": "leakage_conductance"}
-_NETLIST = {"netlist": None, "load_probe": "load_probe", "leakage_conductance": "leakage_conductance"}
+_NETLIST = {"netlist": None, "load_probe": "load_probe", "leakage_conductance": "leakage_conductance",
+            "params": "params"}
 _PARTS = ("snubber", "flyback", "arc")
 _OPTION_KEYS = ("max_step", "reltol", "abstol", "vntol", "chgtol", "method", "temperature", "wall_timeout")
 _MCU_INPUT = {k: k for k in ("voltage", "pull", "pull_resistance", "series_resistance", "input_capacitance",
@@ -767,21 +772,110 @@ def _drop_replaced_alternatives(raw: dict, changes: dict) -> None:
                         table.pop(key, None)
 
 
-def _walk(raw: dict, key: str, scene: str) -> tuple[dict, str]:
-    """The table holding "section.key" (created if missing) and the last part of the key;
-    errors start with the scene's name, like every other error about it."""
-    parts = key.split(".") if isinstance(key, str) else []
-    if len(parts) < 2 or not all(parts):
-        raise ValueError(f"{scene}: key {key!r}: expected 'section.key', e.g. 'initial.angle_deg'")
+_KEY_STEP = re.compile(r"([^.\[\]]+)((?:\[[^\[\]]*\])*)")
+_INDEX = re.compile(r"\[([^\[\]]*)\]")
+
+
+def key_steps(key) -> list:
+    """The steps of a scene key: names (str) and list indices (int), e.g. "rivet[0].mass" ->
+    ["rivet", 0, "mass"], "magnet.fixed_gap[1].tube[0].length" -> ["magnet", "fixed_gap", 1,
+    "tube", 0, "length"]. A key has at least two steps ("section.key" or "section[i]");
+    ValueError (without a prefix) otherwise."""
+    if not isinstance(key, str):
+        raise ValueError(f"key {key!r}: expected 'section.key', e.g. 'initial.angle_deg' or 'rivet[0].mass'")
+    steps: list = []
+    for part in key.split("."):
+        match = _KEY_STEP.fullmatch(part)
+        if match is None:
+            raise ValueError(f"key {key!r}: expected 'section.key', e.g. 'initial.angle_deg' or 'rivet[0].mass' "
+                             "(names joined by '.', list entries as name[index])")
+        steps.append(match.group(1))
+        for index in _INDEX.findall(match.group(2)):
+            if not index.isdigit():
+                raise ValueError(f"key {key!r}: index [{index}]: expected a whole number >= 0 (the first entry "
+                                 "is [0])")
+            steps.append(int(index))
+    if len(steps) < 2:
+        raise ValueError(f"key {key!r}: expected 'section.key', e.g. 'initial.angle_deg' or 'rivet[0].mass'")
+    return steps
+
+
+def _shown(steps: list) -> str:
+    """The key of ``steps`` as written: names joined by '.', indices in brackets."""
+    text = ""
+    for step in steps:
+        text += f"[{step}]" if isinstance(step, int) else (f".{step}" if text else step)
+    return text
+
+
+def _walk(raw: dict, key: str, where: str, *, create: bool = True) -> tuple:
+    """(the table or list holding the key's last step, that step: a name or an index). Tables
+    on the way are created when missing (``create``); lists never are, nor their entries:
+    an index must name an entry the scene has. Errors say ``where`` first and name the key
+    as written."""
+    try:
+        steps = key_steps(key)
+    except ValueError as err:
+        raise ValueError(f"{where}: {err}") from None
     node = raw
-    for part in parts[:-1]:
-        node = node.setdefault(part, {})
-        if isinstance(node, list):
-            raise ValueError(f"{scene}: key {key!r}: [[{part}]] is a list of tables, which a key cannot "
-                             f"reach into; change it in the scene file")
-        if not isinstance(node, dict):
-            raise ValueError(f"{scene}: key {key!r}: {part!r} is not a table")
-    return node, parts[-1]
+    for k, step in enumerate(steps):
+        here = _shown(steps[:k + 1])
+        if isinstance(step, int):
+            if not isinstance(node, list):  # checked on the way down; the root is a table
+                raise ValueError(f"{where}: key {key!r}: {_shown(steps[:k])} is not a list")
+            if step >= len(node):
+                entries = f"{len(node)} entr{'y' if len(node) == 1 else 'ies'}"
+                at = _shown(steps[:k])
+                span = f" (only {at}[0])" if len(node) == 1 else f" ({at}[0] to {at}[{len(node) - 1}])" if node else ""
+                raise ValueError(f"{where}: key {key!r}: index [{step}] is beyond {_shown(steps[:k])}, which has "
+                                 f"{entries}{span}")
+        if k == len(steps) - 1:
+            return node, step
+        nxt = steps[k + 1]
+        if isinstance(step, int):
+            child = node[step]
+        else:
+            child = node.get(step)
+            if child is None:
+                if isinstance(nxt, int):
+                    raise ValueError(f"{where}: key {key!r}: index [{nxt}] is beyond {here}, which has 0 entries "
+                                     f"(the scene has no {here})")
+                if not create:
+                    return None, None
+                child = node[step] = {}
+        if isinstance(nxt, int):
+            if not isinstance(child, list):
+                kind = "a table" if isinstance(child, dict) else f"{child!r}"
+                raise ValueError(f"{where}: key {key!r}: {here} is {kind}, not a list: an index [{nxt}] "
+                                 f"reaches into lists only" + (f"; write {here}.{steps[k + 2]}" if isinstance(
+                                     child, dict) and k + 2 < len(steps) else ""))
+        elif isinstance(child, list):
+            n = len(child)
+            raise ValueError(f"{where}: key {key!r}: {here} is a list of {n} entr{'y' if n == 1 else 'ies'} "
+                             f"([[{here}]]): name one by its index, {here}[0].{nxt}")
+        elif not isinstance(child, dict):
+            raise ValueError(f"{where}: key {key!r}: {here} = {child!r} is not a table")
+        node = child
+    raise AssertionError("unreachable")
+
+
+def key_value(raw: dict, key: str, where: str):
+    """The value a scene document gives ``key`` (any key Scene.set takes), None when it gives
+    none; a key that cannot be in a scene is an error as for Scene.set."""
+    node, last = _walk(raw, key, where, create=False)
+    if node is None:
+        return None
+    return node[last] if isinstance(node, list) else node.get(last)
+
+
+def set_keys(raw: dict, changes: dict, where: str) -> dict:
+    """A copy of a scene document with each key of ``changes`` ("section.key",
+    "rivet[0].mass", "circuit.params.RF", ...) set to its value (tuples as lists)."""
+    doc = copy.deepcopy(raw)
+    for key, value in changes.items():
+        node, last = _walk(doc, key, where)
+        node[last] = list(value) if isinstance(value, tuple) else copy.deepcopy(value)
+    return doc
 
 
 def _rebuild_scene(raw: dict, base_dir: str, name: str) -> Scene:

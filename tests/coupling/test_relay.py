@@ -142,3 +142,20 @@ def test_bad_coil_and_magnet_keys_are_one_line_naming_the_key(change, message):
 def test_the_suppression_is_a_scene_key():
     scene = default_scene().set("coil.suppression", "diode")
     assert scene.circuit.circuit.coil.suppression == "diode"
+
+
+def test_an_actuator_alone_writes_its_folder_and_plots(tmp_path, capsys):
+    """The plunger solenoid (no contact): the command line writes its tables, the coil panels
+    as waveforms.png and a relay line; no contact plot is attempted."""
+    from pathlib import Path
+
+    from coupling.app.cli import main
+
+    scene = Path(__file__).resolve().parents[2] / "examples" / "plunger_solenoid.toml"
+    out = tmp_path / "out"
+    assert main(["run", str(scene), "--out", str(out), "--plots", "--quiet"]) == 0
+    assert "switchsim: relay: armature at the pole" in capsys.readouterr().out
+    assert (out / "waveforms.png").stat().st_size > 10_000
+    assert not (out / "openings.png").exists() and not (out / "normal_force.png").exists()
+    html = (out / "waveforms.html").read_text()
+    assert all(name in html for name in ("coil current", "magnetic force", "armature travel"))
