@@ -88,6 +88,26 @@ def warm_up() -> None:
             "armature": dict(armature, card_position=0.01, card_lever=1.0, card_free_travel=2e-4,
                              card_stiffness=1e5, card_damping=0.1),
             "initial": dict(height=2e-4), "contact": dict(reference_speed=0.5), "solver": dict(t_end=4e-3)}
+    # contact pairs ([[fixed]]): a changeover's blade between an NO contact below and a
+    # spherical NC stop above it, three pairs (a row of quadratures beyond the first two)
+    blade = dict(length=0.02, width=0.003, thickness=0.0003, tip_radius=0.0016, modes={"axial": 1, "bending": 3},
+                 **steel)
+    changeover = {"bar": blade, "mount": dict(kind="clamp", position=0.02),
+                  "rivet": [dict(position=0.0015, offset=-0.0003, radius=0.001, name="low"),
+                            dict(position=0.0015, offset=0.0003, radius=0.001, name="high"),
+                            dict(position=0.004, offset=-0.0003, radius=0.001, name="aux")],
+                  "fixed": [dict(point="low", name="NO", gap=2e-5),
+                            dict(point="high", name="NC", facing="down", gap=0.0, shape="sphere", radius=0.002),
+                            dict(point="aux", name="stop", gap=3e-5, electrical=False)],
+                  "force": [dict(position=0.01, time=[0.0, 1e-3], value=[0.5, -2.0])],
+                  "friction": dict(mu=0.3), "solver": dict(t_end=2e-3)}
+    solver = ImpactSolver(scene_from_dict(changeover), keep_dense=True)
+    segment = solver.advance(1e-3)
+    segment.pair_forces(0.5 * (segment.t_start + segment.t_end))
+    segment.tip_forces(0.5 * (segment.t_start + segment.t_end))
+    solver.advance(2e-3)
+    solver.contact_series(np.linspace(0.0, 2e-3, 5))
+    solver.result().energy_table  # noqa: B018
     for doc in (alone, card):
         solver = ImpactSolver(scene_from_dict(doc), keep_dense=True)
         t_end = doc["solver"]["t_end"]

@@ -25,6 +25,7 @@ from . import aot
 # module of its numba source
 ENTRY_POINTS = {
     "dense_contact": "integrator", "dense_eval": "integrator", "dense_tip_forces": "integrator",
+    "dense_pair_forces": "integrator",
     "event_values": "integrator", "integrate": "integrator", "dynamics": "kernel", "energies": "kernel",
     "energy_table": "kernel", "make_work": "kernel", "project_to_stick": "kernel", "scaled_rebound": "kernel",
     "armature_table": "kernel", "armature_force": "kernel",

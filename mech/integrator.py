@@ -18,9 +18,9 @@ import numpy as np
 from .jit import njit
 from .kernel import (
     A_FN, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_COMPRESSION, EV_CONTACT, EV_SLIP, EV_STICK,
-    C_C, C_K, C_ON, C_R, F_BETA, F_BLOCK_Z, F_VBOUND, F_VREG, FRICTION_EXACT, I_FRICTION, I_N, I_PLANAR, NEV_TIP, SLIP, STICK,
-    AP_HMAX, AP_TRAVEL, EA_CARD, EA_POLE, EA_REST, EA_SEAT, EA_TURN, I_ARM_CARD, I_MOUNT, MOUNT_NONE,
-    NEV, arm_offset, dynamics, normal_force, tip_offset, unpack,
+    C_C, C_K, C_N, C_ON, C_R, C_Z, F_BETA, F_VBOUND, F_VREG, FRICTION_EXACT, I_FRICTION, I_N, I_PLANAR, NAUX,
+    NEV_TIP, SLIP, STICK, AP_HMAX, AP_TRAVEL, EA_CARD, EA_POLE, EA_REST, EA_SEAT, EA_TURN, I_ARM_CARD, I_MOUNT,
+    MOUNT_NONE, NEV_ARM, arm_offset, dynamics, normal_force, tip_offset, unpack,
 )
 from .friction import REVERSAL_DEADBAND
 from .kernel_layout import (  # noqa: F401  (re-exported: the integrator's status codes)
@@ -61,21 +61,22 @@ def _dense_coefficients(y, ynew, h, k1, k3, k4, k5, k6, k7, coef):
 
 @njit(cache=True)
 def event_values(y, aux, sv, eref, mdl, g, arm=None):
-    """Event function values into g (NEV): the contact points' (events_from_aux) from a
-    dynamics evaluation's aux, then the armature's (armature_events) from the state y and
-    what that evaluation left in its scratch vector ``sv`` (the dynamics' work[22]); 1 (never
-    crossing) without an armature (arm None: kernel.dynamics)."""
+    """Event function values into g (kernel_layout.event_count of the model's contact rows):
+    the contact rows' (events_from_aux) from a dynamics evaluation's aux, then the
+    armature's (armature_events) from the state y and what that evaluation left in its
+    scratch vector ``sv`` (the dynamics' work[22]); 1 (never crossing) without an armature
+    (arm None: kernel.dynamics)."""
     events_from_aux(aux, eref, mdl, g)
     if arm is not None:
         armature_events(y, sv, mdl, arm, g)
     else:
-        for k in range(2 * NEV_TIP, NEV):
+        for k in range(g.shape[0] - NEV_ARM, g.shape[0]):
             g[k] = 1.0
 
 
 @njit(cache=True)
 def armature_events(y, sv, mdl, arm, g):
-    """The armature's event functions into g[2 NEV_TIP:], each positive while open (1 where
+    """The armature's event functions into g[rows NEV_TIP:], each positive while open (1 where
     the model has none of it, never crossing): the rest stop q, the pole stop travel - q
     (-1 while seated on it: held closed), the card's gap to the bar (m); while a stop is
     closed and the armature not seated, its speed (a turn); while seated, the force
@@ -85,8 +86,9 @@ def armature_events(y, sv, mdl, arm, g):
     not the dynamics' whole work tuple: a compiled call takes a tuple's arrays one by one.)"""
     ipar = mdl[1]
     apar, _, closed = arm
-    base = 2 * NEV_TIP
-    for k in range(base, NEV):
+    nev = g.shape[0]
+    base = nev - NEV_ARM
+    for k in range(base, nev):
         g[k] = 1.0
     off = arm_offset(ipar[I_N], ipar[I_PLANAR], ipar[I_MOUNT])
     qa = y[off]
@@ -103,12 +105,12 @@ def armature_events(y, sv, mdl, arm, g):
 
 @njit(cache=True)
 def events_from_aux(aux, eref, mdl, g):
-    """The contact points' event function values into g[:2 NEV_TIP] from a dynamics
+    """The contact rows' event function values into g[:rows NEV_TIP] from a dynamics
     evaluation's aux."""
     beta = mdl[0][F_BETA]
     vres = mdl[0][F_VREG]
     cpar = mdl[9]
-    for i in range(2):
+    for i in range(cpar.shape[0]):
         k_h = cpar[i, C_K]
         c_h = cpar[i, C_C]
         pen = aux[i, A_Y]
@@ -126,7 +128,7 @@ def events_from_aux(aux, eref, mdl, g):
 @njit(cache=True)
 def _active(k, g_old, g_new, regime, fmodel):
     """Whether event k is watched in a step with end values g_old, g_new."""
-    if k >= 2 * NEV_TIP:
+    if k >= regime.shape[0] * NEV_TIP:
         return True  # the armature's: its stops and card, always (constant where absent)
     i = k // NEV_TIP
     kind = k % NEV_TIP
@@ -204,7 +206,8 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
     rec_t, rec_y, rec_aux, rec_fmax = rec
     dense_t0, dense_h, dense_coef = dense
     N = y.shape[0]
-    nev = NEV
+    rows = mdl[9].shape[0]  # contact rows
+    nev = rows * NEV_TIP + NEV_ARM
     fpar = mdl[0]
     fmodel = mdl[1][I_FRICTION]
     sv = work[22]  # (the dynamics' scratch vector: what the armature's events read)
@@ -218,9 +221,9 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
     ytmp = np.empty(N)
     ynew = np.empty(N)
     coef = np.empty((5, N))
-    aux_stage = np.empty((2, 8))
-    aux_old = np.empty((2, 8))
-    aux_new = np.empty((2, 8))
+    aux_stage = np.empty((rows, NAUX))
+    aux_old = np.empty((rows, NAUX))
+    aux_new = np.empty((rows, NAUX))
     g_old = np.empty(nev)
     g_new = np.empty(nev)
     g_mid = np.empty(nev)
@@ -251,14 +254,16 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
             return BUFFER_FULL, t, h, n_rec, -1
         if stats[0] + stats[1] >= max_steps:
             return MAX_STEPS, t, h, n_rec, -1
-        # The contact-time bound on the step matters only where a tip could reach the
-        # block within the step: far above it, a tip needs gap / v_bound to arrive
-        # (v_bound bounds every tip's approach speed from the energy available). A
-        # switched-off contact row (a held bar with one contact) does not count.
-        if mdl[9][1, C_ON] == 0.0:
-            gap = -aux_old[0, A_Y]
-        else:
-            gap = -aux_old[0, A_Y] if aux_old[0, A_Y] < aux_old[1, A_Y] else -aux_old[1, A_Y]
+        # The contact-time bound on the step matters only where a contact point could
+        # reach its fixed contact within the step: far from it, it needs gap / v_bound to
+        # arrive (v_bound bounds every point's approach speed from the energy available).
+        # A switched-off contact row (a held bar with one contact) does not count. (The gap
+        # taken is the largest of the rows', as the two-point model always took it: the
+        # nearer point's bound is then left to the error control.)
+        gap = -aux_old[0, A_Y]
+        for i in range(1, rows):
+            if mdl[9][i, C_ON] != 0.0 and -aux_old[i, A_Y] > gap:
+                gap = -aux_old[i, A_Y]
         hcap = hmax
         if gap > 0.0 and 0.5 * gap / fpar[F_VBOUND] > hmax:
             hcap = 0.5 * gap / fpar[F_VBOUND]
@@ -426,8 +431,8 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
         for i in range(N):
             y[i] = ynew[i]
             k1[i] = k7[i]
-        for i in range(2):
-            for c_ in range(8):
+        for i in range(rows):
+            for c_ in range(NAUX):
                 aux_old[i, c_] = aux_new[i, c_]
         for k in range(nev):
             g_old[k] = g_new[k]
@@ -459,30 +464,35 @@ def _record(n_rec, t_start, h, t_end, y_end, aux_end, aux_start, coef, rec, dens
     N = y_end.shape[0]
     for i in range(N):
         rec_y[n_rec, i] = y_end[i]
-    for i in range(2):
-        for c_ in range(8):
+    rows = aux_end.shape[0]
+    touching = False
+    for i in range(rows):
+        for c_ in range(NAUX):
             rec_aux[n_rec, i, c_] = aux_end[i, c_]
         rec_fmax[n_rec, i] = max(aux_end[i, A_FN], aux_start[i, A_FN])
-    if aux_end[0, A_Y] > 0.0 or aux_end[1, A_Y] > 0.0 or aux_start[0, A_Y] > 0.0 or aux_start[1, A_Y] > 0.0:
+        if aux_end[i, A_Y] > 0.0 or aux_start[i, A_Y] > 0.0:
+            touching = True
+    if touching:
         ymid = np.empty(N)
-        forces = np.empty(5)
+        forces = np.empty((rows, 2))
         for f in (0.25, 0.5, 0.75):
             dense_eval(coef, f * theta_end, ymid)
-            tip_forces(ymid, mdl, forces)  # the normal forces alone: no right-hand side
-            for i in range(2):
-                if forces[i] > rec_fmax[n_rec, i]:
-                    rec_fmax[n_rec, i] = forces[i]
+            pair_forces(ymid, mdl, forces)  # the normal forces alone: no right-hand side
+            for i in range(rows):
+                if forces[i, 0] > rec_fmax[n_rec, i]:
+                    rec_fmax[n_rec, i] = forces[i, 0]
 
 
 @njit(cache=True)
 def dense_contact(times, t_valid, dense_t0, dense_h, dense_coef, regimes, mdl,
                   eref, work, out, arm=None):
-    """Per tip penetration (m), rate (m/s) and normal force (N) at sorted ``times`` from the
-    stored dense output; out has shape (len(times), 2, 3)."""
+    """Per contact row penetration (m), rate (m/s) and normal force (N) at sorted ``times``
+    from the stored dense output; out has shape (len(times), rows, 3)."""
     N = dense_coef.shape[2]
+    rows = out.shape[1]
     y = np.empty(N)
     dy = np.empty(N)
-    aux = np.empty((2, 8))
+    aux = np.empty((rows, NAUX))
     k = 0
     n = t_valid.shape[0]
     for m in range(times.shape[0]):
@@ -491,18 +501,15 @@ def dense_contact(times, t_valid, dense_t0, dense_h, dense_coef, regimes, mdl,
             k += 1
         dense_eval(dense_coef[k], (t - dense_t0[k]) / dense_h[k], y)
         dynamics(t, y, mdl, regimes[k], eref, dy, aux, work, arm)
-        for i in range(2):
+        for i in range(rows):
             out[m, i, 0] = aux[i, A_Y]
             out[m, i, 1] = aux[i, A_YDOT]
             out[m, i, 2] = aux[i, A_FN]
 
 
 @njit(cache=True)
-def dense_tip_forces(t, t_valid, dense_t0, dense_h, dense_coef, mdl, out):
-    """Normal force (N) of each tip, the gap (m) of the nearer tip and each tip's
-    penetration (m) at time t from the dense output, into out = (F_0, F_1, gap, y_0, y_1):
-    only what a circuit needs, without the full right-hand side (the ngspice callbacks ask
-    for it thousands of times per run)."""
+def _dense_state(t, t_valid, dense_t0, dense_h, dense_coef):
+    """The state at time t (s) from the dense output of steps ending at t_valid."""
     n_steps = t_valid.shape[0]
     lo = 0
     hi = n_steps - 1
@@ -516,22 +523,57 @@ def dense_tip_forces(t, t_valid, dense_t0, dense_h, dense_coef, mdl, out):
     N = dense_coef.shape[2]
     y = np.empty(N)
     dense_eval(dense_coef[k], (t - dense_t0[k]) / dense_h[k], y)
-    tip_forces(y, mdl, out)
+    return y
+
+
+@njit(cache=True)
+def dense_tip_forces(t, t_valid, dense_t0, dense_h, dense_coef, mdl, out):
+    """Normal force (N) of the first two contact rows, the gap (m) of the nearest and the
+    first two's penetration (m) at time t from the dense output, into out = (F_0, F_1, gap,
+    y_0, y_1): only what a circuit needs, without the full right-hand side (the ngspice
+    callbacks ask for it thousands of times per run)."""
+    tip_forces(_dense_state(t, t_valid, dense_t0, dense_h, dense_coef), mdl, out)
+
+
+@njit(cache=True)
+def dense_pair_forces(t, t_valid, dense_t0, dense_h, dense_coef, mdl, out):
+    """``pair_forces`` at time t (s) from the dense output: out (rows, 2), each contact row's
+    normal force (N) and penetration (m)."""
+    pair_forces(_dense_state(t, t_valid, dense_t0, dense_h, dense_coef), mdl, out)
 
 
 @njit(cache=True)
 def tip_forces(y, mdl, out):
-    """out = (F_0, F_1, gap, y_0, y_1) of state y: each contact point's normal force (N),
-    the nearer one's gap (m, 0 when touching) and each one's penetration (m), from the
-    kinematics alone (the normal force follows the penetration and its rate; no
-    accelerations, so a fraction of a right-hand side's cost)."""
+    """out = (F_0, F_1, gap, y_0, y_1) of state y: the first two contact rows' normal force
+    (N), the nearest row's gap (m, 0 when touching; 1e300 without a contact point) and the
+    first two's penetration (m) (pair_forces)."""
+    cpar = mdl[9]
+    rows = cpar.shape[0]
+    pf = np.empty((rows, 2))
+    pair_forces(y, mdl, pf)
+    gap = 1e300
+    for i in range(rows):
+        if cpar[i, C_ON] != 0.0 and -pf[i, 1] < gap:
+            gap = -pf[i, 1]
+    out[0] = pf[0, 0]
+    out[1] = pf[1, 0]
+    out[2] = gap if gap > 0.0 else 0.0
+    out[3] = pf[0, 1]
+    out[4] = pf[1, 1]
+
+
+@njit(cache=True)
+def pair_forces(y, mdl, out):
+    """out (rows, 2) of state y: each contact row's normal force (N) and penetration (m,
+    negative: its gap to its fixed contact), from the kinematics alone (the normal force
+    follows the penetration and its rate; no accelerations, so a fraction of a right-hand
+    side's cost). A switched-off row, and every row of a model without a bar: 0 and -1e3."""
     fpar, ipar, psi, xc, cpar = mdl[0], mdl[1], mdl[6], mdl[8], mdl[9]
+    rows = cpar.shape[0]
     if ipar[I_MOUNT] == MOUNT_NONE:  # no bar: no contact point
-        out[0] = 0.0
-        out[1] = 0.0
-        out[2] = 1e300
-        out[3] = -1e3
-        out[4] = -1e3
+        for i in range(rows):
+            out[i, 0] = 0.0
+            out[i, 1] = -1e3
         return
     n = ipar[I_N]
     planar = ipar[I_PLANAR]
@@ -542,14 +584,13 @@ def tip_forces(y, mdl, out):
     w = np.empty(3)
     eta = np.empty(n)
     unpack(y, n, planar, r, R, q, V, w, eta)
-    gap = 1e300
     s = np.empty(3)
     d = np.empty(3)
-    no_axis = np.zeros((2, 3))
-    for i in range(2):
+    no_axis = np.zeros((rows, 3))
+    for i in range(rows):
         if cpar[i, C_ON] == 0.0:
-            out[i] = 0.0
-            out[3 + i] = -1e3
+            out[i, 0] = 0.0
+            out[i, 1] = -1e3
             continue
         tip_offset(i, xc, psi, q, n, s)
         tip_offset(i, no_axis, psi, eta, n, d)
@@ -558,9 +599,7 @@ def tip_forces(y, mdl, out):
         vb1 = w[2] * s[0] - w[0] * s[2] + d[1]
         vb2 = w[0] * s[1] - w[1] * s[0] + d[2]
         vz = V[2] + R[2, 0] * vb0 + R[2, 1] * vb1 + R[2, 2] * vb2
-        pen = cpar[i, C_R] - (zc - fpar[F_BLOCK_Z])
-        out[i] = normal_force(pen, -vz, cpar[i, C_K], cpar[i, C_C], fpar[F_BETA])
-        out[3 + i] = pen
-        if -pen < gap:
-            gap = -pen
-    out[2] = gap if gap > 0.0 else 0.0
+        sg = cpar[i, C_N]
+        pen = cpar[i, C_R] - sg * (zc - cpar[i, C_Z])
+        out[i, 0] = normal_force(pen, -sg * vz, cpar[i, C_K], cpar[i, C_C], fpar[F_BETA])
+        out[i, 1] = pen

@@ -13,9 +13,12 @@ Equations (see docs/mechanics.md for the derivation):
     m dV/dt = F
     [J  B ] [dw/dt  ]   [tau - w x h - dJ/dt w                                    ]
     [B' mI] [deta/dt] = [Q - K q - C eta + 1/2 w' dJ/dq_j w + 2 w . sum_k S_jk eta_k]
-with h = J w + B eta. The block is the plane z = 0; tip i is a sphere of radius R whose
-centre is the material point x_i = -+(L/2 - R) on the axis. Stick is an exact
-constraint (zero slip velocity of the contact point), its force solved each evaluation.
+with h = J w + B eta. Each contact row is a pair: a contact point of the bar (a sphere of
+radius R centred on a material point: an end cap x_i = -+(L/2 - R) on the axis, or a
+rivet) and the fixed contact it strikes, a plane z = C_Z facing up (below the bar, as the
+block z = 0) or down (above it); the point's penetration, normal force and repulsion act
+along that plane's normal. Stick is an exact constraint (zero slip velocity of the contact
+point), its force solved each evaluation.
 
 All functions here are numba-compiled; their Python sources (``.py_func``) are the
 readable reference and are tested against the compiled versions.
@@ -32,7 +35,8 @@ from .jit import njit
 from .inertia import inertia_matrix, inertia_terms, inertia_terms_sparse, schur_complement
 from .kernel_layout import (  # noqa: F401  (re-exported: the kernel's own names)
     F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MAX_RATIO, F_RTIP, D_VALUE, D_SLOPE, D_T0, K_MU, K_REPULSION,
-    F_VREG, F_BAUM, F_VBOUND, F_BLOCK_Z, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN,
+    F_VREG, F_BAUM, F_VBOUND, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN, C_Z, C_N, MAX_PAIRS,
+    quadrature_rows,
     N_FPAR, I_N, I_PLANAR, I_FRICTION, I_MOUNT, I_NLOAD, I_INERTIA, N_IPAR, INERTIA_GRAM,
     INERTIA_SPARSE, FRICTION_NONE, FRICTION_EXACT, FRICTION_REGULARIZED, MOUNT_FREE, MOUNT_CLAMP,
     MOUNT_PIVOT, C_K, C_C, C_R, C_ON, LOAD_FORCE, LOAD_SPRING, L_KIND, L_POINT, L_BODY, L_DX,
@@ -49,6 +53,7 @@ from .kernel_layout import (  # noqa: F401  (re-exported: the kernel's own names
 # the pure-Python laws and layout, compiled for the loop (their modules stay numba-free)
 layout = njit(cache=True)(state_sizes)
 arm_offset = njit(cache=True)(armature_offset)
+quad_rows = njit(cache=True)(quadrature_rows)
 normal_force = njit(cache=True)(_contact_laws.normal_force)
 friction_limit = njit(cache=True)(_friction.friction_limit)
 regularized_scale = njit(cache=True)(_friction.regularized_scale)
@@ -111,9 +116,11 @@ def make_work(n):
         np.zeros((3, 3)), np.zeros((3, n)), np.zeros((3, 3)),  # J B Ainv
         np.zeros(3), np.zeros(n), np.zeros(3),  # f_r f_e F
         np.zeros(3), np.zeros(n), np.zeros(3),  # wdot etadot Vdot
-        np.zeros((2, 3)), np.zeros((2, 3)), np.zeros((2, 3)),  # s_tip sdot_tip theta_dot_tip (body)
-        np.zeros((2, 3)),  # vP world
-        np.zeros((4, 3)), np.zeros((4, n)), np.zeros((4, 3)),  # unit responses: wdot etadot Vdot
+        # per contact row (at most MAX_PAIRS): s_tip sdot_tip theta_dot_tip (body), vP (world)
+        np.zeros((MAX_PAIRS, 3)), np.zeros((MAX_PAIRS, 3)), np.zeros((MAX_PAIRS, 3)),
+        np.zeros((MAX_PAIRS, 3)),
+        # unit responses wdot etadot Vdot: 2 tangential directions per sticking row
+        np.zeros((2 * MAX_PAIRS, 3)), np.zeros((2 * MAX_PAIRS, n)), np.zeros((2 * MAX_PAIRS, 3)),
         np.zeros(12), np.zeros((3, 3)),  # small vectors (an armature's terms at 6-10), Schur complement
     )
 
@@ -337,7 +344,9 @@ def table_value(tabs, start, count, t):
 
 @njit(cache=True)
 def _tip_accel(k, R, s_tip, psi, theta, n, Rtip, Vdot, wdot, etadot, out):
-    """World acceleration of tip k's contact point from (Vdot, wdot, etadot), no velocity terms."""
+    """World acceleration of contact row k's contact point from (Vdot, wdot, etadot), no
+    velocity terms; Rtip: the point's signed offset from the cap's centre along -z (the
+    cap's radius times its fixed contact's normal, C_N)."""
     # a = Vdot + R (wdot x s + Psi etadot) + (R (wdot + Theta etadot)) x (0, 0, -Rtip)
     ab0 = wdot[1] * s_tip[k, 2] - wdot[2] * s_tip[k, 1]
     ab1 = wdot[2] * s_tip[k, 0] - wdot[0] * s_tip[k, 2]
@@ -448,9 +457,9 @@ def card_penetration(qa, va, z, vz, apar):
 def _armature_alone(t, y, ipar, arm, drive, dy, aux, sv):
     """dynamics of a model without a bar: the armature's two states, its quadratures (the
     drive's work, the dissipation), its terms into sv[6:11] as beside a bar
-    (_armature_on_bar), and the two contact rows of aux switched off."""
+    (_armature_on_bar), and the contact rows of aux switched off."""
     apar, again, closed = arm
-    for i in range(2):
+    for i in range(aux.shape[0]):
         for c_ in range(NAUX):
             aux[i, c_] = 0.0
         aux[i, A_Y] = -1e3
@@ -520,14 +529,14 @@ def _armature_rates(y, base, arm, sv, dy):
 
 @njit(cache=True)
 def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
-    """Time derivative of the state into ``dy``; per-contact-point quantities into ``aux`` (2, NAUX).
+    """Time derivative of the state into ``dy``; per-contact-row quantities into ``aux`` (rows, NAUX).
 
     mdl: the model arrays and, last, the drive (model.BarModel.kernel_arrays: each contact
     point's friction coefficient and repulsion and the armature's force over time, set by
     the caller, found through the model's index array cdrive and ipar[I_ARM_DRIVE]; the
-    model's arrays never change). regime: (2,) FREE/SLIP/STICK per
-    contact point (friction bookkeeping; the normal force always follows the
-    penetration). eref: (2, 2) reference slip direction per contact point.
+    model's arrays never change). regime: (rows,) FREE/SLIP/STICK per
+    contact row (friction bookkeeping; the normal force always follows the
+    penetration). eref: (rows, 2) reference slip direction per contact row.
     arm: None, or the armature's arrays (model.BarModel.kernel_armature: its parameters
     AP_*, its gain table, its contacts' states EA_*). An argument of its own, not in mdl:
     numba compiles the kernel once for None, where every armature branch is removed
@@ -549,7 +558,6 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
     unpack(y, n, planar, r, R, q, V, w, eta)
     m = fpar[F_MASS]
     beta = fpar[F_BETA]
-    zb = fpar[F_BLOCK_Z]
 
     # Inertia, centrifugal, gyroscopic, stiffness and damping terms (mech/inertia.py):
     # the Gram-product route for the analytic free-free basis, the sparse-list route for a
@@ -598,7 +606,8 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
     n_stick = 0
     Fw = sv[0:3]
     Mw = sv[3:6]
-    for i in range(2):
+    rows = cpar.shape[0]
+    for i in range(rows):
         if cpar[i, C_ON] == 0.0:
             # no such contact point: a far gap that never closes
             for c_ in range(NAUX):
@@ -611,6 +620,8 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
         k_h = cpar[i, C_K]
         c_h = cpar[i, C_C]
         Rtip = cpar[i, C_R]
+        sg = cpar[i, C_N]  # the fixed contact's normal: +1 facing up, -1 facing down
+        rs = sg * Rtip  # the contact point: the cap's centre + (0, 0, -rs)
         # cap centre: body position, velocity; section rotation rate
         s_tip[i, 0] = xc[i, 0]
         s_tip[i, 1] = xc[i, 1]
@@ -635,12 +646,12 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
         ob2 = w[2] + th_tip[i, 2]
         ow0 = R[0, 0] * ob0 + R[0, 1] * ob1 + R[0, 2] * ob2
         ow1 = R[1, 0] * ob0 + R[1, 1] * ob1 + R[1, 2] * ob2
-        # contact point P = centre + (0, 0, -Rtip): v_P = v_c + Omega x (0, 0, -Rtip)
-        vP[i, 0] = vc0 - ow1 * Rtip
-        vP[i, 1] = vc1 + ow0 * Rtip
+        # contact point P = centre + (0, 0, -rs): v_P = v_c + Omega x (0, 0, -rs)
+        vP[i, 0] = vc0 - ow1 * rs
+        vP[i, 1] = vc1 + ow0 * rs
         vP[i, 2] = vc2
-        pen = Rtip - (zc - zb)
-        pdot = -vc2
+        pen = Rtip - sg * (zc - cpar[i, C_Z])
+        pdot = -sg * vc2
         fn = normal_force(pen, pdot, k_h, c_h, beta)
         aux[i, A_Y] = pen
         aux[i, A_YDOT] = pdot
@@ -658,7 +669,7 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
         if fn > 0.0:
             Fw[0] = 0.0
             Fw[1] = 0.0
-            Fw[2] = fn
+            Fw[2] = sg * fn
             Mw[0] = 0.0
             Mw[1] = 0.0
             Mw[2] = 0.0
@@ -687,9 +698,9 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
                 Fw[0] = ftx
                 Fw[1] = fty
                 Fw[2] = 0.0
-                # moment of the friction force about the sphere centre: (0,0,-Rtip) x Ft
-                Mw[0] = Rtip * fty
-                Mw[1] = -Rtip * ftx
+                # moment of the friction force about the sphere centre: (0,0,-rs) x Ft
+                Mw[0] = rs * fty
+                Mw[1] = -rs * ftx
                 Mw[2] = 0.0
                 _add_point_force(i, Fw, Mw, R, s_tip, psi, theta, n, F, f_r, f_e)
                 aux[i, A_FTX] = ftx
@@ -697,20 +708,20 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
                 d_friction -= ftx * vP[i, 0] + fty * vP[i, 1]
                 aux[i, A_MARGIN] = lim - math.sqrt(ftx * ftx + fty * fty)
         if pen > 0.0:
-            # a driven force on the touching contact point along the block's normal, away
-            # from it (Holm's electrodynamic repulsion of the constriction): it acts through
-            # the contact point, so it has no moment about the cap centre; its power is work
-            # put in (Q_WIN)
+            # a driven force on the touching contact point along its fixed contact's normal,
+            # away from it (Holm's electrodynamic repulsion of the constriction): it acts
+            # through the contact point, so it has no moment about the cap centre; its power
+            # is work put in (Q_WIN)
             rep = drive_at(t, drive, cdrive[i, K_REPULSION])
             if rep != 0.0:
                 Fw[0] = 0.0
                 Fw[1] = 0.0
-                Fw[2] = rep
+                Fw[2] = sg * rep
                 Mw[0] = 0.0
                 Mw[1] = 0.0
                 Mw[2] = 0.0
                 _add_point_force(i, Fw, Mw, R, s_tip, psi, theta, n, F, f_r, f_e)
-                w_drive += rep * vP[i, 2]
+                w_drive += Fw[2] * vP[i, 2]
 
     w_in = w_drive
     nload = ipar[I_NLOAD]
@@ -781,18 +792,19 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
     if dy.shape[0] >= base + NQ:
         dy[base + Q_WIN] = w_in
         dy[base + Q_DLOAD] = d_load
-    for i in range(2):
+    for i in range(rows):
         p = aux[i, A_FN] * aux[i, A_YDOT]
-        dy[base + Q_WCOMP + 2 * i] = p if p > 0.0 else 0.0
-        dy[base + Q_WCOMP + 2 * i + 1] = p if p < 0.0 else 0.0
-        dy[base + Q_IMPULSE + i] = aux[i, A_FN]
+        q_comp, q_rest, q_imp = quad_rows(i)
+        dy[base + q_comp] = p if p > 0.0 else 0.0
+        dy[base + q_rest] = p if p < 0.0 else 0.0
+        dy[base + q_imp] = aux[i, A_FN]
 
 
 @njit(cache=True)
 def _sticking_tips(regime, aux):
-    tips = np.empty(2, np.int64)
+    tips = np.empty(regime.shape[0], np.int64)
     ns = 0
-    for i in range(2):
+    for i in range(regime.shape[0]):
         if regime[i] == STICK and aux[i, A_FN] > 0.0:
             tips[ns] = i
             ns += 1
@@ -938,14 +950,15 @@ def _stick_matrix(n, planar, mount, R, s_tip, psi, theta, Ainv, B, m, cpar, tips
             Fz[:] = 0.0
             Fw[:] = 0.0
             Fw[d] = 1.0
-            Mw[0] = cpar[i, C_R] * Fw[1]
-            Mw[1] = -cpar[i, C_R] * Fw[0]
+            Mw[0] = cpar[i, C_N] * cpar[i, C_R] * Fw[1]
+            Mw[1] = -cpar[i, C_N] * cpar[i, C_R] * Fw[0]
             Mw[2] = 0.0
             _add_point_force(i, Fw, Mw, R, s_tip, psi, theta, n, Fz, f_r, f_e)
             _solve_mounted(mount, Fz, f_r, f_e, Ainv, B, m, n, u_Vdot[col], u_wdot[col], u_etadot[col])
             for b_k in range(ns):
                 k = tips[b_k]
-                _tip_accel(k, R, s_tip, psi, theta, n, cpar[k, C_R], u_Vdot[col], u_wdot[col], u_etadot[col], acc)
+                _tip_accel(k, R, s_tip, psi, theta, n, cpar[k, C_N] * cpar[k, C_R], u_Vdot[col], u_wdot[col],
+                           u_etadot[col], acc)
                 for d2 in range(ndir):
                     W[b_k * ndir + d2, col] = acc[d2]
     return W
@@ -968,7 +981,7 @@ def _apply_stick(fpar, n, planar, mount, R, w, eta, s_tip, sd_tip, th_tip, vP, r
     # R (2 w x sdot + w x (w x s)) + (R (w x theta_dot)) x (0, 0, -Rtip)
     for b_k in range(ns):
         k = tips[b_k]
-        Rtip = cpar[k, C_R]
+        Rtip = cpar[k, C_N] * cpar[k, C_R]  # (signed: the contact point is the centre + (0, 0, -Rtip))
         _tip_accel(k, R, s_tip, psi, theta, n, Rtip, Vdot, wdot, etadot, acc)
         s0, s1, s2 = s_tip[k, 0], s_tip[k, 1], s_tip[k, 2]
         ws0 = w[1] * s2 - w[2] * s1
@@ -1141,11 +1154,11 @@ def energies(y, mdl, work, out, arm=None):
         el += 0.5 * q[sp_idx[e, 0]] * sp_val[e] * q[sp_idx[e, 1]]
     hz = 0.0
     s = np.empty(3)
-    for i in range(2):
+    for i in range(cpar.shape[0]):
         if cpar[i, C_ON] == 0.0:
             continue
         tip_offset(i, xc, psi, q, n, s)
-        pen = cpar[i, C_R] - (r[2] + R[2, 0] * s[0] + R[2, 1] * s[1] + R[2, 2] * s[2] - fpar[F_BLOCK_Z])
+        pen = cpar[i, C_R] - cpar[i, C_N] * (r[2] + R[2, 0] * s[0] + R[2, 1] * s[1] + R[2, 2] * s[2] - cpar[i, C_Z])
         if pen > 0.0:
             hz += 0.4 * cpar[i, C_K] * pen * pen * math.sqrt(pen)
     sp = 0.0

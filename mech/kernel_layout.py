@@ -8,11 +8,11 @@ that imports nothing lets the Python side run without loading the compiler.
 from __future__ import annotations
 
 
-# fpar indices (F_K, F_C, F_RTIP: the first contact point's values, kept for the scales;
-# the kernel reads each contact point's own from cpar)
+# fpar indices (F_K, F_C, F_RTIP: the first contact pair's values, kept for the scales;
+# the kernel reads each contact pair's own from cpar, its fixed contact's plane too)
 (F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MAX_RATIO, F_RTIP, F_VREG, F_BAUM,
- F_VBOUND, F_BLOCK_Z, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN) = range(17)
-N_FPAR = 17
+ F_VBOUND, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN) = range(16)
+N_FPAR = 16
 # the armature's one-sided contacts (its rest stop, pole stop and card, EA_* below) that
 # the solver has found closed at its events (1.0) or open (0.0), and whether it is seated:
 # their forces act only while closed, so a step never integrates across the jump c v of a
@@ -43,9 +43,22 @@ FRICTION_NONE, FRICTION_EXACT, FRICTION_REGULARIZED = 0, 1, 2
 # with a piecewise-constant velocity (none), pivoted about body y (rotation only, planar);
 # MOUNT_NONE: no bar at all, an armature alone (its state only)
 MOUNT_FREE, MOUNT_CLAMP, MOUNT_PIVOT, MOUNT_NONE = 0, 1, 2, 3
-# per contact point (cpar rows 0, 1): Hertz stiffness N/m^1.5, damping c, cap radius m,
-# 1.0 when the point exists
-C_K, C_C, C_R, C_ON = range(4)
+# per contact pair (cpar rows: a contact point of the bar and the fixed contact it strikes;
+# at least CONTACT_ROWS rows, the model's own pairs first, a row without a pair switched
+# off): Hertz stiffness N/m^1.5, damping c, cap radius m, 1.0 when the pair exists, the
+# world height of the fixed contact's surface m (the plane z = C_Z) and its normal, +1.0
+# facing up (below the bar: the block) or -1.0 facing down (above it: the NC contact of a
+# changeover), along which the point's penetration, the normal force and a repulsion act
+C_K, C_C, C_R, C_ON, C_Z, C_N = range(6)
+N_CPAR = 6
+# contact rows of every model: a model of one pair (a single contact) carries a second,
+# switched-off row, so that the one- and two-point models of before the pairs keep their
+# arrays, events and state; beyond them a model has one row per pair, at most MAX_PAIRS
+# (a changeover's NO and NC, a bridge's two points, the two of a double-break
+# changeover): the stick constraint's matrix (2 per pair in 3D) stays small, and each
+# pair adds NEV_TIP events and 3 quadratures
+CONTACT_ROWS = 2
+MAX_PAIRS = 4
 # per load (rows of ``load``): actuator force (a time table of magnitude times a unit
 # direction, world or body frame) or linear spring-dashpot to a world anchor
 LOAD_FORCE, LOAD_SPRING = 0, 1
@@ -63,14 +76,16 @@ N_APAR = 13  # AP_HMAX: s, the longest step while a stop or the card is closed (
 N_ARM = 2  # its states
 # regimes of a tip
 FREE, SLIP, STICK = 0, 1, 2
-# quadratures: dissipations; per tip i, compression work at Q_WCOMP + 2i, restitution
-# work at Q_WCOMP + 2i + 1, normal impulse at Q_IMPULSE + i; work put in by actuators
-# and by a moving clamp (Q_WIN); dashpot dissipation of springs and pivot (Q_DLOAD)
-# (the last two exist only in models with loads or a mount: NQ_FREE quadratures otherwise,
-# so a plain free bar's state and error norm are what they were)
+# quadratures: dissipations; per contact row i < 2, compression work at Q_WCOMP + 2i,
+# restitution work at Q_WCOMP + 2i + 1, normal impulse at Q_IMPULSE + i; work put in by
+# actuators and by a moving clamp (Q_WIN); dashpot dissipation of springs and pivot
+# (Q_DLOAD) (the last two exist only in models with loads or a mount: NQ_FREE quadratures
+# otherwise, so a plain free bar's state and error norm are what they were); rows i >= 2
+# (models of more than two pairs) have their three after Q_DLOAD (quadrature_rows)
 Q_DNORMAL, Q_DFRICTION, Q_DMODAL, Q_WCOMP, Q_IMPULSE, Q_WIN, Q_DLOAD = 0, 1, 2, 3, 7, 9, 10
 NQ_FREE = 9
 NQ = 11
+NQ_PAIR = 3  # per contact row beyond the first two: compression work, restitution work, impulse
 # aux columns per tip
 A_Y, A_YDOT, A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_MARGIN = range(8)
 NAUX = 8
@@ -78,7 +93,7 @@ NAUX = 8
 # turn (dy/dt = 0: splits the normal work into compression and restitution exactly)
 EV_CONTACT, EV_CLIP, EV_SLIP, EV_STICK, EV_COMPRESSION = range(5)
 NEV_TIP = 5
-# the armature's events, after the tips' (index 2 NEV_TIP + EA_*): the rest stop (q), the
+# the armature's events, after the contact rows' (index rows x NEV_TIP + EA_*): the rest stop (q), the
 # pole stop (travel - q) and the card (its gap to the bar), each positive while open; the
 # turn (its speed, watched while a stop is closed and it is not seated) and the seat (the
 # force pressing it onto the stop it is seated on, watched while seated). The same indices
@@ -87,12 +102,28 @@ NEV_TIP = 5
 # stop (held there, its stop's force the reaction; docs/mechanics.md, "The armature")
 EA_REST, EA_POLE, EA_CARD, EA_TURN, EA_SEAT = range(5)
 NEV_ARM = 5
-NEV = 2 * NEV_TIP + NEV_ARM
+NEV = CONTACT_ROWS * NEV_TIP + NEV_ARM  # events of a model of CONTACT_ROWS rows (event_count)
 
 
 # what one call of the integrator ended with (mech.integrator.integrate)
 DONE, EVENT, BUFFER_FULL, STEP_TOO_SMALL, NOT_FINITE, MAX_STEPS = range(6)
 STATUS_TEXT = ("done", "event", "buffer full", "step size too small", "non-finite state", "too many steps")
+
+
+def quadrature_rows(i: int) -> tuple[int, int, int]:
+    """Offsets in the quadratures of contact row i's compression work, restitution work
+    (J) and normal impulse (N s): Q_WCOMP + 2i, + 1 and Q_IMPULSE + i for the first two
+    rows, NQ + NQ_PAIR (i - 2) + 0, 1, 2 beyond them."""
+    if i < 2:
+        return Q_WCOMP + 2 * i, Q_WCOMP + 2 * i + 1, Q_IMPULSE + i
+    base = NQ + NQ_PAIR * (i - 2)
+    return base, base + 1, base + 2
+
+
+def event_count(rows: int) -> int:
+    """Events of a model with ``rows`` contact rows: NEV_TIP per row, then the armature's
+    (at rows x NEV_TIP + EA_*)."""
+    return rows * NEV_TIP + NEV_ARM
 
 
 def state_sizes(n: int, planar: bool) -> tuple[int, int]:

@@ -8,9 +8,14 @@ and its invariants about the frame origin: the support for a held bar, the compo
 centroid for a free one.
 
 Geometry (body frame): b1 along the bar, origin at ``x0`` m from tip 0; a point at
-``position`` s m from tip 0 with ``offset`` h m along b3 sits at (s - x0, 0, h). Contact
-points are rows 0 and 1 of the point arrays (a missing second one is switched off);
-load points follow.
+``position`` s m from tip 0 with ``offset`` h m along b3 sits at (s - x0, 0, h).
+
+Contact pairs: a contact point of the bar (a rivet or an end cap) and the fixed contact it
+strikes. With [block], every contact point strikes the block (a pair per point, at most
+two); with [[fixed]] entries, each is a pair with the point it names (at most
+kernel_layout.MAX_PAIRS). The pairs' points are the first rows of the point arrays, at
+least kernel_layout.CONTACT_ROWS of them (a missing second one is switched off); load
+points follow.
 """
 
 from __future__ import annotations
@@ -23,8 +28,8 @@ import numpy as np
 from .beam_fe import FEBeam, PointMass, beam_basis, beam_invariants, point_shapes
 from .contact_laws import hertz_stiffness
 from .kernel_layout import (
-    L_AX, L_AY, L_AZ, L_BODY, L_C, L_DX, L_DY, L_DZ, L_K, L_KIND, L_POINT,
-    L_T0, L_TN, LOAD_FORCE, LOAD_SPRING, N_LOAD,
+    C_C, C_K, C_N, C_ON, C_R, C_Z, CONTACT_ROWS, L_AX, L_AY, L_AZ, L_BODY, L_C, L_DX, L_DY, L_DZ, L_K, L_KIND,
+    L_POINT, L_T0, L_TN, LOAD_FORCE, LOAD_SPRING, N_CPAR, N_LOAD,
 )
 from .modal_basis import ModalBasis
 from .parameters import MechScene
@@ -43,27 +48,71 @@ class ContactPoint:
     poisson_ratio: float
 
 
+@dataclass(frozen=True)
+class ContactPair:
+    """A contact point and the fixed contact it strikes (SI). fixed: the fixed contact's
+    name ("block" for [block]); key: where the scene gives it ("block", "fixed[1]"), for
+    messages; shape "plane" or "sphere" (radius m; offset m of its top from the point's
+    start along the bar's horizontal direction); normal: +1.0 facing up (below the bar),
+    -1.0 facing down (above it); height (m, world z of its surface) or gap (m from the
+    point's cap at the start), one of them None; its material (Pa, -); electrical: a
+    contact the circuit sees (False: a mechanical stop)."""
+
+    point: ContactPoint
+    fixed: str
+    key: str
+    shape: str
+    radius: float | None
+    offset: float
+    normal: float
+    height: float | None
+    gap: float | None
+    youngs_modulus: float
+    poisson_ratio: float
+    electrical: bool
+
+    @property
+    def effective_radius(self) -> float:
+        """m: the Hertz radius of the point's cap against the fixed contact, R1 R2 / (R1 + R2)
+        against a sphere."""
+        r = self.point.radius
+        return r if self.shape != "sphere" else r * self.radius / (r + self.radius)
+
+
 def needs_mechanism(scene: MechScene) -> bool:
-    """True when the scene is more than the free bar on its two end caps (an armature's card
-    is a load point on the bar)."""
-    return bool(scene.mount.held or scene.rivets or scene.forces or scene.springs
+    """True when the scene is more than the free bar on its two end caps over the plane
+    block (an armature's card is a load point on the bar)."""
+    return bool(scene.mount.held or scene.rivets or scene.forces or scene.springs or scene.fixed
                 or scene.block.shape != "plane" or scene.armature.has_card)
 
 
 def contact_points(scene: MechScene) -> list[ContactPoint]:
-    """The contact caps: the rivets, or else the end caps not inside a clamp or hinge."""
+    """The contact caps: the rivets, or else the end caps not inside a clamp or hinge, named
+    as MechScene.contact_point_names says."""
     bar = scene.bar
+    names = scene.contact_point_names()
     if scene.rivets:
-        return [ContactPoint(rv.name, rv.position, rv.offset, rv.radius,
+        return [ContactPoint(name, rv.position, rv.offset, rv.radius,
                              rv.youngs_modulus or bar.youngs_modulus,
                              rv.poisson_ratio if rv.poisson_ratio is not None else bar.poisson_ratio)
-                for rv in scene.rivets]
-    tips = [ContactPoint(f"tip {i}", s, 0.0, bar.tip_radius, bar.youngs_modulus, bar.poisson_ratio)
-            for i, s in enumerate((bar.tip_radius, bar.length - bar.tip_radius))]
-    if scene.mount.held:
-        # an end cap within its radius of the support is held, not a contact
-        tips = [tp for tp in tips if abs(tp.position - scene.mount.position) > bar.tip_radius]
-    return tips
+                for name, rv in zip(names, scene.rivets)]
+    ends = {"tip0": bar.tip_radius, "tip1": bar.length - bar.tip_radius}
+    return [ContactPoint(name, ends[name], 0.0, bar.tip_radius, bar.youngs_modulus, bar.poisson_ratio)
+            for name in names]
+
+
+def contact_pairs(scene: MechScene) -> list[ContactPair]:
+    """The contact pairs, in the order of their contact rows: one per [[fixed]] entry (in
+    its order) with the point it names; with [block], one per contact point."""
+    cps = contact_points(scene)
+    if not scene.fixed:
+        b = scene.block
+        return [ContactPair(cp, "block", "block", b.shape, b.radius, b.offset, 1.0, 0.0, None,
+                            b.youngs_modulus, b.poisson_ratio, True) for cp in cps]
+    by_name = {cp.name: cp for cp in cps}
+    return [ContactPair(by_name[fx.point], name, fx.key, fx.shape, fx.radius, fx.offset, fx.normal, fx.height,
+                        fx.gap, fx.youngs_modulus, fx.poisson_ratio, fx.electrical)
+            for name, fx in zip(scene.fixed_names(), scene.fixed)]
 
 
 def fe_beam(scene: MechScene) -> FEBeam:
@@ -89,12 +138,18 @@ class MechanismArrays:
     basis: ModalBasis
     x0: float  # m from tip 0: the body frame's origin
     points: tuple  # (psi (P, n, 3), theta (P, n, 3), xc (P, 3))
-    contacts: list  # ContactPoint per enabled contact row
+    pairs: list  # ContactPair per enabled contact row
     first_moments: np.ndarray  # (3, 2n + 1): c, L_j, H_j
     load: np.ndarray  # (n_loads, N_LOAD)
     tables: np.ndarray  # (2, k)
     spring_points: list  # (load row, spring) for the rest-length set-up
     card_row: int = -1  # the armature card's point row (-1: no card)
+    rows: int = CONTACT_ROWS  # contact rows (the pairs', at least CONTACT_ROWS): the load points' rows follow
+
+    @property
+    def contacts(self) -> list:
+        """The ContactPoint of each enabled contact row."""
+        return [p.point for p in self.pairs]
 
 
 def build_arrays(scene: MechScene, planar: bool) -> MechanismArrays:
@@ -109,7 +164,8 @@ def build_arrays(scene: MechScene, planar: bool) -> MechanismArrays:
     x0 = inv.x0
     n = inv.n
 
-    cps = contact_points(scene)
+    pairs = contact_pairs(scene)
+    cps = [p.point for p in pairs]
     s_pts = [cp.position for cp in cps]
     h_pts = [cp.offset for cp in cps]
     loads = list(scene.forces) + list(scene.springs)
@@ -118,8 +174,9 @@ def build_arrays(scene: MechScene, planar: bool) -> MechanismArrays:
     if scene.armature.has_card:  # the card's point on the axis, after the loads'
         s_pts.append(scene.armature.card_position)
         h_pts.append(0.0)
-    # two contact rows always; a missing second contact is a switched-off dummy row
-    if len(cps) < 2:
+    # CONTACT_ROWS contact rows at least; a missing second contact is a switched-off dummy row
+    rows = max(len(cps), CONTACT_ROWS)
+    if len(cps) < CONTACT_ROWS:
         s_pts.insert(len(cps), s_pts[0] if s_pts else 0.0)
         h_pts.insert(len(cps), 0.0)
     if len(cps) == 0:
@@ -144,7 +201,7 @@ def build_arrays(scene: MechScene, planar: bool) -> MechanismArrays:
     times, values = [], []
     for k, ld in enumerate(loads):
         row = load[k]
-        row[L_POINT] = 2 + k
+        row[L_POINT] = rows + k
         if k < len(scene.forces):
             row[L_KIND] = LOAD_FORCE
             row[L_BODY] = 1.0 if ld.frame == "body" else 0.0
@@ -167,24 +224,56 @@ def build_arrays(scene: MechScene, planar: bool) -> MechanismArrays:
         psi_tip=psi[:2], theta_tip=theta[:2], x_centre=xc[:2, 0].copy(),
     )
     springs = [(len(scene.forces) + k, sp) for k, sp in enumerate(scene.springs)]
-    card = 2 + len(loads) if scene.armature.has_card else -1
-    return MechanismArrays(basis, x0, (psi, theta, xc), cps, first, load, tables, springs, card)
+    card = rows + len(loads) if scene.armature.has_card else -1
+    return MechanismArrays(basis, x0, (psi, theta, xc), pairs, first, load, tables, springs, card, rows)
 
 
-def contact_parameters(cps, block, stiffness_override, dampings) -> np.ndarray:
-    """cpar rows (k N/m^1.5, c, cap radius m, on) of the contact points.
-
-    The Hertz stiffness uses the effective radius R1 R2/(R1 + R2) against a spherical block.
-    """
-    cpar = np.zeros((2, 4))
-    for i, cp in enumerate(cps):
-        r_eff = cp.radius
-        if block.shape == "sphere":
-            r_eff = cp.radius * block.radius / (cp.radius + block.radius)
-        k = stiffness_override or hertz_stiffness(r_eff, cp.youngs_modulus, cp.poisson_ratio,
-                                                  block.youngs_modulus, block.poisson_ratio)
-        cpar[i] = (k, dampings[i] if i < len(dampings) else dampings[0], cp.radius, 1.0)
+def contact_parameters(pairs, rows: int, stiffness_override, dampings, planes=None) -> np.ndarray:
+    """cpar (rows, N_CPAR) of the contact pairs (kernel_layout C_*): Hertz stiffness
+    (N/m^1.5) of the point's cap against its fixed contact (the effective radius R1 R2 /
+    (R1 + R2) against a sphere), damping c, cap radius m, on, and the fixed contact's
+    plane: ``planes`` (height m, normal +-1) per pair (None: z = 0 facing up, the block's);
+    rows without a pair are switched off."""
+    cpar = np.zeros((rows, N_CPAR))
+    for i, pair in enumerate(pairs):
+        cp = pair.point
+        k = stiffness_override or hertz_stiffness(pair.effective_radius, cp.youngs_modulus, cp.poisson_ratio,
+                                                  pair.youngs_modulus, pair.poisson_ratio)
+        cpar[i, [C_K, C_C, C_R, C_ON]] = (k, dampings[i] if i < len(dampings) else dampings[0], cp.radius, 1.0)
+        cpar[i, [C_Z, C_N]] = planes[i] if planes is not None else (0.0, 1.0)
     return cpar
+
+
+def fixed_planes(pairs, xc: np.ndarray, R0: np.ndarray, z0: float) -> list[tuple[float, float]]:
+    """(height m, normal +-1) of each pair's fixed contact, its surface placed where the
+    scene says: ``height``, or ``gap`` from its point's cap in the initial pose (frame
+    height z0 m, rotation R0, no deflection). A fixed contact facing up above its point's
+    cap centre, or one its point starts inside of (deeper than 1e-9 of the cap's radius,
+    a round-off of a hand-computed height), is an error naming its key."""
+    out = []
+    for i, pair in enumerate(pairs):
+        r = pair.point.radius
+        z = z0 + float((R0 @ xc[i])[2])  # the cap's centre
+        n = pair.normal
+        height = z - n * (r + pair.gap) if pair.height is None else pair.height
+        if pair.height is None:  # (round-off must not put the point a hair inside it)
+            while r - n * (z - height) > 0.0:
+                height = float(np.nextafter(height, -n * math.inf))
+        where = "height" if pair.height is not None else "gap"
+        value = pair.height if pair.height is not None else pair.gap
+        if n > 0.0 and height > z:
+            raise ValueError(f"{pair.key}.{where} = {value!r}: it faces up, but its surface (z = {height:.6g} m) "
+                             f"lies above its point {pair.point.name!r} (cap centre at z = {z:.6g} m); a fixed "
+                             "contact above the point faces down (facing = 'down')")
+        pen = r - n * (z - height)
+        if pen > 1e-9 * r:
+            side = "top" if n < 0.0 else "bottom"
+            edge = z - n * r
+            raise ValueError(f"{pair.key}.{where} = {value!r}: its point {pair.point.name!r} would start {pen:.3g} m "
+                             f"inside it (the cap's {side} is at z = {edge:.6g} m); place its surface at or "
+                             f"{'above' if n < 0.0 else 'below'} that (or give gap >= 0)")
+        out.append((height, n))
+    return out
 
 
 def frame_height(scene: MechScene, xc: np.ndarray, cps, R0: np.ndarray) -> float:
@@ -254,10 +343,10 @@ def closing_work(scene: MechScene, arr: MechanismArrays) -> float:
     gravity over the initial gap); a scale for the error control, not a prediction."""
     gap = scene.initial.height
     # each load's largest force times how far its point travels while the contact closes
-    force = sum(max(abs(v) for v in f.table()[1]) * _lever(arr, scene, 2 + k)
+    force = sum(max(abs(v) for v in f.table()[1]) * _lever(arr, scene, arr.rows + k)
                 for k, f in enumerate(scene.forces))
     nf = len(scene.forces)
-    force += sum((abs(sp.preload or 0.0) + sp.stiffness * gap) * _lever(arr, scene, 2 + nf + k)
+    force += sum((abs(sp.preload or 0.0) + sp.stiffness * gap) * _lever(arr, scene, arr.rows + nf + k)
                  for k, sp in enumerate(scene.springs))
     xc = arr.points[2]
     if scene.mount.kind == "pivot":

@@ -20,6 +20,7 @@ from .contact_laws import damping_formula, hertz_impact, hertz_stiffness
 from .damping_calibration import calibrate_damping
 from .drives import ARMATURE_DRIVE, DriveKind, kind_of
 from .kernel_layout import (
+    C_N, C_Z, CONTACT_ROWS, N_CPAR, NEV_TIP, NQ_PAIR, event_count, quadrature_rows,
     CONTACT_DRIVES, D_VALUE, F_BAUM, F_BETA, F_C, F_G, F_GAMMA, F_VBOUND, F_K, F_MASS, F_MAX_RATIO, F_RTIP,
     N_DRIVE, AP_CARD_C, AP_CARD_K, AP_CARD_Z0, AP_DAMPING, AP_FREE, AP_LEVER, AP_MASS, AP_PRELOAD, AP_RATE,
     AP_HMAX, AP_STOP_C, AP_STOP_K, AP_TRAVEL, I_ARMATURE, I_ARM_CARD, I_ARM_DRIVE, I_ARM_NGAIN, MOUNT_NONE, N_APAR,
@@ -32,8 +33,8 @@ from .kernel_layout import (
     L_BODY, L_DX, L_DZ, L_KIND, L_POINT, L_T0, L_TN, LOAD_FORCE,
 )
 from .mechanism import (
-    MechanismArrays, build_arrays, closing_work, contact_parameters,
-    effective_contact_mass, fe_beam, frame_height, impulse_mass, needs_mechanism,
+    MechanismArrays, build_arrays, closing_work, contact_pairs, contact_parameters,
+    effective_contact_mass, fe_beam, fixed_planes, frame_height, impulse_mass, needs_mechanism,
 )
 from .modal_basis import ModalBasis, _quadrature, build_modal_basis, sparse_invariants
 from .mode_count import CAP, SAFETY, choose_mode_count
@@ -136,13 +137,14 @@ def contact_scales(scene: MechScene, n_modes: int) -> ContactScales:
 def mechanism_scales(scene: MechScene, arr: MechanismArrays, n_modes: int) -> ContactScales:
     """Contact constants and scales of a mechanism scene (held bar, rivets, loads).
 
-    The reference impact is the first contact point's: its effective mass
+    The reference impact is the first contact pair's: its point's effective mass
     (mechanism.effective_contact_mass) at the speed the closing work could give it (held
     bars) or the free-flight speed (free bars); ``contact.reference_speed`` overrides.
+    Each pair's damping is calibrated on its own stiffness; the shortest contact (the
+    step bound) is the stiffest pair's.
     """
-    con, blk = scene.contact, scene.block
-    cps = arr.contacts
-    ks = contact_parameters(cps, blk, con.stiffness, (0.0,))[: len(cps), C_K]
+    con = scene.contact
+    ks = contact_parameters(arr.pairs, arr.rows, con.stiffness, (0.0,))[: len(arr.pairs), C_K]
     m_eff = effective_contact_mass(arr, scene)
     work = closing_work(scene, arr)
     if scene.mount.held:
@@ -168,7 +170,7 @@ def mechanism_scales(scene: MechScene, arr: MechanismArrays, n_modes: int) -> Co
     return ContactScales(
         stiffness=k0, damping=dampings[0], beta=con.beta, reference_speed=v_ref, reference_mass=m_eff,
         penetration_scale=hertz_impact(m_eff, k0, v_ref).max_penetration,
-        shortest_contact=hertz_impact(m_min, k0, v_max).contact_time,
+        shortest_contact=hertz_impact(m_min, float(np.max(ks)), v_max).contact_time,
         energy_scale=max(e_avail, 1e-12), speed_bound=v_max, dampings=tuple(dampings),
     )
 
@@ -232,7 +234,8 @@ def _pivot_arc_bound(model: "BarModel", y0: np.ndarray, loads: list, energy: flo
     c = model.first_moments[:, 0]  # kg m, about the hinge (the frame origin)
     psi, _, xc = model.points
     phi0 = float(y0[2])
-    caps = [(xc[i], model.cpar[i, C_R]) for i in range(2) if model.cpar[i, C_ON] != 0.0]
+    cp = model.cpar
+    caps = [(xc[i], cp[i, C_R], cp[i, C_Z], cp[i, C_N]) for i in range(model.rows) if cp[i, C_ON] != 0.0]
 
     def potential(phi):
         phi = np.asarray(phi, dtype=float)
@@ -251,9 +254,9 @@ def _pivot_arc_bound(model: "BarModel", y0: np.ndarray, loads: list, energy: flo
         return v
 
     def clearance(phi, depth):
-        """m: the lowest cap's height above the block at angle(s) phi, plus ``depth``."""
+        """m: the nearest cap's gap to its fixed contact at angle(s) phi, plus ``depth``."""
         phi = np.asarray(phi, dtype=float)
-        z = [y0[1] - np.sin(phi) * p[0] + np.cos(phi) * p[2] - r for p, r in caps]
+        z = [sg * (y0[1] - np.sin(phi) * p[0] + np.cos(phi) * p[2] - zf) - r for p, r, zf, sg in caps]
         return np.min(z, axis=0) + depth
 
     def limit(direction, depth):
@@ -298,8 +301,9 @@ def _elastic_bound(model: "BarModel", y0: np.ndarray, loads: list, phi: float, e
     free = load_release_bound(K, f, energy)
     if not constrained or free <= 0.0:
         return free
-    c = -(psi[0] @ R[2])  # downward displacement of contact point 0 per unit q (m)
-    gap = float(y0[1] + R[2] @ xc[0]) - float(model.cpar[0, C_R])  # its cap above the block at the start
+    sg, zf = float(model.cpar[0, C_N]), float(model.cpar[0, C_Z])
+    c = -sg * (psi[0] @ R[2])  # displacement of contact pair 0's point towards its fixed contact per unit q (m)
+    gap = sg * (float(y0[1] + R[2] @ xc[0]) - zf) - float(model.cpar[0, C_R])  # its gap at the start
     k = float(model.cpar[0, C_K])
     depth = (2.5 * (free + max(energy, 0.0)) / k) ** 0.4 if k > 0.0 else 0.0
     return load_release_bound(K, f, energy, c, max(gap, 0.0) + depth)
@@ -482,8 +486,8 @@ class BarModel:
     relmask: np.ndarray
     max_step: float
     sparse: tuple  # the sparse inertia invariants (mech.modal_basis.sparse_invariants)
-    points: tuple  # (psi, theta, xc): contact caps (rows 0, 1) then load points
-    cpar: np.ndarray  # (2, 4) per contact point: k, c, cap radius, on
+    points: tuple  # (psi, theta, xc): the contact pairs' points (``rows`` rows) then load points
+    cpar: np.ndarray  # (rows, N_CPAR) per contact pair (kernel_layout C_*): k, c, cap radius, on, plane
     first_moments: np.ndarray  # (3, 2n + 1): c (kg m), L_j (kg), H_j (kg m), body frame
     load: np.ndarray  # (n_loads, N_LOAD) actuator forces and springs
     tables: np.ndarray  # (2, n) concatenated time tables of the loads
@@ -497,6 +501,25 @@ class BarModel:
     # the armature (kernel_layout AP_*; zeros without one) and its gain table (3, knots)
     apar: np.ndarray = field(default_factory=lambda: np.zeros(N_APAR))
     again: np.ndarray = field(default_factory=lambda: np.zeros((3, 0)))
+    # the contact pairs (mech.mechanism.ContactPair: the point, the fixed contact it strikes,
+    # its plane and whether the circuit sees it), in the order of their contact rows
+    pairs: tuple = ()
+
+    @property
+    def rows(self) -> int:
+        """Contact rows of the kernel's arrays (cpar, aux, regimes): the pairs' and, for a
+        single pair, a switched-off second (kernel_layout.CONTACT_ROWS)."""
+        return int(self.cpar.shape[0])
+
+    @property
+    def event_count(self) -> int:
+        """Event functions: NEV_TIP per contact row, then the armature's."""
+        return event_count(self.rows)
+
+    @property
+    def armature_event_base(self) -> int:
+        """Index of the armature's first event (kernel_layout EA_* follow it)."""
+        return self.rows * NEV_TIP
 
     @property
     def n(self) -> int:
@@ -580,18 +603,18 @@ class BarModel:
         """Per contact row: (outward body axis of its cap, cap half-angle rad), or (None, 0)
         where no cap limit applies (a rivet on the axis of the bar)."""
         bar = self.scene.bar
-        ends = {"tip 0": np.array([-1.0, 0.0, 0.0]), "tip 1": np.array([1.0, 0.0, 0.0])}
+        ends = {"tip0": np.array([-1.0, 0.0, 0.0]), "tip1": np.array([1.0, 0.0, 0.0])}
         if self.mechanism is None:
-            return [(ends["tip 0"], bar.cap_half_angle), (ends["tip 1"], bar.cap_half_angle)]
+            return [(ends["tip0"], bar.cap_half_angle), (ends["tip1"], bar.cap_half_angle)]
         out = []
         for cp in self.mechanism.contacts:
-            if cp.name in ends:
+            if cp.name in ends and not self.scene.rivets:
                 out.append((ends[cp.name], bar.cap_half_angle))
             elif cp.offset != 0.0:
                 out.append((np.array([0.0, 0.0, math.copysign(1.0, cp.offset)]), 0.5 * math.pi))
             else:
                 out.append((None, 0.0))
-        return out + [(None, 0.0)] * (2 - len(out))
+        return out + [(None, 0.0)] * (self.rows - len(out))
 
     @functools.cached_property
     def rest_window(self) -> float:
@@ -639,10 +662,18 @@ class BarModel:
         return float(y[sl["pos"]][0] + self.rotation(y)[0] @ s_body)
 
     @functools.cached_property
-    def sphere_top_x(self) -> float:
-        """m: world x of a spherical block's top: below the first contact point at the
-        start, shifted by block.offset."""
-        return self.contact_point_x(self.initial_state(), 0) + self.scene.block.offset
+    def sphere_tops(self) -> tuple:
+        """m per contact pair: world x of its spherical fixed contact's top (None: a plane):
+        [block]'s below the first contact point at the start, a [[fixed]] sphere's below (or
+        above) its own, each shifted by its offset."""
+        y0 = self.initial_state()
+        out = []
+        for i, pair in enumerate(self.pairs):
+            if pair.shape != "sphere":
+                out.append(None)
+                continue
+            out.append(self.contact_point_x(y0, 0 if pair.key == "block" else i) + pair.offset)
+        return tuple(out)
 
     def loads_ramping(self, t: float) -> bool:
         """True if some actuator force changes right after t (s): t lies inside a table
@@ -661,7 +692,7 @@ class BarModel:
     def nq(self) -> int:
         """Number of quadratures: the input-work and load-dissipation ones only when the
         scene has loads or a mount, or the model was built with ``input_work``."""
-        return quadrature_count(self.ipar, self.input_work)
+        return quadrature_count(self.ipar, self.input_work, self.rows)
 
     def slices(self) -> dict:
         """Named slices of the state vector."""
@@ -744,10 +775,13 @@ class BarModel:
         return y
 
 
-def quadrature_count(ipar: np.ndarray, input_work: bool) -> int:
+def quadrature_count(ipar: np.ndarray, input_work: bool, rows: int = CONTACT_ROWS) -> int:
     """NQ with the input-work and load-dissipation quadratures (a mount, loads, an armature,
     or asked for: a driven force on a free bar), NQ_FREE without them (a plain free bar
-    keeps the state and error norm it always had)."""
+    keeps the state and error norm it always had); a model of more than CONTACT_ROWS
+    contact rows has NQ and NQ_PAIR more per row beyond them (kernel_layout.quadrature_rows)."""
+    if rows > CONTACT_ROWS:
+        return NQ + NQ_PAIR * (rows - CONTACT_ROWS)
     held = ipar[I_MOUNT] != MOUNT_FREE or ipar[I_NLOAD] > 0 or ipar[I_ARMATURE] != 0
     return NQ if held or input_work else NQ_FREE
 
@@ -818,7 +852,9 @@ def build_model(scene: MechScene, *, input_work: bool = False) -> BarModel:
         ipar[I_MOUNT] = {"free": MOUNT_FREE, "clamp": MOUNT_CLAMP, "pivot": MOUNT_PIVOT}[scene.mount.kind]
         ipar[I_NLOAD] = len(arr.load)
     arm = scene.armature
-    n_points = 2 if arr is None else len(arr.contacts)
+    pairs = tuple(contact_pairs(scene)) if arr is None else tuple(arr.pairs)
+    rows = CONTACT_ROWS if arr is None else arr.rows
+    n_points = len(pairs)
     if arm.present:
         ipar[I_ARMATURE] = 1
         ipar[I_ARM_DRIVE] = 2 * n_points  # after the contact points' channels
@@ -832,7 +868,7 @@ def build_model(scene: MechScene, *, input_work: bool = False) -> BarModel:
     dstar = cs.penetration_scale
     vstar = cs.reference_speed
     npos, nvel = state_sizes(n, planar)
-    nq = quadrature_count(ipar, input_work)
+    nq = quadrature_count(ipar, input_work, rows)
     atol = np.empty(npos + nvel + (N_ARM if arm.present else 0) + nq)
     rel = np.zeros_like(atol)
     sl = state_slices(n, planar, nq, arm.present)
@@ -856,18 +892,20 @@ def build_model(scene: MechScene, *, input_work: bool = False) -> BarModel:
         atol[sl["quad"]] = rtol * cs.energy_scale
     # Quadrature of the impulse is in N s, not J: scale it by the reference momentum.
     quad0 = sl["quad"].start
-    atol[quad0 + 7: quad0 + 9] = rtol * cs.reference_mass * vstar
+    for i in range(rows):
+        atol[quad0 + quadrature_rows(i)[2]] = rtol * cs.reference_mass * vstar
     max_step = 0.25 * cs.shortest_contact
     if scene.solver.max_step is not None:
         max_step = min(max_step, scene.solver.max_step)
     if arr is None:
         xc = np.zeros((2, 3))
         xc[:, 0] = basis.x_centre
-        cpar = np.zeros((2, 4))
+        cpar = np.zeros((CONTACT_ROWS, N_CPAR))
         cpar[:, C_K] = cs.stiffness
         cpar[:, C_C] = cs.damping
         cpar[:, C_R] = scene.bar.tip_radius
         cpar[:, C_ON] = 1.0
+        cpar[:, C_N] = 1.0  # the block: the plane z = 0 facing up
         parts = dict(points=(basis.psi_tip, basis.theta_tip, xc), cpar=cpar,
                      first_moments=np.zeros((3, 2 * n + 1)), load=np.zeros((0, N_LOAD)), tables=np.zeros((2, 1)))
     else:
@@ -875,7 +913,8 @@ def build_model(scene: MechScene, *, input_work: bool = False) -> BarModel:
             _pivot_parameters(fpar, scene, arr.points[2])
         parts = dict(points=arr.points, mechanism=arr, first_moments=arr.first_moments, load=arr.load.copy(),
                      tables=arr.tables,
-                     cpar=contact_parameters(arr.contacts, scene.block, scene.contact.stiffness, cs.dampings))
+                     cpar=contact_parameters(arr.pairs, rows, scene.contact.stiffness, cs.dampings,
+                                             _fixed_planes(scene, arr, planar)))
     names, cdrive = contact_drives(n_points, len(parts["cpar"]))
     if arm.present:
         names += (ARMATURE_DRIVE,)
@@ -884,7 +923,7 @@ def build_model(scene: MechScene, *, input_work: bool = False) -> BarModel:
                      else gain_table(None, None))
     model = BarModel(scene, planar, basis, cs, fpar, ipar, math.radians(scene.initial.azimuth_deg), atol, rel,
                      max_step, sparse_invariants(basis), mode_count=mode_count, drive_names=names, cdrive=cdrive,
-                     input_work=input_work, **parts)
+                     input_work=input_work, pairs=pairs, **parts)
     if arr is not None and arr.spring_points:
         # the springs' rest lengths are measured on the initial state, which the other
         # arrays define: a second, complete model with them
@@ -894,6 +933,16 @@ def build_model(scene: MechScene, *, input_work: bool = False) -> BarModel:
         card = int(model.ipar[I_ARM_CARD])
         model = replace(model, apar=armature_parameters(arm, _card_height(model), point_mobility(model, card)))
     return model
+
+
+def _fixed_planes(scene: MechScene, arr: MechanismArrays, planar: bool):
+    """(height m, normal) of each pair's fixed contact ([[fixed]]; None for [block]: z = 0
+    facing up), placed in the initial pose as BarModel.initial_state places the bar."""
+    if not scene.fixed:
+        return None
+    R0 = rotation_z(math.radians(scene.initial.azimuth_deg)) @ rotation_y(-math.radians(scene.initial.angle_deg))
+    z0 = frame_height(scene, arr.points[2], arr.contacts, R0)
+    return fixed_planes(arr.pairs, arr.points[2], R0, z0)
 
 
 def point_mobility(model: "BarModel", p: int) -> float:
@@ -971,7 +1020,8 @@ def armature_model(scene: MechScene) -> BarModel:
     again = (gain_table(arm.force_gain["position"], arm.force_gain["gain"]) if arm.force_gain
              else gain_table(None, None))
     return BarModel(scene, True, basis, cs, fpar, ipar, 0.0, atol, rel, max_step, sparse_invariants(basis),
-                    points=(np.zeros((2, 0, 3)), np.zeros((2, 0, 3)), np.zeros((2, 3))), cpar=np.zeros((2, 4)),
+                    points=(np.zeros((2, 0, 3)), np.zeros((2, 0, 3)), np.zeros((2, 3))),
+                    cpar=np.zeros((CONTACT_ROWS, N_CPAR)),
                     first_moments=np.zeros((3, 1)), load=np.zeros((0, N_LOAD)), tables=np.zeros((2, 1)),
                     drive_names=(ARMATURE_DRIVE,), cdrive=np.full((2, len(CONTACT_DRIVES)), -1, dtype=np.int64),
                     apar=armature_parameters(arm), again=again)

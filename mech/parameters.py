@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 from typing import Callable, Literal, Union
 
 from .validation import (
-    check_bool, check_choice, check_count, check_finite, check_magnitude, check_nonnegative, check_position,
-    check_positive, check_range, check_table, check_vector3, check_whole,
+    check_bool, check_choice, check_count, check_finite, check_magnitude, check_name, check_nonnegative,
+    check_position, check_positive, check_range, check_table, check_vector3, check_whole,
 )
 
 MuLike = Union[float, Callable[[float], float]]
@@ -44,6 +44,8 @@ HISTORY_ROWS = 100_000  # the default: twice what history.csv keeps at most by d
 ENERGY_TOLERANCE_MAX = 5e-3  # a larger audit residual is an energy error of the size a bounce dissipates
 TABLE_POINTS_MAX = 100_000  # points of a force table or a clamp's travel
 LOADS_MAX = 100  # [[force]] and [[spring]] entries together
+FIXED_MAX = 4  # [[fixed]] entries: contact pairs (kernel_layout.MAX_PAIRS)
+RIVETS_WITH_BLOCK = 2  # [[rivet]] entries with the one fixed contact [block] (each a contact pair)
 DIRECTION_MAX = 1e6  # components of a force's direction before it is normalized
 
 
@@ -500,12 +502,15 @@ class Spring:
 
 @dataclass(frozen=True)
 class Rivet:
-    """A spherical contact cap on the bar (a contact rivet).
+    """A spherical contact cap on the bar (a contact rivet): a contact point.
 
     position: m along the bar from tip 0; offset: m from the bar's axis along body b3 (the
     face normal of a blade; negative: the underside, towards the block when the blade
-    lies flat above it). radius: m, of the cap; mass: kg, carried by the bar at that point.
-    youngs_modulus (Pa) and poisson_ratio: the rivet's own material (None: the bar's).
+    lies flat above it; positive: the top, towards a fixed contact above it). radius: m, of
+    the cap; mass: kg, carried by the bar at that point. youngs_modulus (Pa) and
+    poisson_ratio: the rivet's own material (None: the bar's). name: how [[fixed]] entries,
+    the results and a circuit refer to it (None: "rivet<k>", k its place among the rivets).
+    key: the entry's place in the scene ("rivet[1]"), for messages; not a scene key.
     """
 
     position: float = 0.0
@@ -514,10 +519,11 @@ class Rivet:
     mass: float = 0.0
     youngs_modulus: float | None = None
     poisson_ratio: float | None = None
-    name: str = "rivet"
+    name: str | None = None
+    key: str = "rivet"
 
     def __post_init__(self):
-        n = self.name
+        n = self.key
         check_finite(f"{n}.position", self.position)
         check_magnitude(f"{n}.offset", self.offset, LENGTH_MAX)
         check_positive(f"{n}.radius", self.radius, high=LENGTH_MAX)
@@ -526,6 +532,85 @@ class Rivet:
             check_positive(f"{n}.youngs_modulus", self.youngs_modulus, high=MODULUS_MAX)
         if self.poisson_ratio is not None:
             check_range(f"{n}.poisson_ratio", self.poisson_ratio, -1.0, 0.5)
+        if self.name is not None:
+            check_name(f"{n}.name", self.name)
+
+
+FIXED_SHAPES = ("plane", "sphere")
+FACINGS = ("up", "down")
+
+
+@dataclass(frozen=True)
+class FixedContact:
+    """A fixed contact struck by one contact point of the moving part: a counter-contact
+    (the NO or NC contact of a changeover, one of a bridge's two) or, with
+    ``electrical = false``, a mechanical stop only.
+
+    point: the name of the contact point that strikes it: a [[rivet]]'s ``name`` (default
+    "rivet<k>") or, on a bar without rivets, "tip0" / "tip1" (its end caps). name: its own
+    (None: "fixed<k>", k its place among the fixed contacts). shape: "plane" or "sphere"
+    (a fixed rivet of ``radius`` m, taken as its tangent plane at the point nearest the
+    bar, its curvature in the Hertz stiffness, as [block]'s; ``offset`` m shifts its top
+    from its point's start along the bar's horizontal direction). facing: "up" (below the
+    moving part, its surface facing up, as [block]) or "down" (above it, facing down: the
+    NC contact of a changeover). Where its surface is: ``height`` (m, world z; [block]'s
+    surface is at 0) or ``gap`` (m, >= 0: from its point's cap at the start, along its
+    facing; 0: touching); one of them. youngs_modulus (Pa), poisson_ratio: its material.
+    electrical: true for a contact the circuit sees, false for a stop.
+    key: the entry's place in the scene ("fixed[1]"), for messages; not a scene key.
+    """
+
+    point: str | None = None
+    name: str | None = None
+    shape: str = "plane"
+    radius: float | None = None
+    offset: float = 0.0
+    facing: str = "up"
+    height: float | None = None
+    gap: float | None = None
+    youngs_modulus: float = 210e9
+    poisson_ratio: float = 0.3
+    electrical: bool = True
+    key: str = "fixed"
+
+    def __post_init__(self):
+        n = self.key
+        if self.point is None:
+            raise ValueError(f"{n}.point: needed: the name of the contact point that strikes it (a [[rivet]]'s "
+                             "name, or 'tip0' / 'tip1' for the bar's end caps)")
+        check_name(f"{n}.point", self.point)
+        if self.name is not None:
+            check_name(f"{n}.name", self.name)
+        check_choice(f"{n}.shape", self.shape, FIXED_SHAPES)
+        if self.shape == "sphere":
+            if self.radius is None:
+                raise ValueError(f"{n}.radius: needed for {n}.shape = 'sphere' (m)")
+            check_positive(f"{n}.radius", self.radius, high=LENGTH_MAX)
+        else:
+            if self.radius is not None:
+                raise ValueError(f"{n}.radius: only a spherical fixed contact has a radius; set {n}.shape = 'sphere'")
+            if self.offset != 0.0:
+                raise ValueError(f"{n}.offset: shifts a spherical fixed contact's top; set {n}.shape = 'sphere'")
+        check_magnitude(f"{n}.offset", self.offset, LENGTH_MAX)
+        check_choice(f"{n}.facing", self.facing, FACINGS)
+        if self.height is None and self.gap is None:
+            raise ValueError(f"{n}.height: needed: give height (m, world z of its surface) or gap (m from its "
+                             "point at the start), one of them")
+        if self.height is not None and self.gap is not None:
+            raise ValueError(f"{n}.height = {self.height!r} and {n}.gap = {self.gap!r}: give height (m, world z of "
+                             "its surface) or gap (m from its point at the start), not both")
+        if self.height is not None:
+            check_magnitude(f"{n}.height", self.height, LENGTH_MAX)
+        else:
+            check_nonnegative(f"{n}.gap", self.gap, high=LENGTH_MAX)
+        check_positive(f"{n}.youngs_modulus", self.youngs_modulus, high=MODULUS_MAX)
+        check_range(f"{n}.poisson_ratio", self.poisson_ratio, -1.0, 0.5)
+        check_bool(f"{n}.electrical", self.electrical)
+
+    @property
+    def normal(self) -> float:
+        """+1.0 facing up (below the moving part), -1.0 facing down (above it): world z of its outward normal."""
+        return 1.0 if self.facing == "up" else -1.0
 
 
 ARMATURE_KINDS = ("none", "plunger", "clapper")
@@ -684,7 +769,10 @@ class MechScene:
     """Everything the impact solver needs. gravity: m/s^2 (>= 0), acting along -z.
 
     bar: None is an armature alone (no contact spring, no contact): then ``armature`` is
-    given and no mount, force, spring or rivet."""
+    given and no mount, force, spring, rivet or fixed contact.
+    The fixed contacts: ``block`` (one, below the bar, struck by every contact point) or
+    ``fixed`` (FixedContact entries, each struck by the contact point it names; every
+    contact point strikes at least one), not both."""
 
     bar: Bar | None = field(default_factory=Bar)
     block: Block = field(default_factory=Block)
@@ -698,6 +786,7 @@ class MechScene:
     springs: tuple = ()
     rivets: tuple = ()
     armature: Armature = field(default_factory=Armature)
+    fixed: tuple = ()
 
     def __post_init__(self):
         check_nonnegative("environment.gravity", self.gravity, high=GRAVITY_MAX)
@@ -706,7 +795,7 @@ class MechScene:
                           ("mount", Mount), ("armature", Armature)):
             if not isinstance(getattr(self, name), cls) and not (name == "bar" and self.bar is None):
                 raise ValueError(f"{name}: expected a {cls.__name__}, got {type(getattr(self, name)).__name__}")
-        for name, cls in (("forces", PointForce), ("springs", Spring), ("rivets", Rivet)):
+        for name, cls in (("forces", PointForce), ("springs", Spring), ("rivets", Rivet), ("fixed", FixedContact)):
             items = tuple(getattr(self, name))
             object.__setattr__(self, name, items)
             for item in items:
@@ -731,9 +820,9 @@ class MechScene:
         if not self.armature.present:
             raise ValueError("bar: a scene without a bar is an armature alone; give [armature] with "
                              "kind = 'plunger' or 'clapper', or a [bar]")
-        for name in ("forces", "springs", "rivets"):
+        for name, shown in (("forces", "force"), ("springs", "spring"), ("rivets", "rivet"), ("fixed", "fixed")):
             if getattr(self, name):
-                raise ValueError(f"[[{name[:-1]}]]: acts on the bar, and this scene has none (an armature alone)")
+                raise ValueError(f"[[{shown}]]: acts on the bar, and this scene has none (an armature alone)")
         if self.mount.held:
             raise ValueError("mount.kind: holds the bar, and this scene has none (an armature alone)")
         if self.armature.has_card:
@@ -743,6 +832,22 @@ class MechScene:
     @property
     def has_bar(self) -> bool:
         return self.bar is not None
+
+    def contact_point_names(self) -> tuple[str, ...]:
+        """The names of the bar's contact points, in their order: its rivets' (``name``, or
+        "rivet<k>"), or without rivets its end caps "tip0" and "tip1", but for a cap within
+        its radius of a clamp or hinge (held, not a contact)."""
+        if self.rivets:
+            return tuple(rv.name or f"rivet{k}" for k, rv in enumerate(self.rivets))
+        bar = self.bar
+        caps = (("tip0", bar.tip_radius), ("tip1", bar.length - bar.tip_radius))
+        if self.mount.held:
+            caps = tuple(c for c in caps if abs(c[1] - self.mount.position) > bar.tip_radius)
+        return tuple(name for name, _ in caps)
+
+    def fixed_names(self) -> tuple[str, ...]:
+        """The names of the [[fixed]] entries (``name``, or "fixed<k>"), in their order."""
+        return tuple(fx.name or f"fixed{k}" for k, fx in enumerate(self.fixed))
 
     def _check_mechanism(self) -> None:
         """Cross-section checks: points on the bar, held bars in one plane, rivets apart."""
@@ -760,21 +865,31 @@ class MechScene:
             if mnt.held and sp.anchor[1] != 0.0:
                 raise ValueError(f"{sp.name}.anchor = {list(sp.anchor)!r}: a held bar moves in the "
                                  "x-z plane; the anchor must have y = 0")
-        if len(self.rivets) > 2:
-            raise ValueError(f"[[rivet]]: {len(self.rivets)} rivets given; at most 2 contact points are "
-                             "supported (a single or a bridge contact)")
+        seen = set()
+        for rv, name in zip(self.rivets, self.contact_point_names()):
+            if name in seen:
+                raise ValueError(f"{rv.key}.name: its name {name!r} is another rivet's too; give each its own")
+            seen.add(name)
+        if self.fixed:
+            self._check_fixed()
+        elif len(self.rivets) > RIVETS_WITH_BLOCK:
+            raise ValueError(f"[[rivet]]: {len(self.rivets)} rivets given; the one fixed contact [block] takes at "
+                             f"most {RIVETS_WITH_BLOCK} (a single or a bridge contact); for more, give each "
+                             "its fixed contact in [[fixed]] entries")
         half_t = 0.5 * (self.bar.thickness if self.bar.thickness is not None else self.bar.diameter)
         for rv in self.rivets:
-            check_position(f"{rv.name}.position", rv.position, L)
+            check_position(f"{rv.key}.position", rv.position, L)
             if abs(rv.offset) > half_t + rv.radius:
-                raise ValueError(f"{rv.name}.offset = {rv.offset!r}: the rivet's cap centre must lie within "
+                raise ValueError(f"{rv.key}.offset = {rv.offset!r}: the rivet's cap centre must lie within "
                                  f"its radius of the bar's face (|offset| <= {half_t + rv.radius!r} m)")
             if mnt.kind == "clamp" and abs(rv.position - mnt.position) < rv.radius:
-                raise ValueError(f"{rv.name}.position = {rv.position!r}: the rivet sits in the clamp "
+                raise ValueError(f"{rv.key}.position = {rv.position!r}: the rivet sits in the clamp "
                                  f"(mount.position = {mnt.position!r}); it must be at least its radius away")
-        if len(self.rivets) == 2 and abs(self.rivets[0].position - self.rivets[1].position) < (
-                self.rivets[0].radius + self.rivets[1].radius) and self.rivets[0].offset == self.rivets[1].offset:
-            raise ValueError("rivet[1].position: the two rivets overlap; place them at least the sum of their radii apart")
+        for k, b in enumerate(self.rivets):
+            for a in self.rivets[:k]:
+                if abs(a.position - b.position) < a.radius + b.radius and a.offset == b.offset:
+                    raise ValueError(f"{b.key}.position: the rivets {a.key} and {b.key} overlap; place them at "
+                                     "least the sum of their radii apart")
         if mnt.held:
             if self.initial.azimuth_deg != 0.0:
                 raise ValueError(f"initial.azimuth_deg = {self.initial.azimuth_deg!r}: a held bar lies in "
@@ -793,6 +908,46 @@ class MechScene:
             if self.initial.resting:
                 raise ValueError("initial.resting: a held bar is placed by initial.height (gap of its "
                                  "contact) and closed by its forces; remove initial.resting")
-        if self.initial.resting and (self.rivets or self.forces or self.springs):
-            raise ValueError("initial.resting: the resting start is for the free bar on its tips "
-                             "without rivets, forces or springs")
+        if self.initial.resting and (self.rivets or self.forces or self.springs or self.fixed):
+            raise ValueError("initial.resting: the resting start is for the free bar on its tips on [block] "
+                             "without rivets, forces, springs or [[fixed]] contacts")
+
+    def _check_fixed(self) -> None:
+        """[[fixed]] against the contact points: at most FIXED_MAX, not with [block], names
+        unique, each naming a contact point, every contact point struck; on a held bar
+        (its b3 the world's z but for its tilt) a rivet on the underside strikes only
+        below it, one on the top only above it."""
+        if len(self.fixed) > FIXED_MAX:
+            raise ValueError(f"[[fixed]]: {len(self.fixed)} fixed contacts given; at most {FIXED_MAX} contact pairs "
+                             "are supported (a changeover's NO and NC, a bridge's two points)")
+        if self.block != Block():
+            raise ValueError("[block]: this scene gives its fixed contacts as [[fixed]] entries; describe the "
+                             "block as one of them (facing = 'up', height = 0) and remove [block]")
+        points = self.contact_point_names()
+        names = self.fixed_names()
+        for k, fx in enumerate(self.fixed):
+            if names.index(names[k]) < k:
+                raise ValueError(f"{fx.key}.name: its name {names[k]!r} is another fixed contact's too; give each "
+                                 "its own")
+            if fx.point not in points:
+                where = "rivets" if self.rivets else "end caps (with rivets only rivets touch)"
+                raise ValueError(f"{fx.key}.point = {fx.point!r}: no such contact point; the bar's {where}: "
+                                 f"{', '.join(map(repr, points)) or 'none'}")
+            if self.rivets and self.mount.held:
+                rv = self.rivets[points.index(fx.point)]
+                if rv.offset * fx.normal > 0.0:
+                    side, other = ("top", "above") if rv.offset > 0.0 else ("underside", "below")
+                    raise ValueError(f"{fx.key}.facing = {fx.facing!r}: its point {fx.point!r} is a rivet on the "
+                                     f"blade's {side} ({rv.key}.offset = {rv.offset!r}), which strikes only a "
+                                     f"fixed contact {other} it (facing = {'down' if fx.normal > 0 else 'up'!r})")
+        struck = {fx.point for fx in self.fixed}
+        ends = {"tip0": self.bar.tip_radius, "tip1": self.bar.length - self.bar.tip_radius}
+        for k, p in enumerate(points):
+            if not self.rivets and self.mount.held and abs(ends[p] - self.mount.position) <= (
+                    self.bar.tip_radius * (1.0 + 1e-9)):
+                continue  # (an end cap at the mount, to round-off: held there, nothing to strike)
+            if p not in struck:
+                where = f"rivet[{k}]" if self.rivets else f"end cap {p!r}"
+                raise ValueError(f"{where}: the contact point {p!r} strikes no fixed contact; name it as the "
+                                 "point of a [[fixed]] entry (a mechanical stop: electrical = false)"
+                                 + ("" if self.rivets else ", or hold that end in the mount"))

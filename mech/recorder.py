@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .kernel_layout import A_FN, NAUX
+from .kernel_layout import A_FN, CONTACT_ROWS, NAUX
 
 # bytes a run may take for its history (with the growth of its buffers and the copy a
 # result makes): a scene whose solver.history_rows would need more is refused before it
@@ -35,26 +35,27 @@ DENSE_BYTES = 64 * 2**20
 CHUNK = 16384
 
 
-def row_bytes(state_size: int, n_extra: int = 0, dense: bool = False) -> int:
-    """Bytes of one history row (t, state, aux, peak force, regimes, extra states), and with
-    ``dense`` of one row of dense output (start, length, 5 x state coefficients)."""
-    base = 8 * (1 + state_size + 2 * NAUX + 2 + 2 + n_extra)
+def row_bytes(state_size: int, n_extra: int = 0, dense: bool = False, contact_rows: int = CONTACT_ROWS) -> int:
+    """Bytes of one history row (t, state, aux, peak force, regimes, extra states) of a model
+    of ``contact_rows`` contact rows, and with ``dense`` of one row of dense output (start,
+    length, 5 x state coefficients)."""
+    base = 8 * (1 + state_size + contact_rows * (NAUX + 2) + n_extra)
     return base + (8 * (2 + 5 * state_size) if dense else 0)
 
 
-def history_memory(state_size: int, rows: int, n_extra: int = 0) -> int:
+def history_memory(state_size: int, rows: int, n_extra: int = 0, contact_rows: int = CONTACT_ROWS) -> int:
     """Bytes the history of ``rows`` rows may take at its peak: the buffer of those rows and
     a stepper's room (CHUNK) while it doubles (old and new, up to twice that) plus the
     result's copy of the rows."""
-    return (2 * (rows + CHUNK) + rows) * row_bytes(state_size, n_extra)
+    return (2 * (rows + CHUNK) + rows) * row_bytes(state_size, n_extra, contact_rows=contact_rows)
 
 
 class Recorder:
     """Growable buffers of the history (all SI, one row per record):
 
-    - t (s), y (state), aux (2, NAUX) per contact point, fmax (2,) the largest normal force
-      (N) sampled over the step that ends at the row (after thinning: since the kept row
-      before), regime (2,) per contact point, ext (the extra states of a coupled model,
+    - t (s), y (state), aux (contact_rows, NAUX) per contact row, fmax (contact_rows,) the
+      largest normal force (N) sampled over the step that ends at the row (after thinning:
+      since the kept row before), regime (contact_rows,), ext (the extra states of a coupled model,
       mech.solver.CoupledStates);
     - with ``keep_dense``, each row's dense output from row ``dense_base`` on: the step's
       start (s), length (s) and its 5 x N DOPRI5 coefficients (mech.integrator.dense_eval),
@@ -66,7 +67,7 @@ class Recorder:
     """
 
     def __init__(self, state_size: int, n_extra: int = 0, capacity: int = 4096, keep_dense: bool = False,
-                 row_limit: int | None = None):
+                 row_limit: int | None = None, contact_rows: int = CONTACT_ROWS):
         if capacity < 2:
             raise ValueError(f"capacity = {capacity!r}: at least 2 rows")
         self.n = 0
@@ -80,9 +81,9 @@ class Recorder:
         self.on_commit = None
         self.t = np.empty(capacity)
         self.y = np.empty((capacity, state_size))
-        self.aux = np.empty((capacity, 2, NAUX))
-        self.fmax = np.empty((capacity, 2))
-        self.regime = np.empty((capacity, 2), dtype=np.int64)
+        self.aux = np.empty((capacity, contact_rows, NAUX))
+        self.fmax = np.empty((capacity, contact_rows))
+        self.regime = np.empty((capacity, contact_rows), dtype=np.int64)
         self.ext = np.empty((capacity, n_extra))
         self.dense_base = 0
         dcap = capacity if keep_dense else 1
@@ -233,7 +234,7 @@ class Recorder:
 
     @property
     def last_aux(self) -> np.ndarray:
-        """(2, NAUX) of the last row (a view)."""
+        """(contact_rows, NAUX) of the last row (a view)."""
         return self.aux[self.n - 1]
 
     def columns(self, start: int = 0, stop: int | None = None) -> dict:

@@ -24,7 +24,7 @@ import numpy as np
 from .compiled import armature_table, energy_table
 from .kernel_layout import (
     A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_Y, A_YDOT, Q_DFRICTION, Q_DMODAL, Q_DNORMAL,
-    Q_DLOAD, Q_IMPULSE, Q_WCOMP, Q_WIN, C_ON, C_R,
+    Q_DLOAD, Q_WIN, C_ON, quadrature_rows,
 )
 from .model import BarModel
 from .rotations import rotation_z
@@ -168,7 +168,7 @@ class ImpactResult:
             for j, (fam, order) in enumerate(zip(m.basis.families, m.basis.orders)):
                 data[f"q_{fam}{order}"] = self.states[:, sl["q"]][:, j]
                 data[f"eta_{fam}{order}"] = self.states[:, sl["eta"]][:, j]
-            for i in range(2):
+            for i in range(m.rows):
                 a = self.aux[:, i, :]
                 ft = self._horizontal(a[:, [A_FTX, A_FTY]])
                 vs = self._horizontal(a[:, [A_VTX, A_VTY]])
@@ -229,7 +229,8 @@ class ImpactResult:
     def history(self):
         """pandas DataFrame of ``history_columns`` (regimes as categoricals)."""
         if "history" not in self._cache:
-            self._cache["history"] = _frame(self.history_columns, ("regime_0", "regime_1"))
+            regimes = tuple(f"regime_{i}" for i in range(self.model.rows))
+            self._cache["history"] = _frame(self.history_columns, regimes)
         return self._cache["history"]
 
     @property
@@ -241,7 +242,7 @@ class ImpactResult:
             return self._cache["contact_columns"]
         rows = []
         quad0 = self.model.slices()["quad"].start
-        for i in range(2):
+        for i in range(self.model.rows):
             start = None
             if self.aux[0, i, A_Y] > 0.0:
                 start = dict(time=self.t[0], penetration_rate=self.aux[0, i, A_YDOT])
@@ -278,9 +279,10 @@ class ImpactResult:
         y0, y1 = self._state_at(t0), self._state_at(t1)
         mask = (self.t >= t0) & (self.t <= t1)
         peak = float(self.peak_force[mask, tip].max()) if mask.any() else 0.0
-        impulse = y1[quad0 + Q_IMPULSE + tip] - y0[quad0 + Q_IMPULSE + tip]
-        w_comp = y1[quad0 + Q_WCOMP + 2 * tip] - y0[quad0 + Q_WCOMP + 2 * tip]
-        w_rest = y1[quad0 + Q_WCOMP + 2 * tip + 1] - y0[quad0 + Q_WCOMP + 2 * tip + 1]
+        q_comp, q_rest, q_imp = (quad0 + q for q in quadrature_rows(tip))
+        impulse = y1[q_imp] - y0[q_imp]
+        w_comp = y1[q_comp] - y0[q_comp]
+        w_rest = y1[q_rest] - y0[q_rest]
         v_in = float(start["penetration_rate"])
         v_out = float(-end["penetration_rate"])
         complete = not end.get("open", False)
@@ -298,7 +300,7 @@ class ImpactResult:
         if "phase_columns" in self._cache:
             return self._cache["phase_columns"]
         rows = []
-        for i in range(2):
+        for i in range(self.model.rows):
             codes = self.regimes[:, i]
             start = 0
             for k in range(1, len(codes) + 1):
@@ -328,12 +330,30 @@ class ImpactResult:
     @property
     def restitution(self) -> dict:
         """Kinematic and energetic restitution of the first complete contact (nan if none)."""
+        return self._first_restitution(np.ones(len(self.contact_columns["tip"]), bool))
+
+    def _first_restitution(self, which: np.ndarray) -> dict:
         c = self.contact_columns
-        done = np.flatnonzero(c["complete"])
+        done = np.flatnonzero(c["complete"] & which)
         if not len(done):
             return {"kinematic": float("nan"), "energetic": float("nan")}
         k = done[0]
         return {"kinematic": float(c["kinematic_restitution"][k]), "energetic": float(c["energetic_restitution"][k])}
+
+    @property
+    def pairs(self) -> list[dict]:
+        """One entry per contact pair (mech.solver.ImpactSolver.pairs), in the order of the
+        contact rows (the ``_<i>`` columns, the contacts' ``tip``): index, point (the
+        contact point's name), fixed (its fixed contact's name), facing ("up" or "down"),
+        electrical, contacts (how many contact intervals), restitution (kinematic and
+        energetic of its first complete contact; nan if none) and deepest_penetration (m;
+        negative: its closest approach)."""
+        tips = self.contact_columns["tip"]
+        return [{"index": i, "point": p.point.name, "fixed": p.fixed, "facing": "up" if p.normal > 0.0 else "down",
+                 "electrical": bool(p.electrical), "contacts": int(np.count_nonzero(tips == i)),
+                 "restitution": self._first_restitution(tips == i),
+                 "deepest_penetration": self._max_penetration(i) if len(self.aux) else float("nan")}
+                for i, p in enumerate(self.model.pairs)]
 
     @property
     def energy(self) -> dict:
@@ -430,23 +450,23 @@ class ImpactResult:
 
     @property
     def deepest_penetration(self) -> float:
-        """m: the deepest penetration of any contact point into the block over the run (0: none)."""
-        return max(self._max_penetration(0), self._max_penetration(1), 0.0) if len(self.aux) else 0.0
+        """m: the deepest penetration of any contact point into its fixed contact over the run (0: none)."""
+        if not len(self.aux):
+            return 0.0
+        return max(*(self._max_penetration(i) for i in range(self.model.rows)), 0.0)
 
     @property
     def contact_depths(self) -> list[tuple[str, float, float]]:
-        """(name, deepest penetration m, effective radius m) of each contact point that can
-        touch: the cap's radius, against a spherical block R1 R2 / (R1 + R2) (where Hertz's
-        small-deformation law is judged)."""
-        block = self.model.scene.block
+        """(name, deepest penetration m, effective radius m) of each contact pair: the cap's
+        radius, against a spherical fixed contact R1 R2 / (R1 + R2) (where Hertz's
+        small-deformation law is judged). name: "contact point <i>", with [[fixed]] entries
+        followed by the point and its fixed contact, "(<point> on <fixed>)"."""
         out = []
-        for i in range(2):
+        for i, pair in enumerate(self.model.pairs):
             if self.model.cpar[i, C_ON] == 0.0 or not len(self.aux):
                 continue
-            r = float(self.model.cpar[i, C_R])
-            if block.shape == "sphere":
-                r = r * block.radius / (r + block.radius)
-            out.append((f"contact point {i}", self._max_penetration(i), r))
+            name = f"contact point {i}" + ("" if pair.key == "block" else f" ({pair.point.name} on {pair.fixed})")
+            out.append((name, self._max_penetration(i), pair.effective_radius))
         return out
 
     @property
@@ -487,8 +507,12 @@ class ImpactResult:
         c = self.contact_columns
         arm = {"armature": {k: _num(v) if isinstance(v, float) else v for k, v in self.armature.items()}} \
             if self.model.has_armature else {}
+        pairs = {"pairs": [{k: (_num(v) if isinstance(v, float) else
+                                {kk: _num(vv) for kk, vv in v.items()} if isinstance(v, dict) else v)
+                            for k, v in p.items()} for p in self.pairs]} if self.model.scene.fixed else {}
         return {
             **arm,
+            **pairs,
             "contacts": [
                 {k: (int(c[k][j]) if k == "tip" else (bool(c[k][j]) if k == "complete" else _num(c[k][j])))
                  for k in CONTACT_COLUMNS}

@@ -11,7 +11,9 @@ default listed in docs/scene_keys.md; ``DEFAULT_SCENE_TOML`` is one scene, not t
                 stiffness, preload_torque, damping
     [[force]]   position, direction [3], frame ("world" | "body"), magnitude | (time, value)
     [[spring]]  anchor [3], position, stiffness, preload | rest_length, damping
-    [[rivet]]   position, offset, radius, mass, youngs_modulus, poisson_ratio
+    [[rivet]]   position, offset, radius, mass, youngs_modulus, poisson_ratio, name
+    [[fixed]]   point, name, shape ("plane" | "sphere"), radius, offset, facing ("up" | "down"),
+                height | gap, youngs_modulus, poisson_ratio, electrical (instead of [block])
     [armature]  kind ("none" | "plunger" | "clapper"), mass | inertia, travel, spring_rate,
                 spring_preload, stop_stiffness, stop_damping, damping, initial_position,
                 initial_speed, card_position, card_lever, card_free_travel, card_stiffness,
@@ -39,7 +41,8 @@ import math
 import tomllib
 
 from .parameters import (
-    Armature, Bar, Block, Contact, Friction, Initial, MechScene, Mount, PointForce, Rivet, SolverOptions, Spring,
+    Armature, Bar, Block, Contact, FixedContact, Friction, Initial, MechScene, Mount, PointForce, Rivet,
+    SolverOptions, Spring,
 )
 from .validation import check_file, check_keys
 
@@ -58,10 +61,14 @@ LIST_SECTIONS = {
     "force": ("forces", PointForce),
     "spring": ("springs", Spring),
     "rivet": ("rivets", Rivet),
+    "fixed": ("fixed", FixedContact),
 }
+# the field of an entry of an array of tables that holds its place ("force[0]", for the
+# messages; not a scene key): ``name``, or ``key`` where ``name`` is a key the scene gives
+PLACE_FIELDS = {"rivet": "key", "fixed": "key"}
 ENVIRONMENT_KEYS = ("gravity",)
 # what an armature alone (an [armature] and no [bar]) may not have: they belong to the bar
-BAR_SECTIONS = ("block", "initial", "contact", "friction", "mount", "force", "spring", "rivet")
+BAR_SECTIONS = ("block", "initial", "contact", "friction", "mount", "force", "spring", "rivet", "fixed")
 # every top-level name a mechanics scene may hold (tables and arrays of tables)
 SCENE_SECTIONS = tuple(SECTIONS) + tuple(LIST_SECTIONS) + ("environment",)
 
@@ -104,6 +111,13 @@ t_end = 0.05
 
 def _field_names(cls) -> list[str]:
     return [f.name for f in dataclasses.fields(cls)]
+
+
+def entry_keys(section: str) -> list[str]:
+    """The keys an entry of the array of tables ``section`` ([[force]], [[rivet]], ...) may
+    hold: its dataclass's fields but the one that holds its place (PLACE_FIELDS)."""
+    place = PLACE_FIELDS.get(section, "name")
+    return [f for f in _field_names(LIST_SECTIONS[section][1]) if f != place]
 
 
 def _section(name: str, cls, table: dict, where: str):
@@ -172,10 +186,10 @@ def scene_from_dict(doc: dict, *, where: str = "scene", extra_sections=()) -> Me
         if not isinstance(entries, list) or not all(isinstance(e, dict) for e in entries):
             raise ValueError(f"{where}: [[{name}]]: expected an array of tables ([[{name}]] blocks)")
         items = []
+        place = PLACE_FIELDS.get(name, "name")
         for k, entry in enumerate(entries):
-            allowed = [f for f in _field_names(cls) if f != "name"]  # the name is the entry's place
-            check_keys(f"{where}: {name}[{k}]", entry, allowed)
-            items.append(_section(name, cls, dict(entry, name=f"{name}[{k}]"), where))
+            check_keys(f"{where}: {name}[{k}]", entry, entry_keys(name))
+            items.append(_section(name, cls, dict(entry, **{place: f"{name}[{k}]"}), where))
         parts[fld] = tuple(items)
     env = doc.get("environment", {})
     if not isinstance(env, dict):
@@ -272,6 +286,8 @@ def scene_to_dict(scene: MechScene) -> dict:
     out["environment"] = {"gravity": scene.gravity}
     if not scene.armature.present:
         del out["armature"]
+    if scene.fixed and "block" in out:
+        del out["block"]  # (its fixed contacts are the [[fixed]] entries)
     if not scene.mount.held and "mount" in out:
         del out["mount"]
     elif scene.mount.base_motion is not None:
@@ -279,9 +295,9 @@ def scene_to_dict(scene: MechScene) -> dict:
         out["mount"]["base_motion"] = {"time": list(bm["time"]), "displacement": [list(d) for d in bm["displacement"]]}
     for name, (fld, cls) in LIST_SECTIONS.items():
         items = getattr(scene, fld)
+        keys = entry_keys(name)
         if items:
-            out[name] = [{f.name: (list(v) if isinstance(v, tuple) else v)
-                          for f in dataclasses.fields(cls)
-                          if f.name != "name" and (v := getattr(it, f.name)) is not None}
+            out[name] = [{key: (list(v) if isinstance(v, tuple) else v)
+                          for key in keys if (v := getattr(it, key)) is not None}
                          for it in items]
     return out

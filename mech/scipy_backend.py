@@ -13,7 +13,7 @@ import numpy as np
 from .compiled import dynamics, event_values
 from .kernel_layout import (
     A_FN, A_Y, A_YDOT, D_VALUE, DONE, EV_CLIP, EV_COMPRESSION, EV_SLIP, EV_STICK, EVENT, FREE, FRICTION_EXACT,
-    I_FRICTION, NAUX, NEV, NEV_TIP, NOT_FINITE, SLIP, STICK,
+    I_FRICTION, NAUX, NEV_TIP, NOT_FINITE, SLIP, STICK,
 )
 
 from .stepping import Outcome
@@ -51,9 +51,10 @@ def scipy_segment(solver, t_target: float, method: str):
     eref = solver.eref.copy()
     work = solver.work
     rec = solver.recorder
-    aux = np.empty((2, NAUX))
-    aux_mid = np.empty((2, NAUX))
-    g = np.empty(NEV)
+    rows = m.rows
+    aux = np.empty((rows, NAUX))
+    aux_mid = np.empty((rows, NAUX))
+    g = np.empty(m.event_count)
     N = m.state_size
     counter = {"nfev": 0}
     coupled = solver.coupled
@@ -75,7 +76,7 @@ def scipy_segment(solver, t_target: float, method: str):
 
     def make_event(k):
         # the contact points' events (tip i, kind), then the armature's (always watched)
-        i, kind = divmod(k, NEV_TIP) if k < 2 * NEV_TIP else (-1, -1)
+        i, kind = divmod(k, NEV_TIP) if k < m.armature_event_base else (-1, -1)
         seen = {}  # t -> value at the last few times asked (see below)
 
         def ev(t, y):
@@ -124,7 +125,7 @@ def scipy_segment(solver, t_target: float, method: str):
         return ev
 
     t_start = solver.t
-    events = [make_event(k) for k in range(NEV)]
+    events = [make_event(k) for k in range(m.event_count)]
     rtol = solver.scene.solver.rtol
     # solve_ivp's error test is |err| <= atol + rtol |y| for every component, so positions
     # also get a relative share (the compiled loop holds them to atol alone): the baseline
@@ -183,7 +184,7 @@ def scipy_segment(solver, t_target: float, method: str):
             # be a tenth of the contact: measured, the quarter points alone missed a 925 N
             # peak by 0.7 N on DOP853's steps at rtol 1e-8)
             h = sol.t[k] - sol.t[k - 1]
-            samples = np.empty((5, 2))
+            samples = np.empty((5, rows))
             samples[0] = rec.aux[r - 1, :, A_FN] if r > 0 else aux[:, A_FN]
             samples[4] = aux[:, A_FN]
             for j, f in enumerate((0.25, 0.5, 0.75), start=1):
@@ -191,7 +192,7 @@ def scipy_segment(solver, t_target: float, method: str):
                          aux_mid, work, arm)
                 samples[j] = aux_mid[:, A_FN]
             peak = samples.max(axis=0)
-            for tip in range(2):
+            for tip in range(rows):
                 j = int(np.argmax(samples[:, tip]))
                 curvature = samples[j - 1, tip] - 2.0 * samples[j, tip] + samples[j + 1, tip] if 0 < j < 4 else 0.0
                 if curvature < 0.0:

@@ -28,13 +28,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .compiled import (
-    armature_force, armature_table, dense_contact, dense_eval, dense_tip_forces, dynamics, energies, energy_table,
-    event_values, make_work, project_to_stick,
+    armature_force, armature_table, dense_contact, dense_eval, dense_pair_forces, dense_tip_forces, dynamics,
+    energies, energy_table, event_values, make_work, project_to_stick,
 )
 from .kernel_layout import (
-    A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, BUFFER_FULL, C_ON, C_R, DONE, EV_CLIP, EV_COMPRESSION,
-    D_SLOPE, D_VALUE, EA_CARD, EA_POLE, EA_REST, EA_SEAT, EA_TURN, EV_CONTACT, EV_SLIP, EV_STICK, EVENT, F_MASS, FREE,
-    FRICTION_EXACT, I_FRICTION, NAUX, NEV, NEV_TIP, Q_WIN, SLIP, STATUS_TEXT, STICK, state_sizes,
+    A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, BUFFER_FULL, C_N, C_ON, C_R, DONE, EV_CLIP,
+    EV_COMPRESSION, D_SLOPE, D_VALUE, EA_CARD, EA_POLE, EA_REST, EA_SEAT, EA_TURN, EV_CONTACT, EV_SLIP, EV_STICK,
+    EVENT, F_MASS, FREE, FRICTION_EXACT, I_FRICTION, NAUX, NEV_ARM, NEV_TIP, Q_WIN, SLIP, STATUS_TEXT, STICK,
+    state_sizes,
 )
 from .contact_laws import hertz_impact
 from .drives import set_step, step_targets, values_at
@@ -71,7 +72,7 @@ class CoupledStates:
     coefficient. A monolithic co-simulation reference is built this way without the
     mechanics knowing what the states are.
     initial: (size,) initial values; atol: (size,) absolute tolerances.
-    rhs(t, z, contact) -> dz/dt, with contact (2, 3): per tip penetration (m),
+    rhs(t, z, contact) -> dz/dt, with contact (rows, 3): per contact row penetration (m),
     penetration rate (m/s), normal force (N).
     friction_coefficient(t, z) -> mu (N^gamma).
     """
@@ -110,6 +111,8 @@ class Segment:
     _out: np.ndarray = field(repr=False, default_factory=lambda: np.empty(5))
     _last_t: float = field(repr=False, default=float("nan"))
     _last_forces: tuple = field(repr=False, default=(0.0, 0.0, 0.0, 0.0, 0.0))
+    _pairs_t: float = field(repr=False, default=float("nan"))
+    _pairs_last: np.ndarray = field(repr=False, default=None)
     _arm_t: float = field(repr=False, default=float("nan"))
     _arm_last: tuple = field(repr=False, default=(0.0, 0.0))
 
@@ -126,20 +129,21 @@ class Segment:
         return out
 
     def contact(self, t: float) -> np.ndarray:
-        """(2, 3) per tip: penetration (m), penetration rate (m/s), normal force (N) at t."""
+        """(rows, 3) per contact row: penetration (m), penetration rate (m/s), normal force (N) at t."""
         y = self.state(t)
         if self._work is None:
             self._work = make_work(self._model.n)
         dy = np.empty_like(y)
-        aux = np.empty((2, NAUX))
+        rows = self._model.rows
+        aux = np.empty((rows, NAUX))
         k = int(np.searchsorted(self._t_valid, t)) if len(self._t_valid) else 0
         k = min(k, max(len(self._regime) - 1, 0))
-        regime = self._regime[k] if len(self._regime) else np.zeros(2, np.int64)
+        regime = self._regime[k] if len(self._regime) else np.zeros(rows, np.int64)
         dynamics(t, y, self._arrays, regime, self._eref, dy, aux, self._work, self._arm)
         return aux[:, [A_Y, A_YDOT, A_FN]].copy()
 
     def normal_force(self, t: float) -> float:
-        """N: total normal force of both tips at t."""
+        """N: total normal force of every contact row at t."""
         return float(self.contact(t)[:, 2].sum())
 
     def armature(self, t: float) -> tuple[float, float]:
@@ -170,11 +174,41 @@ class Segment:
         self._arm_t, self._arm_last = t, out
         return out
 
+    def pair_forces(self, t: float) -> np.ndarray:
+        """(rows, 3) at t (s): each contact row's (pair's, ImpactSolver.pairs) normal force
+        (N), penetration (m) and gap to its fixed contact (m, 0 when touching), by a compiled
+        evaluation of the dense output (as ``tip_forces``). A row without a pair (a single
+        contact's switched-off second row): 0, -1e3, 1e3. The same read-only array is
+        returned for repeated calls at the same t."""
+        if t == self._pairs_t:
+            return self._pairs_last
+        if not (self.t_start - 1e-15 <= t <= self.t_end + 1e-15):
+            raise ValueError(f"t = {t!r}: outside the segment [{self.t_start!r}, {self.t_end!r}] s")
+        out = np.empty((self._model.rows, 3))
+        if len(self._t_valid) == 0 or t <= self.t_start:
+            c = self.contact(t)
+            out[:, 0] = c[:, 2]
+            out[:, 1] = c[:, 0]
+        else:
+            dense_pair_forces(t, self._t_valid, self._t0, self._h, self._coef, self._arrays, out[:, :2])
+        out[:, 2] = np.maximum(-out[:, 1], 0.0)
+        out.flags.writeable = False
+        self._pairs_t, self._pairs_last = t, out
+        return out
+
+    def pair_force(self, t: float, k: int) -> tuple[float, float, float]:
+        """(normal force N, penetration m, gap m) of contact pair k at t (s): ``pair_forces``'s row k."""
+        if not 0 <= k < len(self._model.pairs):
+            raise ValueError(f"k = {k!r}: this model's contact pairs are 0 to {len(self._model.pairs) - 1}")
+        row = self.pair_forces(t)[k]
+        return float(row[0]), float(row[1]), float(row[2])
+
     def tip_forces(self, t: float) -> tuple[float, float, float, float, float]:
-        """(F_0, F_1, gap, y_0, y_1) at t: each tip's normal force (N), the nearer tip's
-        height above the block (m, 0 when touching) and each tip's penetration (m), by a
-        compiled evaluation of the dense output (about 1/10 the cost of ``contact``).
-        Repeated calls at the same t are cached."""
+        """(F_0, F_1, gap, y_0, y_1) at t: the first two contact rows' normal force (N), the
+        nearest row's gap to its fixed contact (m, 0 when touching) and the first two rows'
+        penetration (m), by a compiled evaluation of the dense output (about 1/10 the cost
+        of ``contact``); for a model of more pairs, ``pair_forces``. Repeated calls at the
+        same t are cached."""
         if t == self._last_t:
             return self._last_forces
         if not (self.t_start - 1e-15 <= t <= self.t_end + 1e-15):
@@ -218,10 +252,11 @@ class ImpactSolver:
         self.t = 0.0
         self.y = m.initial_state()
         self.h = 0.0
-        self.regime = np.zeros(2, dtype=np.int64)
-        self.eref = np.zeros((2, 2))
+        rows = m.rows  # contact rows (the pairs', kernel_layout.CONTACT_ROWS at least)
+        self.regime = np.zeros(rows, dtype=np.int64)
+        self.eref = np.zeros((rows, 2))
         self.eref[:, 0] = 1.0
-        self.ev_sign = np.zeros(NEV)
+        self.ev_sign = np.zeros(m.event_count)
         self.stats = np.zeros(4, dtype=np.int64)
         self.events: list[dict] = []
         self._last_event_time = -1.0
@@ -229,7 +264,7 @@ class ImpactSolver:
         self.wall_time = 0.0
         self.projection_energy = 0.0
         self.work = make_work(m.n)  # the compiled kernel's scratch arrays
-        self._aux = np.empty((2, NAUX))
+        self._aux = np.empty((rows, NAUX))
         self._dy = np.empty(m.state_size)
         # what changes during the run besides the state: the named drive channels over time
         # (one row each, kernel_layout D_*), passed to the kernel beside the model's arrays
@@ -239,21 +274,22 @@ class ImpactSolver:
             self.drive[m.drive_rows("mu"), D_VALUE] = coupled.friction_coefficient(0.0, self.z)
         # which of the armature's stops and card are closed (kernel_layout EA_*): set at its
         # events from the watched sides (_armature_signs), read by the kernel
-        self.armature_closed = np.zeros(NEV - 2 * NEV_TIP)
+        self.armature_closed = np.zeros(NEV_ARM)
         self.arrays = m.kernel_arrays(self.drive)
         self.arm = m.kernel_armature(self.armature_closed)  # (None without an armature)
-        rows = scene.solver.history_rows
-        if history_memory(m.state_size, rows, len(self.z)) > MEMORY_LIMIT:
+        keep = scene.solver.history_rows
+        memory = history_memory(m.state_size, keep, len(self.z), m.rows)
+        if memory > MEMORY_LIMIT:
             raise ValueError(
-                f"solver.history_rows = {rows}: with {m.state_size} states per row the history could take "
-                f"{history_memory(m.state_size, rows, len(self.z)) / 2**30:.3g} GiB, more than the "
+                f"solver.history_rows = {keep}: with {m.state_size} states per row the history could take "
+                f"{memory / 2**30:.3g} GiB, more than the "
                 f"{MEMORY_LIMIT / 2**30:g} GiB a run may take; keep fewer rows (or fewer modes)")
-        self.recorder = Recorder(m.state_size, len(self.z), capacity, keep_dense, row_limit=rows)
+        self.recorder = Recorder(m.state_size, len(self.z), capacity, keep_dense, row_limit=keep, contact_rows=rows)
         self.recorder.on_full = self._make_room
         self.recorder.on_commit = self._check_rows
         self._thin_mid_run = False  # thinning inside advance: only in run() (no index is held then)
         self.thinning = dict(resolution=0.0, until=0.0, rows_dropped=0, max_abs_residual=0.0, max_kinetic=0.0,
-                             max_drive_work=-math.inf, max_speed=0.0, max_penetration=[-math.inf, -math.inf])
+                             max_drive_work=-math.inf, max_speed=0.0, max_penetration=[-math.inf] * rows)
         self.stepper: Stepper = CompiledStepper() if backend == "dopri5" else ScipyStepper(backend[6:])
         self._jumps = base_velocity_jumps(scene)
         self._jump_index = 0
@@ -289,9 +325,18 @@ class ImpactSolver:
     @property
     def drive_names(self) -> tuple[str, ...]:
         """The drive channels of this model, which ``advance`` takes: "mu.<i>" and
-        "repulsion.<i>" of each contact point i, and "armature.force" with an armature
+        "repulsion.<i>" of each contact pair i, and "armature.force" with an armature
         (mech.drives)."""
         return self.model.drive_names
+
+    @property
+    def pairs(self) -> tuple:
+        """The contact pairs, in the order of the contact rows (index i: ``drive_names``'
+        "mu.<i>", ``Segment.pair_forces``' row i, the results' columns ``_<i>``): each a
+        mech.mechanism.ContactPair with ``point.name`` (the contact point: a rivet's name,
+        "tip0" or "tip1"), ``fixed`` (its fixed contact's name; "block" for [block]),
+        ``electrical`` (False: a mechanical stop) and ``normal`` (+1 facing up, -1 down)."""
+        return self.model.pairs
 
     def armature_now(self) -> tuple[float, float]:
         """(q, dq/dt) of the armature now: its travel from the rest stop, m and m/s (plunger)
@@ -552,16 +597,17 @@ class ImpactSolver:
         th["max_penetration"] = [max(a, float(b)) for a, b in zip(th["max_penetration"], pen)]
 
     def _check_rows(self, start: int, rows: int) -> None:
-        """Recorder.on_commit: stop a run whose contact point has sunk deeper into the block
-        than its cap's radius. The cap is then wholly inside the block: no contact law
+        """Recorder.on_commit: stop a run whose contact point has sunk deeper into its fixed
+        contact than its cap's radius. The cap is then wholly inside it: no contact law
         describes that, nothing after it means anything, and such a run (the relay's blade
         under a 5.4 MN armature force) otherwise goes on at steps of 1e-9 s for hours."""
         pen = self.recorder.aux[start:start + rows, :, A_Y].max(axis=0)
         cps = self.model.cpar
-        for i in range(2):
+        for i, pair in enumerate(self.model.pairs):
             if cps[i, C_ON] != 0.0 and pen[i] > cps[i, C_R]:
+                into = "the block" if pair.key == "block" else f"its fixed contact {pair.fixed!r}"
                 raise MechSolverError(
-                    f"contact point {i} went {pen[i]:.3g} m into the block by t = {self.t!r} s, deeper than its "
+                    f"contact point {i} went {pen[i]:.3g} m into {into} by t = {self.t!r} s, deeper than its "
                     f"cap's {cps[i, C_R]:.3g} m radius: no contact law describes that; the loads press the "
                     f"contact far beyond what it can carry (forces, springs, gravity)", self.t, self.named_state(),
                     partial=self.result())
@@ -632,8 +678,9 @@ class ImpactSolver:
         self.holds = [list(h) for h in holds]
 
     def contact_series(self, times) -> np.ndarray:
-        """(len(times), 2, 3): per tip penetration (m), rate (m/s), normal force (N) at the
-        given times (s, within the integrated span), from the dense output (keep_dense=True)."""
+        """(len(times), rows, 3): per contact row penetration (m), rate (m/s), normal force
+        (N) at the given times (s, within the integrated span), from the dense output
+        (keep_dense=True)."""
         if not self.keep_dense:
             raise ValueError("contact_series needs the dense output: build the solver with keep_dense=True")
         times = np.asarray(times, dtype=float)
@@ -645,7 +692,7 @@ class ImpactSolver:
         if len(times) and (times[order[0]] < start - 1e-15 or times[order[-1]] > self.t + 1e-15):
             raise ValueError(f"times must lie in [{start!r}, {self.t!r}] s"
                              + (" (the dense output before was released)" if b else ""))
-        out = np.empty((len(times), 2, 3))
+        out = np.empty((len(times), self.model.rows, 3))
         dense_contact(times[order], rec.t[b:n], rec.dense_t0[:n - b], rec.dense_h[:n - b], rec.dense_coef[:n - b],
                       rec.regime[b:n], self.arrays, self.eref, self.work, out, self.arm)
         result = np.empty_like(out)
@@ -676,11 +723,11 @@ class ImpactSolver:
         return self._hold_until if self.at_rest else self.t
 
     def friction_engaged(self) -> np.ndarray:
-        """(2,) bool: each contact point is sliding or sticking (in a friction regime) now."""
+        """(rows,) bool: each contact row is sliding or sticking (in a friction regime) now."""
         return self.regime != FREE
 
     def contact_now(self) -> np.ndarray:
-        """(2, 3) per tip: penetration (m), rate (m/s), normal force (N) at the current time."""
+        """(rows, 3) per contact row: penetration (m), rate (m/s), normal force (N) at the current time."""
         aux = self._evaluate()
         return aux[:, [A_Y, A_YDOT, A_FN]].copy()
 
@@ -799,7 +846,7 @@ class ImpactSolver:
         # below the stick tolerance; it does not keep a quiet bar from being at rest
         aux = self._evaluate()
         slipping = any(self.regime[i] == SLIP and math.hypot(aux[i, A_VTX], aux[i, A_VTY]) > tol
-                       for i in range(2))
+                       for i in range(self.model.rows))
         # a force on a ramp is not a constant load, however slowly the bar follows it
         # (nor is a driven force on a ramp: a repulsion that grows within the step)
         # an armature between its stops with its card open is not held: it floats on its
@@ -948,18 +995,19 @@ class ImpactSolver:
 
     def _handle_event(self, ev: int) -> None:
         tip, kind = divmod(ev, NEV_TIP)
+        base = self.model.armature_event_base
         same_instant = abs(self.t - self._last_event_time) <= 1e-12 * max(abs(self.t), 1e-6)
         self._chatter = self._chatter + 1 if same_instant else 0
         self._last_event_time = self.t
         if self._chatter > CHATTER_LIMIT:
-            last = (f"armature {ARMATURE_EVENTS[ev - 2 * NEV_TIP]}" if ev >= 2 * NEV_TIP
+            last = (f"armature {ARMATURE_EVENTS[ev - base]}" if ev >= base
                     else f"tip {tip} {EVENT_KINDS[kind]}")
             raise MechSolverError(
                 f"regime switching does not settle at t = {self.t!r} s: {self._chatter} events at one "
                 f"instant (last: {last}, regimes "
                 f"{[REGIME_NAMES[r] for r in self.regime]})", self.t, self.named_state(), partial=self.result())
-        if ev >= 2 * NEV_TIP:
-            self._armature_event(ev - 2 * NEV_TIP)
+        if ev >= base:
+            self._armature_event(ev - base)
             return
         if kind == EV_COMPRESSION:
             # a restart for the work split only (the time of maximum compression is in the
@@ -996,10 +1044,11 @@ class ImpactSolver:
             name = "stick_end"
         if name is not None:
             self._log(tip, name, old[tip], aux)
-        # The other tip may have crossed at the same instant (a symmetric landing): its
+        # Another contact row may have crossed at the same instant (a symmetric landing): its
         # regime changed at this restart without an event of its own.
-        other = 1 - tip
-        if (old[other] == FREE) != (self.regime[other] == FREE):
+        for other in range(self.model.rows):
+            if other == tip or (old[other] == FREE) == (self.regime[other] == FREE):
+                continue
             if self.regime[other] != FREE:
                 self._check_cap(other)
                 self.h = min(self.h, self._onset_step)
@@ -1011,8 +1060,8 @@ class ImpactSolver:
         their value says (at a stop, not pressed: open); and so which of its stops and card
         are closed (the seat is set by _seat and _unseat alone). The turn and the seat are
         watched by which stops are closed: their values are taken again once that is set."""
-        base = 2 * NEV_TIP
-        for k in range(base, NEV):
+        base = self.model.armature_event_base
+        for k in range(base, self.model.event_count):
             if triggered == k:
                 self.ev_sign[k] = -self.ev_sign[k]
             else:
@@ -1030,7 +1079,7 @@ class ImpactSolver:
         """The armature's event signs and contact states for the current state."""
         if not self.model.has_armature:
             return
-        g = np.empty(NEV)
+        g = np.empty(self.model.event_count)
         event_values(self.y, self._evaluate(), self.work[22], self.eref, self.arrays, g, self.arm)
         self._armature_signs(g, triggered)
 
@@ -1040,7 +1089,7 @@ class ImpactSolver:
         (where it may be seated), or a seated armature's press vanishing (it leaves the
         stop). The regimes of the contact points do not change: the card's force on the
         bar is a load like the others."""
-        ev = 2 * NEV_TIP + k
+        ev = self.model.armature_event_base + k
         if k == EA_TURN:
             self.ev_sign[ev] = -self.ev_sign[ev]
             self._seat()
@@ -1154,8 +1203,8 @@ class ImpactSolver:
         if axis is None:
             return
         R = self.model.rotation(self.y)
-        outward_z = float(R[2] @ axis)  # z of the cap's outward axis
-        angle = math.acos(max(-1.0, min(1.0, -outward_z)))  # between outward axis and -z
+        inward_z = -float(self.model.cpar[tip, C_N] * (R[2] @ axis))  # the cap's outward axis along the fixed contact's inward normal
+        angle = math.acos(max(-1.0, min(1.0, inward_z)))  # between the outward axis and that normal
         if angle > half_angle + 1e-9:
             self.events.append(dict(
                 time=self.t, tip=tip, kind="invalid_contact_geometry", regime_before="", regime_after="",
@@ -1165,22 +1214,23 @@ class ImpactSolver:
             ))
 
     def _check_sphere_block(self, tip: int) -> None:
-        """A spherical block is treated by its tangent plane at the top: a contact a
-        horizontal distance d from the top sees the sphere d^2 / (2 R) lower than that
-        plane. Flag a contact where that exceeds a tenth of the Hertz penetration scale."""
-        blk = self.scene.block
-        if blk.shape != "sphere":
+        """A spherical fixed contact is treated by its tangent plane at the top: a contact a
+        horizontal distance d from the top sees the sphere d^2 / (2 R) beyond that plane. Flag a contact where that exceeds a tenth of the Hertz penetration scale."""
+        if tip >= len(self.model.pairs) or self.model.pairs[tip].shape != "sphere":
             return
+        pair = self.model.pairs[tip]
         x = self.model.contact_point_x(self.y, tip)
-        d = x - self.model.sphere_top_x
-        drop = d * d / (2.0 * blk.radius)
+        d = x - self.model.sphere_tops[tip]
+        drop = d * d / (2.0 * pair.radius)
         if drop > 0.1 * self.model.contact.penetration_scale:
+            what = "block" if pair.key == "block" else f"fixed contact {pair.fixed!r}"
             self.events.append(dict(
                 time=self.t, tip=tip, kind="invalid_contact_geometry", regime_before="", regime_after="",
                 penetration=0.0, penetration_rate=0.0, normal_force=0.0, slip_speed=0.0,
-                note=f"contact {d * 1e3:.3g} mm from the top of the spherical block (radius {blk.radius * 1e3:.3g} mm): "
-                     f"the sphere lies {drop:.2g} m below its tangent plane there, more than a tenth of the "
-                     f"contact's penetration scale; the tangent-plane treatment does not hold (block.offset?)",
+                note=f"contact {d * 1e3:.3g} mm from the top of the spherical {what} (radius {pair.radius * 1e3:.3g} "
+                     f"mm): the sphere lies {drop:.2g} m {'below' if pair.normal > 0.0 else 'above'} its tangent "
+                     "plane there, more than a tenth of the "
+                     f"contact's penetration scale; the tangent-plane treatment does not hold ({pair.key}.offset?)",
             ))
 
     def _start_from_rest(self, new: np.ndarray, tol: float) -> None:
@@ -1199,7 +1249,7 @@ class ImpactSolver:
         aux = self._aux  # evaluated by the caller for this state
         rest = new.copy()
         any_rest = False
-        for i in range(2):
+        for i in range(len(new)):
             if new[i] != FREE and aux[i, A_FN] > 0.0 and math.hypot(aux[i, A_VTX], aux[i, A_VTY]) <= tol:
                 rest[i] = STICK
                 any_rest = True
@@ -1233,7 +1283,8 @@ class ImpactSolver:
         # A triggered event's state can sit a round-off away from the root on either side
         # (solve_ivp does not say which); its crossing direction decides there.
         tiny = 1e-9 * self.model.contact.penetration_scale
-        for i in range(2):
+        rows = self.model.rows
+        for i in range(rows):
             pen = aux[i, A_Y]
             if triggered == NEV_TIP * i + EV_CONTACT and abs(pen) <= tiny:
                 # at the surface the tip's normal speed says where it goes; only where that
@@ -1270,7 +1321,7 @@ class ImpactSolver:
         # Stick needs the holding force within the limit; the tips are coupled through the bar.
         # A tip whose own stick-limit event fired slips: the located state can sit a
         # round-off inside the limit, and keeping the tip stuck would re-fire the event.
-        for i in range(2):
+        for i in range(rows):
             if triggered == NEV_TIP * i + EV_STICK and new[i] == STICK:
                 aux = self._evaluate()
                 ft = np.array([aux[i, A_FTX], aux[i, A_FTY]])
@@ -1282,7 +1333,7 @@ class ImpactSolver:
             self.regime[:] = new
             aux = self._evaluate()
             changed = False
-            for i in range(2):
+            for i in range(rows):
                 if new[i] != STICK:
                     continue
                 ft = np.array([aux[i, A_FTX], aux[i, A_FTY]])
@@ -1296,10 +1347,10 @@ class ImpactSolver:
                 break
         self.regime[:] = new
         aux = self._evaluate()
-        g = np.empty(NEV)
+        g = np.empty(self.model.event_count)
         event_values(self.y, aux, self.work[22], self.eref, self.arrays, g, self.arm)
         self._armature_signs(g, triggered)
-        for i in range(2):
+        for i in range(rows):
             b = NEV_TIP * i
             self.ev_sign[b + EV_CONTACT] = -1.0 if new[i] == FREE else 1.0
             gc = g[b + EV_CLIP]

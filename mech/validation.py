@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import difflib
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -173,6 +174,18 @@ def check_position(name: str, value, length: float) -> float:
     if not 0.0 <= x <= length:
         raise ValueError(f"{name} = {x!r}: must lie on the bar, in [0, {length!r}] m from tip 0")
     return x
+
+
+NAME_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9_]{0,31}")
+
+
+def check_name(name: str, value) -> str:
+    """A name a scene gives a part (a contact point, a fixed contact) for other keys, the
+    results and a circuit to refer to: a letter, then up to 31 letters, digits or '_'."""
+    if not isinstance(value, str) or not NAME_PATTERN.fullmatch(value):
+        raise ValueError(f"{name} = {_short(value)}: expected a name: a letter, then up to 31 letters, "
+                         "digits or '_'")
+    return value
 
 
 def check_file(name: str, path) -> Path:

@@ -22,6 +22,10 @@ Each is one line that says what was seen, when, and what to add to the scene. Ch
    the run is unsound, coupling.core.soundness).
 6. The arc model on without a breakdown voltage, when an open gap's voltage passes air
    breakdown: that gap would re-ignite (item 1 names the setting to add).
+7. Fixed contacts ([[fixed]]) the circuit does not tell apart: its one contact is fed by
+   the mechanics' first two contact pairs in parallel (conductances summed, closed while
+   either touches), whatever their fixed contacts are; separate circuit blocks per fixed
+   contact are not yet built. Said whenever that is not one electrical fixed contact.
 """
 
 from __future__ import annotations
@@ -157,10 +161,43 @@ def fit_warnings(scene) -> list[str]:
     return [f"contact laws from {trib.source}: {line}" for line in outlier_lines(trib.fit)]
 
 
+def pairs_warning(scene) -> str | None:
+    """Item 7: the line for a coupled scene whose [[fixed]] contacts the circuit's one contact
+    does not stand for (more than one electrical fixed contact, a stop feeding it, an
+    electrical one left out), None otherwise (a [block] scene: its contact points all strike
+    the one fixed contact, which the circuit's contact is)."""
+    mech = scene.mech
+    contacts = getattr(getattr(scene.circuit, "circuit", None), "contacts", ())
+    if mech is None or mech.bar is None or not mech.fixed or not contacts:
+        return None
+    names = mech.fixed_names()
+    pairs = [f"{i} ({fx.point} on {name})" for i, (fx, name) in enumerate(zip(mech.fixed, names))]
+    fed = set(range(min(len(mech.fixed), 2)))  # the ContactLink's points (0, 1)
+    electrical = {i for i, fx in enumerate(mech.fixed) if fx.electrical}
+    if len(electrical) <= 1 and fed == electrical:
+        return None
+    line = (f"[[fixed]]: the circuit's contact {contacts[0].label} stands for contact pair"
+            f"{'s' if len(fed) > 1 else ''} {' and '.join(pairs[i] for i in sorted(fed))} in parallel, "
+            "as one circuit contact (their conductances summed, closed while either touches, the arc's gap "
+            "the nearest of all pairs)")
+    stops = [names[i] for i in sorted(fed - electrical)]
+    if stops:
+        line += f", the stop {', '.join(map(repr, stops))} (electrical = false) among them"
+    left = [pairs[i] for i in sorted(electrical - fed)]
+    if left:
+        line += f"; the electrical pair {', '.join(left)} is not in the circuit"
+    return (line + "; separate circuit blocks per fixed contact (a changeover's NO and NC, a bridge's two "
+            "contacts in series) are not yet built: its waveforms, bounce metrics and operations are those of "
+            "that one parallel contact")
+
+
 def run_warnings(result) -> list[str]:
     """All warnings for a CoupledResult."""
     scene = result.scene
     out = fit_warnings(scene)
+    line = pairs_warning(scene)
+    if line:
+        out.append(line)
     if result.mechanics is not None:
         out += hertz_warnings(result.mechanics)
     w = result.waveform_columns

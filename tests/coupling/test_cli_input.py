@@ -14,6 +14,8 @@ from cli_checks import assert_one_line_error, run_cli
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from coupling.core import scene as cs
+
 
 # --- audit reproductions ---------------------------------------------------------------
 
@@ -159,8 +161,9 @@ NUMERIC_KEYS = sorted(OUT_OF_RANGE) + [("initial", "azimuth_deg")]
 CHOICE_KEYS = [("bar", "bending"), ("contact", "law"), ("contact", "calibration"), ("friction", "model"),
                ("solver", "model")]
 BOOL_KEYS = [("output", "csv"), ("output", "plots"), ("output", "history"), ("initial", "resting")]
-KNOWN_SECTIONS = {"bar", "block", "initial", "contact", "friction", "solver", "environment", "tribology",
-                  "circuit", "coupling", "output"}
+# every section a scene accepts (Hypothesis draws string constants of the code under test,
+# such as "rivet", among its texts)
+KNOWN_SECTIONS = set(cs.MECH_SECTIONS) | set(cs.COUPLING_SECTIONS)
 
 not_a_number = st.one_of(
     st.sampled_from([math.nan, math.inf, -math.inf]),

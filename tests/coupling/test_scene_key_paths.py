@@ -290,6 +290,7 @@ EXAMPLES = {
     "magnet.pole_leakage": {"width": 0.03, "radius": 1e-3},
     "magnet.iron": [{"shape": "prism", "length": 0.02, "area": 5e-5, "material": "9SMnPb28"}],
     "magnet.fixed_gap": [{"tube": [{"shape": "axial", "length": 1e-4, "area": 2e-5}]}],
+    "rivet.name": "mid", "fixed.name": "NO", "fixed.radius": 2e-3, "fixed.facing": "down", "fixed.gap": 2e-3,
 }
 RC_PLAIN = "net\n.param RS=1\nV1 a 0 24\nXCONTACT a b\nVLOAD b c 0\nR1 c 0 {RS}\n"
 COUPLED = {"tribology": {"source": "illustrative"}, "circuit": {}, "solver": {"t_end": 1e-3}}
@@ -326,8 +327,13 @@ def _base_and_key(section: str, key: str) -> tuple[dict, str]:
     from coupling.core import scene as cs
 
     if section in LIST_SECTIONS:
-        entry = {"force": {"magnitude": 1.0}, "spring": {"stiffness": 1e3}, "rivet": {}}[section]
-        return {section: [entry], "solver": {"t_end": 1e-3}}, f"{section}[0].{key}"
+        entry = {"force": {"magnitude": 1.0}, "spring": {"stiffness": 1e3}, "rivet": {},
+                 "fixed": {"point": "tip0", "gap": 1e-3}}[section]
+        if section == "fixed" and key in ("radius", "offset"):
+            entry = dict(entry, shape="sphere", radius=1e-3)
+        # a [[fixed]] entry's point tip0: the bar clamped at tip 1 (every contact point strikes one)
+        held = {"mount": {"kind": "clamp", "position": 0.3}} if section == "fixed" else {}
+        return {section: [entry], **held, "solver": {"t_end": 1e-3}}, f"{section}[0].{key}"
     if section in SECTIONS or section == "environment":
         context = {"block": {"block": {"shape": "sphere", "radius": 1e-3}} if key in ("radius", "offset") else {},
                    "mount": {"mount": {"kind": "pivot", "position": 0.3}},
@@ -387,6 +393,8 @@ NEEDS_COMPANIONS = {"bar.width", "bar.thickness", "mount.base_motion", "force.ti
                     "circuit.schedule", "circuit.snubber", "circuit.flyback", "circuit.arc", "metrics.logic",
                     "duty.life", "contact.damping", "block.shape", "armature.kind", "tribology.source",
                     "circuit.arc.ayrton_c", "contact.calibration",
+                    # another contact point, a sphere's radius with it, height instead of gap
+                    "fixed.point", "fixed.shape", "fixed.height",
                     # a table magnet's keys in a flux-tube scene, and the choice between them
                     "magnet.model", "magnet.currents", "magnet.gaps", "magnet.flux_linkages", "magnet.forces",
                     "magnet.force_tolerance"}

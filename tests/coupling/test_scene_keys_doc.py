@@ -15,7 +15,7 @@ from coupling.core import scene as cs
 from coupling.core.device import COIL_KEYS, FLUX_TUBE_KEYS, PLACEMENT_KEYS, TABLE_KEYS
 from coupling.core.duty import DUTY_KEYS, LIFE_KEYS
 from coupling.core.metrics import MetricSettings
-from mech.scene import ENVIRONMENT_KEYS, LIST_SECTIONS, SECTIONS
+from mech.scene import ENVIRONMENT_KEYS, LIST_SECTIONS, SECTIONS, entry_keys
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "scene_keys.md"
 
@@ -52,8 +52,8 @@ def test_every_accepted_key_is_documented_and_nothing_else():
     expected["bar"] = (expected["bar"] - {"axial_modes", "bending_modes"}) | {"modes"}
     expected["initial"] = expected["initial"]
     expected["environment"] = set(ENVIRONMENT_KEYS)
-    for name, (_field, cls) in LIST_SECTIONS.items():  # [[force]], [[spring]], [[rivet]]
-        expected[name] = _fields(cls) - {"name"}  # (the name is the entry's place, force[0], ...)
+    for name in LIST_SECTIONS:  # [[force]], [[spring]], [[rivet]], [[fixed]]
+        expected[name] = set(entry_keys(name))  # (not the field holding the entry's place, force[0], ...)
     expected["tribology"] = {"source", "fit", "data", "mu", "resistance", "feedback"}
     expected["circuit"] = set(cs.CIRCUIT_KEYS)
     expected["circuit.schedule"] = {"make", "break", "closed_resistance", "edge_time", "opening_speed"}
@@ -90,7 +90,11 @@ NO_VALUE = object()  # "-": no value, or the key is needed
 NETLIST = "net\nV1 a 0 24\nXCONTACT a b\nVLOAD b c 0\nR1 c 0 12\n"
 COUPLED = {"tribology": {"source": "illustrative"}, "circuit": {}}
 # entries of the arrays of tables with the keys they need (a key checked is left out)
-ENTRIES = {"force": {"magnitude": 1.0}, "spring": {"stiffness": 1e3}, "rivet": {}}
+ENTRIES = {"force": {"magnitude": 1.0}, "spring": {"stiffness": 1e3}, "rivet": {},
+           "fixed": {"point": "tip0", "gap": 1e-3}}
+# and the rest of the scene such an entry needs: [[fixed]] on a blade clamped at tip 1 (its
+# one contact point tip 0: every contact point must strike a fixed contact)
+ENTRY_SCENES = {"fixed": {"mount": {"kind": "clamp", "position": 0.3}}}
 # keys no dataclass field holds: the alternatives choosing the laws or the contact, file names
 NO_FIELD = {("tribology", k) for k in ("source", "fit", "data", "mu", "resistance")} | {
     ("circuit", "netlist"), ("circuit", "schedule"), ("circuit.schedule", "make"), ("circuit.schedule", "break")}
@@ -168,7 +172,7 @@ def _field_without(section: str, key: str, patch: dict, folder: Path):
         return getattr(part, key)
     if section in LIST_SECTIONS:
         entry = {k: v for k, v in ENTRIES[section].items() if k != key}
-        scene = cs.scene_from_dict({section: [entry]})
+        scene = cs.scene_from_dict({section: [entry], **ENTRY_SCENES.get(section, {})})
         return getattr(getattr(scene.mech, LIST_SECTIONS[section][0])[0], key)
     if section == "tribology":
         return getattr(cs.scene_from_dict(COUPLED).tribology, key)
