@@ -200,6 +200,10 @@ def duty_from_table(table: dict, mech, tribology, circuit) -> DutySettings:
     check_keys("[duty]", table, DUTY_KEYS)
     if circuit is None:
         raise ValueError("[duty] needs a [circuit]: contact duty comes from the current and the arcs")
+    if mech is not None and getattr(mech, "fixed", ()):
+        # its geometry (the fixed cap's radius and height, the gap) is read from [block]
+        raise ValueError("[duty] with [[fixed]] contacts: contact duty reads the fixed contact's geometry from "
+                         "[block]; describe the one electrical contact with [block] for a duty run")
     kw = dict(table)
     if "materials" not in kw:
         law = tribology.laws.resistance_law if tribology is not None else None
