@@ -359,11 +359,11 @@ def closing_work(scene: MechScene, arr: MechanismArrays) -> float:
 def base_velocity_jumps(scene: MechScene) -> list[tuple[float, np.ndarray]]:
     """(time s, world velocity jump m/s) at each breakpoint of a piecewise-linear base
     travel; the velocity is zero before the first and after the last point."""
-    bm = scene.mount.base_motion
-    if bm is None:
+    table = scene.mount.base_table()
+    if table is None:
         return []
-    ts = np.array(bm["time"], dtype=float)
-    ds = np.array(bm["displacement"], dtype=float)
+    ts = np.array(table[0], dtype=float)
+    ds = np.array(table[1], dtype=float)
     vel = np.zeros((len(ts) + 1, 3))
     if len(ts) > 1:
         vel[1:-1] = np.diff(ds, axis=0) / np.diff(ts)[:, None]

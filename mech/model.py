@@ -642,7 +642,7 @@ class BarModel:
         out = []
         for f in self.scene.forces:
             if f.time is not None:
-                out += list(f.time)
+                out += list(f.table()[0])
         return sorted(out)
 
     def rotation(self, y: np.ndarray) -> np.ndarray:
@@ -682,7 +682,7 @@ class BarModel:
         for f in self.scene.forces:
             if f.time is None:
                 continue
-            ts, vs = f.time, f.value
+            ts, vs = f.table()
             for k in range(len(ts) - 1):
                 if ts[k] <= t < ts[k + 1] and vs[k] != vs[k + 1]:
                     return True

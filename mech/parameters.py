@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Callable, Literal, Union
 
+from .table_smoothing import INTERPOLATIONS, smooth_samples
 from .validation import (
     check_bool, check_choice, check_count, check_finite, check_magnitude, check_name, check_nonnegative,
     check_position, check_positive, check_range, check_table, check_vector3, check_whole,
@@ -377,7 +378,8 @@ class Mount:
     position: m along the bar from tip 0 (``length`` holds it at the tip-1 end, so tip 0 or
     a rivet strikes). base_motion (clamp only): prescribed travel of the clamp,
     ``{time = [...] s, displacement = [[x, y, z], ...] m}`` in the world frame, linear
-    between points (constant before the first and after the last).
+    between points (constant before the first and after the last), or with
+    ``interpolation = "pchip"`` a monotone cubic through them (mech.table_smoothing).
     stiffness: N m/rad, torsion spring of the pivot; preload_torque: N m, its torque at
     the initial position, turning the free end towards the block; damping: N m s/rad.
     """
@@ -414,12 +416,26 @@ class Mount:
                 raise ValueError("mount.base_motion: only a clamped bar has a moving base "
                                  f"(mount.kind = {self.kind!r})")
             bm = self.base_motion
-            if not isinstance(bm, dict) or set(bm) != {"time", "displacement"}:
+            if not isinstance(bm, dict) or not {"time", "displacement"} <= set(bm) <= {
+                    "time", "displacement", "interpolation"}:
                 raise ValueError(f"mount.base_motion = {bm!r}: expected "
-                                 "{time = [...], displacement = [[x, y, z], ...]}")
+                                 "{time = [...], displacement = [[x, y, z], ...]} (and interpolation)")
             ts, ds = check_table("mount.base_motion", bm["time"], bm["displacement"], width=3, time_high=T_END_MAX,
                                  value_high=LENGTH_MAX, max_points=TABLE_POINTS_MAX)
-            object.__setattr__(self, "base_motion", {"time": ts, "displacement": ds})
+            how = check_choice("mount.base_motion.interpolation", bm.get("interpolation", "linear"), INTERPOLATIONS)
+            object.__setattr__(self, "base_motion", {"time": ts, "displacement": ds, "interpolation": how})
+
+    def base_table(self) -> tuple[tuple, tuple] | None:
+        """(times s, displacements m) the mechanics follows, linear between them: the table as
+        given, or densely sampled from its monotone cubic (interpolation = "pchip"); None
+        without a base motion."""
+        bm = self.base_motion
+        if bm is None:
+            return None
+        if bm["interpolation"] == "linear":
+            return bm["time"], bm["displacement"]
+        ts, ds = smooth_samples(bm["time"], bm["displacement"])
+        return tuple(float(t) for t in ts), tuple(tuple(float(v) for v in d) for d in ds)
 
     @property
     def held(self) -> bool:
@@ -432,7 +448,8 @@ class PointForce:
 
     position: m along the bar from tip 0. direction: a vector (normalized here) in the
     ``frame`` "world" (fixed) or "body" (turning with the bar's frame). magnitude: N,
-    constant; or ``time`` (s) and ``value`` (N) tables, linear between points.
+    constant; or ``time`` (s) and ``value`` (N) tables, linear between points, or with
+    ``interpolation = "pchip"`` a monotone cubic through them (mech.table_smoothing).
     """
 
     position: float = 0.0
@@ -441,6 +458,7 @@ class PointForce:
     magnitude: float | None = None
     time: tuple | None = None
     value: tuple | None = None
+    interpolation: str = "linear"
     name: str = "force"
 
     def __post_init__(self):
@@ -463,12 +481,17 @@ class PointForce:
                                  max_points=TABLE_POINTS_MAX)
             object.__setattr__(self, "time", ts)
             object.__setattr__(self, "value", vs)
+        check_choice(f"{n}.interpolation", self.interpolation, INTERPOLATIONS)
 
     def table(self) -> tuple[tuple, tuple]:
-        """(times s, values N) of the magnitude (one point for a constant)."""
+        """(times s, values N) of the magnitude the mechanics follows, linear between them
+        (one point for a constant; interpolation = "pchip": sampled from its monotone cubic)."""
         if self.magnitude is not None:
             return (0.0,), (float(self.magnitude),)
-        return self.time, self.value
+        if self.interpolation == "linear":
+            return self.time, self.value
+        ts, vs = smooth_samples(self.time, self.value)
+        return tuple(float(t) for t in ts), tuple(float(v) for v in vs)
 
 
 @dataclass(frozen=True)

@@ -292,7 +292,8 @@ def scene_to_dict(scene: MechScene) -> dict:
         del out["mount"]
     elif scene.mount.base_motion is not None:
         bm = scene.mount.base_motion
-        out["mount"]["base_motion"] = {"time": list(bm["time"]), "displacement": [list(d) for d in bm["displacement"]]}
+        out["mount"]["base_motion"] = {"time": list(bm["time"]), "displacement": [list(d) for d in bm["displacement"]],
+                                       **({} if bm["interpolation"] == "linear" else {"interpolation": bm["interpolation"]})}
     for name, (fld, cls) in LIST_SECTIONS.items():
         items = getattr(scene, fld)
         keys = entry_keys(name)

@@ -26,6 +26,12 @@ Each is one line that says what was seen, when, and what to add to the scene. Ch
    the mechanics' first two contact pairs in parallel (conductances summed, closed while
    either touches), whatever their fixed contacts are; separate circuit blocks per fixed
    contact are not yet built. Said whenever that is not one electrical fixed contact.
+8. A clamp's travel given by a linear table whose points ring the blade: each point is a
+   jump of the clamp's velocity dv, which sets the blade's first mode ringing with a free-
+   end amplitude of about 1.566 dv / omega_1 (a clamped-free beam's first-mode participation
+   at its tip, Blevins, Formulas for Natural Frequency and Mode Shape, table 8-1); said when
+   that exceeds RINGING_FRACTION of the contact gap, with interpolation = "pchip" as the
+   remedy when the travel is meant to be smooth.
 """
 
 from __future__ import annotations
@@ -191,6 +197,36 @@ def pairs_warning(scene) -> str | None:
             "that one parallel contact")
 
 
+RINGING_FRACTION = 0.02  # of the contact gap: item 8
+CANTILEVER_TIP_PARTICIPATION = 1.566  # first mode of a clamped-free beam, base excitation, at the free end
+
+
+def table_ringing_warning(mres) -> str | None:
+    """Item 8: the line for a linear clamp travel whose velocity jumps ring the blade's first
+    mode beyond RINGING_FRACTION of the contact gap (mres: the mechanics' result), else None."""
+    from mech.mechanism import base_velocity_jumps
+
+    scene = mres.model.scene
+    bm = scene.mount.base_motion
+    freqs = np.asarray(mres.model.basis.frequencies, dtype=float)
+    if bm is None or bm["interpolation"] != "linear" or len(bm["time"]) < 3 or not len(freqs):
+        return None
+    jumps = base_velocity_jumps(scene)
+    gap = float(scene.initial.height)
+    if not jumps or not gap > 0.0:
+        return None
+    t_jump, dv = max(jumps, key=lambda j: float(np.linalg.norm(j[1])))
+    omega = 2.0 * math.pi * float(freqs.min())
+    amplitude = CANTILEVER_TIP_PARTICIPATION * float(np.linalg.norm(dv)) / omega
+    if amplitude <= RINGING_FRACTION * gap:
+        return None
+    return (f"mount.base_motion is linear between its {len(bm['time'])} points: each is a jump of the clamp's "
+            f"velocity (up to {float(np.linalg.norm(dv)):.3g} m/s, at {t_jump:.6g} s) that rings the blade's first "
+            f"mode ({float(freqs.min()):.4g} Hz) by about {amplitude:.3g} m at its free end, "
+            f"{amplitude / gap:.2g} of the contact gap; if the travel is meant to be smooth, set "
+            "mount.base_motion.interpolation = \"pchip\" (or give many more points)")
+
+
 def run_warnings(result) -> list[str]:
     """All warnings for a CoupledResult."""
     scene = result.scene
@@ -200,6 +236,9 @@ def run_warnings(result) -> list[str]:
         out.append(line)
     if result.mechanics is not None:
         out += hertz_warnings(result.mechanics)
+        line = table_ringing_warning(result.mechanics)
+        if line:
+            out.append(line)
     w = result.waveform_columns
     if w is not None and len(w["time"]) and "contact_voltage" in w:  # (an actuator's coil drive has no contact)
         t = w["time"]

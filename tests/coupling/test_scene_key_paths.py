@@ -285,7 +285,7 @@ EXAMPLES = {
     "duty.materials": ["Ag", "AgNi10"], "duty.erosion_coefficient": 1e-12, "duty.cap_height": 1e-4,
     "duty.conductor_radius": 2e-3, "duty.life.stop_on_weld": "never", "duty.life.min_force": 0.1,
     "duty.life.max_resistance": 0.1, "duty.life.gap_range": [1e-4, 2e-3],
-    "coil.on_time": 2e-4, "coil.off_time": 1e-3, "coil.suppression": "diode", "coil.resistance": 50.0,
+    "force.interpolation": "pchip", "coil.on_time": 2e-4, "coil.off_time": 1e-3, "coil.suppression": "diode", "coil.resistance": 50.0,
     "coil.turns": 1000, "magnet.rest_gap": 2e-3, "magnet.working_gap": {"area": 5e-5},
     "magnet.pole_leakage": {"width": 0.03, "radius": 1e-3},
     "magnet.iron": [{"shape": "prism", "length": 0.02, "area": 5e-5, "material": "9SMnPb28"}],
