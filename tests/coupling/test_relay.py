@@ -182,3 +182,17 @@ def test_the_default_relay_reports_its_make_and_its_break_as_one_operation():
                  and e["time"] >= coil["off_time"]]
     assert left_rest < op["make"]["time"] < res.relay["armature_arrival"]
     assert left_pole and left_pole[0] < op["break"]["time"]
+
+
+def test_run_check_compares_operate_and_release_time():
+    """switchsim run --check judges a relay's operate and release time as it judges the make
+    times: the refined rerun's change against max(1 us, 1 % of the switching window)."""
+    from coupling.app.accuracy import compare, metrics_of, time_tolerance, tip_intervals
+
+    res = run(default_scene())
+    base = metrics_of(res)
+    assert base["operate_time"] == res.relay["operate_time"] and base["release_time"] == res.relay["release_time"]
+    tips = tip_intervals(res)
+    late = dict(base, release_time=base["release_time"] + 2 * time_tolerance(base))
+    assert compare(base, late, tips, tips)["moved"] == ["release_time"]
+    assert compare(base, dict(base), tips, tips)["moved"] == []
