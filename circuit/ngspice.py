@@ -465,6 +465,12 @@ class NgspiceSession(NgSpiceShared):
         self._target = math.inf if target is None else float(target)
         try:
             if target is None:
+                if not first and self.last_time() >= t_end - max(1e-9 * t_end, end_tolerance):
+                    # ngspice ended the run at its last pause, within CKTminBreak of t_end (a
+                    # macro step landed there): a "resume" would start the analysis over from
+                    # t = 0 (measured: a 5.75 ns final step made ngspice restart and its
+                    # pause at t = 0 read as Ctrl-C)
+                    return
                 printed = self.command("run" if first else "resume")
                 self._raise_if_failed(printed)
                 # ngspice ends a run once within CKTminBreak (5e-5 TMAX) of t_end: after
