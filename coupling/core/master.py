@@ -439,9 +439,13 @@ class CoSimulation:
         waves["gap"] = np.where(waves["normal_force"] > 0.0, 0.0,
                                 np.maximum(0.0, -np.max(contact[:, :, 0], axis=1)))
         waves["mu"] = self.contact.mu_series(waves["time"])
-        if len(self.contacts) > 1:  # each contact's own (its points' mu from the loop current)
+        if len(self.contacts) > 1:  # each contact's own: its arc's gap and its points' mu
             for link in self.contacts:
-                waves["mu" + link.label[len("contact"):]] = link.mu_series(waves["time"])
+                suffix = link.label[len("contact"):]
+                points = list(link.points)
+                touching = np.any(contact[:, points, 0] > 0.0, axis=1)
+                waves["gap" + suffix] = np.where(touching, 0.0, np.maximum(0.0, -np.max(contact[:, points, 0], axis=1)))
+                waves["mu" + suffix] = link.mu_series(waves["time"])
 
 
 def run(scene: Scene, *, progress: bool = False, check: bool = False) -> CoupledResult:
