@@ -112,18 +112,23 @@ def test_the_loop_current_flows_only_while_both_points_touch(dropped):
 
 
 def test_the_whole_bridge_columns_are_its_contacts_in_series(dropped):
-    """contact_voltage across the bridge is the two contacts' voltages added (Kirchhoff: the
-    node potentials' difference across both, to ngspice's tolerance where the contacts are
-    open and carry the whole supply); contact_resistance their sum while both are closed."""
+    """contact_voltage is the voltage across the whole bridge: open, the supply less the
+    leakage current's drop stands across it (to 1e-6 V, ngspice's VNTOL on the node
+    potentials; measured 2e-9 V); closed, the loop current through both contacts'
+    resistances, I (R_a + R_b), to 2e-4 (RELTOL on the current and on each conductance node)."""
     w = dropped.waveform_columns
-    v = w["contact_voltage"]
-    np.testing.assert_array_equal(v, w["contact_voltage_a"] + w["contact_voltage_b"])
+    v, i = w["contact_voltage"], w["load_current"]
     opened = w["contact_conductance_a"] == 0.0
-    # open: the load carries only leakage, so the supply stands across the bridge (to 1e-9 V)
-    np.testing.assert_allclose(v[opened], V_S - (R_S + R_L) * w["load_current"][opened], atol=1e-6)
-    closed = np.isfinite(w["contact_resistance"])
-    np.testing.assert_allclose(w["contact_resistance"][closed],
-                               w["contact_resistance_a"][closed] + w["contact_resistance_b"][closed], rtol=1e-15)
+    assert opened.sum() > 20
+    np.testing.assert_allclose(v[opened], V_S - (R_S + R_L) * i[opened], rtol=0, atol=1e-6)
+    # (conducting: both above circuit.probes.CLOSED_CONDUCTANCE, where a contact's voltage is
+    # its own current over its conductance; the loop's one current runs through both: KCL)
+    closed = (w["contact_conductance_a"] > 1e-6) & (w["contact_conductance_b"] > 1e-6)
+    assert closed.sum() > 20
+    np.testing.assert_allclose(v[closed], i[closed] * (w["contact_resistance_a"] + w["contact_resistance_b"])[closed],
+                               rtol=2e-4)
+    np.testing.assert_allclose(v[closed], i[closed] * w["contact_resistance"][closed], rtol=2e-4)  # (the bridge's)
+    assert np.all(w["contact_conductance"][opened] == 0.0)
 
 
 @pytest.fixture(scope="module")
