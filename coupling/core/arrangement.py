@@ -45,6 +45,19 @@ def contact_feeds(mech, contacts) -> tuple[tuple[int, ...], ...]:
     return tuple((electrical[c.name.lower()],) for c in contacts)
 
 
+def check_arrangement(mech, circuit) -> None:
+    """A coupled scene's circuit against its mechanics, before anything runs (one-line
+    ValueErrors): each circuit contact has its contact pairs (``contact_feeds``), and
+    several circuit contacts are in series (a bridge: the one arrangement of several built)."""
+    contacts = getattr(circuit, "contacts", ())
+    contact_feeds(mech, contacts)
+    if len(contacts) > 1 and not is_series(circuit):
+        raise ValueError(f"the circuit's contacts ({', '.join(c.name for c in contacts)}) are not one chain in series "
+                         "(XCONTACT_A a m, XCONTACT_B m b, the inner node joining nothing else but elements across a "
+                         "contact): several circuit contacts are a double-break bridge for now (a changeover's are "
+                         "not built yet)")
+
+
 def is_series(circuit) -> bool:
     """True when the circuit's contacts are in series in one loop (a bridge)."""
     return getattr(circuit, "arrangement", None) == "series" and len(getattr(circuit, "contacts", ())) > 1

@@ -598,9 +598,9 @@ def _build(doc: dict, base_dir: Path, name: str) -> Scene:
         factor = tribology.laws.resistance_law.current_factor_expression("I") if tribology is not None else None
         circuit = _circuit(circuit_table, base_dir, factor, device, mech)
         if mech is not None and mech.bar is not None:  # each circuit contact has its contact pairs
-            from coupling.core.arrangement import contact_feeds
+            from coupling.core.arrangement import check_arrangement
 
-            contact_feeds(mech, getattr(circuit.circuit, "contacts", ()))
+            check_arrangement(mech, circuit.circuit)
     elif device is not None:  # an actuator: the coil's drive is the whole circuit
         import circuit as ck
 
