@@ -187,3 +187,10 @@ def test_a_final_step_shorter_than_ngspice_s_end_tolerance_ends_the_run(ringing_
         df = stepper.results()
     assert df.time.iloc[-1] >= BOUNCE_T_END - bounce_options.end_tolerance(BOUNCE_T_END)
     assert (np.diff(df.time.to_numpy()) > 0).all()
+    # the stop condition met at the analysis' last point left ngspice's pause request set;
+    # the next run (any circuit) must not read it as a Ctrl-C
+    try:
+        after = run_transient(ringing_circuit, 1.0, 1e-5, options=bounce_options)
+    except KeyboardInterrupt as err:
+        pytest.fail(f"the next run read the left pause as a Ctrl-C: {err}")
+    assert after.time.iloc[-1] == pytest.approx(1e-5)
