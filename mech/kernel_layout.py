@@ -60,8 +60,10 @@ N_CPAR = 6
 CONTACT_ROWS = 2
 MAX_PAIRS = 4
 # per load (rows of ``load``): actuator force (a time table of magnitude times a unit
-# direction, world or body frame) or linear spring-dashpot to a world anchor
-LOAD_FORCE, LOAD_SPRING = 0, 1
+# direction, world or body frame), linear spring-dashpot to a world anchor, or force-travel
+# spring (a table of its push against its travel, L_T0/L_TN its columns in ``tabs``, after
+# every force's time table; mech/travel_spring.py) with a dashpot, to a world anchor
+LOAD_FORCE, LOAD_SPRING, LOAD_TRAVEL_SPRING = 0, 1, 2
 (L_KIND, L_POINT, L_BODY, L_DX, L_DY, L_DZ, L_T0, L_TN, L_AX, L_AY, L_AZ, L_K, L_C, L_L0) = range(14)
 N_LOAD = 14
 # the armature (mech/armature.py): a rigid body with one coordinate q (m or rad, the travel

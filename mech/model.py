@@ -368,6 +368,8 @@ def _spring_rest_lengths(model: "BarModel") -> np.ndarray:
         length = float(np.linalg.norm(x - np.array(sp.anchor)))
         if sp.rest_length is not None:
             rest = sp.rest_length
+        elif sp.from_table:
+            rest = length  # a force-travel spring's travel 0 at the start
         elif sp.preload is not None:
             rest = length - sp.preload / sp.stiffness
             if rest < 0.0:
