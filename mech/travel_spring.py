@@ -7,6 +7,15 @@ points) and tabs[1, ...] (forces): linear between its points and, beyond its end
 its end segments (so a straight-line table is a linear spring at every travel, and the
 force stays continuous wherever the bar goes). The spring's stored energy at travel x is
 travel_work(x) - travel_work(0): the work of pressing it from its rest length.
+
+With hysteresis (a press and a release table on the same travels) the push is the
+branches' mean plus a stick force z (N, a state), a smooth Jenkins element of the Bouc-Wen
+kind: z follows the travel x elastically, dz/dt = k_s dx/dt, while it moves back into the
+band |z| <= F_h(x) (half the gap between the branches), and is drawn onto the band's edge
+while it moves out, dz/dt = k_s dx/dt (1 - (z / F_h)^2), so that a press follows the press
+branch (z -> +F_h) and a release the release branch (z -> -F_h) past a turn of 2 F_h / k_s.
+It stores z^2 / (2 k_s) and dissipates z (dx/dt - dz/dt / k_s) >= 0, exactly what the
+force's power leaves over: the energy audit closes by construction.
 """
 
 from __future__ import annotations
@@ -53,3 +62,14 @@ def travel_work(x: float, tabs, start: int, count: int) -> float:
     slope = (tabs[1, hi] - tabs[1, lo]) / (tabs[0, hi] - tabs[0, lo])
     d = x - tabs[0, lo]
     return acc + d * (tabs[1, lo] + 0.5 * slope * d)
+
+
+def stick_rate(z: float, rate: float, half: float, floor: float, ks: float) -> float:
+    """N/s: the stick force's rate dz/dt for the travel's rate ``rate`` (m/s), the band's
+    half-width ``half`` (N, raised to ``floor`` where the branches meet: the element's
+    stiffness k_s / F_h stays bounded) and the stick spring's stiffness ``ks`` (N/m)."""
+    if rate * z > 0.0:
+        band = half if half > floor else floor
+        u = z / band
+        return ks * rate * (1.0 - u * u)
+    return ks * rate
