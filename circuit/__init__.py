@@ -7,7 +7,8 @@ channels (``<label>.conductance`` S, ``<label>.gap`` m) and result columns.
 - ``Stepper``: co-simulation stepping (advance to t_next with G(t) and breakpoints).
 - ``run_transient`` / ``run_pwl_reference``: one-shot runs.
 - ``ContactSchedule``: prescribed make/break instants.
-- ``SwitchCircuit`` and its parts, ``McuInput`` (a switch read by a microcontroller pin),
+- ``SwitchCircuit`` and its parts, ``BridgeCircuit`` (a double-break bridge: two contacts
+  in series), ``McuInput`` (a switch read by a microcontroller pin),
   ``NetlistCircuit``: the circuit.
 - ``ArcModel``: arc/breakdown of the opening gap (optionally growing with the gap distance).
 """
@@ -35,6 +36,7 @@ from .probes import COLUMNS, Probes
 from .schedule import ContactSchedule
 from .stepping import StepResult, Stepper
 from .templates import (
+    BridgeCircuit,
     CapacitiveLoad,
     CurrentSource,
     DCSource,
@@ -51,6 +53,7 @@ from .transient import run_pwl_reference, run_transient
 
 __all__ = [
     "ArcModel",
+    "BridgeCircuit",
     "COLUMNS",
     "CapacitiveLoad",
     "CurrentSource",

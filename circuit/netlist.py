@@ -57,6 +57,8 @@ from .validation import check_range
 _RESERVED_ELEMENTS = re.compile(
     r"^(vcontact\w*|bcontact\w*|varc\w*|barc\w*|iarc\w*|rarc\w*|[vrbc]xcoil\w*)$", re.I)
 _RESERVED_NODES = re.compile(r"^(contact_(\w+_)?(s|g|geff)|arc_\w+|xcoil_\w+)$", re.I)
+# nodes of an element line after its name, by its letter (SPICE); others have two
+_NODE_COUNTS = {"s": 4, "e": 4, "g": 4, "q": 3, "j": 3, "m": 4, "t": 4, "o": 4}
 _CONTACT_LINE = re.compile(r"^xcontact(?:_(\w+))?$", re.I)
 _COIL_LINE = re.compile(r"^xcoil$", re.I)
 
@@ -194,6 +196,47 @@ class NetlistCircuit:
     def contacts(self) -> tuple[ContactBlock, ...]:
         """The netlist's contacts, as blocks, in the order of their lines."""
         return tuple(block for _, block in self._parse()[1])
+
+    @property
+    def arrangement(self) -> str | None:
+        """"series" when the netlist's several contacts are in series in one loop (a double-break
+        bridge: XCONTACT_A a m, XCONTACT_B m b): the contacts form one chain whose inner nodes
+        join two contacts and nothing else but elements across one of them (its stray
+        capacitance, a snubber); None otherwise (one contact, or an arrangement not inferred)."""
+        lines, placed, coils, _ = self._parse()
+        if len(placed) < 2:
+            return None
+        degree: dict[str, int] = {}
+        for _, block in placed:
+            a, b = block.node_a.lower(), block.node_b.lower()
+            if a == b:
+                return None
+            for node in (a, b):
+                degree[node] = degree.get(node, 0) + 1
+        inner = {n for n, d in degree.items() if d == 2}
+        ends = [n for n, d in degree.items() if d == 1]
+        if any(d > 2 for d in degree.values()) or len(ends) != 2 or len(inner) != len(placed) - 1 or "0" in inner:
+            return None  # (not one chain: a contact in parallel with another, a branch, a loop)
+        spans = [{block.node_a.lower(), block.node_b.lower()} for _, block in placed]
+        rows = {row for row, _ in placed + coils}
+        depth = 0
+        for i, line in enumerate(lines):
+            tokens = line.text.lower().split()
+            if i == 0 or i in rows or not tokens:
+                continue
+            if tokens[0].startswith(".subckt"):
+                depth += 1
+            elif tokens[0].startswith(".ends"):
+                depth -= 1
+            if depth or tokens[0][0] in ".*+":
+                continue
+            letter = tokens[0][0]
+            count = _NODE_COUNTS.get(letter, 2)
+            nodes = set(t for t in tokens[1:-1] if "=" not in t) if letter == "x" else set(tokens[1:1 + count])
+            touched = nodes & inner
+            if touched and not any(nodes <= span for span in spans):
+                return None  # an inner node reaches outside its two contacts
+        return "series"
 
     @property
     def coils(self) -> tuple[CoilBlock, ...]:

@@ -179,6 +179,9 @@ class NgspiceSession(NgSpiceShared):
         self._target = math.inf
         self._deadline = math.inf
         self._failure: BaseException | None = None
+        # a stop condition met at the analysis' last point leaves ngspice's pause request set
+        # (the analysis ended first): the next run of any circuit would pause at its start
+        self._stale_pause = False
         self._arcs: dict[str, object] = {}  # the ArcState of each arc, by its EXTERNAL current source
         self._arc_by_pointer: dict[int, object] = {}
         self._arc_from = math.nan  # accepted time the arc's step bounds below apply from
@@ -463,9 +466,16 @@ class NgspiceSession(NgSpiceShared):
         """
         self._deadline = math.inf if wall_timeout is None else time.monotonic() + wall_timeout
         self._target = math.inf if target is None else float(target)
+        ended = t_end - max(1e-9 * t_end, end_tolerance)  # ngspice ends a run within this of t_end
         try:
             if target is None:
-                printed = self.command("run" if first else "resume")
+                if not first and self.last_time() >= ended:
+                    # ngspice ended the run at its last pause, within CKTminBreak of t_end (a
+                    # macro step landed there): a "resume" would start the analysis over from
+                    # t = 0 (measured: a 5.75 ns final step made ngspice restart and its
+                    # pause at t = 0 read as Ctrl-C)
+                    return
+                printed = self._unstale(self.command("run" if first else "resume"))
                 self._raise_if_failed(printed)
                 # ngspice ends a run once within CKTminBreak (5e-5 TMAX) of t_end: after
                 # rejected steps near the end its last point can be that early (measured
@@ -476,6 +486,7 @@ class NgspiceSession(NgSpiceShared):
                 # 'stop when time >= x' given before 'run' also becomes a breakpoint at x,
                 # which would cut the step below the target: pause on the first point.
                 printed = self.command("stop when time > 0; run; delete all")
+                self._stale_pause = False  # (consumed by this run's first point, if it was set)
                 self._raise_if_failed(printed)
                 self._check_reached(printed, -math.inf)
             # ngspice parses the number itself; the margin keeps its rounding harmless.
@@ -489,11 +500,20 @@ class NgspiceSession(NgSpiceShared):
                 # A point can fall inside the margin just before the target (a breakpoint
                 # there): then resume again, the step clipping lands on the target.
                 if self._check_reached(printed, threshold):
+                    self._stale_pause = self.last_time() >= ended
                     return
             raise SimulationAborted(f"ngspice did not reach t = {target!r} s after repeated resumes")
         finally:
             self._target = math.inf
             self._deadline = math.inf
+
+    def _unstale(self, printed: list[str]) -> list[str]:
+        """A run that paused at its start on the pause request a previous run left
+        (``_stale_pause``) is resumed: that pause was ours, not a Ctrl-C."""
+        stale, self._stale_pause = self._stale_pause, False
+        if stale and self.last_time() == 0.0 and any("pause requested" in line for line in printed):
+            return self.command("resume")
+        return printed
 
     def _check_reached(self, printed: list[str], threshold: float) -> bool:
         """True if ngspice got to ``threshold``; a pause that was not ours is a user interrupt."""

@@ -33,6 +33,7 @@ from .arc import ArcModel, add_arc
 from .blocks import CoilBlock, ContactBlock
 from .coil_drive import CoilDrive
 from .contact import DEFAULT_LEAKAGE, add_contact, check_current_factor
+from .names import check_block_name
 from .probes import Probes
 from .validation import check_range
 
@@ -336,14 +337,7 @@ class SwitchCircuit:
             next_node = NODE_A if i == len(series) - 1 else next(inner_nodes)
             getattr(c, kind)(name, node, next_node, float(value))
             node = next_node
-        add_contact(c, NODE_A, NODE_B, self.leakage_conductance, self.contact_current_factor)
-        if self.contact_capacitance > 0:
-            c.C("contact", NODE_A, NODE_B, float(self.contact_capacitance))
-        if self.snubber is not None:
-            c.R("snubber", NODE_A, "snubber", float(self.snubber.resistance))
-            c.C("snubber", "snubber", NODE_B, float(self.snubber.capacitance))
-        if self.arc is not None:
-            add_arc(c, self.arc, NODE_A, NODE_B)
+        self._place_switch(c)
         c.V(LOAD_PROBE[1:], NODE_B, "load", 0)
         load = self.load
         if isinstance(load, ResistiveLoad):
@@ -369,6 +363,79 @@ class SwitchCircuit:
             self.coil.add_to(c)
         return c
 
+    def _place_switch(self, c: Circuit) -> None:
+        """What sits between NODE_A and NODE_B: the contact, its capacitance, the snubber, the arc."""
+        add_contact(c, NODE_A, NODE_B, self.leakage_conductance, self.contact_current_factor)
+        if self.contact_capacitance > 0:
+            c.C("contact", NODE_A, NODE_B, float(self.contact_capacitance))
+        if self.snubber is not None:
+            c.R("snubber", NODE_A, "snubber", float(self.snubber.resistance))
+            c.C("snubber", "snubber", NODE_B, float(self.snubber.capacitance))
+        if self.arc is not None:
+            add_arc(c, self.arc, NODE_A, NODE_B)
+
+
+
+# --- a double-break bridge: two contacts in series in one loop ------------------------------
+
+BRIDGE_NODE = "bridge"  # the moving bridge itself, between its two contacts
+
+
+@dataclass(frozen=True)
+class BridgeCircuit(SwitchCircuit):
+    """A ``SwitchCircuit`` whose switch is a double-break bridge: two contacts in series in
+    the one loop, the moving bridge between them (SI units)::
+
+        ... Lwire -- contact_a =CONTACT_<n0>= bridge =CONTACT_<n1>= contact_b --Vload-- load ...
+                   |--Ccontact_<n0>--|      |--Ccontact_<n1>--|    (each contact's stray capacitance)
+                   |--arc path <n0>--|      |--arc path <n1>--|    (each its own arc, optional)
+                   |--Rsnubber--snubber--Csnubber-------------|    (optional, across the whole bridge)
+
+    contact_names: the two contacts' names, in the loop's order from the supply (each a
+        block name, circuit.names: the coupled scene gives its two electrical [[fixed]]
+        contacts' names); each is its own ``ContactBlock`` with its own conductance and gap
+        inputs, arc and result columns (``contact_voltage_<name>``, ...).
+    contact_capacitance: F, across each contact (not across the bridge: in series two
+        such give half of it across the whole).
+    Every other field is SwitchCircuit's; the arc model (``arc``) is each contact's, so at
+    a break the two arcs in series hold twice its burning voltage.
+    """
+
+    contact_names: tuple = ("a", "b")
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        names = self.contact_names
+        if not isinstance(names, (tuple, list)) or len(names) != 2:
+            raise ValueError(f"BridgeCircuit.contact_names = {names!r}: the bridge's two contacts, two names")
+        for name in names:
+            check_block_name("BridgeCircuit.contact_names", name)
+            if not name:
+                raise ValueError("BridgeCircuit.contact_names: each of the bridge's contacts is named")
+        if names[0].lower() == names[1].lower():
+            raise ValueError(f"BridgeCircuit.contact_names = {tuple(names)!r}: two distinct names (SPICE ignores case)")
+        object.__setattr__(self, "contact_names", tuple(names))
+
+    #: how the contacts are arranged in the loop: the current flows only while both are closed
+    arrangement = "series"
+
+    @property
+    def contacts(self) -> tuple[ContactBlock, ...]:
+        """The bridge's two contacts, in the loop's order."""
+        (n0, n1), args = self.contact_names, (self.leakage_conductance, self.contact_current_factor, self.arc)
+        return (ContactBlock(n0, NODE_A, BRIDGE_NODE, *args), ContactBlock(n1, BRIDGE_NODE, NODE_B, *args))
+
+    def _place_switch(self, c: Circuit) -> None:
+        for block in self.contacts:
+            add_contact(c, block.node_a, block.node_b, self.leakage_conductance, self.contact_current_factor,
+                        block.name)
+            if self.contact_capacitance > 0:
+                c.C(block.element("Ccontact")[1:], block.node_a, block.node_b, float(self.contact_capacitance))
+            if self.arc is not None:
+                add_arc(c, self.arc, block.node_a, block.node_b, block.name)
+        if self.snubber is not None:
+            c.R("snubber", NODE_A, "snubber", float(self.snubber.resistance))
+            c.C("snubber", "snubber", NODE_B, float(self.snubber.capacitance))
 
 
 # --- a switch read by a microcontroller input ---------------------------------------------

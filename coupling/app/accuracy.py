@@ -21,6 +21,8 @@ Metrics (pure functions of the per-tip contact intervals and the waveforms, SI):
     peak_force           N, largest normal force of any contact
     peak_contact_voltage V, largest |contact voltage| after the first make (coupled)
     arc_energy           J (coupled)
+    operate_time, release_time   s (a relay: coil switched on to the first make, off to
+                         the break after it; summary.json relay)
 
 The switching window of a run: from its first make to its last switching instant (the
 last make when the run ends closed, the last break when it ends open), without the held
@@ -31,7 +33,8 @@ TOLERANCES (a refinement "did not move" the result when all hold):
     mismatch_time       <= max(1 us, 2 % of the base run's contact time in its switching
                         window, both tips)
     contacts, bounces   equal
-    first/last make, total bounce time   within max(1 us, 1 % of the switching window)
+    first/last make, total bounce time, operate and release time   within max(1 us, 1 % of
+                        the switching window)
     peak_force          within 2 %
     peak_contact_voltage within 2 % + 10 mV
     arc_energy          within 5 % + 1 uJ
@@ -65,7 +68,7 @@ TOLERANCES = dict(mismatch_fraction=0.02, time_floor=1e-6, time_fraction=0.01, p
 SENSITIVITY = 0.01  # the relative change of an input in the sensitivity reruns
 SENSITIVITY_RERUNS = 4
 COUNT_KEYS = ("contacts", "bounces")
-TIME_KEYS = ("first_make", "last_make", "total_bounce_time")
+TIME_KEYS = ("first_make", "last_make", "total_bounce_time", "operate_time", "release_time")
 MAX_MODES = 40  # the largest count a family may have (mech.parameters)
 MIN_RTOL = 1e-13
 MIN_RELTOL = 1e-9
@@ -260,6 +263,10 @@ def metrics_of(result) -> dict:
         b = result.bounce
         out["peak_contact_voltage"] = b.get("peak_contact_voltage")
         out["arc_energy"] = b.get("arc_energy")
+        relay = getattr(result, "relay", None)
+        if relay:
+            out["operate_time"] = relay.get("operate_time")
+            out["release_time"] = relay.get("release_time")
     return out
 
 
@@ -419,6 +426,7 @@ def verdict(entries: list[dict], sensitivity: list[dict] | None = None) -> tuple
 
 
 _UNITS = {"first_make": ("ms", 1e3), "last_make": ("ms", 1e3), "total_bounce_time": ("ms", 1e3),
+          "operate_time": ("ms", 1e3), "release_time": ("ms", 1e3),
           "peak_force": ("N", 1.0), "peak_contact_voltage": ("V", 1.0), "arc_energy": ("mJ", 1e3)}
 
 

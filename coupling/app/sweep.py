@@ -597,8 +597,14 @@ def _one_line(err) -> str:
 
 
 def _write_parquet_atomic(frame, path: Path) -> None:
+    """A pandas frame or an Arrow table to ``path``, whole or not at all (rename)."""
     tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
-    frame.to_parquet(tmp, index=False)
+    if hasattr(frame, "to_parquet"):
+        frame.to_parquet(tmp, index=False)
+    else:
+        import pyarrow.parquet as pq
+
+        pq.write_table(frame, tmp)
     os.replace(tmp, path)
 
 
@@ -698,9 +704,25 @@ class RowWriter:
 
         frame = pd.DataFrame(self.rows)
         path = self.folder / f"part-{self.session}-{self.count:05d}.parquet"
-        _write_parquet_atomic(frame, path)
+        _write_parquet_atomic(_typed_batch(frame), path)
         self.count += 1
         self.rows = []
+
+
+def _typed_batch(frame):
+    """A batch of rows as an Arrow table whose columns with no value at all are of null type:
+    pandas makes such a column float (NaN), and a batch in which a text column (a
+    settle_note) happened to be missing in every row then had a double column where another
+    batch had strings, which no schema unifies (a 1000-run study stopped on it); null merges
+    with any type."""
+    import pyarrow as pa
+
+    table = pa.Table.from_pandas(frame, preserve_index=False)
+    for k, fld in enumerate(table.schema):
+        col = table.column(k)
+        if len(col) and col.null_count == len(col) and not pa.types.is_null(fld.type):
+            table = table.set_column(k, pa.field(fld.name, pa.null()), pa.nulls(len(col)))
+    return table
 
 
 # --- running a sweep -------------------------------------------------------------------

@@ -13,6 +13,8 @@ A link owns what crosses the seam for one pair of blocks, both ways:
 more contact points of the mechanics: its conductance G_F(F_n(t)) from the contact law
 (summed over the points, which touch the same fixed contact), its gap (the nearer
 point's height, for an arc that grows with it) and, back, mu(I) from the loop current.
+A circuit of several contacts (a bridge) has one link per contact, each fed by the
+contact pair of its fixed contact (coupling.core.arrangement).
 """
 
 from __future__ import annotations
@@ -163,12 +165,18 @@ class ContactLink:
         points = self.points
         lo, hi = seg.t_start, seg.t_end
 
+        first_two = points == (0, 1)  # the one circuit contact: the compiled tip_forces' nearest gap
+        near = max(points) < 2  # rows tip_forces gives (F_0, F_1, gap, y_0, y_1), else pair_forces'
+
         def gap(s: float) -> float:
             """m: the arc's length, the smaller point height; 0 while a point touches."""
             s = lo if s < lo else (hi if s > hi else s)
             if any(a <= s <= b for i in points for a, b in intervals[i]):
                 return 0.0
-            return seg.tip_forces(s)[2]
+            if first_two:
+                return seg.tip_forces(s)[2]
+            rows = seg.pair_forces(s)
+            return float(min(rows[i, 2] for i in points))
 
         out = {}
         if gap_wanted:
@@ -183,9 +191,13 @@ class ContactLink:
             forces = None
             for i in points:
                 if any(a <= s <= b for a, b in intervals[i]):
-                    if forces is None:
-                        forces = seg.tip_forces(s)
-                    total += force(forces[i]) * conduction_onset(forces[3 + i], onset)
+                    if near:
+                        if forces is None:
+                            forces = seg.tip_forces(s)
+                        total += force(forces[i]) * conduction_onset(forces[3 + i], onset)
+                    else:
+                        row = seg.pair_forces(s)[i]
+                        total += force(float(row[0])) * conduction_onset(float(row[1]), onset)
             return total
 
         out[f"{self.label}.conductance"] = g

@@ -37,6 +37,7 @@ import numpy as np
 
 from mech import ImpactSolver
 
+from coupling.core.arrangement import contact_feeds, is_series, series_columns
 from coupling.core.exchange import CONTACT_EVENTS, FLUX_FLOOR, CoilLink, ContactLink
 from coupling.core.policy import StepPolicy
 from coupling.core.results import CoupledResult, RunStatus
@@ -134,18 +135,17 @@ class CoSimulation:
                                                time_scale_fraction=COIL_TIME_SCALE_FRACTION) if coil is not None else None
 
     def _links(self) -> list:
-        """The links between the scene's mechanics and circuit blocks: its circuit contact fed
-        by every contact point of the mechanics (they touch the same fixed contact), and the
-        relay's coil driving its armature through the magnet."""
+        """The links between the scene's mechanics and circuit blocks: each circuit contact fed
+        by its contact pairs (coupling.core.arrangement: one contact by the first two, which
+        touch the same fixed contact; each of several by the [[fixed]] contact of its name),
+        and the relay's coil driving its armature through the magnet."""
         circuit = self.scene.circuit.circuit
         links: list = []
         contacts = circuit.contacts
-        if len(contacts) > 1:
-            raise ValueError(f"a coupled scene's circuit holds one contact; this one has {len(contacts)} "
-                             f"({', '.join(c.label for c in contacts)})")
         if contacts and self.scene.mech.bar is not None:
-            links.append(ContactLink(contacts[0].label, (0, 1), self.laws, self.scene.coupling.onset_penetration,
-                                     self.feedback))
+            for block, points in zip(contacts, contact_feeds(self.scene.mech, contacts)):
+                links.append(ContactLink(block.label, points, self.laws, self.scene.coupling.onset_penetration,
+                                         self.feedback))
         coils = getattr(circuit, "coils", ())
         if coils:
             from coupling.core.device import device
@@ -164,7 +164,14 @@ class CoSimulation:
 
     @property
     def contact(self) -> ContactLink | None:
+        """The first contact link: its loop current sets the step rules (contacts in series
+        carry one loop current)."""
         return next((link for link in self.links if isinstance(link, ContactLink)), None)
+
+    @property
+    def contacts(self) -> list[ContactLink]:
+        """Every contact link, in the circuit's order of its contacts."""
+        return [link for link in self.links if isinstance(link, ContactLink)]
 
     @property
     def coil(self) -> CoilLink | None:
@@ -292,13 +299,16 @@ class CoSimulation:
         def current_at(s):
             return policy.extrapolate(i_now, slope, s - t, horizon)
 
-        mu0 = contact.mu(current_at(t)) if contact is not None else 0.0
+        links = self.contacts
+        mu0 = [link.mu(current_at(t)) for link in links]
         arm = mech.armature_now() if coil is not None else None
 
         def drives(end: float) -> dict:
             """The mechanics' drives over [t, end]: each link's, extrapolated to the step's end."""
-            out = {} if contact is None else (contact.drives(mech, mu0, contact.mu(current_at(end)))
-                                              | contact.repulsion(mech, self.scene.duty, current_at, t, end))
+            out = {}
+            for link, mu in zip(links, mu0):
+                out.update(link.drives(mech, mu, link.mu(current_at(end)))
+                           | link.repulsion(mech, self.scene.duty, current_at, t, end))
             if coil is not None:
                 out.update(coil.drives(t, end, arm, self.coil_policy))
             return out
@@ -329,10 +339,12 @@ class CoSimulation:
                 switching = [e["time"] for e in seg.events if e["kind"] in CONTACT_EVENTS]
                 aligned = end is not None
         self.stats["mech_seconds"] += time.perf_counter() - tick
-        if contact is not None:
-            contact.mu_log.append((t, t_next, mu0, contact.mu(current_at(t_next))))
+        for link, mu in zip(links, mu0):
+            link.mu_log.append((t, t_next, mu, link.mu(current_at(t_next))))
         breakpoints = sorted({s for s in switching if t < s <= t_next})
-        inputs = contact.inputs(seg, touching, stepper.uses_gap) if contact is not None else {}
+        inputs = {}
+        for link in links:
+            inputs.update(link.inputs(seg, touching, stepper.uses_gap))
         if coil is not None:
             inputs.update(coil.inputs(seg))
         tick = time.perf_counter()
@@ -344,7 +356,8 @@ class CoSimulation:
             coil.observe(step, seg, self.coil_policy.macro_step)
         if contact is None:
             return t_next, 0.0, jumped, (0.0, math.inf)
-        contact.observe(step, jumped)
+        for link in links:
+            link.observe(step, jumped)
         # a step cut at a make/break ends at a current jump even when the re-run mechanics
         # stops a round-off short of the event (it is then found at the next step's start)
         return t_next, contact.current(step), jumped, contact.tail.rate(policy.macro_step)
@@ -353,19 +366,21 @@ class CoSimulation:
         if self.coil is not None or self.contact is None:
             raise ValueError("coupling.scheme = \"jacobi\" couples a contact alone; a scene with a coil runs "
                              "\"mechanics_first\"")
-        link = self.contact
-        mu = link.mu(i_now)
-        inputs = link.held_inputs(mech.contact_now(), stepper.uses_gap)
+        inputs, drives = {}, {}
+        state = mech.contact_now()
+        for link in self.contacts:
+            mu = link.mu(i_now)
+            inputs.update(link.held_inputs(state, stepper.uses_gap))
+            drives.update(link.drives(mech, mu, mu) | link.repulsion(mech, self.scene.duty, lambda s: i_now, t, t_next))
+            link.mu_log.append((t, t_next, mu, mu))
         tick = time.perf_counter()
-        mech.advance(t_next, link.drives(mech, mu, mu)
-                     | link.repulsion(mech, self.scene.duty, lambda s: i_now, t, t_next))
+        mech.advance(t_next, drives)
         self.stats["mech_seconds"] += time.perf_counter() - tick
-        link.mu_log.append((t, t_next, mu, mu))
         tick = time.perf_counter()
         step = stepper.advance(t_next, inputs=inputs)
         self.stats["circuit_seconds"] += time.perf_counter() - tick
         self._sample_contact(mech, step)
-        return link.current(step), t_next
+        return self.contact.current(step), t_next
 
     def _sample_contact(self, mech, step) -> None:
         """Note the circuit's new points of a macro step (a step's reader starts at the
@@ -397,6 +412,9 @@ class CoSimulation:
         waves = stepper.result_columns(probes=self.scene.circuit.probes)
         kept = waves["time"] <= mech.t + 1e-15
         waves = {name: values[kept] for name, values in waves.items()}
+        circuit = self.scene.circuit.circuit
+        if is_series(circuit):  # the whole bridge beside its contacts' own columns
+            waves.update(series_columns(waves, circuit.contacts))
         if self.contact is not None:
             self._contact_columns(mech, waves)
         if self.coil is not None:
@@ -421,6 +439,13 @@ class CoSimulation:
         waves["gap"] = np.where(waves["normal_force"] > 0.0, 0.0,
                                 np.maximum(0.0, -np.max(contact[:, :, 0], axis=1)))
         waves["mu"] = self.contact.mu_series(waves["time"])
+        if len(self.contacts) > 1:  # each contact's own: its arc's gap and its points' mu
+            for link in self.contacts:
+                suffix = link.label[len("contact"):]
+                points = list(link.points)
+                touching = np.any(contact[:, points, 0] > 0.0, axis=1)
+                waves["gap" + suffix] = np.where(touching, 0.0, np.maximum(0.0, -np.max(contact[:, points, 0], axis=1)))
+                waves["mu" + suffix] = link.mu_series(waves["time"])
 
 
 def run(scene: Scene, *, progress: bool = False, check: bool = False) -> CoupledResult:

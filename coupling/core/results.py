@@ -1,7 +1,8 @@
 """The outcome of a run: mechanics result, circuit waveforms, bounce metrics, warnings, files and plots.
 
 Bounce metrics (``bounce`` in summary.json) are computed by coupling.core.metrics from the
-closed intervals of the contact (mechanics: the union of the tips' contact intervals;
+closed intervals of the contact (mechanics: the union of the tips' contact intervals, for
+contacts in series their intersection, coupling.core.arrangement;
 prescribed schedule: its intervals) and the waveform; every key is defined in
 docs/coupling.md ("Bounce metrics"). Warnings (``warnings``) come from
 coupling.core.diagnostics.
@@ -117,10 +118,12 @@ class CoupledResult:
 
     @property
     def closed_intervals(self) -> list[tuple[float, float]]:
-        """Intervals (s) during which the contact is closed."""
+        """Intervals (s) during which the contact is closed (contacts in series, a bridge: while
+        every one touches; coupling.core.arrangement)."""
         if self.mechanics is not None:
-            c = self.mechanics.contact_columns
-            return merge_intervals(zip(c["t_start"], c["t_end"]))
+            from coupling.core.arrangement import switch_closed
+
+            return switch_closed(self.scene, self.mechanics.contact_columns)[0]
         sched = self.scene.circuit.schedule
         return [(a, min(b, self.scene.t_end)) for a, b in sched.intervals if a < self.scene.t_end]
 
@@ -128,7 +131,9 @@ class CoupledResult:
     def closed_at_end(self) -> bool:
         """Whether the contact is closed when the run ends (a contact still going on)."""
         if self.mechanics is not None:
-            return bool((~self.mechanics.contact_columns["complete"]).any())
+            from coupling.core.arrangement import switch_closed
+
+            return switch_closed(self.scene, self.mechanics.contact_columns)[1]
         return bool(self.scene.circuit.schedule.is_closed(self.scene.t_end))
 
     @property

@@ -12,6 +12,8 @@ A scene names only what it needs, and only that is built:
                   | "mcu_input" (voltage, pull, pull_resistance, series_resistance,
                   input_capacitance, logic_low, logic_high, contact_capacitance, leakage_conductance)
                   | "short_circuit" (resistive, shorted at fault_time: fault_resistance, fault_rise)
+                  | "bridge" (resistive, its switch a double-break bridge: two contacts in series,
+                  named as the scene's two electrical [[fixed]] contacts)
                   voltage, source_resistance (voltage templates) | current, compliance_voltage,
                   output_capacitance, output_resistance (current_source), wiring_resistance,
                   wiring_inductance, load_resistance, load_inductance, load_capacitance,
@@ -76,7 +78,8 @@ POINTS_PER_MACRO_STEP = 4
 WAVE_COPIES = 3
 MECH_WAVE_COLUMNS = 8  # normal_force_0/1, penetration_0/1, normal_force, gap, mu (+1 spare)
 MACRO_STEP_LOG_BYTES = 152  # the friction coefficient's log, one entry per macro step
-TEMPLATES = ("resistive", "inductive", "capacitive", "current_source", "netlist", "mcu_input", "short_circuit")
+TEMPLATES = ("resistive", "inductive", "capacitive", "current_source", "netlist", "mcu_input", "short_circuit",
+             "bridge")
 SCHEMES = ("mechanics_first", "jacobi")
 
 
@@ -349,6 +352,7 @@ _LOADS = {
                    "bleed_resistance": "bleed_resistance"},
     "current_source": {"load_resistance": "resistance"},
     "short_circuit": {"load_resistance": "resistance"},
+    "bridge": {"load_resistance": "resistance"},
 }
 _FAULT = {"fault_time": "fault_time", "fault_resistance": "fault_resistance", "fault_rise": "fault_rise"}
 _TEMPLATE_CIRCUIT = {"contact_capacitance": "contact_capacitance", "leakage_conductance": "leakage_conductance"}
@@ -382,7 +386,8 @@ def circuit_key_names(ck) -> dict:
     for cls, keys in ((ck.DCSource, _VOLTAGE_SOURCE), (ck.CurrentSource, _CURRENT_SOURCE), (ck.Wiring, _WIRING),
                       (ck.ResistiveLoad, _LOADS["resistive"]), (ck.InductiveLoad, _LOADS["inductive"]),
                       (ck.CapacitiveLoad, _LOADS["capacitive"]), (ck.SwitchCircuit, _TEMPLATE_CIRCUIT),
-                      (ck.NetlistCircuit, _NETLIST), (ck.McuInput, _MCU_INPUT), (ck.ShortCircuit, _FAULT)):
+                      (ck.NetlistCircuit, _NETLIST), (ck.McuInput, _MCU_INPUT), (ck.ShortCircuit, _FAULT),
+                      (ck.BridgeCircuit, _TEMPLATE_CIRCUIT)):
         names.update({f"{cls.__name__}.{name}": f"circuit.{key}" for key, name in keys.items() if name})
     for part, cls in zip(_PARTS, (ck.Snubber, ck.FlybackDiode, ck.ArcModel)):
         names[f"SwitchCircuit.{part}"] = names[f"NetlistCircuit.{part}"] = f"circuit.{part}"
@@ -391,8 +396,9 @@ def circuit_key_names(ck) -> dict:
     names.update({f"ContactSchedule.{name}": f"circuit.schedule.{'make/break' if name == 'intervals' else key}"
                   for key, name in _SCHEDULE.items()})
     names["SwitchCircuit.load"] = "circuit.template"
-    names.update({f"ShortCircuit.{k.split('.', 1)[1]}": v for k, v in list(names.items())
-                  if k.startswith("SwitchCircuit.")})  # a ShortCircuit is a SwitchCircuit
+    for cls in ("ShortCircuit", "BridgeCircuit"):  # each a SwitchCircuit
+        names.update({f"{cls}.{k.split('.', 1)[1]}": v for k, v in list(names.items())
+                      if k.startswith("SwitchCircuit.")})
     names["CircuitSpec.probes"] = "circuit.probes"  # what to record, beside the circuit itself
     return names
 
@@ -428,9 +434,28 @@ def _part(table: dict, name: str, cls):
     return cls(**value)
 
 
-def _circuit(table: dict, base_dir: Path, current_factor: str | None, device=None):
+def _bridge_names(mech) -> tuple[str, str]:
+    """The bridge template's two contact names: the scene's two electrical [[fixed]] contacts'."""
+    from circuit.names import BLOCK_NAME
+
+    fixed = list(getattr(mech, "fixed", ()) or ()) if mech is not None else []
+    names = mech.fixed_names() if fixed else ()
+    electrical = [(k, names[k]) for k, fx in enumerate(fixed) if fx.electrical]
+    if len(electrical) != 2:
+        have = f"{len(electrical)} ({', '.join(n for _, n in electrical)})" if fixed else "none ([block] or no bar)"
+        raise ValueError(f"circuit.template = \"bridge\" needs two electrical [[fixed]] contacts, the bridge's two "
+                         f"(each struck by its own contact point); this scene has {have}")
+    for k, name in electrical:
+        if not BLOCK_NAME.fullmatch(name):
+            raise ValueError(f"fixed[{k}].name = {name!r}: a bridge's contact is named in the circuit by its fixed "
+                             "contact's name, a letter then up to 15 letters or digits")
+    return tuple(n for _, n in electrical)
+
+
+def _circuit(table: dict, base_dir: Path, current_factor: str | None, device=None, mech=None):
     """[circuit] as its CircuitSpec; with the relay's ``device`` ([coil], [magnet]) the coil
-    and its drive join the template's circuit (a netlist places it with an XCOIL line)."""
+    and its drive join the template's circuit (a netlist places it with an XCOIL line); the
+    bridge template takes its contacts' names from the mechanics' (``mech``) [[fixed]]."""
     import circuit as ck
 
     table = check_keys("[circuit]", _table("[circuit]", table), CIRCUIT_KEYS)
@@ -471,9 +496,14 @@ def _circuit(table: dict, base_dir: Path, current_factor: str | None, device=Non
             else:
                 source = ck.DCSource(**_fields(table, _VOLTAGE_SOURCE))
                 load = {"resistive": ck.ResistiveLoad, "inductive": ck.InductiveLoad, "capacitive": ck.CapacitiveLoad,
-                        "short_circuit": ck.ResistiveLoad}[template](**_fields(table, _LOADS[template]))
+                        "short_circuit": ck.ResistiveLoad, "bridge": ck.ResistiveLoad}[template](**_fields(table, _LOADS[template]))
             cls, fault = (ck.ShortCircuit, _fields(table, _FAULT)) if template == "short_circuit" else (
                 ck.SwitchCircuit, {})
+            if template == "bridge":
+                if "schedule" in table:
+                    raise ValueError("circuit.schedule with template = \"bridge\": a bridge's two contacts are "
+                                     "driven by the mechanics' [[fixed]] contacts, not by a schedule")
+                cls, fault = ck.BridgeCircuit, dict(contact_names=_bridge_names(mech))
             circ = cls(source=source, load=load, wiring=ck.Wiring(**_fields(table, _WIRING)),
                        snubber=_part(table, "snubber", ck.Snubber), flyback=_part(table, "flyback", ck.FlybackDiode),
                        arc=arc, contact_current_factor=current_factor, coil=None if device is None else device.drive(),
@@ -566,7 +596,11 @@ def _build(doc: dict, base_dir: Path, name: str) -> Scene:
     if circuit_table is not None:
         # R_c(F, I) = g(|I|)/G_F(F): the current factor goes into ngspice (solved without lag)
         factor = tribology.laws.resistance_law.current_factor_expression("I") if tribology is not None else None
-        circuit = _circuit(circuit_table, base_dir, factor, device)
+        circuit = _circuit(circuit_table, base_dir, factor, device, mech)
+        if mech is not None and mech.bar is not None:  # each circuit contact has its contact pairs
+            from coupling.core.arrangement import check_arrangement
+
+            check_arrangement(mech, circuit.circuit)
     elif device is not None:  # an actuator: the coil's drive is the whole circuit
         import circuit as ck
 

@@ -168,3 +168,29 @@ def test_a_make_just_after_the_macro_time_restarts_the_integration(ringing_circu
     assert times[1] - t0 < 2e-9  # measured 0.87 ns (2.6e-17 to 4e-11), 0.1 and 1 ns; was 10 ns
     # The ramp is resolved: several points inside it.
     assert np.sum((times > t0) & (times < t0 + delta + 10e-9)) >= 3
+
+
+def test_a_final_step_shorter_than_ngspice_s_end_tolerance_ends_the_run(ringing_circuit, bounce_options):
+    """A macro step landing within CKTminBreak of t_end finishes ngspice's analysis; the final
+    step after it (5.75 ns in the study that found it) used to 'resume' a finished analysis,
+    which ngspice starts over from t = 0 and which read as a Ctrl-C. The run now ends there,
+    its last point within the end tolerance, its waveform the same as with one step less."""
+    short = 0.5 * bounce_options.end_tolerance(BOUNCE_T_END)
+    with Stepper(ringing_circuit, BOUNCE_T_END, bounce_options) as stepper:
+        stepper.advance(BOUNCE_T_END / 2, 1.0)
+        stepper.advance(BOUNCE_T_END - short, 1.0)
+        try:
+            stepper.advance(BOUNCE_T_END, 1.0)
+        except KeyboardInterrupt as err:  # (would stop the whole test session)
+            pytest.fail(f"the final step read as a Ctrl-C: {err}")
+        assert stepper.finished
+        df = stepper.results()
+    assert df.time.iloc[-1] >= BOUNCE_T_END - bounce_options.end_tolerance(BOUNCE_T_END)
+    assert (np.diff(df.time.to_numpy()) > 0).all()
+    # the stop condition met at the analysis' last point left ngspice's pause request set;
+    # the next run (any circuit) must not read it as a Ctrl-C
+    try:
+        after = run_transient(ringing_circuit, 1.0, 1e-5, options=bounce_options)
+    except KeyboardInterrupt as err:
+        pytest.fail(f"the next run read the left pause as a Ctrl-C: {err}")
+    assert after.time.iloc[-1] == pytest.approx(1e-5)

@@ -1,5 +1,5 @@
-"""Coupled scenes with [[fixed]] contacts, while the circuit has one contact (separate circuit
-blocks per fixed contact are not built yet).
+"""Coupled scenes with [[fixed]] contacts and a circuit of one contact (a bridge's two circuit
+contacts, each fed by its own fixed contact: tests/coupling/test_bridge.py).
 
 One fixed contact through [[fixed]] is the [block] scene in the circuit too: the mechanics
 agree bit for bit (tests/mech/test_mech_pairs.py), so the circuit's inputs and every

@@ -159,3 +159,40 @@ def test_an_actuator_alone_writes_its_folder_and_plots(tmp_path, capsys):
     assert not (out / "openings.png").exists() and not (out / "normal_force.png").exists()
     html = (out / "waveforms.html").read_text()
     assert all(name in html for name in ("coil current", "magnetic force", "armature travel"))
+
+
+def test_the_default_relay_reports_its_make_and_its_break_as_one_operation():
+    """The coil-driven default: one operation, its make (the top-level bounce keys describe
+    it) and its complete break; operate and release time are those operations' times less
+    the coil's switching times."""
+    res = run(default_scene())
+    assert res.status.value == "ok", res.message
+    (op,) = res.operations
+    coil = default_scene().raw["coil"]
+    assert op["make"]["bounces"] == res.bounce["bounces"] and op["make"]["settled"]
+    assert op["make"]["time"] == pytest.approx(res.bounce["first_make"], abs=1e-12)
+    assert op["break"]["complete"] and op["break"]["arc_duration"] > 0.0
+    assert res.relay["operate_time"] == pytest.approx(op["make"]["time"] - coil["on_time"], abs=1e-12)
+    assert res.relay["release_time"] == pytest.approx(op["break"]["time"] - coil["off_time"], abs=1e-12)
+    # the contact makes after the armature has left its rest stop and before it reaches the
+    # pole (the card's overtravel), and breaks after it has left the pole
+    events = res.mechanics.events
+    left_rest = min(e["time"] for e in events if e.get("stop") == "rest" and e["kind"] == "armature_stop_end")
+    left_pole = [e["time"] for e in events if e.get("stop") == "pole" and e["kind"] == "armature_stop_end"
+                 and e["time"] >= coil["off_time"]]
+    assert left_rest < op["make"]["time"] < res.relay["armature_arrival"]
+    assert left_pole and left_pole[0] < op["break"]["time"]
+
+
+def test_run_check_compares_operate_and_release_time():
+    """switchsim run --check judges a relay's operate and release time as it judges the make
+    times: the refined rerun's change against max(1 us, 1 % of the switching window)."""
+    from coupling.app.accuracy import compare, metrics_of, time_tolerance, tip_intervals
+
+    res = run(default_scene())
+    base = metrics_of(res)
+    assert base["operate_time"] == res.relay["operate_time"] and base["release_time"] == res.relay["release_time"]
+    tips = tip_intervals(res)
+    late = dict(base, release_time=base["release_time"] + 2 * time_tolerance(base))
+    assert compare(base, late, tips, tips)["moved"] == ["release_time"]
+    assert compare(base, dict(base), tips, tips)["moved"] == []

@@ -111,6 +111,10 @@ DERIVED = {("duty", k) for k in ("materials", "conductor_radius", "cap_height")}
 ACTUATOR = {"armature": {"kind": "plunger", "mass": 0.026, "travel": 4.75e-3, "stop_stiffness": 1e11},
             "magnet": {"model": "plunger_solenoid"}, "coil": {}}
 DUTY = {"tribology": {"resistance": {"law": "holm", "materials": ["Ag", "Ag"]}, "mu": 0.3}, "circuit": {}}
+# the bridge template names its contacts after two electrical [[fixed]] contacts: a free bar's
+# two end caps over two of them
+BRIDGE = {"fixed": [{"point": "tip0", "name": "a", "gap": 1e-3}, {"point": "tip1", "name": "b", "gap": 1e-3}],
+          "tribology": {"source": "illustrative"}}
 OPTION_KEYS = {f.name for f in dataclasses.fields(ck.SimulationOptions)}
 CONTEXTS = {"initial": {"held bar": {"mount": {"kind": "clamp", "position": 0.3}}}}
 
@@ -195,6 +199,10 @@ def _field_without(section: str, key: str, patch: dict, folder: Path):
     if section != "circuit":  # a sub-table: [circuit.arc], [circuit.schedule], ...
         part = section.split(".")[1]
         table[part] = {k: v for k, v in table.get(part, {}).items() if k != key}
+    if table.get("template") == "bridge":  # a coupled scene: its mechanics name the contacts
+        table.pop("schedule")
+        spec = cs.scene_from_dict({"circuit": table, **BRIDGE}, base_dir=folder).circuit
+        return _circuit_value(spec, f"{section}.{key}")
     spec = cs.scene_from_dict({"circuit": table}, base_dir=folder).circuit
     return _circuit_value(spec, f"{section}.{key}")
 

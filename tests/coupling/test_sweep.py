@@ -158,3 +158,23 @@ def test_batches_with_different_columns_read_back_as_one_dataset(tmp_path):
     assert df["bounce.bounces"].iloc[0] == 2 and pd.isna(df["bounce.bounces"].iloc[1])
     assert df["bounce.bounces"].iloc[2] == 1.5
     assert list(df.error.fillna("")) == ["", "boom", ""]
+
+
+def test_batches_whose_text_column_is_missing_in_every_row_read_as_one_table(tmp_path):
+    """A 1000-run study stopped when one batch's rows all lacked a text column (settle_note:
+    a float column of NaN there) and another's had it (strings): no schema unified them."""
+    from coupling.app.sweep import RowWriter, read_results
+
+    writer = RowWriter(tmp_path / "results", "s1", size=2)
+    # batch 1: no settle_note in either row (a failed run's row holds NaN there): pandas
+    # makes the column float
+    writer.add({"run_id": "run0", "status": "failed", "bounce.bounces": 3, "bounce.settle_note": float("nan")})
+    writer.add({"run_id": "run1", "status": "ok", "bounce.bounces": 4, "bounce.settle_note": None})
+    writer.add({"run_id": "run2", "status": "ok", "bounce.bounces": 5, "bounce.settle_note": "not settled"})
+    writer.add({"run_id": "run3", "status": "ok", "bounce.bounces": 6, "bounce.settle_note": None})
+    writer.flush()
+    df = read_results(tmp_path).sort_values("run_id")
+    assert list(df.run_id) == ["run0", "run1", "run2", "run3"]
+    assert list(df["bounce.bounces"]) == [3, 4, 5, 6]
+    assert df["bounce.settle_note"].tolist()[2] == "not settled" and df["bounce.settle_note"].isna().tolist() == [
+        True, True, False, True]
