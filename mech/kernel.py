@@ -30,7 +30,10 @@ import math
 
 import numpy as np
 
-from . import armature as _armature, contact_laws as _contact_laws, friction as _friction, rotations as _rotations
+from . import (
+    armature as _armature, contact_laws as _contact_laws, friction as _friction, rotations as _rotations,
+    travel_spring as _travel_spring,
+)
 from .jit import njit
 from .inertia import inertia_matrix, inertia_terms, inertia_terms_sparse, schur_complement
 from .kernel_layout import (  # noqa: F401  (re-exported: the kernel's own names)
@@ -39,8 +42,8 @@ from .kernel_layout import (  # noqa: F401  (re-exported: the kernel's own names
     quadrature_rows,
     N_FPAR, I_N, I_PLANAR, I_FRICTION, I_MOUNT, I_NLOAD, I_INERTIA, N_IPAR, INERTIA_GRAM,
     INERTIA_SPARSE, FRICTION_NONE, FRICTION_EXACT, FRICTION_REGULARIZED, MOUNT_FREE, MOUNT_CLAMP,
-    MOUNT_PIVOT, C_K, C_C, C_R, C_ON, LOAD_FORCE, LOAD_SPRING, L_KIND, L_POINT, L_BODY, L_DX,
-    L_DY, L_DZ, L_T0, L_TN, L_AX, L_AY, L_AZ, L_K, L_C, L_L0, N_LOAD, FREE, SLIP, STICK,
+    MOUNT_PIVOT, C_K, C_C, C_R, C_ON, LOAD_FORCE, LOAD_SPRING, LOAD_TRAVEL_SPRING, L_KIND, L_POINT, L_BODY, L_DX,
+    L_DY, L_DZ, L_T0, L_TN, L_AX, L_AY, L_AZ, L_K, L_C, L_L0, L_R0, L_KS, L_FLOOR, L_ZBACK, N_LOAD, FREE, SLIP, STICK,
     Q_DNORMAL, Q_DFRICTION, Q_DMODAL, Q_WCOMP, Q_IMPULSE, Q_WIN, Q_DLOAD, NQ_FREE, NQ, A_Y,
     A_YDOT, A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_MARGIN, NAUX, EV_CONTACT, EV_CLIP, EV_SLIP,
     EV_STICK, EV_COMPRESSION, NEV_TIP, NEV, EA_REST, EA_POLE, EA_CARD, EA_SEAT, MOUNT_NONE, I_ARMATURE,
@@ -61,6 +64,9 @@ slip_direction = njit(cache=True)(_friction.slip_direction)
 scaled_rebound = njit(cache=True)(_contact_laws.scaled_rebound)  # the damping calibration's impact
 stop_force = njit(cache=True)(_armature.stop_force)
 return_force = njit(cache=True)(_armature.return_force)
+travel_force = njit(cache=True)(_travel_spring.travel_force)
+travel_work = njit(cache=True)(_travel_spring.travel_work)
+stick_rate = njit(cache=True)(_travel_spring.stick_rate)
 gain_at = njit(cache=True)(_armature.gain_at)
 
 
@@ -213,10 +219,11 @@ def spring_length(ld, load, x):
 
 
 @njit(cache=True)
-def _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r, f_e, Fw, Mw):
-    """Add load ``ld`` (actuator force or spring-dashpot) to the generalized forces.
+def _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r, f_e, Fw, Mw, y, dy):
+    """Add load ``ld`` (actuator force, spring-dashpot or force-travel spring) to the
+    generalized forces; a spring with hysteresis writes its stick force's rate into dy.
 
-    Returns (power the actuator puts in, W; power the dashpot dissipates, W).
+    Returns (power the actuator puts in, W; power the dashpot and the hysteresis dissipate, W).
     """
     p = int(load[ld, L_POINT])
     x = np.empty(3)
@@ -251,11 +258,28 @@ def _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r
             e1 = 0.0
             e2 = 0.0
         ldot = v[0] * e0 + v[1] * e1 + v[2] * e2
-        f = -(load[ld, L_K] * (length - load[ld, L_L0]) + load[ld, L_C] * ldot)
+        if load[ld, L_KIND] == LOAD_SPRING:
+            f = -(load[ld, L_K] * (length - load[ld, L_L0]) + load[ld, L_C] * ldot)
+        else:
+            x_t = load[ld, L_L0] - length
+            t0 = int(load[ld, L_T0])
+            tn = int(load[ld, L_TN])
+            f = travel_force(x_t, tabs, t0, tn)
+            back = int(load[ld, L_ZBACK])
+            if back > 0:  # the branches' mean plus the stick force (mech/travel_spring.py)
+                release = travel_force(x_t, tabs, int(load[ld, L_R0]), tn)
+                zi = y.shape[0] - back
+                z = y[zi]
+                ks = load[ld, L_KS]
+                zdot = stick_rate(z, -ldot, 0.5 * (f - release), load[ld, L_FLOOR], ks)
+                dy[zi] = zdot
+                p_diss += z * (-ldot - zdot / ks)
+                f = 0.5 * (f + release) + z
+            f -= load[ld, L_C] * ldot
         Fw[0] = f * e0
         Fw[1] = f * e1
         Fw[2] = f * e2
-        p_diss = load[ld, L_C] * ldot * ldot
+        p_diss += load[ld, L_C] * ldot * ldot
     _add_force_at(p, s0, s1, s2, Fw, Mw, R, psi, theta, n, F, f_r, f_e)
     return p_in, p_diss
 
@@ -726,7 +750,8 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
     w_in = w_drive
     nload = ipar[I_NLOAD]
     for ld in range(nload):
-        w_in_l, d_l = _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r, f_e, Fw, Mw)
+        w_in_l, d_l = _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r, f_e, Fw, Mw,
+                                  y, dy)
         w_in += w_in_l
         d_load += d_l
 
@@ -1169,6 +1194,19 @@ def energies(y, mdl, work, out, arm=None):
             load_point_motion(int(load[ld, L_POINT]), xc, psi, r, R, q, V, w, eta, n, x, v)
             ext = spring_length(ld, load, x) - load[ld, L_L0]
             sp += 0.5 * load[ld, L_K] * ext * ext
+        elif load[ld, L_KIND] == LOAD_TRAVEL_SPRING:
+            load_point_motion(int(load[ld, L_POINT]), xc, psi, r, R, q, V, w, eta, n, x, v)
+            travel = load[ld, L_L0] - spring_length(ld, load, x)
+            t0 = int(load[ld, L_T0])
+            tn = int(load[ld, L_TN])
+            u = travel_work(travel, tabs, t0, tn) - travel_work(0.0, tabs, t0, tn)
+            back = int(load[ld, L_ZBACK])
+            if back > 0:  # the branches' mean and the stick spring
+                r0 = int(load[ld, L_R0])
+                z = y[y.shape[0] - back]
+                u = 0.5 * (u + travel_work(travel, tabs, r0, tn) - travel_work(0.0, tabs, r0, tn))
+                u += 0.5 * z * z / load[ld, L_KS]
+            sp += u
     if ipar[I_MOUNT] == MOUNT_PIVOT:
         th = fpar[F_PIV_SIGN] * (y[2] - fpar[F_PIV_PHI0])
         sp += 0.5 * fpar[F_PIV_K] * th * th - fpar[F_PIV_T0] * th

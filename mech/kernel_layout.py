@@ -60,10 +60,17 @@ N_CPAR = 6
 CONTACT_ROWS = 2
 MAX_PAIRS = 4
 # per load (rows of ``load``): actuator force (a time table of magnitude times a unit
-# direction, world or body frame) or linear spring-dashpot to a world anchor
-LOAD_FORCE, LOAD_SPRING = 0, 1
-(L_KIND, L_POINT, L_BODY, L_DX, L_DY, L_DZ, L_T0, L_TN, L_AX, L_AY, L_AZ, L_K, L_C, L_L0) = range(14)
-N_LOAD = 14
+# direction, world or body frame), linear spring-dashpot to a world anchor, or force-travel
+# spring (a table of its push against its travel, L_T0/L_TN its columns in ``tabs``, after
+# every force's time table; mech/travel_spring.py) with a dashpot, to a world anchor; with
+# hysteresis also its release table (L_R0, same travels), the stick spring's stiffness L_KS
+# (N/m), the floor of the band's half-width L_FLOOR (N) and its state, the stick force z
+# (N), at y[len(y) - L_ZBACK] (the springs' states close the state vector, after the
+# quadratures; L_ZBACK 0: none)
+LOAD_FORCE, LOAD_SPRING, LOAD_TRAVEL_SPRING = 0, 1, 2
+(L_KIND, L_POINT, L_BODY, L_DX, L_DY, L_DZ, L_T0, L_TN, L_AX, L_AY, L_AZ, L_K, L_C, L_L0,
+ L_R0, L_KS, L_FLOOR, L_ZBACK) = range(18)
+N_LOAD = 18
 # the armature (mech/armature.py): a rigid body with one coordinate q (m or rad, the travel
 # from its rest stop), its parameters in ``apar`` (SI: kg or kg m^2; m or rad; N/m or
 # N m/rad; N or N m; N s/m or N m s/rad; the card's lever m per unit q, free travel m,

@@ -28,8 +28,9 @@ import numpy as np
 from .beam_fe import FEBeam, PointMass, beam_basis, beam_invariants, point_shapes
 from .contact_laws import hertz_stiffness
 from .kernel_layout import (
-    C_C, C_K, C_N, C_ON, C_R, C_Z, CONTACT_ROWS, L_AX, L_AY, L_AZ, L_BODY, L_C, L_DX, L_DY, L_DZ, L_K, L_KIND,
-    L_POINT, L_T0, L_TN, LOAD_FORCE, LOAD_SPRING, N_CPAR, N_LOAD,
+    C_C, C_K, C_N, C_ON, C_R, C_Z, CONTACT_ROWS, L_AX, L_AY, L_AZ, L_BODY, L_C, L_DX, L_DY, L_DZ, L_FLOOR, L_K,
+    L_KIND, L_KS, L_R0, L_ZBACK,
+    L_POINT, L_T0, L_TN, LOAD_FORCE, LOAD_SPRING, LOAD_TRAVEL_SPRING, N_CPAR, N_LOAD,
 )
 from .modal_basis import ModalBasis
 from .parameters import MechScene
@@ -212,10 +213,23 @@ def build_arrays(scene: MechScene, planar: bool) -> MechanismArrays:
             times += list(ts)
             values += list(vs)
         else:
-            row[L_KIND] = LOAD_SPRING
+            row[L_KIND] = LOAD_TRAVEL_SPRING if ld.from_table else LOAD_SPRING
             row[L_AX], row[L_AY], row[L_AZ] = ld.anchor
-            row[L_K] = ld.stiffness
+            row[L_K] = 0.0 if ld.from_table else ld.stiffness
             row[L_C] = ld.damping
+    hysteretic = [k for k, ld in enumerate(loads) if k >= len(scene.forces) and ld.hysteretic]
+    for k, ld in enumerate(loads):  # force-travel tables after every time table
+        if k >= len(scene.forces) and ld.from_table:
+            load[k, L_T0] = len(times)
+            load[k, L_TN] = len(ld.travel)
+            times += list(ld.travel)
+            values += list(ld.force)
+            if ld.hysteretic:  # its release branch on the same travels, its stick force's state
+                load[k, L_R0] = len(times)
+                times += list(ld.travel)
+                values += list(ld.release_force)
+                load[k, L_KS], load[k, L_FLOOR] = ld.stick_stiffness()
+                load[k, L_ZBACK] = len(hysteretic) - hysteretic.index(k)
     tables = np.array([times, values], dtype=float) if times else np.zeros((2, 1))
 
     basis = ModalBasis(
@@ -346,8 +360,8 @@ def closing_work(scene: MechScene, arr: MechanismArrays) -> float:
     force = sum(max(abs(v) for v in f.table()[1]) * _lever(arr, scene, arr.rows + k)
                 for k, f in enumerate(scene.forces))
     nf = len(scene.forces)
-    force += sum((abs(sp.preload or 0.0) + sp.stiffness * gap) * _lever(arr, scene, arr.rows + nf + k)
-                 for k, sp in enumerate(scene.springs))
+    force += sum((max(abs(v) for v in sp.force) if sp.from_table else abs(sp.preload or 0.0) + sp.stiffness * gap)
+                 * _lever(arr, scene, arr.rows + nf + k) for k, sp in enumerate(scene.springs))
     xc = arr.points[2]
     if scene.mount.kind == "pivot":
         r = max(float(np.hypot(xc[0, 0], xc[0, 2])), 1e-9)

@@ -30,7 +30,7 @@ from .kernel_layout import (
     F_VREG, FRICTION_EXACT, FRICTION_NONE, FRICTION_REGULARIZED, I_FRICTION, I_N,
     I_PLANAR, I_MOUNT, I_NLOAD, MOUNT_CLAMP, MOUNT_FREE, MOUNT_PIVOT, N_FPAR,
     F_PIV_C, F_PIV_K, F_PIV_PHI0, F_PIV_SIGN, F_PIV_T0, L_L0, I_INERTIA, INERTIA_GRAM, INERTIA_SPARSE, N_IPAR, N_LOAD, NQ, NQ_FREE, C_C, C_K, C_ON, C_R, state_sizes,
-    L_BODY, L_DX, L_DZ, L_KIND, L_POINT, L_T0, L_TN, LOAD_FORCE,
+    L_AX, L_AZ, L_BODY, L_DX, L_DZ, L_KIND, L_POINT, L_R0, L_T0, L_TN, L_ZBACK, LOAD_FORCE,
 )
 from .mechanism import (
     MechanismArrays, build_arrays, closing_work, contact_pairs, contact_parameters,
@@ -40,6 +40,7 @@ from .modal_basis import ModalBasis, _quadrature, build_modal_basis, sparse_inva
 from .mode_count import CAP, SAFETY, choose_mode_count
 from .modes import axial_frequencies, bending_frequencies, bending_shape, free_free_roots
 from .parameters import MechScene
+from .travel_spring import travel_force
 from .rotations import matrix_to_quaternion, quat_to_matrix, rotation_y, rotation_z  # noqa: F401
 
 
@@ -368,6 +369,8 @@ def _spring_rest_lengths(model: "BarModel") -> np.ndarray:
         length = float(np.linalg.norm(x - np.array(sp.anchor)))
         if sp.rest_length is not None:
             rest = sp.rest_length
+        elif sp.from_table:
+            rest = length  # a force-travel spring's travel 0 at the start
         elif sp.preload is not None:
             rest = length - sp.preload / sp.stiffness
             if rest < 0.0:
@@ -379,10 +382,29 @@ def _spring_rest_lengths(model: "BarModel") -> np.ndarray:
     return load
 
 
-def state_slices(n: int, planar: bool, nq: int, armature: bool = False, bar: bool = True) -> dict:
+def _stick_start(model: "BarModel", y: np.ndarray) -> None:
+    """Each spring with hysteresis starts on its press branch: its stick force z the band's
+    half-width at its travel in state y (the point placed rigidly, as _spring_rest_lengths
+    measures its rest length)."""
+    load = model.load
+    xc = model.points[2]
+    R0 = rotation_y(-math.radians(model.scene.initial.angle_deg))
+    r0 = np.array([y[0], 0.0, y[1]]) if model.planar else y[0:3]
+    for row in np.flatnonzero(load[:, L_ZBACK] > 0):
+        ld = load[row]
+        x = r0 + R0 @ xc[int(ld[L_POINT])]
+        travel = float(ld[L_L0] - np.linalg.norm(x - ld[L_AX:L_AZ + 1]))
+        t0, tn = int(ld[L_T0]), int(ld[L_TN])
+        press = travel_force(travel, model.tables, t0, tn)
+        release = travel_force(travel, model.tables, int(ld[L_R0]), tn)
+        y[len(y) - int(ld[L_ZBACK])] = 0.5 * (press - release)
+
+
+def state_slices(n: int, planar: bool, nq: int, armature: bool = False, bar: bool = True, nh: int = 0) -> dict:
     """Named slices of the state vector for n modes and nq quadratures; with an armature,
     "armature" (its q and rate) between the bar's speeds and the quadratures; without a
-    bar, only "armature" and "quad"."""
+    bar, only "armature" and "quad"; with nh springs with hysteresis, "hysteresis" (their
+    stick forces, N, in the order of the springs) after the quadratures, closing the vector."""
     if not bar:
         return {"armature": slice(0, N_ARM), "quad": slice(N_ARM, N_ARM + nq)}
     if planar:
@@ -397,6 +419,8 @@ def state_slices(n: int, planar: bool, nq: int, armature: bool = False, bar: boo
         a0 = out["quad"].start
         out["armature"] = slice(a0, a0 + N_ARM)
         out["quad"] = slice(a0 + N_ARM, a0 + N_ARM + nq)
+    if nh:
+        out["hysteresis"] = slice(out["quad"].stop, out["quad"].stop + nh)
     return out
 
 
@@ -596,7 +620,12 @@ class BarModel:
     @property
     def state_size(self) -> int:
         npos, nvel = state_sizes(self.n, self.planar) if self.has_bar else (0, 0)
-        return npos + nvel + (N_ARM if self.has_armature else 0) + self.nq
+        return npos + nvel + (N_ARM if self.has_armature else 0) + self.nq + self.hysteresis_count
+
+    @property
+    def hysteresis_count(self) -> int:
+        """The force-travel springs with hysteresis, one state each (their stick forces)."""
+        return int(np.count_nonzero(self.load[:, L_ZBACK] > 0)) if len(self.load) else 0
 
     @property
     def cap_axes(self) -> list:
@@ -696,7 +725,7 @@ class BarModel:
 
     def slices(self) -> dict:
         """Named slices of the state vector."""
-        return state_slices(self.n, self.planar, self.nq, self.has_armature, self.has_bar)
+        return state_slices(self.n, self.planar, self.nq, self.has_armature, self.has_bar, self.hysteresis_count)
 
     @property
     def armature_drive_row(self) -> int:
@@ -741,6 +770,8 @@ class BarModel:
         if self.has_armature:
             arm = self.scene.armature
             y[self.slices()["armature"]] = (arm.start_position, arm.initial_speed)
+        if self.hysteresis_count:
+            _stick_start(self, y)
         return y
 
     def _bar_initial_state(self) -> np.ndarray:
@@ -869,9 +900,13 @@ def build_model(scene: MechScene, *, input_work: bool = False) -> BarModel:
     vstar = cs.reference_speed
     npos, nvel = state_sizes(n, planar)
     nq = quadrature_count(ipar, input_work, rows)
-    atol = np.empty(npos + nvel + (N_ARM if arm.present else 0) + nq)
+    nh = int(np.count_nonzero(arr.load[:, L_ZBACK] > 0)) if arr is not None and len(arr.load) else 0
+    atol = np.empty(npos + nvel + (N_ARM if arm.present else 0) + nq + nh)
     rel = np.zeros_like(atol)
-    sl = state_slices(n, planar, nq, arm.present)
+    sl = state_slices(n, planar, nq, arm.present, nh=nh)
+    if nh:  # the stick forces against their springs' largest force
+        atol[sl["hysteresis"]] = rtol * max(max(abs(f) for f in sp.force) for sp in scene.springs if sp.hysteretic)
+        rel[sl["hysteresis"]] = 1.0
     atol[sl["pos"]] = rtol * dstar
     atol[sl["angle" if planar else "quat"]] = rtol * dstar / L
     atol[sl["q"]] = rtol * dstar

@@ -13,7 +13,10 @@ import math
 from dataclasses import dataclass, field
 from typing import Callable, Literal, Union
 
+import numpy as np
+
 from .table_smoothing import INTERPOLATIONS, smooth_samples
+from .travel_spring import travel_work
 from .validation import (
     check_bool, check_choice, check_count, check_finite, check_magnitude, check_name, check_nonnegative,
     check_position, check_positive, check_range, check_table, check_vector3, check_whole,
@@ -496,31 +499,138 @@ class PointForce:
 
 @dataclass(frozen=True)
 class Spring:
-    """A linear spring and dashpot from a fixed world ``anchor`` (m) to the bar at
-    ``position`` (m from tip 0). stiffness: N/m (> 0); damping: N s/m. Give ``preload``
-    (N, the spring's pull towards the anchor at the initial position; negative pushes)
-    or ``rest_length`` (m); neither: unstressed at the start."""
+    """A spring and dashpot from a fixed world ``anchor`` (m) to the bar at ``position`` (m
+    from tip 0); damping: N s/m. Either linear: stiffness N/m (> 0), with ``preload`` (N,
+    the spring's pull towards the anchor at the initial position; negative pushes) or
+    ``rest_length`` (m), neither: unstressed at the start. Or a force-travel spring (a
+    dome, a snap-action spring: mech/travel_spring.py): ``travel`` (m, strictly
+    increasing, its compression from the rest length: positive shorter) and ``force`` (N,
+    one per travel, its push away from the anchor; any sign of slope), linear between the
+    points and along the end segments beyond them; its rest length ``rest_length`` (m) or,
+    without it, its length at the start (travel 0 there). ``release_force`` (N, one per
+    travel, at or below ``force``): the release branch of a spring with hysteresis, which
+    follows the press table while pressed, the release table while released
+    (mech/travel_spring.py; it starts on the press branch)."""
 
     anchor: tuple[float, float, float] = (0.0, 0.0, 0.0)
     position: float = 0.0
-    stiffness: float = 0.0
+    stiffness: float | None = None
     preload: float | None = None
     rest_length: float | None = None
     damping: float = 0.0
+    travel: tuple | None = None
+    force: tuple | None = None
+    release_force: tuple | None = None
     name: str = "spring"
 
     def __post_init__(self):
         n = self.name
         object.__setattr__(self, "anchor", check_vector3(f"{n}.anchor", self.anchor, LENGTH_MAX))
         check_finite(f"{n}.position", self.position)
-        check_positive(f"{n}.stiffness", self.stiffness, high=STIFFNESS_MAX)
         check_nonnegative(f"{n}.damping", self.damping, high=DAMPING_MAX)
         if self.preload is not None and self.rest_length is not None:
             raise ValueError(f"{n}: give preload or rest_length, not both")
-        if self.preload is not None:
-            check_magnitude(f"{n}.preload", self.preload, FORCE_MAX)
         if self.rest_length is not None:
             check_nonnegative(f"{n}.rest_length", self.rest_length, high=LENGTH_MAX)
+        if self.travel is None and self.force is None:
+            if self.release_force is not None:
+                raise ValueError(f"{n}.release_force: a release branch needs its press branch, {n}.travel (m) and "
+                                 f"{n}.force (N)")
+            if self.stiffness is None:
+                raise ValueError(f"{n}: give stiffness (N/m, a linear spring) or travel (m) and force (N) tables "
+                                 "(a force-travel spring)")
+            check_positive(f"{n}.stiffness", self.stiffness, high=STIFFNESS_MAX)
+            if self.preload is not None:
+                check_magnitude(f"{n}.preload", self.preload, FORCE_MAX)
+            return
+        for key in ("stiffness", "preload"):
+            if getattr(self, key) is not None:
+                raise ValueError(f"{n}.{key} = {getattr(self, key)!r}: a force-travel spring (travel and force "
+                                 f"tables) takes its force from its table; remove {n}.{key}")
+        xs, fs = force_travel_table(n, self.travel, self.force)
+        object.__setattr__(self, "travel", xs)
+        object.__setattr__(self, "force", fs)
+        if self.release_force is not None:
+            _, rs = force_travel_table(n, xs, self.release_force, force_key="release_force")
+            for k, (f, r) in enumerate(zip(fs, rs)):
+                if r > f:
+                    raise ValueError(f"{n}.release_force[{k}] = {r!r}: above the press branch there ({n}.force[{k}] "
+                                     f"= {f!r} N); the release branch lies at or below it (a loop dissipates)")
+            if rs == fs:
+                raise ValueError(f"{n}.release_force: equal to {n}.force at every travel (no hysteresis); remove it")
+            object.__setattr__(self, "release_force", rs)
+
+    @property
+    def hysteretic(self) -> bool:
+        """True for a force-travel spring with a release branch."""
+        return self.release_force is not None
+
+    def stick_stiffness(self) -> tuple[float, float]:
+        """(N/m, N): the stick spring's stiffness k_s and the floor of the band's half-width
+        of a spring with hysteresis (mech/travel_spring.py). k_s = 1000 F_h,max / span: a
+        turn leaves one branch for the other within 2 F_h / k_s, 0.2 % of the table's
+        span; the press follows its branch to 1 % within 2.6 F_h / k_s. The floor, 1e-3
+        F_h,max, keeps the element's stiffness k_s / F_h bounded where the branches meet
+        (the force there within 1e-3 F_h,max of them)."""
+        half = max(0.5 * (f - r) for f, r in zip(self.force, self.release_force))
+        span = self.travel[-1] - self.travel[0]
+        return 1000.0 * half / span, 1e-3 * half
+    @property
+    def from_table(self) -> bool:
+        """True for a force-travel spring (travel and force tables)."""
+        return self.travel is not None
+
+    def releasable_energy(self) -> float:
+        """J: the most energy a force-travel spring can give up from its start (travel 0,
+        energy 0) anywhere in its table's travel: -min U, U(x) the integral of its force
+        from 0, whose least lies at a table point or where the force crosses zero going up;
+        with hysteresis the larger of its two branches' (its force lies between them). 0 for
+        a linear spring (its stored energy at the start counts as the scene's)."""
+        if not self.from_table:
+            return 0.0
+        branches = (self.force,) if self.release_force is None else (self.force, self.release_force)
+        return max(_releasable(self.travel, fs) for fs in branches)
+
+
+def _releasable(travel, force) -> float:
+    """J: -min of the integral of the table (travel, force) from 0, 0 if never negative."""
+    tabs = np.array([travel, force], dtype=float)
+    n = len(travel)
+    xs = list(travel)
+    for k in range(n - 1):
+        f0, f1 = force[k], force[k + 1]
+        if f0 < 0.0 < f1:
+            xs.append(travel[k] + (travel[k + 1] - travel[k]) * f0 / (f0 - f1))
+    base = travel_work(0.0, tabs, 0, n)
+    return max(0.0, -min(travel_work(x, tabs, 0, n) - base for x in xs))
+
+
+def force_travel_table(name: str, travel, force, force_key: str = "force") -> tuple[tuple, tuple]:
+    """(travels m, forces N) of the force-travel spring ``name`` checked: both lists of
+    finite numbers, at least two and at most TABLE_POINTS_MAX travels, strictly increasing
+    and within LENGTH_MAX, one force (within FORCE_MAX) per travel. Errors name the key."""
+    numbers = (int, float)
+    for key, items in (("travel", travel), (force_key, force)):
+        if items is None:
+            other = force_key if key == "travel" else "travel"
+            raise ValueError(f"{name}.{key}: missing; a force-travel spring needs both {name}.travel (m) "
+                             f"and {name}.{force_key} (N), one force per travel (it has {name}.{other})")
+        if isinstance(items, (str, dict)) or not hasattr(items, "__iter__") or \
+                any(isinstance(v, bool) or not isinstance(v, numbers) for v in items):
+            raise ValueError(f"{name}.{key} = {items!r:.80}: expected a list of numbers")
+    if len(travel) > TABLE_POINTS_MAX:
+        raise ValueError(f"{name}.travel: {len(travel)} points; at most {TABLE_POINTS_MAX} allowed")
+    xs = tuple(check_magnitude(f"{name}.travel[{k}]", v, LENGTH_MAX) for k, v in enumerate(travel))
+    fs = tuple(check_magnitude(f"{name}.{force_key}[{k}]", v, FORCE_MAX) for k, v in enumerate(force))
+    if len(xs) < 2:
+        raise ValueError(f"{name}.travel = {list(xs)!r}: {len(xs)} point(s); give at least two travels")
+    if len(fs) != len(xs):
+        raise ValueError(f"{name}.{force_key}: {len(fs)} forces for {len(xs)} travels; give one force per travel")
+    for k in range(1, len(xs)):
+        if xs[k] <= xs[k - 1]:
+            raise ValueError(f"{name}.travel[{k}] = {xs[k]!r}: travels must increase strictly (previous "
+                             f"{xs[k - 1]!r} m); a force-travel table gives one force per travel")
+    return xs, fs
 
 
 @dataclass(frozen=True)

@@ -438,12 +438,14 @@ class ImpactResult:
         scene = m.scene
         if not m.has_bar:  # an armature alone: its drive's work is what the run measured
             return 0.0, math.inf
+        # a force-travel spring can give up energy from rest (a dome snapping through)
+        snap = sum(sp.releasable_energy() for sp in scene.springs)
         if not scene.mount.held:  # a free bar can drop its centre to the tip radius
-            w_rest = m.basis.mass * scene.gravity * max(z0 - scene.bar.tip_radius, 0.0)
+            w_rest = m.basis.mass * scene.gravity * max(z0 - scene.bar.tip_radius, 0.0) + snap
             return w_rest, (math.inf if scene.forces else w_rest)
         from .model import load_work_bound
 
-        w_rest = load_work_bound(m, e_in, forces=False)
+        w_rest = load_work_bound(m, e_in, forces=False) + snap
         if scene.mount.base_motion is not None or scene.armature.present:
             return w_rest, math.inf  # a moving clamp's or an armature drive's work: what the run measured
         return w_rest, (load_work_bound(m, e_in) if scene.forces else w_rest)

@@ -10,7 +10,8 @@ default listed in docs/scene_keys.md; ``DEFAULT_SCENE_TOML`` is one scene, not t
     [mount]     kind ("free" | "clamp" | "pivot"), position, base_motion {time, displacement},
                 stiffness, preload_torque, damping
     [[force]]   position, direction [3], frame ("world" | "body"), magnitude | (time, value)
-    [[spring]]  anchor [3], position, stiffness, preload | rest_length, damping
+    [[spring]]  anchor [3], position, stiffness, preload | rest_length, damping; or travel, force
+                [, release_force] (a force-travel spring), rest_length, damping
     [[rivet]]   position, offset, radius, mass, youngs_modulus, poisson_ratio, name
     [[fixed]]   point, name, shape ("plane" | "sphere"), radius, offset, facing ("up" | "down"),
                 height | gap, youngs_modulus, poisson_ratio, electrical (instead of [block])

@@ -147,7 +147,7 @@ SCENE = {
     "force": {"position": "m", "direction": "-", "frame": "-", "magnitude": "N", "time": "s", "value": "N",
               "interpolation": "-"},
     "spring": {"anchor": "m", "position": "m", "stiffness": "N/m", "preload": "N", "rest_length": "m",
-               "damping": "N s/m"},
+               "damping": "N s/m", "travel": "m", "force": "N", "release_force": "N"},
     "rivet": {"position": "m", "offset": "m", "radius": "m", "mass": "kg", "youngs_modulus": "Pa",
               "poisson_ratio": "-", "name": "-"},
     "fixed": {"point": "-", "name": "-", "shape": "-", "radius": "m", "offset": "m", "facing": "-", "height": "m",
