@@ -656,7 +656,7 @@ def memory_estimate(scene: Scene) -> dict:
 def _largest_state(mech: MechScene) -> int:
     """The longest state vector the scene's model can have: its mode counts ("auto": at the
     cap of mech.mode_count), planar or 3D as mech.model.is_planar decides, with the input-work
-    quadratures of a held or loaded bar."""
+    quadratures of a held or loaded bar and a hysteretic spring's state."""
     from mech.kernel_layout import NQ, NQ_FREE, state_sizes
     from mech.mode_count import CAP
     from mech.model import is_planar
@@ -670,7 +670,9 @@ def _largest_state(mech: MechScene) -> int:
     bending = CAP if bar.bending_modes == "auto" else bar.bending_modes
     n = axial + bending * (1 if planar else 2)
     npos, nvel = state_sizes(n, planar)
-    return npos + nvel + extra + (NQ if (mech.mount.held or mech.forces or mech.springs) else NQ_FREE)
+    # a force-travel spring with hysteresis carries one state (its stick force)
+    hysteresis = sum(1 for s in mech.springs if getattr(s, "release_force", None) is not None)
+    return npos + nvel + extra + hysteresis + (NQ if (mech.mount.held or mech.forces or mech.springs) else NQ_FREE)
 
 
 def check_work(scene: Scene) -> None:

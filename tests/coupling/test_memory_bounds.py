@@ -191,3 +191,18 @@ def test_the_coupled_run_samples_its_contact_in_batches_and_releases_the_dense_o
         assert column.tobytes() == batched.waveform_columns[name].tobytes(), name
     assert mech_whole.dense_rows == len(mech_whole.recorder.t[:mech_whole.recorder.n])
     assert 0 < mech_batched.dense_rows < 256 + 4096 and mech_batched.recorder.dense_base > 0
+
+
+def test_the_state_estimate_counts_a_hysteretic_spring_s_state():
+    """The memory estimate's largest state is the model's own, a hysteretic force-travel
+    spring's stick force included (the estimate missed it)."""
+    from coupling.core.scene import _largest_state
+    from mech import ImpactSolver
+
+    loop = dict(travel=[0.0, 2e-4, 4e-4], force=[0.0, 0.5, 0.8], release_force=[0.0, 0.2, 0.4])
+    doc = {"bar": dict(length=0.05, diameter=0.005, tip_radius=0.0025, modes=0),
+           "mount": dict(kind="pivot", position=0.05),
+           "spring": [dict(anchor=[-0.05, 0.0, -1.0], position=0.0, **loop)],
+           "initial": dict(height=1e-3), "environment": dict(gravity=0.0), "solver": dict(t_end=1e-3)}
+    scene = scene_from_dict(doc, name="loop")
+    assert _largest_state(scene.mech) == len(ImpactSolver(scene.mech).y)
