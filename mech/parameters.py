@@ -9,6 +9,7 @@ the scene keys (docs/scene_keys.md, tested against it).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Callable, Literal, Union
@@ -493,6 +494,12 @@ class PointForce:
             return (0.0,), (float(self.magnitude),)
         if self.interpolation == "linear":
             return self.time, self.value
+        return self._smoothed
+
+    @functools.cached_property
+    def _smoothed(self) -> tuple[tuple, tuple]:
+        # sampled once: the solver asks for the table at every rest window it watches
+        # (mech.model.loads_ramping, load_change_times)
         ts, vs = smooth_samples(self.time, self.value)
         return tuple(float(t) for t in ts), tuple(float(v) for v in vs)
 
