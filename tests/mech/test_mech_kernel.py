@@ -341,14 +341,21 @@ def test_normal_forces_from_the_kinematics_equal_the_right_hand_sides(name):
     the normal forces and penetrations of the full right-hand side."""
     from pathlib import Path
 
-    from coupling.core.scene import builtin_scene, load_scene
+    import tomllib
+
     from mech import ImpactSolver
     from mech.compiled import dense_tip_forces, dynamics, make_work
     from mech.kernel_layout import A_FN, A_Y, C_ON, NAUX
+    from mech.scene import SCENE_SECTIONS, scene_from_dict
 
     root = Path(__file__).resolve().parents[2]
-    scene = load_scene(root / "examples" / "pushbutton.toml") if name == "pushbutton" else builtin_scene(name)
-    solver = ImpactSolver(scene.mech)
+    path = root / "examples" / "pushbutton.toml" if name == "pushbutton" else root / "coupling" / "scenes" / f"{name}.toml"
+    doc = {k: v for k, v in tomllib.loads(path.read_text()).items() if k in SCENE_SECTIONS}
+    # the mechanics of the shipped scene (read from its file: these tests build scenes from
+    # mech alone); coupled, its mu comes from [tribology], here a Coulomb 0.3 keeps friction on
+    doc.setdefault("friction", {"mu": 0.3})
+    mech_scene = scene_from_dict(doc, where=str(path))
+    solver = ImpactSolver(mech_scene)
     res = solver.run()
     arrays, work = solver.arrays, make_work(solver.model.n)
     aux, dy, out = np.empty((2, NAUX)), np.empty(res.states.shape[1]), np.empty(5)

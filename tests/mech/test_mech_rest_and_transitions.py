@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from coupling import scene_from_dict
+from mech.scene import scene_from_dict
 from mech import ImpactSolver
 from mech.friction import REVERSAL_DEADBAND, slip_direction
 from mech.parameters import RTOL_MAX
@@ -24,7 +24,7 @@ GRAZING = {"bar": BAR, "initial": {"height": 1e-6, "angle_deg": 30.0, "velocity"
 
 
 def mech_scene(doc, **solver):
-    ms = scene_from_dict(doc).mech
+    ms = scene_from_dict(doc)
     rtol = solver.pop("rtol", None)
     opts = dataclasses.replace(ms.solver, **solver)
     if rtol is not None:
