@@ -60,7 +60,7 @@ from __future__ import annotations
 import math
 import time
 
-from coupling.core.metrics import DEFAULT_SETTLE_WINDOW
+from coupling.core.metrics import DEFAULT_SETTLE_WINDOW, intersection
 from coupling.core.results import merge_intervals
 
 TOLERANCES = dict(mismatch_fraction=0.02, time_floor=1e-6, time_fraction=0.01, peak_force=0.02,
@@ -80,21 +80,6 @@ MIN_RELTOL = 1e-9
 def measure(intervals) -> float:
     """s: total length of the union of intervals [(a, b), ...]."""
     return float(sum(b - a for a, b in merge_intervals(intervals)))
-
-
-def intersection(a, b) -> list[tuple[float, float]]:
-    """The intersection of two unions of intervals, as sorted disjoint intervals."""
-    a, b = merge_intervals(a), merge_intervals(b)
-    out, i, j = [], 0, 0
-    while i < len(a) and j < len(b):
-        lo, hi = max(a[i][0], b[j][0]), min(a[i][1], b[j][1])
-        if hi > lo:
-            out.append((lo, hi))
-        if a[i][1] < b[j][1]:
-            i += 1
-        else:
-            j += 1
-    return out
 
 
 def mismatch_time(a, b) -> float:

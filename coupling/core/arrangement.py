@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from coupling.core.metrics import merge_intervals
+from coupling.core.metrics import intersection, merge_intervals
 
 LEGACY_POINTS = (0, 1)  # the one circuit contact's feeding pairs
 
@@ -63,21 +63,6 @@ def is_series(circuit) -> bool:
     return getattr(circuit, "arrangement", None) == "series" and len(getattr(circuit, "contacts", ())) > 1
 
 
-def intersect(a, b) -> list[tuple[float, float]]:
-    """The intersection of two unions of intervals (s), merged and sorted."""
-    a, b = merge_intervals(a), merge_intervals(b)
-    out, i, j = [], 0, 0
-    while i < len(a) and j < len(b):
-        lo, hi = max(a[i][0], b[j][0]), min(a[i][1], b[j][1])
-        if lo < hi:
-            out.append((lo, hi))
-        if a[i][1] < b[j][1]:
-            i += 1
-        else:
-            j += 1
-    return out
-
-
 def switch_closed(scene, contact_columns) -> tuple[list[tuple[float, float]], bool]:
     """(closed intervals s, closed at the end) of the circuit's switch from the mechanics'
     contact intervals (``contact_columns``: tip, t_start, t_end, complete): every pair's
@@ -94,7 +79,7 @@ def switch_closed(scene, contact_columns) -> tuple[list[tuple[float, float]], bo
     for points in feeds:
         mine = np.isin(tips, points)
         own = merge_intervals(zip(starts[mine], ends[mine]))
-        closed = own if closed is None else intersect(closed, own)
+        closed = own if closed is None else intersection(closed, own)
         at_end = at_end and bool((still & mine).any())
     return closed, at_end
 

@@ -88,6 +88,21 @@ def merge_intervals(intervals) -> list[tuple[float, float]]:
     return [(a, b) for a, b in out]
 
 
+def intersection(a, b) -> list[tuple[float, float]]:
+    """The intersection of two unions of intervals (s), as sorted disjoint intervals."""
+    a, b = merge_intervals(a), merge_intervals(b)
+    out, i, j = [], 0, 0
+    while i < len(a) and j < len(b):
+        lo, hi = max(a[i][0], b[j][0]), min(a[i][1], b[j][1])
+        if hi > lo:
+            out.append((lo, hi))
+        if a[i][1] < b[j][1]:
+            i += 1
+        else:
+            j += 1
+    return out
+
+
 def make_instants(intervals, t_start: float, tol: float) -> list[float]:
     """s: the makes, interval starts after t_start (tolerance tol)."""
     return [a for a, _ in merge_intervals(intervals) if a > t_start + tol]
