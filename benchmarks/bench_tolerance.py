@@ -8,8 +8,10 @@ return spring's preload (5 %), the contact gap (5 %), the magnet's rest gap (5 %
 3 sigma) and the coil's resistance (7 %, uniform); limit: operate time 4.6 ms.
 
 Measured: the whole command from spawn to exit, the client's resident memory sampled every
-second from /proc (its peak in each quarter of the study: flat means no quarter above the
-first by more than a few MB), and the study's own statistics of the operate time. Not a
+second from /proc (its peak in each quarter of the runs, the end of the runs read from the
+progress lines: flat means the last quarter within 25 MiB of the second, the first holding
+the first results' imports; and its peak at the statistics stage after the runs, which reads the
+rows' batch files), and the study's own statistics of the operate time. Not a
 test: run by hand,
 
     .venv/bin/python benchmarks/bench_tolerance.py [--samples 1000] [--no-write]
@@ -25,6 +27,7 @@ import os
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -72,10 +75,24 @@ def main() -> None:
     sweep.write_text(SWEEP.format(samples=args.samples, limit=LIMIT))
     out = tmp / "out"
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    cmd = [sys.executable, "-m", "coupling", "sweep", str(sweep), "--out", str(out), "--workers", str(args.workers),
-           "--quiet"]
+    cmd = [sys.executable, "-m", "coupling", "sweep", str(sweep), "--out", str(out), "--workers", str(args.workers)]
     start = time.perf_counter()
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    # the progress lines on stderr say when the last run is done: the statistics stage follows
+    first_done_at: list[float] = []
+    runs_done_at: list[float] = []
+    errors: list[str] = []
+
+    def follow() -> None:
+        for line in proc.stderr:
+            errors.append(line)
+            if " runs done" in line and not first_done_at:
+                first_done_at.append(time.perf_counter() - start)
+            if f"{args.samples}/{args.samples} runs done" in line and not runs_done_at:
+                runs_done_at.append(time.perf_counter() - start)
+
+    reader = threading.Thread(target=follow, daemon=True)
+    reader.start()
     samples: list[tuple[float, float]] = []
     while proc.poll() is None:
         r = rss_mib(proc.pid)
@@ -83,15 +100,21 @@ def main() -> None:
             samples.append((time.perf_counter() - start, r))
         time.sleep(1.0)
     wall = time.perf_counter() - start
-    stdout, stderr = proc.communicate()
+    reader.join(timeout=10)
     if proc.returncode != 0:
-        raise SystemExit(f"sweep failed ({proc.returncode}): {stderr.strip()[-2000:]}")
+        raise SystemExit(f"sweep failed ({proc.returncode}): {''.join(errors).strip()[-2000:]}")
     stats = json.loads((out / "statistics.json").read_text())
     op = stats["relay.operate_time"]
+    files = len(list((out / "results").glob("part-*.parquet")))
+    # the runs: from the first finished (the cluster has started) to the last; quarters of it
+    first = first_done_at[0] if first_done_at else 0.0
+    end = runs_done_at[0] if runs_done_at else wall
     quarters = []
     for k in range(4):
-        part = [r for t, r in samples if k * wall / 4 <= t < (k + 1) * wall / 4]
+        lo, hi = first + k * (end - first) / 4, first + (k + 1) * (end - first) / 4
+        part = [r for t, r in samples if lo <= t < hi]
         quarters.append(max(part) if part else float("nan"))
+    after = max((r for t, r in samples if t >= end), default=float("nan"))
     try:
         load = os.getloadavg()[0]
     except OSError:
@@ -104,12 +127,12 @@ def main() -> None:
         f"- {args.samples} samples of the default relay's make (8 ms each), "
         f"{study.get('rows', args.samples)} rows, {study.get('failed', 0)} failed: **{wall / 60:.1f} min** whole "
         f"command (target <= 15 min: {'met' if wall <= 900 else 'not met'}), {wall / args.samples:.2f} s per sample.",
-        f"- client resident memory, peak per quarter of the study: "
+        f"- client resident memory, peak per quarter of the runs: "
         + ", ".join(f"{q:.0f}" for q in quarters) + " MiB: "
-        + (f"flat (the last within {quarters[-1] - quarters[0]:+.0f} MiB of the first)"
-           if quarters[-1] - quarters[0] <= 50 else
-           f"not flat (the last {quarters[-1] - quarters[0]:+.0f} MiB above the first: it holds the "
-           "statistics and plots stage, which reads every row and imports pandas, SciPy and matplotlib)") + ".",
+        + (f"flat (the last within {quarters[-1] - quarters[1]:+.0f} MiB of the second)" if abs(quarters[-1] - quarters[1]) <= 25 else
+           f"not flat (the last {quarters[-1] - quarters[1]:+.0f} MiB above the second)")
+        + f"; then {after:.0f} MiB at the statistics and plots stage (it reads the rows, {files} batch files, "
+        "and imports SciPy and matplotlib).",
         f"- operate time: mean {op['mean']['value'] * 1e3:.4f} ms (95 % interval "
         f"{op['mean']['interval'][0] * 1e3:.4f}-{op['mean']['interval'][1] * 1e3:.4f}), std "
         f"{op['std']['value'] * 1e6:.1f} us, p99 {op['p99']['value'] * 1e3:.4f} ms; beyond {LIMIT * 1e3:g} ms: "

@@ -178,3 +178,45 @@ def test_batches_whose_text_column_is_missing_in_every_row_read_as_one_table(tmp
     assert list(df["bounce.bounces"]) == [3, 4, 5, 6]
     assert df["bounce.settle_note"].tolist()[2] == "not settled" and df["bounce.settle_note"].isna().tolist() == [
         True, True, False, True]
+
+
+def test_a_long_study_leaves_few_batch_files_and_every_row_once(tmp_path):
+    """The writer merges every `merge` files of one size into one, and so up: 100 batches
+    with merge = 4 leave at most 3 files per level (4 levels here), each row read once,
+    columns that differ between batches (a failed run's row lacks the summary) unified."""
+    writer = RowWriter(tmp_path / "results", "s1", every=math.inf, size=1, merge=4)
+    for k in range(100):
+        row = {"run_id": f"run{k:03d}", "status": "ok" if k % 7 else "failed", "x": float(k)}
+        if k % 7:
+            row["bounce.bounces"] = k
+        writer.add(row)
+    writer.flush()
+    files = sorted((tmp_path / "results").glob("part-*.parquet"))
+    # 100 in base 4 is 1210: one file of 64 batches, two of 16, one of 4, none single
+    assert len(files) == 1 + 2 + 1
+    df = read_results(tmp_path)
+    assert list(df.run_id) == [f"run{k:03d}" for k in range(100)]  # in the order written
+    assert df.x.tolist() == [float(k) for k in range(100)]
+    assert df["bounce.bounces"].isna().tolist() == [k % 7 == 0 for k in range(100)]
+
+
+def test_a_merge_stopped_before_its_deletes_reads_each_row_once(tmp_path):
+    """A merge writes the merged file, then deletes the batches it holds: stopped between the
+    two (a kill), both are on disk, and the rows are still read, and counted, once."""
+    import shutil
+
+    from coupling.app.sweep import finished_run_ids
+
+    folder = tmp_path / "results"
+    writer = RowWriter(folder, "s1", every=math.inf, size=1, merge=4)
+    for k in range(3):
+        writer.add({"run_id": f"run{k}", "status": "ok", "x": float(k)})
+    kept = sorted(folder.glob("part-*.parquet"))
+    shutil.copytree(folder, tmp_path / "copy")
+    writer.add({"run_id": "run3", "status": "ok", "x": 3.0})  # the fourth batch: merged, the three deleted
+    assert [f.name for f in folder.glob("part-*.parquet")] == ["part-s1-00000to00003.parquet"]
+    for f in kept:  # as if the deletes had not happened
+        shutil.copy(tmp_path / "copy" / f.name, folder / f.name)
+    assert len(list(folder.glob("part-*.parquet"))) == 4
+    assert sorted(read_results(tmp_path).run_id) == ["run0", "run1", "run2", "run3"]
+    assert finished_run_ids(tmp_path) == {"run0", "run1", "run2", "run3"}
