@@ -8,6 +8,7 @@ reports the errors under its own key names (coupling.core.scene translates 'Clas
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import numbers
 
@@ -46,3 +47,22 @@ def check_choice(owner: str, field: str, value: object, choices) -> str:
     if isinstance(value, (list, dict)) or value not in choices:
         raise ValueError(f"{owner}.{field} = {value!r}: allowed values are {', '.join(map(repr, choices))}")
     return value
+
+
+# --- scene keys: each dataclass field that a scene key sets carries the key's description ---
+
+def scene_key(default=dataclasses.MISSING, *, unit: str, doc: str = "", default_factory=dataclasses.MISSING,
+        shown: str | None = None):
+    """A dataclass field that is a scene key of the dataclass's section (its ``SECTION``,
+    e.g. "circuit.arc"): its default, its SI unit ("-": none) and a one-line meaning, the row of
+    docs/scene_keys.md (written by ``python -m coupling.app.keys_doc``). ``shown``: the default
+    column when the default is not one value (it depends on another key)."""
+    meta = {"unit": unit, "doc": doc}
+    if shown is not None:
+        meta["default"] = shown
+    return dataclasses.field(default=default, default_factory=default_factory, metadata=meta)
+
+
+def internal(default=dataclasses.MISSING, *, default_factory=dataclasses.MISSING):
+    """A dataclass field that no scene key sets (a part built from other keys, a title)."""
+    return dataclasses.field(default=default, default_factory=default_factory, metadata={"internal": True})

@@ -63,7 +63,7 @@ from mech.scene import SCENE_SECTIONS as MECH_SECTIONS
 from mech.scene import read_toml
 from mech.scene import scene_from_dict as mech_scene_from_dict
 from mech.validation import (
-    check_bool, check_choice, check_file, check_keys, check_nonnegative, check_positive, check_whole,
+    check_bool, check_choice, check_file, check_keys, check_nonnegative, check_positive, check_whole, scene_key,
 )
 
 COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output", "metrics", "duty", "coil", "magnet")
@@ -107,11 +107,11 @@ class CouplingOptions:
     that ngspice's truncation-error control cannot follow at tight RELTOL.
     """
 
-    scheme: str = "mechanics_first"
-    macro_step: float = 2e-6
-    max_macro_step: float | None = 1e-4
-    align_events: bool = True
-    onset_penetration: float = 10e-9
+    scheme: str = scene_key("mechanics_first", unit="-", doc='or "jacobi"')
+    macro_step: float = scene_key(2e-6, unit="s", doc="exchange interval while a tip touches")
+    max_macro_step: float | None = scene_key(1e-4, unit="s", doc="while both tips are free")
+    align_events: bool = scene_key(True, unit="-", doc="end a macro step at each make/break")
+    onset_penetration: float = scene_key(10e-9, unit="m", doc="conduction ramps in over this penetration")
 
     def __post_init__(self):
         check_choice("coupling.scheme", self.scheme, SCHEMES)
@@ -140,13 +140,18 @@ class OutputOptions:
     kept, at most [solver] history_rows besides those); docs/coupling.md, "Outputs".
     """
 
-    csv: bool = True
-    parquet: bool = True
-    plots: bool = False  # PNGs on request (`switchsim run --plots`, `switchsim plot DIR`): drawing them costs more than a run
-    history: bool = True
-    html: bool = True
-    history_resolution: float = 1e-6
-    history_max_rows: int = 50_000
+    csv: bool = scene_key(True, unit="-", doc="waveforms.csv")
+    parquet: bool = scene_key(True, unit="-", doc="waveforms.parquet")
+    # PNGs on request only: drawing them costs more than a run
+    plots: bool = scene_key(
+        False, unit="-", doc="PNG plots (`switchsim run --plots`, or `switchsim plot DIR` afterwards)")
+    history: bool = scene_key(True, unit="-", doc="mechanics history.csv")
+    html: bool = scene_key(True, unit="-", doc="waveforms.html (interactive)")
+    history_resolution: float = scene_key(
+        1e-6, unit="s", doc="history.csv rows at most this close, besides event rows")
+    history_max_rows: int = scene_key(
+        50_000, unit="-",
+        doc="and at most this many of them (0: every row the run kept, see `[solver] history_rows`); at most 1e7")
 
     def __post_init__(self):
         for name in ("csv", "parquet", "plots", "history", "html"):

@@ -71,6 +71,32 @@ def test_every_accepted_key_is_documented_and_nothing_else():
         assert doc[section] == keys, f"[{section}]: missing {keys - doc[section]}, extra {doc[section] - keys}"
 
 
+def test_the_key_tables_are_written_from_the_dataclass_fields():
+    """Each generated table of the page is what coupling.app.keys_doc writes from the fields
+    now: a key added, renamed or redescribed in its dataclass without regenerating fails here."""
+    from coupling.app import keys_doc
+
+    text = DOC.read_text()
+    assert keys_doc.render(text) == text, f"docs/scene_keys.md is stale: run `{keys_doc.COMMAND}`"
+
+
+def test_a_field_without_its_key_description_is_named():
+    """A field added without scene_key(...) or internal(...) stops the generator, naming the
+    field and what to add (so that a new key gets its row)."""
+    from coupling.app.keys_doc import field_rows
+    from mech.validation import internal, scene_key
+
+    @dataclasses.dataclass(frozen=True)
+    class Widget:
+        width: float = scene_key(1e-3, unit="m", doc="how wide")
+        place: str = internal("widget[0]")
+        depth: float = 2e-3
+
+    with pytest.raises(ValueError, match=r"Widget\.depth: no scene-key description; declare it as "
+                                         r"`depth: \.\.\. = scene_key\(<default>, unit="):
+        field_rows(Widget)
+
+
 def test_readme_relay_quick_start_scene_is_valid():
     """The README's "model my relay" scene validates as written (and uses the material law)."""
     import tomllib
