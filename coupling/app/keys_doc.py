@@ -19,6 +19,8 @@ import re
 import sys
 from pathlib import Path
 
+import circuit as ck
+
 DOC = Path(__file__).resolve().parents[2] / "docs" / "scene_keys.md"
 COMMAND = "python -m coupling.app.keys_doc"
 HEADER = ("| key | unit | default | meaning |", "|---|---|---|---|")
@@ -37,10 +39,41 @@ def section_classes() -> dict[str, tuple]:
     out = {name: (cls,) for name, cls in SECTIONS.items()}
     out.update({name: (cls,) for name, (_, cls) in LIST_SECTIONS.items()})
     out["environment"] = (MechScene,)  # gravity; its other fields are the sections
+    out["circuit"] = _circuit_classes()
+    out.update({cls.SECTION: (cls,) for cls in (ck.Snubber, ck.FlybackDiode, ck.ArcModel, ck.ContactSchedule)})
     out["coupling"] = (CouplingOptions,)
     out["output"] = (OutputOptions,)
     out["metrics"] = (MetricSettings,)
     return out
+
+
+def _circuit_classes() -> tuple:
+    """[circuit]'s dataclasses: the scene's own fields (template, ...), each template's, the
+    ngspice options."""
+    from coupling.core.scene import TEMPLATES, CircuitSpec, template_classes
+
+    out = [CircuitSpec]
+    for template in TEMPLATES:
+        out += [cls for cls in template_classes(template) if cls not in out]
+    return tuple(out) + (ck.SimulationOptions,)
+
+
+def _template_defaults(key: str) -> str | None:
+    """A [circuit] key's default where templates differ, "12 (inductive: 24; capacitive:
+    0.5)": the first template's, then each other's that differs; None where all agree."""
+    from coupling.core.scene import TEMPLATES, template_classes
+
+    shown = {}
+    for template in TEMPLATES:
+        for cls in template_classes(template):
+            row = next((r for r in field_rows(cls) if r[0] == key), None)
+            if row is not None:
+                shown.setdefault(template, row[2])
+    values = list(shown.values())
+    if len(set(values)) < 2:
+        return None
+    others = [f"{t}: {v}" for t, v in shown.items() if v != values[0]]
+    return f"{values[0]} ({'; '.join(others)})"
 
 
 def field_rows(cls) -> list[tuple[str, str, str, str]]:
@@ -58,6 +91,10 @@ def field_rows(cls) -> list[tuple[str, str, str, str]]:
                 f"`{f.name}: ... = scene_key(<default>, unit=\"<SI unit or ->\", doc=\"<one line>\")` "
                 "(mech.validation or circuit.validation), or `internal(<default>)` when no scene key sets it; "
                 f"then run `{COMMAND}`")
+        for key, unit, doc in meta.get("keys", ()):  # a field several keys set: each its row, no default
+            rows.append((key, unit, "-", doc))
+        if "keys" in meta:
+            continue
         key = meta.get("key", f.name)
         if key in seen:
             continue
@@ -94,8 +131,11 @@ def _number(x: float) -> str:
         return str(int(x))
     if 1e-3 <= abs(x) < 1e6:
         return repr(x)
-    exponent = 3 * math.floor(math.log10(abs(x)) / 3)  # engineering form: 210e9, 100e-12
-    return f"{x / 10.0 ** exponent:.6g}e{exponent}"
+    mantissa, exponent = f"{x:.6e}".split("e")
+    plain = f"{mantissa.rstrip('0').rstrip('.')}e{int(exponent)}"  # 1e-14, not 1.000000e-14 or 10e-15
+    third = 3 * math.floor(math.log10(abs(x)) / 3)
+    engineering = f"{x / 10.0 ** third:.6g}e{third}"  # 210e9, not 2.1e11
+    return min(plain, engineering, key=len)
 
 
 def table(section: str) -> list[str]:
@@ -109,6 +149,8 @@ def table(section: str) -> list[str]:
         for key, unit, shown, doc in field_rows(cls):
             if key not in seen:
                 seen.add(key)
+                if section == "circuit":
+                    shown = _template_defaults(key) or shown
                 cell = doc.replace("|", "\\|")
                 lines.append(f"| `{key}` | {unit} | {shown} | {cell} |" if cell else f"| `{key}` | {unit} | {shown} | |")
     return lines

@@ -107,7 +107,7 @@ def test_readme_relay_quick_start_scene_is_valid():
     block = re.search(r"```toml\n(# relay\.toml.*?)```", text, re.S).group(1)
     scene = scene_from_dict(tomllib.loads(block), name="relay")
     assert scene.kind == "coupled" and scene.tribology.laws.resistance_law.materials == ("AgNi10", "Ag")
-    assert scene.mech.initial.height == 0.4e-3 and scene.circuit.circuit.load.resistance == 5.0
+    assert scene.mech.initial.height == 0.4e-3 and scene.circuit.circuit.load.load_resistance == 5.0
 
 
 # --- the default column ------------------------------------------------------------------
@@ -168,16 +168,17 @@ def _plain(value):
 
 
 def _circuit_value(spec, name: str):
-    """The field a circuit scene key ('circuit.voltage', 'circuit.arc.min_voltage') sets."""
-    if name in ("circuit.template", "circuit.probes"):
-        return getattr(spec, name.split(".")[1])
-    parts = [spec.circuit, spec.options, spec.schedule] + [getattr(spec.circuit, a, None) for a in (
-        "source", "load", "wiring", "snubber", "flyback", "arc")]
-    objects = {type(o).__name__: o for o in parts if o is not None}
-    for class_field, key in cs.circuit_key_names(ck).items():
-        owner, fld = class_field.split(".")
-        if key == name and owner in objects:
-            return getattr(objects[owner], fld)
+    """The field a circuit scene key ('circuit.voltage', 'circuit.arc.min_voltage') sets: the
+    field of that name of the built circuit's parts (the fields are named as the keys)."""
+    *section, key = name.split(".")
+    if section == ["circuit"]:
+        c = spec.circuit
+        parts = [spec, spec.options, c] + [getattr(c, a, None) for a in ("source", "load", "wiring")]
+    else:
+        parts = [{"circuit.schedule": spec.schedule}.get(".".join(section), getattr(spec.circuit, section[1], None))]
+    for part in parts:
+        if part is not None and key in {f.name for f in dataclasses.fields(part)}:
+            return getattr(part, key)
     raise AssertionError(f"{name}: no field of the built circuit is set by it")
 
 
