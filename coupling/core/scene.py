@@ -188,6 +188,7 @@ class Scene:
     name: str = "scene"
     metrics: Any = None  # coupling.core.metrics.MetricSettings
     duty: Any = None  # coupling.core.duty.DutySettings, when the scene has [duty]
+    schedule_t_end: float | None = None  # s: a schedule scene's run length ([solver] t_end, its one key there)
 
     @property
     def kind(self) -> str:
@@ -201,9 +202,7 @@ class Scene:
     @property
     def t_end(self) -> float:
         """s: length of the run ([solver] t_end)."""
-        if self.mech is not None:
-            return self.mech.solver.t_end
-        return SolverOptions(**self.raw.get("solver", {})).t_end  # a schedule scene: [solver] t_end alone
+        return self.mech.solver.t_end if self.mech is not None else self.schedule_t_end
 
     def set(self, key: str, value) -> "Scene":
         """A new scene with ``key`` set to value, re-validated: "section.key",
@@ -542,9 +541,10 @@ def _build(doc: dict, base_dir: Path, name: str) -> Scene:
 
     tribology = _tribology(doc["tribology"], base_dir) if "tribology" in doc else None
 
-    mech = None
-    if schedule_given:
-        SolverOptions(**solver_table)  # [solver] t_end alone: the run's length
+    mech = schedule_t_end = None
+    if schedule_given:  # [solver] t_end alone: the run's length, checked as the key's field would
+        t_end = solver_table.get("t_end", _field_default(SolverOptions, "t_end"))
+        schedule_t_end = check_positive("solver.t_end", t_end, high=T_END_MAX)
     else:
         mech_doc = {k: v for k, v in doc.items() if k in MECH_SECTIONS}
         if tribology is not None:
@@ -584,9 +584,15 @@ def _build(doc: dict, base_dir: Path, name: str) -> Scene:
     metrics, circuit = _metrics(doc, circuit)
     duty = _duty(doc, mech, tribology, circuit)
     scene = Scene(raw=copy.deepcopy(doc), base_dir=base_dir, mech=mech, tribology=tribology, circuit=circuit,
-                  coupling=coupling, output=output, name=name, metrics=metrics, duty=duty)
+                  coupling=coupling, output=output, name=name, metrics=metrics, duty=duty,
+                  schedule_t_end=schedule_t_end)
     check_work(scene)
     return scene
+
+
+def _field_default(cls, name: str):
+    """The default of ``cls``'s field ``name``: the default of the key it is."""
+    return next(f.default for f in dataclasses.fields(cls) if f.name == name)
 
 
 def macro_steps(scene: Scene) -> float:

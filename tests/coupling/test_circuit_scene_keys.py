@@ -59,6 +59,21 @@ def test_value_errors_name_the_scene_key(circuit, key, internal):
     assert internal not in text
 
 
+def test_a_schedule_scene_runs_for_its_solver_t_end():
+    """A circuit-only scene's length is its [solver] t_end (its one key there), held by the
+    scene itself: the waveforms end there; left out, the key's documented default; a bad
+    value is refused naming the key, and any other [solver] key as well."""
+    schedule = {"schedule": {"make": [1e-4], "break": [3e-4]}, "max_step": 1e-5}
+    scene = scene_from_dict({"circuit": schedule, "solver": {"t_end": 6e-4}})
+    assert scene.mech is None and scene.t_end == 6e-4 and scene.set("solver.t_end", 8e-4).t_end == 8e-4
+    assert run(scene).waveforms["time"].iloc[-1] == pytest.approx(6e-4, rel=1e-12)
+    assert scene_from_dict({"circuit": schedule}).t_end == 0.05  # docs/scene_keys.md, [solver] t_end
+    with pytest.raises(ValueError, match=r"^s.toml: solver.t_end = -1.0: must be > 0$"):
+        scene_from_dict({"circuit": schedule, "solver": {"t_end": -1.0}}, name="s.toml")
+    with pytest.raises(ValueError, match=r"only \[solver\] t_end may stay"):
+        scene_from_dict({"circuit": schedule, "solver": {"t_end": 1e-3, "rtol": 1e-6}})
+
+
 def test_schedule_errors_name_the_scene_key():
     doc = {"circuit": {"schedule": {"make": [2e-4], "break": [1e-4], "closed_resistance": 0.01}},
            "solver": {"t_end": 1e-3}}
