@@ -33,6 +33,7 @@ def section_classes() -> dict[str, tuple]:
     from mech.parameters import MechScene
     from mech.scene import LIST_SECTIONS, SECTIONS
 
+    from coupling.core.duty import DutySettings, LifeLimits
     from coupling.core.metrics import MetricSettings
     from coupling.core.scene import CouplingOptions, OutputOptions
 
@@ -41,6 +42,8 @@ def section_classes() -> dict[str, tuple]:
     out["environment"] = (MechScene,)  # gravity; its other fields are the sections
     out["circuit"] = _circuit_classes()
     out.update({cls.SECTION: (cls,) for cls in (ck.Snubber, ck.FlybackDiode, ck.ArcModel, ck.ContactSchedule)})
+    out["duty"] = (DutySettings,)
+    out["duty.life"] = (LifeLimits,)
     out["coupling"] = (CouplingOptions,)
     out["output"] = (OutputOptions,)
     out["metrics"] = (MetricSettings,)
