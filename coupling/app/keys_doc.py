@@ -30,6 +30,7 @@ _TABLE = re.compile(r"(<!-- keys \[([a-z_.]+)\][^\n]*-->\n)(.*?)(<!-- end keys -
 def section_classes() -> dict[str, tuple]:
     """Scene section (as docs/scene_keys.md heads it, without brackets) -> the dataclasses
     whose fields are its keys, in the order of their rows."""
+    from circuit.coil_drive import CoilDrive
     from mech.parameters import MechScene
     from mech.scene import LIST_SECTIONS, SECTIONS
 
@@ -42,6 +43,7 @@ def section_classes() -> dict[str, tuple]:
     out["environment"] = (MechScene,)  # gravity; its other fields are the sections
     out["circuit"] = _circuit_classes()
     out.update({cls.SECTION: (cls,) for cls in (ck.Snubber, ck.FlybackDiode, ck.ArcModel, ck.ContactSchedule)})
+    out["coil"] = (CoilDrive,)  # (and the winding's resistance and turns, which make its CoilBlock)
     out["duty"] = (DutySettings,)
     out["duty.life"] = (LifeLimits,)
     out["coupling"] = (CouplingOptions,)
