@@ -335,14 +335,14 @@ class SwitchCircuit:
             c.D("clamp", "src", "clamp", model=CLAMP_MODEL, temperature=CLAMP_TEMPERATURE)
             c.model(CLAMP_MODEL, "D", IS=CLAMP_SATURATION_CURRENT, N=1.0, RS=0.0)
             c.V("clamp", "clamp", gnd, float(source.clamp_source_voltage))
-            internal = 0.0
+            r_source = 0.0
         else:
             c.V("source", "src", gnd, float(source.voltage))
-            internal = source.source_resistance
+            r_source = source.source_resistance
         series = [
             (kind, name, value)
             for kind, name, value in (
-                ("R", "source", internal),
+                ("R", "source", r_source),
                 ("R", "wire", self.wiring.wiring_resistance),
                 ("L", "wire", self.wiring.wiring_inductance),
             )

@@ -403,7 +403,7 @@ def _part(table: dict, name: str, cls):
         return cls()
     if not isinstance(value, dict):
         raise ValueError(f"circuit.{name} = {value!r}: expected true, false or a table of keys")
-    allowed = [f.name for f in dataclasses.fields(cls)]
+    allowed = key_fields(cls)
     check_keys(f"circuit.{name}", value, allowed)
     if name == "snubber" and len(value) != 2:
         missing = sorted(set(allowed) - set(value))
