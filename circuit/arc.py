@@ -94,12 +94,12 @@ from __future__ import annotations
 import math
 from bisect import bisect_left, insort
 from dataclasses import dataclass
-from typing import Callable, Sequence
+from typing import Callable, ClassVar, Sequence
 
 from PySpice.Spice.Netlist import Circuit
 
 from .contact import check_block_name, named
-from .validation import check_range
+from .validation import check_range, scene_key
 
 SENSE_SOURCE = "Varc"
 STATE_SOURCE = "Iarc_on"
@@ -155,20 +155,23 @@ class ArcModel:
         relaxation; order 1-10 us for arcs in air). Only with "ayrton".
     """
 
-    min_voltage: float = 12.0
-    min_current: float = 0.4
-    resistance: float = 0.05
-    formation_time: float = 1e-6
-    breakdown_voltage: float | None = None
-    column_gradient: float = 0.0
-    breakdown_gradient: float = 0.0
-    characteristic: str = "linear"
-    ayrton_c: float = 0.0
-    ayrton_d: float = 0.0
-    time_constant: float = 1e-6
+    SECTION: ClassVar[str] = "circuit.arc"
+    min_voltage: float = scene_key(12.0, unit="V", doc="minimum arc voltage")
+    min_current: float = scene_key(0.4, unit="A", doc="minimum arc current")
+    resistance: float = scene_key(0.05, unit="ohm")
+    formation_time: float = scene_key(1e-6, unit="s")
+    breakdown_voltage: float | None = scene_key(None, unit="V", doc="re-ignition across the gap; omitted: none")
+    column_gradient: float = scene_key(0.0, unit="V/m", doc="arc voltage growth with the gap")
+    breakdown_gradient: float = scene_key(
+        0.0, unit="V/m", doc="breakdown voltage growth with the gap (needs `breakdown_voltage`)")
+    characteristic: str = scene_key(
+        "linear", unit="-", doc='"linear": U_min + E_col d + R_arc I; "ayrton": U_min + E_col d + (C + D d) / I')
+    ayrton_c: float = scene_key(0.0, unit="W", doc='Ayrton\'s C (characteristic = "ayrton")')
+    ayrton_d: float = scene_key(0.0, unit="W/m", doc="Ayrton's D: C's growth with the gap (needs the gap)")
+    time_constant: float = scene_key(1e-6, unit="s", doc="how fast the Ayrton arc's voltage follows its current")
 
     def __post_init__(self) -> None:
-        name = "ArcModel"
+        name = self.SECTION
         check_range(name, "min_voltage", self.min_voltage, "V", 0.0, 1000.0, low_open=True)
         check_range(name, "min_current", self.min_current, "A", 0.0, 100.0, low_open=True)
         check_range(name, "resistance", self.resistance, "ohm", 1e-4, 100.0)

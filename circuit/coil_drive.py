@@ -33,7 +33,7 @@ from PySpice.Spice.Netlist import Circuit
 
 from .blocks import CoilBlock
 from .probes import Probes
-from .validation import check_range
+from .validation import check_range, internal, scene_key
 
 SUPPRESSIONS = ("none", "diode", "zener", "rc")
 SUPPLY_NODE = "coil_supply"
@@ -59,19 +59,25 @@ class CoilDrive:
     diode_saturation_current: A, IS of the suppression diodes (N = 1.8, RS = 0.05 ohm).
     """
 
-    coil: CoilBlock
-    voltage: float = 12.0
-    on_time: float = 0.0
-    off_time: Optional[float] = None
-    suppression: str = "none"
-    zener_voltage: float = 24.0
-    rc_resistance: float = 100.0
-    rc_capacitance: float = 100e-9
-    switch_resistance: float = 0.1
-    switch_capacitance: float = 100e-12
-    switch_breakdown: float = 100.0
-    edge_time: float = 1e-6
-    diode_saturation_current: float = 1e-9
+    coil: CoilBlock = scene_key(keys=(  # [coil] resistance and turns make the coil (with [magnet])
+        ("resistance", "ohm", 'the winding; needed except with `magnet.model = "plunger_solenoid"` (10)'),
+        ("turns", "-", 'the winding; needed with `magnet.model = "flux_tubes"` (plunger_solenoid: 957); not with '
+                       '"table"')))
+    voltage: float = scene_key(12.0, unit="V", doc="the coil supply")
+    on_time: float = scene_key(0.0, unit="s", doc="the driver switches on (0: a step at the start)")
+    off_time: Optional[float] = scene_key(None, unit="s", doc="the driver switches off; omitted: stays on")
+    suppression: str = scene_key(
+        "none", unit="-",
+        doc='"none" (the driver avalanches at `switch_breakdown`), "diode" (freewheeling), "zener" (a diode in '
+            'series with a zener), "rc"')
+    zener_voltage: float = scene_key(24.0, unit="V", doc='"zener" only')
+    rc_resistance: float = scene_key(100.0, unit="ohm", doc='"rc" only')
+    rc_capacitance: float = scene_key(100e-9, unit="F", doc='"rc" only')
+    switch_resistance: float = scene_key(0.1, unit="ohm", doc="the driver when on")
+    switch_capacitance: float = scene_key(100e-12, unit="F", doc="the driver's output capacitance")
+    switch_breakdown: float = scene_key(100.0, unit="V", doc="the driver's avalanche voltage, > `voltage`")
+    edge_time: float = scene_key(1e-6, unit="s", doc="the driver's switching time")
+    diode_saturation_current: float = internal(1e-9)
 
     def __post_init__(self) -> None:
         name = "CoilDrive"

@@ -43,6 +43,7 @@ import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import ClassVar
 
 from PySpice.Spice.Netlist import Circuit
 
@@ -52,7 +53,7 @@ from .contact import DEFAULT_LEAKAGE, check_current_factor
 from .errors import NetlistInputError
 from .netlist_check import DECK_TITLE, NetlistLine, check_lines, logical_lines, param_spans, read_netlist
 from .probes import Probes
-from .validation import check_range
+from .validation import check_range, internal, scene_key
 
 _RESERVED_ELEMENTS = re.compile(
     r"^(vcontact\w*|bcontact\w*|varc\w*|barc\w*|iarc\w*|rarc\w*|[vrbc]xcoil\w*)$", re.I)
@@ -86,15 +87,23 @@ class NetlistCircuit:
         ``from_file``; ``text`` is then the inlined netlist).
     """
 
-    text: str
-    load_probe: str | None = "VLOAD"
-    arc: ArcModel | None = None
-    leakage_conductance: float = DEFAULT_LEAKAGE
-    contact_current_factor: str | None = None
-    origins: tuple[tuple[str, int], ...] | None = field(default=None, compare=False, repr=False)
-    coil_resistance: float | None = None
-    coil_current: str | None = None
-    params: tuple[tuple[str, float], ...] | None = None
+    SECTION: ClassVar[str] = "circuit"
+    text: str = internal()  # the netlist read from [circuit] netlist (a file name)
+    load_probe: str | None = scene_key(
+        "VLOAD", unit="-",
+        doc='template "netlist": the 0 V source in series with the load (its current is the load current)')
+    arc: ArcModel | None = scene_key(
+        None, unit="-", doc="the arc model: true (its defaults) or a table: [circuit.arc]; omitted or false: none")
+    leakage_conductance: float = scene_key(DEFAULT_LEAKAGE, unit="S", doc="open-contact insulation")
+    contact_current_factor: str | None = internal(None)
+    origins: tuple[tuple[str, int], ...] | None = field(default=None, compare=False, repr=False, metadata={"internal": True})
+    coil_resistance: float | None = internal(None)
+    coil_current: str | None = internal(None)
+    params: tuple[tuple[str, float], ...] | None = scene_key(
+        None, unit="-",
+        doc='template "netlist": new values of the netlist\'s own `.param` definitions, `{ RF = 10e3, CF = 1e-9 '
+            "}` (numbers, in the netlist's units; SPICE names ignore case): [circuit.params]; a name the netlist "
+            "does not define at its top level is refused")
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "params", _param_values(self.params) if self.params else None)
@@ -104,9 +113,9 @@ class NetlistCircuit:
             raise ValueError(f"NetlistCircuit.arc = {self.arc!r}: must be an ArcModel or None")
         if self.load_probe is not None and not (isinstance(self.load_probe, str)
                                                 and re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", self.load_probe)):
-            raise ValueError(f"NetlistCircuit.load_probe = {self.load_probe!r}: the name of a voltage source "
+            raise ValueError(f"{self.SECTION}.load_probe = {self.load_probe!r}: the name of a voltage source "
                              "(letters, digits, _) or None")
-        check_range("NetlistCircuit", "leakage_conductance", self.leakage_conductance, "S", 0.0, 1e-3)
+        check_range(self.SECTION, "leakage_conductance", self.leakage_conductance, "S", 0.0, 1e-3)
         check_current_factor("NetlistCircuit", self.contact_current_factor)
         if (self.coil_resistance is None) != (self.coil_current is None):
             raise ValueError("NetlistCircuit.coil_resistance and NetlistCircuit.coil_current: give both (a coil) "
@@ -268,21 +277,21 @@ def _param_values(params) -> tuple[tuple[str, float], ...]:
     if isinstance(params, dict):
         params = tuple(params.items())
     if not isinstance(params, (tuple, list)) or not all(isinstance(p, (tuple, list)) and len(p) == 2 for p in params):
-        raise ValueError(f"NetlistCircuit.params = {params!r:.200}: expected a table of name = number")
+        raise ValueError(f"circuit.params = {params!r:.200}: expected a table of name = number")
     out = []
     for name, value in params:
         if not (isinstance(name, str) and re.fullmatch(r"[A-Za-z_]\w*", name)):
-            raise ValueError(f"NetlistCircuit.params: {name!r:.60} is not a parameter name (a letter or _, then "
+            raise ValueError(f"circuit.params: {name!r:.60} is not a parameter name (a letter or _, then "
                              "letters, digits, _)")
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
                 or abs(value) > PARAM_MAX:
-            raise ValueError(f"NetlistCircuit.params.{name} = {value!r:.60}: expected a finite number, "
+            raise ValueError(f"circuit.params.{name} = {value!r:.60}: expected a finite number, "
                              f"|value| <= {PARAM_MAX:g}")
         out.append((name, float(value)))
     lowered = [name.lower() for name, _ in out]
     for name in out:
         if lowered.count(name[0].lower()) > 1:
-            raise ValueError(f"NetlistCircuit.params.{name[0]}: given twice (SPICE names ignore case)")
+            raise ValueError(f"circuit.params.{name[0]}: given twice (SPICE names ignore case)")
     return tuple(out)
 
 
@@ -323,6 +332,6 @@ def _with_params(lines: list[NetlistLine], params: tuple[tuple[str, float], ...]
             lowered = {n.lower(): n for n in names}
             close = get_close_matches(key, list(lowered), n=1, cutoff=0.5)
             hint = f"; did you mean {lowered[close[0]]!r}?" if close else ""
-            raise ValueError(f"NetlistCircuit.params.{name} = {value!r}: the netlist has no '.param {name}' at its "
+            raise ValueError(f"circuit.params.{name} = {value!r}: the netlist has no '.param {name}' at its "
                              f"top level{hint} (its parameters: {', '.join(names) or 'none'})")
     return out

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
-from .validation import check_choice, check_range
+from .validation import check_choice, check_range, scene_key
 
 _METHODS = ("trap", "gear")
 
@@ -33,17 +34,19 @@ class SimulationOptions:
         On expiry the run is aborted and SimulationTimeout raised.
     """
 
-    max_step: float | None = None
-    reltol: float = 1e-4
-    abstol: float = 1e-12
-    vntol: float = 1e-6
-    chgtol: float = 1e-14
-    method: str = "gear"
-    temperature: float = 27.0
-    wall_timeout: float | None = 600.0
+    SECTION: ClassVar[str] = "circuit"
+    max_step: float | None = scene_key(
+        None, unit="s", doc="ngspice TMAX; omitted: from the run length (docs/circuit.md)")
+    reltol: float = scene_key(1e-4, unit="-", doc="ngspice RELTOL")
+    abstol: float = scene_key(1e-12, unit="A", doc="ngspice ABSTOL")
+    vntol: float = scene_key(1e-6, unit="V", doc="ngspice VNTOL")
+    chgtol: float = scene_key(1e-14, unit="C", doc="ngspice CHGTOL")
+    method: str = scene_key("gear", unit="-", doc='or "trap"')
+    temperature: float = scene_key(27.0, unit="degC", doc="ngspice TEMP")
+    wall_timeout: float | None = scene_key(600.0, unit="s", doc="wall-clock limit of one run or macro step")
 
     def __post_init__(self) -> None:
-        name = "SimulationOptions"
+        name = self.SECTION
         if self.max_step is not None:
             check_range(name, "max_step", self.max_step, "s", 0.0, 1.0, low_open=True)
         check_range(name, "reltol", self.reltol, "", 1e-9, 0.1)

@@ -27,11 +27,11 @@ from __future__ import annotations
 import bisect
 import math
 from dataclasses import dataclass
-from typing import Callable, Sequence
+from typing import Callable, ClassVar, Sequence
 
 import numpy as np
 
-from .validation import check_range
+from .validation import check_range, scene_key
 
 Resistance = Callable[[float], float]
 
@@ -50,13 +50,17 @@ class ContactSchedule:
         module docstring), for an arc model whose voltage grows with the gap.
     """
 
-    intervals: tuple[tuple[float, float], ...]
-    closed_resistance: float | Resistance = 0.01
-    edge_time: float = 10e-9
-    opening_speed: float | None = None
+    SECTION: ClassVar[str] = "circuit.schedule"
+    intervals: tuple[tuple[float, float], ...] = scene_key(keys=(
+        ("make", "s", "make instants"),
+        ("break", "s", "break instants (as many as makes, or one fewer: ends closed)")))
+    closed_resistance: float | Resistance = scene_key(0.01, unit="ohm")
+    edge_time: float = scene_key(10e-9, unit="s", doc="conductance ramp at each edge")
+    opening_speed: float | None = scene_key(
+        None, unit="m/s", doc="the gap for an arc whose voltage grows with it; omitted: no gap")
 
     def __post_init__(self) -> None:
-        name = "ContactSchedule"
+        name = self.SECTION
         check_range(name, "edge_time", self.edge_time, "s", 0.0, 1e-3)
         if self.opening_speed is not None:
             check_range(name, "opening_speed", self.opening_speed, "m/s", 0.0, 1e3, low_open=True)
@@ -68,21 +72,21 @@ class ContactSchedule:
         try:
             pairs = tuple((float(a), float(b)) for a, b in self.intervals)
         except (TypeError, ValueError):
-            raise ValueError(f"{name}.intervals = {self.intervals!r}: must be pairs (t_make, t_break) in s") from None
+            raise ValueError(f"{name}.make/break: intervals {self.intervals!r} must be pairs (t_make, t_break) in s") from None
         object.__setattr__(self, "intervals", pairs)
         previous_break = -math.inf
         for i, (make, brk) in enumerate(pairs):
             if math.isnan(make) or math.isnan(brk) or math.isinf(make):
-                raise ValueError(f"{name}.intervals[{i}] = {(make, brk)!r}: t_make must be finite, t_break a number or inf")
+                raise ValueError(f"{name}.make/break[{i}] = {(make, brk)!r}: t_make must be finite, t_break a number or inf")
             if make < previous_break or (i > 0 and make <= 0):
                 raise ValueError(
-                    f"{name}.intervals[{i}] = {(make, brk)!r}: intervals must increase and not overlap "
+                    f"{name}.make/break[{i}] = {(make, brk)!r}: intervals must increase and not overlap "
                     f"(previous break at {previous_break!r} s)"
                 )
             ramps = (0.0 if make <= 0 else self.edge_time) + (0.0 if math.isinf(brk) else self.edge_time)
             if brk - make < ramps or brk <= max(make, 0.0):
                 raise ValueError(
-                    f"{name}.intervals[{i}] = {(make, brk)!r}: a closed interval must last at least "
+                    f"{name}.make/break[{i}] = {(make, brk)!r}: a closed interval must last at least "
                     f"its ramps ({ramps!r} s) and end after it starts"
                 )
             previous_break = brk
@@ -104,11 +108,11 @@ class ContactSchedule:
         """From make instants and break instants (s); one more make than breaks leaves it closed.
         ``fields``: closed_resistance, edge_time, opening_speed (omitted: the field's default)."""
         if any(isinstance(v, (str, bytes, dict)) or not hasattr(v, "__len__") for v in (make, brk)):
-            raise ValueError(f"ContactSchedule.intervals: make = {make!r}, break = {brk!r}: expected lists of times (s)")
+            raise ValueError(f"{cls.SECTION}.make = {make!r}, {cls.SECTION}.break = {brk!r}: expected lists of times (s)")
         make, brk = list(make), list(brk)
         if len(brk) not in (len(make), len(make) - 1):
             raise ValueError(
-                f"ContactSchedule.from_events: {len(make)} makes need {len(make)} or {len(make) - 1} breaks, got {len(brk)}"
+                f"{cls.SECTION}.make/break: {len(make)} makes need {len(make)} or {len(make) - 1} breaks, got {len(brk)}"
             )
         ends = brk + [math.inf] * (len(make) - len(brk))
         return cls(tuple(zip(make, ends)), **fields)

@@ -24,8 +24,8 @@ and capacitance and a compliance clamp; see its docstring for the netlist)::
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from typing import Union
+from dataclasses import dataclass
+from typing import ClassVar, Union
 
 from PySpice.Spice.Netlist import Circuit
 
@@ -35,7 +35,7 @@ from .coil_drive import CoilDrive
 from .contact import DEFAULT_LEAKAGE, add_contact, check_current_factor
 from .names import check_block_name
 from .probes import Probes
-from .validation import check_range
+from .validation import check_range, internal, scene_key
 
 BOLTZMANN_OVER_CHARGE = 8.617333262e-5  # V/K
 CLAMP_TEMPERATURE = 27.0  # degC: the clamp diode's instance temperature (fixed, whatever TEMP)
@@ -49,14 +49,16 @@ LOAD_PROBE = "Vload"
 
 @dataclass(frozen=True)
 class DCSource:
-    """DC supply: open-circuit voltage (V, positive) and internal resistance (ohm)."""
+    """DC supply: open-circuit voltage (V, positive) and its internal resistance
+    ``source_resistance`` (ohm)."""
 
-    voltage: float = 24.0
-    internal_resistance: float = 0.01
+    SECTION: ClassVar[str] = "circuit"  # the scene section of its keys: [circuit] voltage, ...
+    voltage: float = scene_key(24.0, unit="V", doc="source; mcu_input: the logic supply Vcc")
+    source_resistance: float = scene_key(0.01, unit="ohm")
 
     def __post_init__(self) -> None:
-        check_range("DCSource", "voltage", self.voltage, "V", 0.0, 1e5, low_open=True)
-        check_range("DCSource", "internal_resistance", self.internal_resistance, "ohm", 0.0, 1e6)
+        check_range(self.SECTION, "voltage", self.voltage, "V", 0.0, 1e5, low_open=True)
+        check_range(self.SECTION, "source_resistance", self.source_resistance, "ohm", 0.0, 1e6)
 
 
 @dataclass(frozen=True)
@@ -91,16 +93,18 @@ class CurrentSource:
     clamp carries less than 1e-5 I_set: constant-current mode.
     """
 
-    current: float = 1.0
-    compliance_voltage: float = 20.0
-    output_capacitance: float = 1e-6
-    output_resistance: float = 1e4
+    SECTION: ClassVar[str] = "circuit"
+    current: float = scene_key(1.0, unit="A", doc="current_source: set current")
+    compliance_voltage: float = scene_key(20.0, unit="V", doc="current_source: the most the supply puts out")
+    output_capacitance: float = scene_key(1e-6, unit="F", doc="current_source")
+    output_resistance: float = scene_key(1e4, unit="ohm", doc="current_source")
 
     def __post_init__(self) -> None:
-        check_range("CurrentSource", "current", self.current, "A", 0.0, 1e3, low_open=True)
-        check_range("CurrentSource", "compliance_voltage", self.compliance_voltage, "V", 0.0, 1e5, low_open=True)
-        check_range("CurrentSource", "output_capacitance", self.output_capacitance, "F", 0.0, 1.0, low_open=True)
-        check_range("CurrentSource", "output_resistance", self.output_resistance, "ohm", 1e-3, 1e12)
+        name = self.SECTION
+        check_range(name, "current", self.current, "A", 0.0, 1e3, low_open=True)
+        check_range(name, "compliance_voltage", self.compliance_voltage, "V", 0.0, 1e5, low_open=True)
+        check_range(name, "output_capacitance", self.output_capacitance, "F", 0.0, 1.0, low_open=True)
+        check_range(name, "output_resistance", self.output_resistance, "ohm", 1e-3, 1e12)
 
     @property
     def thermal_voltage(self) -> float:
@@ -133,54 +137,60 @@ Source = Union[DCSource, CurrentSource]
 
 @dataclass(frozen=True)
 class Wiring:
-    """Loop wiring between source and contact: resistance (ohm) and inductance (H, ~1 uH per metre of loop)."""
+    """Loop wiring between source and contact: wiring_resistance (ohm) and wiring_inductance
+    (H, ~1 uH per metre of loop)."""
 
-    resistance: float = 0.01
-    inductance: float = 1e-6
+    SECTION: ClassVar[str] = "circuit"
+    wiring_resistance: float = scene_key(0.01, unit="ohm")
+    wiring_inductance: float = scene_key(1e-6, unit="H")
 
     def __post_init__(self) -> None:
-        check_range("Wiring", "resistance", self.resistance, "ohm", 0.0, 1e3)
-        check_range("Wiring", "inductance", self.inductance, "H", 0.0, 1.0)
+        check_range(self.SECTION, "wiring_resistance", self.wiring_resistance, "ohm", 0.0, 1e3)
+        check_range(self.SECTION, "wiring_inductance", self.wiring_inductance, "H", 0.0, 1.0)
 
 
 @dataclass(frozen=True)
 class ResistiveLoad:
-    """Resistive load, ohm."""
+    """Resistive load: load_resistance, ohm."""
 
-    resistance: float = 12.0
+    SECTION: ClassVar[str] = "circuit"
+    load_resistance: float = scene_key(12.0, unit="ohm")
 
     def __post_init__(self) -> None:
-        check_range("ResistiveLoad", "resistance", self.resistance, "ohm", 1e-6, 1e9)
+        check_range(self.SECTION, "load_resistance", self.load_resistance, "ohm", 1e-6, 1e9)
 
 
 @dataclass(frozen=True)
 class InductiveLoad:
-    """Series R-L load (relay coil, motor winding): resistance (ohm), inductance (H)."""
+    """Series R-L load (relay coil, motor winding): load_resistance (ohm), load_inductance (H)."""
 
-    resistance: float = 24.0
-    inductance: float = 10e-3
+    SECTION: ClassVar[str] = "circuit"
+    load_resistance: float = scene_key(24.0, unit="ohm")
+    load_inductance: float = scene_key(10e-3, unit="H", doc="inductive")
 
     def __post_init__(self) -> None:
-        check_range("InductiveLoad", "resistance", self.resistance, "ohm", 1e-6, 1e9)
-        check_range("InductiveLoad", "inductance", self.inductance, "H", 0.0, 100.0, low_open=True)
+        check_range(self.SECTION, "load_resistance", self.load_resistance, "ohm", 1e-6, 1e9)
+        check_range(self.SECTION, "load_inductance", self.load_inductance, "H", 0.0, 100.0, low_open=True)
 
 
 @dataclass(frozen=True)
 class CapacitiveLoad:
-    """Inrush load: series resistance (ohm), then a capacitance (F) with a bleed resistance (ohm) across it.
+    """Inrush load: series load_resistance (ohm), then load_capacitance (F) with bleed_resistance (ohm) across it.
 
     The bleed resistor is the load's steady consumption and gives the capacitor a DC
     path, so the operating point is defined with the contact open.
     """
 
-    resistance: float = 0.5
-    capacitance: float = 100e-6
-    bleed_resistance: float = 1e3
+    SECTION: ClassVar[str] = "circuit"
+    load_resistance: float = scene_key(0.5, unit="ohm")
+    load_capacitance: float = scene_key(100e-6, unit="F", doc="capacitive")
+    bleed_resistance: float = scene_key(1e3, unit="ohm", doc="capacitive")
 
     def __post_init__(self) -> None:
-        check_range("CapacitiveLoad", "resistance", self.resistance, "ohm", 1e-6, 1e9)
-        check_range("CapacitiveLoad", "capacitance", self.capacitance, "F", 0.0, 1.0, low_open=True)
-        check_range("CapacitiveLoad", "bleed_resistance", self.bleed_resistance, "ohm", 1e-3, 1e12)
+        name = self.SECTION
+        check_range(name, "load_resistance", self.load_resistance, "ohm", 1e-6, 1e9)
+        check_range(name, "load_capacitance", self.load_capacitance, "F", 0.0, 1.0, low_open=True)
+        check_range(name, "bleed_resistance", self.bleed_resistance, "ohm", 1e-3, 1e12)
 
 
 Load = Union[ResistiveLoad, InductiveLoad, CapacitiveLoad]
@@ -190,26 +200,29 @@ Load = Union[ResistiveLoad, InductiveLoad, CapacitiveLoad]
 class Snubber:
     """RC snubber across the contact: resistance (ohm) in series with capacitance (F)."""
 
-    resistance: float = 100.0
-    capacitance: float = 100e-9
+    SECTION: ClassVar[str] = "circuit.snubber"
+    resistance: float = scene_key(100.0, unit="ohm", shown="-")
+    capacitance: float = scene_key(100e-9, unit="F", shown="-")
 
     def __post_init__(self) -> None:
-        check_range("Snubber", "resistance", self.resistance, "ohm", 0.0, 1e6, low_open=True)
-        check_range("Snubber", "capacitance", self.capacitance, "F", 0.0, 1e-3, low_open=True)
+        check_range(self.SECTION, "resistance", self.resistance, "ohm", 0.0, 1e6, low_open=True)
+        check_range(self.SECTION, "capacitance", self.capacitance, "F", 0.0, 1e-3, low_open=True)
 
 
 @dataclass(frozen=True)
 class FlybackDiode:
     """Freewheeling diode across an inductive load (ngspice D model: IS in A, N, RS in ohm)."""
 
-    saturation_current: float = 1e-9
-    emission_coefficient: float = 1.8
-    series_resistance: float = 0.05
+    SECTION: ClassVar[str] = "circuit.flyback"
+    saturation_current: float = scene_key(1e-9, unit="A", doc="diode I_s")
+    emission_coefficient: float = scene_key(1.8, unit="-", doc="diode n")
+    series_resistance: float = scene_key(0.05, unit="ohm")
 
     def __post_init__(self) -> None:
-        check_range("FlybackDiode", "saturation_current", self.saturation_current, "A", 1e-20, 1e-3, low_open=True)
-        check_range("FlybackDiode", "emission_coefficient", self.emission_coefficient, "", 0.5, 5.0)
-        check_range("FlybackDiode", "series_resistance", self.series_resistance, "ohm", 0.0, 100.0)
+        name = self.SECTION
+        check_range(name, "saturation_current", self.saturation_current, "A", 1e-20, 1e-3, low_open=True)
+        check_range(name, "emission_coefficient", self.emission_coefficient, "", 0.5, 5.0)
+        check_range(name, "series_resistance", self.series_resistance, "ohm", 0.0, 100.0)
 
 
 @dataclass(frozen=True)
@@ -232,32 +245,39 @@ class SwitchCircuit:
         print(circuit.build())        # the netlist
     """
 
-    source: Source = field(default_factory=DCSource)
-    load: Load = field(default_factory=ResistiveLoad)
-    wiring: Wiring = field(default_factory=Wiring)
-    contact_capacitance: float = 100e-12
-    snubber: Snubber | None = None
-    flyback: FlybackDiode | None = None
-    arc: ArcModel | None = None
-    leakage_conductance: float = DEFAULT_LEAKAGE
-    contact_current_factor: str | None = None
-    title: str = "switchsim contact circuit"
-    coil: CoilDrive | None = None
+    SECTION: ClassVar[str] = "circuit"
+    source: Source = internal(default_factory=DCSource)  # its keys are the source's fields
+    load: Load = internal(default_factory=ResistiveLoad)
+    wiring: Wiring = internal(default_factory=Wiring)
+    contact_capacitance: float = scene_key(
+        100e-12, unit="F", doc="across the contact (bridge: across each of its two)")
+    snubber: Snubber | None = scene_key(
+        None, unit="-", doc="RC across the contact, `{resistance = 100.0, capacitance = 100e-9}` (ohm, F; give "
+        "both): [circuit.snubber]; omitted or false: none")
+    flyback: FlybackDiode | None = scene_key(
+        None, unit="-", doc="a diode across an inductive load: true (its defaults) or a table: [circuit.flyback]; "
+        "omitted or false: none")
+    arc: ArcModel | None = scene_key(
+        None, unit="-", doc="the arc model: true (its defaults) or a table: [circuit.arc]; omitted or false: none")
+    leakage_conductance: float = scene_key(DEFAULT_LEAKAGE, unit="S", doc="open-contact insulation")
+    contact_current_factor: str | None = internal(None)  # from [tribology]'s resistance law
+    title: str = internal("switchsim contact circuit")
+    coil: CoilDrive | None = internal(None)  # from [coil]
 
     def __post_init__(self) -> None:
-        name = "SwitchCircuit"
+        name = self.SECTION
         if not isinstance(self.source, (DCSource, CurrentSource)):
-            raise ValueError(f"{name}.source = {self.source!r}: must be a DCSource or CurrentSource")
+            raise ValueError(f"SwitchCircuit.source = {self.source!r}: must be a DCSource or CurrentSource")
         if not isinstance(self.wiring, Wiring):
-            raise ValueError(f"{name}.wiring = {self.wiring!r}: must be a Wiring")
+            raise ValueError(f"SwitchCircuit.wiring = {self.wiring!r}: must be a Wiring")
         if not isinstance(self.load, (ResistiveLoad, InductiveLoad, CapacitiveLoad)):
             raise ValueError(
-                f"{name}.load = {self.load!r}: must be a ResistiveLoad, InductiveLoad or CapacitiveLoad"
+                f"SwitchCircuit.load = {self.load!r}: must be a ResistiveLoad, InductiveLoad or CapacitiveLoad"
             )
         for attr, kind in (("snubber", Snubber), ("flyback", FlybackDiode), ("arc", ArcModel), ("coil", CoilDrive)):
             value = getattr(self, attr)
             if value is not None and not isinstance(value, kind):
-                raise ValueError(f"{name}.{attr} = {value!r}: must be a {kind.__name__} or None")
+                raise ValueError(f"SwitchCircuit.{attr} = {value!r}: must be a {kind.__name__} or None")
         if self.flyback is not None and not isinstance(self.load, InductiveLoad):
             raise ValueError(
                 f"{name}.flyback is set but load is {type(self.load).__name__}: "
@@ -265,18 +285,18 @@ class SwitchCircuit:
             )
         if isinstance(self.source, CurrentSource):
             if not isinstance(self.load, ResistiveLoad):
-                raise ValueError(f"{name}.load is {type(self.load).__name__}: a CurrentSource drives a "
+                raise ValueError(f"SwitchCircuit.load is {type(self.load).__name__}: a CurrentSource drives a "
                                  "ResistiveLoad (the rest of the loop: leads, specimen)")
-            closed = self.wiring.resistance + self.load.resistance
+            closed = self.wiring.wiring_resistance + self.load.load_resistance
             if self.source.compliance_voltage < self.source.current * closed:
                 raise ValueError(
-                    f"CurrentSource.compliance_voltage = {self.source.compliance_voltage:g} V is below "
-                    f"CurrentSource.current x (Wiring.resistance + ResistiveLoad.resistance) = "
+                    f"{name}.compliance_voltage = {self.source.compliance_voltage:g} V is below "
+                    f"{name}.current x ({name}.wiring_resistance + {name}.load_resistance) = "
                     f"{self.source.current:g} A x {closed:g} ohm = {self.source.current * closed:g} V: the "
                     "supply could not drive the set current even through the closed contact"
                 )
         check_range(name, "contact_capacitance", self.contact_capacitance, "F", 0.0, 1e-6)
-        series_l = self.wiring.inductance + (self.load.inductance if isinstance(self.load, InductiveLoad)
+        series_l = self.wiring.wiring_inductance + (self.load.load_inductance if isinstance(self.load, InductiveLoad)
                                              and self.flyback is None else 0.0)
         if self.contact_capacitance == 0.0 and series_l > 0.0 and self.snubber is None:
             raise ValueError(
@@ -285,9 +305,9 @@ class SwitchCircuit:
                 "small'); give the contact's stray capacitance (> 0 F, default 1e-10 F) or a snubber"
             )
         check_range(name, "leakage_conductance", self.leakage_conductance, "S", 0.0, 1e-3)
-        check_current_factor(name, self.contact_current_factor)
+        check_current_factor(type(self).__name__, self.contact_current_factor)
         if not isinstance(self.title, str) or "\n" in self.title:
-            raise ValueError(f"{name}.title = {self.title!r}: must be a one-line string")
+            raise ValueError(f"SwitchCircuit.title = {self.title!r}: must be a one-line string")
 
     @property
     def contacts(self) -> tuple[ContactBlock, ...]:
@@ -315,16 +335,16 @@ class SwitchCircuit:
             c.D("clamp", "src", "clamp", model=CLAMP_MODEL, temperature=CLAMP_TEMPERATURE)
             c.model(CLAMP_MODEL, "D", IS=CLAMP_SATURATION_CURRENT, N=1.0, RS=0.0)
             c.V("clamp", "clamp", gnd, float(source.clamp_source_voltage))
-            internal = 0.0
+            r_source = 0.0
         else:
             c.V("source", "src", gnd, float(source.voltage))
-            internal = source.internal_resistance
+            r_source = source.source_resistance
         series = [
             (kind, name, value)
             for kind, name, value in (
-                ("R", "source", internal),
-                ("R", "wire", self.wiring.resistance),
-                ("L", "wire", self.wiring.inductance),
+                ("R", "source", r_source),
+                ("R", "wire", self.wiring.wiring_resistance),
+                ("L", "wire", self.wiring.wiring_inductance),
             )
             if value > 0
         ]
@@ -341,13 +361,13 @@ class SwitchCircuit:
         c.V(LOAD_PROBE[1:], NODE_B, "load", 0)
         load = self.load
         if isinstance(load, ResistiveLoad):
-            c.R("load", "load", gnd, float(load.resistance))
+            c.R("load", "load", gnd, float(load.load_resistance))
         elif isinstance(load, InductiveLoad):
-            c.R("load", "load", "load_l", float(load.resistance))
-            c.L("load", "load_l", gnd, float(load.inductance))
+            c.R("load", "load", "load_l", float(load.load_resistance))
+            c.L("load", "load_l", gnd, float(load.load_inductance))
         else:
-            c.R("load", "load", "load_c", float(load.resistance))
-            c.C("load", "load_c", gnd, float(load.capacitance))
+            c.R("load", "load", "load_c", float(load.load_resistance))
+            c.C("load", "load_c", gnd, float(load.load_capacitance))
             c.R("bleed", "load_c", gnd, float(load.bleed_resistance))
         if self.flyback is not None:
             d = self.flyback
@@ -401,7 +421,7 @@ class BridgeCircuit(SwitchCircuit):
     a break the two arcs in series hold twice its burning voltage.
     """
 
-    contact_names: tuple = ("a", "b")
+    contact_names: tuple = internal(("a", "b"))  # the scene's two electrical [[fixed]] contacts
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -484,20 +504,27 @@ class McuInput:
     ``make_time_constant``).
     """
 
-    voltage: float = 3.3
-    pull: str = "up"
-    pull_resistance: float = 10e3
-    series_resistance: float = 1e3
-    input_capacitance: float = 100e-9
-    logic_low: float = 0.99
-    logic_high: float = 2.31
-    contact_capacitance: float = 5e-12
-    leakage_conductance: float = DEFAULT_LEAKAGE
-    contact_current_factor: str | None = None
-    title: str = "switchsim mcu input"
+    SECTION: ClassVar[str] = "circuit"
+    voltage: float = scene_key(3.3, unit="V")
+    pull: str = scene_key(
+        "up", unit="-", doc='mcu_input: "up" (pull resistor to Vcc, the contact to ground: active low) or "down" '
+        "(pull resistor to ground, the contact to Vcc)")
+    pull_resistance: float = scene_key(10e3, unit="ohm", doc="mcu_input: the pull-up (pull-down) resistor, > 0")
+    series_resistance: float = scene_key(1e3, unit="ohm", doc="mcu_input: from the switch node to the pin (0: none)")
+    input_capacitance: float = scene_key(
+        100e-9, unit="F", doc="mcu_input: from the pin to ground (the filter C plus the pin's own)")
+    logic_low: float = scene_key(
+        0.99, unit="V", doc="mcu_input: the input reads low below it (Schmitt threshold; the default of "
+        "`[metrics] logic`)")
+    logic_high: float = scene_key(
+        2.31, unit="V", doc="mcu_input: the input reads high above it (> `logic_low`, < `voltage`)")
+    contact_capacitance: float = scene_key(5e-12, unit="F")
+    leakage_conductance: float = scene_key(DEFAULT_LEAKAGE, unit="S")
+    contact_current_factor: str | None = internal(None)
+    title: str = internal("switchsim mcu input")
 
     def __post_init__(self) -> None:
-        name = "McuInput"
+        name = self.SECTION
         check_range(name, "voltage", self.voltage, "V", 0.0, 1e3, low_open=True)
         if isinstance(self.pull, (list, dict)) or self.pull not in PULLS:
             raise ValueError(f"{name}.pull = {self.pull!r}: allowed values are 'up' (pull-up to Vcc, contact "
@@ -515,9 +542,9 @@ class McuInput:
                              f"{self.voltage:g} V: the pin never rises above the supply")
         check_range(name, "contact_capacitance", self.contact_capacitance, "F", 0.0, 1e-6)
         check_range(name, "leakage_conductance", self.leakage_conductance, "S", 0.0, 1e-3)
-        check_current_factor(name, self.contact_current_factor)
+        check_current_factor(type(self).__name__, self.contact_current_factor)
         if not isinstance(self.title, str) or "\n" in self.title:
-            raise ValueError(f"{name}.title = {self.title!r}: must be a one-line string")
+            raise ValueError(f"McuInput.title = {self.title!r}: must be a one-line string")
 
     @property
     def nodes(self) -> tuple[str, str]:
@@ -597,26 +624,29 @@ class ShortCircuit(SwitchCircuit):
         Bfault   load 0 I=V(load)*V(fault_g)
     """
 
-    fault_time: float = 1e-3
-    fault_resistance: float = 0.01
-    fault_rise: float = 1e-6
+    fault_time: float = scene_key(1e-3, unit="s", doc="short_circuit: when the load is shorted")
+    fault_resistance: float = scene_key(
+        0.01, unit="ohm", doc="short_circuit: the short's resistance (the fault current E / (R_source + R_wire + "
+        "R_c + R_fault || R_load))")
+    fault_rise: float = scene_key(
+        1e-6, unit="s", doc="short_circuit: over which the short's conductance ramps in (> 0)")
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        name = "ShortCircuit"
+        name = self.SECTION
         check_range(name, "fault_time", self.fault_time, "s", 0.0, 1e3)
         check_range(name, "fault_resistance", self.fault_resistance, "ohm", 1e-6, 1e6)
         check_range(name, "fault_rise", self.fault_rise, "s", 0.0, 10.0, low_open=True)
         if isinstance(self.source, CurrentSource):
-            raise ValueError(f"{name}.source is a CurrentSource: a fault is a short behind a voltage source "
+            raise ValueError(f"ShortCircuit.source is a CurrentSource: a fault is a short behind a voltage source "
                              "(DCSource), whose current only the loop's impedance limits")
 
     def fault_current(self, contact_resistance: float = 0.0) -> float:
         """A: the steady current through the closed contact (``contact_resistance``, ohm) with
         the short in place (inductances carry no voltage then; an inductive load's L is a short)."""
-        load = self.load.resistance
+        load = self.load.load_resistance
         parallel = load * self.fault_resistance / (load + self.fault_resistance)
-        loop = self.source.internal_resistance + self.wiring.resistance + contact_resistance + parallel
+        loop = self.source.source_resistance + self.wiring.wiring_resistance + contact_resistance + parallel
         return self.source.voltage / loop
 
     def fault_vertices(self) -> list[tuple[float, float]]:

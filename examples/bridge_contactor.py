@@ -52,7 +52,7 @@ def extinction_gap(result, arcs: int) -> dict:
     on = np.any([np.abs(w[f"arc_current{n}"]) > 1e-3 for n in names], axis=0) & after
     k = int(np.flatnonzero(on)[-1])
     gap = float(sum(w[f"gap{n}"][k] for n in names))
-    loop = c.source.internal_resistance + c.wiring.resistance + c.load.resistance + arcs * arc.resistance
+    loop = c.source.source_resistance + c.wiring.wiring_resistance + c.load.load_resistance + arcs * arc.resistance
     closed_form = (c.source.voltage - arcs * arc.min_voltage - arc.min_current * loop) / arc.column_gradient
     return dict(time=float(w["time"][k]), gap=gap, gap_closed_form=float(closed_form),
                 break_time=brk["time"], arc_duration=brk["arc_duration"], arc_energy=brk["arc_energy"],

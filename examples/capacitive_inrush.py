@@ -52,8 +52,8 @@ def scene(fast: bool = False):
 
 def constants(sc) -> dict:
     c = sc.circuit.circuit
-    return dict(E=c.source.voltage, R_series=c.source.internal_resistance + c.wiring.resistance + c.load.resistance,
-                C=c.load.capacitance, R_bleed=c.load.bleed_resistance, I_min=c.arc.min_current,
+    return dict(E=c.source.voltage, R_series=c.source.source_resistance + c.wiring.wiring_resistance + c.load.load_resistance,
+                C=c.load.load_capacitance, R_bleed=c.load.bleed_resistance, I_min=c.arc.min_current,
                 U_min=c.arc.min_voltage)
 
 

@@ -106,14 +106,14 @@ def circuit_numbers(result) -> dict:
         settled |= (t > a + AFTER_MAKE) & (t < e - BEFORE_BREAK)
     r_c = w.contact_resistance.to_numpy()
     settled &= (w.normal_force.to_numpy() >= FIRM) & np.isfinite(r_c)
-    r_loop = c.wiring.resistance + c.load.resistance + r_c[settled]
+    r_loop = c.wiring.wiring_resistance + c.load.load_resistance + r_c[settled]
     expected = src.current * src.output_resistance / (src.output_resistance + r_loop)
     i = w.load_current.to_numpy()[settled]
     mu = w.mu.to_numpy()
     laws = sc.tribology.laws
-    r_min = c.wiring.resistance + c.load.resistance
-    ring = (src.compliance_voltage / np.sqrt(c.wiring.inductance / src.output_capacitance)
-            * np.exp(-r_min * AFTER_MAKE / (2 * c.wiring.inductance)) if c.wiring.inductance > 0 else 0.0)
+    r_min = c.wiring.wiring_resistance + c.load.load_resistance
+    ring = (src.compliance_voltage / np.sqrt(c.wiring.wiring_inductance / src.output_capacitance)
+            * np.exp(-r_min * AFTER_MAKE / (2 * c.wiring.wiring_inductance)) if c.wiring.wiring_inductance > 0 else 0.0)
     return dict(
         set_current=src.current, closed_points=int(settled.sum()),
         closed_current_max_rel_error=float(np.max(np.abs(i / expected - 1.0))) if settled.any() else None,

@@ -80,10 +80,10 @@ def variants(fast: bool) -> dict:
 def constants(sc) -> dict:
     c = sc.circuit.circuit
     arc = load_scene(SCENE).circuit.circuit.arc  # the scene's arc, also for the variants without one
-    L = c.load.inductance + c.wiring.inductance
+    L = c.load.load_inductance + c.wiring.wiring_inductance
     C = c.contact_capacitance
-    return dict(E=c.source.voltage, R_series=c.source.internal_resistance + c.wiring.resistance + c.load.resistance,
-                L=L, C=C, L_wire=c.wiring.inductance, U_min=arc.min_voltage, I_min=arc.min_current,
+    return dict(E=c.source.voltage, R_series=c.source.source_resistance + c.wiring.wiring_resistance + c.load.load_resistance,
+                L=L, C=C, L_wire=c.wiring.wiring_inductance, U_min=arc.min_voltage, I_min=arc.min_current,
                 E_col=arc.column_gradient, R_arc=arc.resistance, Z=math.sqrt(L / C) if C > 0 else math.inf,
                 snubber=c.snubber)
 

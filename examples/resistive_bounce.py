@@ -52,8 +52,8 @@ def circuit_constants(sc) -> dict:
     """SI values the closed forms need, read from the scene's circuit."""
     c = sc.circuit.circuit
     arc = c.arc
-    return dict(E=c.source.voltage, R_series=c.source.internal_resistance + c.wiring.resistance + c.load.resistance,
-                L_wire=c.wiring.inductance, C_contact=c.contact_capacitance, U_min=arc.min_voltage,
+    return dict(E=c.source.voltage, R_series=c.source.source_resistance + c.wiring.wiring_resistance + c.load.load_resistance,
+                L_wire=c.wiring.wiring_inductance, C_contact=c.contact_capacitance, U_min=arc.min_voltage,
                 I_min=arc.min_current, E_col=arc.column_gradient, R_arc=arc.resistance)
 
 

@@ -20,7 +20,7 @@ from .table_smoothing import INTERPOLATIONS, smooth_samples
 from .travel_spring import travel_work
 from .validation import (
     check_bool, check_choice, check_count, check_finite, check_magnitude, check_name, check_nonnegative,
-    check_position, check_positive, check_range, check_table, check_vector3, check_whole,
+    check_position, check_positive, check_range, check_table, check_vector3, check_whole, internal, scene_key,
 )
 
 MuLike = Union[float, Callable[[float], float]]
@@ -71,18 +71,27 @@ class Bar:
     modal_damping: damping ratio of every elastic mode (default 0: none).
     """
 
-    length: float = 0.3
-    diameter: float | None = 0.01
-    width: float | None = None
-    thickness: float | None = None
-    tip_radius: float = 0.005
-    youngs_modulus: float = 210e9
-    poisson_ratio: float = 0.3
-    density: float = 7850.0
-    axial_modes: int | str = "auto"
-    bending_modes: int | str = "auto"
-    bending: Literal["euler_bernoulli", "paper_shear"] = "euler_bernoulli"
-    modal_damping: float = 0.0
+    length: float = scene_key(0.3, unit="m", doc="tip to tip")
+    diameter: float | None = scene_key(0.01, unit="m", doc="round section (or `width` and `thickness`)")
+    width: float | None = scene_key(None, unit="m", doc="rectangular section, with `thickness`")
+    thickness: float | None = scene_key(None, unit="m", doc="rectangular section, bending direction")
+    tip_radius: float = scene_key(0.005, unit="m", doc="spherical tip caps, >= half the section")
+    youngs_modulus: float = scene_key(210e9, unit="Pa")
+    poisson_ratio: float = scene_key(0.3, unit="-", doc="in (-1, 0.5)")
+    density: float = scene_key(7850.0, unit="kg/m^3")
+    axial_modes: int | str = scene_key(
+        "auto", unit="-",
+        doc='elastic modes per family (0-40), or `{axial = n, bending = n}` (a family left out: "auto"); "auto": '
+            "every mode below 3 / contact time (docs/mechanics.md)",
+        name="modes")
+    bending_modes: int | str = scene_key(
+        "auto", unit="-",
+        doc='elastic modes per family (0-40), or `{axial = n, bending = n}` (a family left out: "auto"); "auto": '
+            "every mode below 3 / contact time (docs/mechanics.md)",
+        name="modes")
+    bending: Literal["euler_bernoulli", "paper_shear"] = scene_key(
+        "euler_bernoulli", unit="-", doc='or "paper_shear"')
+    modal_damping: float = scene_key(0.0, unit="-", doc="damping ratio of every elastic mode")
 
     def __post_init__(self):
         check_positive("bar.length", self.length, high=LENGTH_MAX)
@@ -171,11 +180,13 @@ class Block:
     misaligns the two contacts and is what such a flag usually means).
     """
 
-    youngs_modulus: float = 210e9
-    poisson_ratio: float = 0.3
-    shape: str = "plane"
-    radius: float | None = None
-    offset: float = 0.0
+    youngs_modulus: float = scene_key(210e9, unit="Pa")
+    poisson_ratio: float = scene_key(0.3, unit="-")
+    shape: str = scene_key(
+        "plane", unit="-", doc='"plane" (surface z = 0) or "sphere" (a fixed rivet, its top at z = 0)')
+    radius: float | None = scene_key(None, unit="m", doc="sphere only: the fixed rivet's radius")
+    offset: float = scene_key(
+        0.0, unit="m", doc="sphere only: shift of its top from below the striking contact, along the bar")
 
     def __post_init__(self):
         check_positive("block.youngs_modulus", self.youngs_modulus, high=MODULUS_MAX)
@@ -207,12 +218,15 @@ class Contact:
     stiffness: N/m^1.5; None = Hertz from the materials and tip radius.
     """
 
-    law: str = "paper"
-    damping: float | None = None
-    restitution: float | None = 0.8
-    reference_speed: float | None = None
-    calibration: Literal["exact", "formula"] = "exact"
-    stiffness: float | None = None
+    law: str = scene_key(
+        "paper", unit="-", doc='normal damping law: "paper", "hunt_crossley", ... (docs/mechanics.md)')
+    damping: float | None = scene_key(None, unit="N s/m^2(.5)", doc="damping coefficient given directly")
+    restitution: float | None = scene_key(0.8, unit="-", doc="target restitution at `reference_speed` (or `damping`)")
+    reference_speed: float | None = scene_key(
+        None, unit="m/s", doc="where `restitution` is calibrated; omitted: the first impact's normal speed")
+    calibration: Literal["exact", "formula"] = scene_key("exact", unit="-", doc='or "formula"')
+    stiffness: float | None = scene_key(
+        None, unit="N/m^1.5", doc="override of the Hertz stiffness; omitted: Hertz from the materials and radii")
 
     def __post_init__(self):
         check_choice("contact.law", self.law, CONTACT_LAWS)
@@ -254,11 +268,12 @@ class Friction:
     regularization_speed: v_s, m/s (regularized model only).
     """
 
-    mu: MuLike = 0.0
-    gamma: float = 0.0
-    model: Literal["exact", "regularized"] = "exact"
-    max_ratio: float = 1.0
-    regularization_speed: float = 1e-4
+    mu: MuLike = scene_key(0.0, unit="N^gamma", doc="friction coefficient (not with `[tribology]`)")
+    gamma: float = scene_key(0.0, unit="-", doc="|F_t| = mu F_n^(1-gamma) (not with `[tribology]`)")
+    model: Literal["exact", "regularized"] = scene_key(
+        "exact", unit="-", doc='stick/slip by events, or "regularized"')
+    max_ratio: float = scene_key(1.0, unit="-", doc="largest |F_t|/F_n")
+    regularization_speed: float = scene_key(1e-4, unit="m/s", doc="regularized model only")
 
     def __post_init__(self):
         if not callable(self.mu):
@@ -297,12 +312,17 @@ class Initial:
     its weight, with the static sag of its modes; height is then not used.
     """
 
-    height: float = 1e-3
-    angle_deg: float = 30.0
-    azimuth_deg: float = 0.0
-    velocity: tuple[float, float, float] = (0.2, 0.0, -1.0)
-    angular_velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    resting: bool = False
+    height: float = scene_key(1e-3, unit="m", doc="lowest tip above the block (the contact gap)")
+    angle_deg: float = scene_key(
+        30.0, unit="deg",
+        doc="bar axis to the surface, [-90, 90]; a bar with a `[mount]` clamp or pivot starts level",
+        shown="30 (held bar: 0)")
+    azimuth_deg: float = scene_key(0.0, unit="deg", doc="direction of the bar's horizontal projection")
+    velocity: tuple[float, float, float] = scene_key(
+        (0.2, 0.0, -1.0), unit="m/s", doc="centre of mass, world frame (z up); a held bar starts at rest",
+        shown="[0.2, 0, -1] (held bar: [0, 0, 0])")
+    angular_velocity: tuple[float, float, float] = scene_key((0.0, 0.0, 0.0), unit="rad/s", doc="world frame")
+    resting: bool = scene_key(False, unit="-", doc="start in static equilibrium on the block")
 
     def __post_init__(self):
         h = check_finite("initial.height", self.height)
@@ -349,14 +369,26 @@ class SolverOptions:
     the memory a run takes grows with this, not with its steps.
     """
 
-    rtol: float = 1e-6
-    t_end: float = 0.05
-    model: Literal["auto", "planar", "3d"] = "auto"
-    max_step: float | None = None
-    stick_velocity_tol: float = 1e-6
-    energy_tolerance: float = 1e-3
-    max_steps: int = 5_000_000
-    history_rows: int = HISTORY_ROWS
+    rtol: float = scene_key(1e-6, unit="-", doc="DOPRI5 relative tolerance")
+    t_end: float = scene_key(
+        0.05, unit="s",
+        doc="length of the run (the built-in scenes set their own). A `[circuit.schedule]` scene keeps "
+            "`[solver]` for this key alone; without it the run lasts 0.05 s")
+    model: Literal["auto", "planar", "3d"] = scene_key("auto", unit="-", doc='"planar", "3d"')
+    max_step: float | None = scene_key(
+        None, unit="s", doc="omitted: a quarter of the shortest contact time (Hertz estimate)")
+    stick_velocity_tol: float = scene_key(1e-6, unit="m/s")
+    energy_tolerance: float = scene_key(
+        1e-3, unit="-",
+        doc="energy residual (relative to the scene's energy scale) above which the result is flagged and "
+            "unsound; at most 5e-3")
+    max_steps: int = scene_key(
+        5_000_000, unit="-", doc="accepted and rejected steps before the run stops unfinished; at most 1e8")
+    history_rows: int = scene_key(
+        HISTORY_ROWS, unit="-",
+        doc="rows of the history a run keeps in memory (besides one stepper's room, at most 16 384 rows); beyond "
+            "them older rows are thinned to a uniform time grid, every event and regime change kept, the steps "
+            'unchanged (docs/mechanics.md, "Memory"); 100 to 1e7')
 
     def __post_init__(self):
         check_range("solver.rtol", self.rtol, 1e-13, RTOL_MAX, closed_high=True)
@@ -388,12 +420,18 @@ class Mount:
     the initial position, turning the free end towards the block; damping: N m s/rad.
     """
 
-    kind: str = "free"
-    position: float | None = None
-    base_motion: dict | None = None
-    stiffness: float = 0.0
-    preload_torque: float = 0.0
-    damping: float = 0.0
+    kind: str = scene_key("free", unit="-", doc='"free", "clamp" (cantilever blade) or "pivot" (hinge about y)')
+    position: float | None = scene_key(
+        None, unit="m", doc="clamp or hinge, along the bar from tip 0 (`length`: at the tip-1 end)")
+    base_motion: dict | None = scene_key(
+        None, unit="s, m",
+        doc="clamp only: `{time = [...], displacement = [[x, y, z], ...]}` travel of the clamp, linear between "
+            'points; with `interpolation = "pchip"` a monotone cubic through them (docs/mechanics.md, "Smooth '
+            'tables")')
+    stiffness: float = scene_key(0.0, unit="N m/rad", doc="pivot only: torsion spring")
+    preload_torque: float = scene_key(
+        0.0, unit="N m", doc="pivot only: the spring's torque at the start, turning the free end towards the block")
+    damping: float = scene_key(0.0, unit="N m s/rad", doc="pivot only")
 
     def __post_init__(self):
         check_choice("mount.kind", self.kind, MOUNT_KINDS)
@@ -456,14 +494,17 @@ class PointForce:
     ``interpolation = "pchip"`` a monotone cubic through them (mech.table_smoothing).
     """
 
-    position: float = 0.0
-    direction: tuple[float, float, float] = (0.0, 0.0, -1.0)
-    frame: str = "world"
-    magnitude: float | None = None
-    time: tuple | None = None
-    value: tuple | None = None
-    interpolation: str = "linear"
-    name: str = "force"
+    position: float = scene_key(0.0, unit="m", doc="along the bar from tip 0")
+    direction: tuple[float, float, float] = scene_key((0.0, 0.0, -1.0), unit="-", doc="normalized; in `frame`")
+    frame: str = scene_key("world", unit="-", doc='"world" (fixed) or "body" (turns with the bar)')
+    magnitude: float | None = scene_key(None, unit="N", doc="constant force ...")
+    time: tuple | None = scene_key(None, unit="s", doc="... or a table of times")
+    value: tuple | None = scene_key(None, unit="N", doc="... and magnitudes, linear between points")
+    interpolation: str = scene_key(
+        "linear", unit="-",
+        doc='"linear" or "pchip": a monotone cubic through the table\'s points, held flat at its ends '
+            '(docs/mechanics.md, "Smooth tables")')
+    name: str = internal("force")
 
     def __post_init__(self):
         n = self.name
@@ -519,16 +560,25 @@ class Spring:
     follows the press table while pressed, the release table while released
     (mech/travel_spring.py; it starts on the press branch)."""
 
-    anchor: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    position: float = 0.0
-    stiffness: float | None = None
-    preload: float | None = None
-    rest_length: float | None = None
-    damping: float = 0.0
-    travel: tuple | None = None
-    force: tuple | None = None
-    release_force: tuple | None = None
-    name: str = "spring"
+    anchor: tuple[float, float, float] = scene_key((0.0, 0.0, 0.0), unit="m", doc="world point")
+    position: float = scene_key(0.0, unit="m", doc="along the bar from tip 0")
+    stiffness: float | None = scene_key(None, unit="N/m", doc="> 0, a linear spring (or `travel` and `force`)")
+    preload: float | None = scene_key(
+        None, unit="N", doc="linear: pull towards the anchor at the start (or `rest_length`; neither: unstressed)")
+    rest_length: float | None = scene_key(
+        None, unit="m", doc="travel 0 of a force-travel spring (default: its length at the start)")
+    damping: float = scene_key(0.0, unit="N s/m")
+    travel: tuple | None = scene_key(
+        None, unit="m", doc="compression from the rest length (positive: shorter), >= 2 points, strictly increasing")
+    force: tuple | None = scene_key(
+        None, unit="N",
+        doc="push away from the anchor at each `travel`, any sign of slope; linear between points, along the end "
+            "segments beyond them")
+    release_force: tuple | None = scene_key(
+        None, unit="N",
+        doc="with hysteresis: the release branch at each `travel`, at or below `force` (the spring follows "
+            "`force` while pressed, `release_force` while released)")
+    name: str = internal("spring")
 
     def __post_init__(self):
         n = self.name
@@ -653,14 +703,17 @@ class Rivet:
     key: the entry's place in the scene ("rivet[1]"), for messages; not a scene key.
     """
 
-    position: float = 0.0
-    offset: float = 0.0
-    radius: float = 1e-3
-    mass: float = 0.0
-    youngs_modulus: float | None = None
-    poisson_ratio: float | None = None
-    name: str | None = None
-    key: str = "rivet"
+    position: float = scene_key(0.0, unit="m", doc="along the bar from tip 0")
+    offset: float = scene_key(0.0, unit="m", doc="from the axis along the face normal b3 (negative: underside)")
+    radius: float = scene_key(1e-3, unit="m", doc="of the cap")
+    mass: float = scene_key(0.0, unit="kg", doc="carried by the bar at that point")
+    youngs_modulus: float | None = scene_key(None, unit="Pa", doc="the rivet's material; omitted: the bar's")
+    poisson_ratio: float | None = scene_key(None, unit="-", doc="omitted: the bar's")
+    name: str | None = scene_key(
+        None, unit="-",
+        doc="how `[[fixed]]`, the results and a circuit refer to it (a letter, then letters, digits, `_`); "
+            'omitted: "rivet<k>", k its place from 0')
+    key: str = internal("rivet")
 
     def __post_init__(self):
         n = self.key
@@ -700,18 +753,31 @@ class FixedContact:
     key: the entry's place in the scene ("fixed[1]"), for messages; not a scene key.
     """
 
-    point: str | None = None
-    name: str | None = None
-    shape: str = "plane"
-    radius: float | None = None
-    offset: float = 0.0
-    facing: str = "up"
-    height: float | None = None
-    gap: float | None = None
-    youngs_modulus: float = 210e9
-    poisson_ratio: float = 0.3
-    electrical: bool = True
-    key: str = "fixed"
+    point: str | None = scene_key(
+        None, unit="-",
+        doc='the contact point that strikes it: a `[[rivet]]`\'s `name`, or "tip0" / "tip1" (the end caps of a '
+            "bar without rivets)")
+    name: str | None = scene_key(
+        None, unit="-", doc='its name in the results and for a circuit; omitted: "fixed<k>", k its place from 0')
+    shape: str = scene_key("plane", unit="-", doc='"plane" or "sphere" (a fixed rivet, taken as its tangent plane)')
+    radius: float | None = scene_key(None, unit="m", doc="sphere only")
+    offset: float = scene_key(
+        0.0, unit="m", doc="sphere only: shift of its top from its point's start, along the bar")
+    facing: str = scene_key(
+        "up", unit="-",
+        doc='"up": below the moving part, facing up (as `[block]`); "down": above it (the NC contact of a '
+            "changeover)")
+    height: float | None = scene_key(
+        None, unit="m",
+        doc="world z of its surface (`[block]`'s is 0; the bar is placed by `initial.height` above z = 0) ...")
+    gap: float | None = scene_key(
+        None, unit="m",
+        doc="... or its distance from its point's cap at the start, along its facing (>= 0; 0: touching); one of "
+            "the two")
+    youngs_modulus: float = scene_key(210e9, unit="Pa")
+    poisson_ratio: float = scene_key(0.3, unit="-")
+    electrical: bool = scene_key(True, unit="-", doc="false: a mechanical stop, which the circuit does not see")
+    key: str = internal("fixed")
 
     def __post_init__(self):
         n = self.key
@@ -782,23 +848,32 @@ class Armature:
     [0, travel]), gain = [...]}, interpolated by monotone cubics (PCHIP); None: gain 1.
     """
 
-    kind: str = "none"
-    mass: float | None = None
-    inertia: float | None = None
-    travel: float | None = None
-    spring_rate: float = 0.0
-    spring_preload: float = 0.0
-    stop_stiffness: float | None = None
-    stop_damping: float = 0.0
-    damping: float = 0.0
-    initial_position: float | None = None
-    initial_speed: float = 0.0
-    card_position: float | None = None
-    card_lever: float | None = None
-    card_free_travel: float = 0.0
-    card_stiffness: float | None = None
-    card_damping: float = 0.0
-    force_gain: dict | None = None
+    kind: str = scene_key(
+        "none", unit="-", doc='"plunger" (translation), "clapper" (rotation about a hinge); "none": no armature')
+    mass: float | None = scene_key(None, unit="kg", doc="plunger only")
+    inertia: float | None = scene_key(None, unit="kg m^2", doc="clapper only, about the hinge")
+    travel: float | None = scene_key(None, unit="m or rad", doc="from the rest stop (q = 0) to the pole stop")
+    spring_rate: float = scene_key(0.0, unit="N/m or N m/rad", doc="return spring, pushing towards the rest stop")
+    spring_preload: float = scene_key(
+        0.0, unit="N or N m", doc="return spring at q = 0 (> 0 holds the armature on its rest stop)")
+    stop_stiffness: float | None = scene_key(None, unit="N/m or N m/rad", doc="both stops: one-sided spring-dashpots")
+    stop_damping: float = scene_key(0.0, unit="N s/m or N m s/rad", doc="both stops")
+    damping: float = scene_key(0.0, unit="N s/m or N m s/rad", doc="viscous, on q")
+    initial_position: float | None = scene_key(
+        None, unit="m or rad", doc="in [0, travel]; omitted: 0, on the rest stop")
+    initial_speed: float = scene_key(0.0, unit="m/s or rad/s")
+    card_position: float | None = scene_key(
+        None, unit="m",
+        doc="along the bar from tip 0: the card that pushes the bar down (world -z), towards the fixed contact; "
+            "omitted: no card")
+    card_lever: float | None = scene_key(None, unit="m/m or m/rad", doc="card travel per unit of q (with a card)")
+    card_free_travel: float = scene_key(0.0, unit="m", doc="card travel before it touches the bar at rest")
+    card_stiffness: float | None = scene_key(None, unit="N/m", doc="the card's one-sided contact (with a card)")
+    card_damping: float = scene_key(0.0, unit="N s/m")
+    force_gain: dict | None = scene_key(
+        None, unit="m or rad, -",
+        doc='`{position = [...], gain = [...]}`: the armature\'s force is the drive "armature.force" times this '
+            "(monotone cubic) over q; omitted: 1")
 
     def __post_init__(self):
         check_choice("armature.kind", self.kind, ARMATURE_KINDS)
@@ -914,19 +989,19 @@ class MechScene:
     ``fixed`` (FixedContact entries, each struck by the contact point it names; every
     contact point strikes at least one), not both."""
 
-    bar: Bar | None = field(default_factory=Bar)
-    block: Block = field(default_factory=Block)
-    contact: Contact = field(default_factory=Contact)
-    friction: Friction = field(default_factory=Friction)
-    initial: Initial = field(default_factory=Initial)
-    solver: SolverOptions = field(default_factory=SolverOptions)
-    gravity: float = 9.80665
-    mount: Mount = field(default_factory=Mount)
-    forces: tuple = ()
-    springs: tuple = ()
-    rivets: tuple = ()
-    armature: Armature = field(default_factory=Armature)
-    fixed: tuple = ()
+    bar: Bar | None = internal(default_factory=Bar)
+    block: Block = internal(default_factory=Block)
+    contact: Contact = internal(default_factory=Contact)
+    friction: Friction = internal(default_factory=Friction)
+    initial: Initial = internal(default_factory=Initial)
+    solver: SolverOptions = internal(default_factory=SolverOptions)
+    gravity: float = scene_key(9.80665, unit="m/s^2")
+    mount: Mount = internal(default_factory=Mount)
+    forces: tuple = internal(())
+    springs: tuple = internal(())
+    rivets: tuple = internal(())
+    armature: Armature = internal(default_factory=Armature)
+    fixed: tuple = internal(())
 
     def __post_init__(self):
         check_nonnegative("environment.gravity", self.gravity, high=GRAVITY_MAX)

@@ -1,30 +1,10 @@
 """Mechanics scenes as TOML (SI units): parsing, validation of keys, the default scene.
 
-Sections and keys (all optional; an omitted key takes its dataclass field's default, the
-default listed in docs/scene_keys.md; ``DEFAULT_SCENE_TOML`` is one scene, not the defaults):
-
-    [bar]       length, diameter | (width, thickness), tip_radius, youngs_modulus,
-                poisson_ratio, density, modes (per family, or {axial = n, bending = n}),
-                bending ("euler_bernoulli" | "paper_shear"), modal_damping
-    [block]     youngs_modulus, poisson_ratio, shape ("plane" | "sphere"), radius, offset
-    [mount]     kind ("free" | "clamp" | "pivot"), position, base_motion {time, displacement},
-                stiffness, preload_torque, damping
-    [[force]]   position, direction [3], frame ("world" | "body"), magnitude | (time, value)
-    [[spring]]  anchor [3], position, stiffness, preload | rest_length, damping; or travel, force
-                [, release_force] (a force-travel spring), rest_length, damping
-    [[rivet]]   position, offset, radius, mass, youngs_modulus, poisson_ratio, name
-    [[fixed]]   point, name, shape ("plane" | "sphere"), radius, offset, facing ("up" | "down"),
-                height | gap, youngs_modulus, poisson_ratio, electrical (instead of [block])
-    [armature]  kind ("none" | "plunger" | "clapper"), mass | inertia, travel, spring_rate,
-                spring_preload, stop_stiffness, stop_damping, damping, initial_position,
-                initial_speed, card_position, card_lever, card_free_travel, card_stiffness,
-                card_damping, force_gain {position, gain}
-    [initial]   height, angle_deg, azimuth_deg, velocity [3], angular_velocity [3]
-    [contact]   law, restitution | damping, reference_speed, calibration, stiffness
-    [friction]  mu, gamma, model, max_ratio, regularization_speed
-    [solver]    rtol, t_end, model, max_step, stick_velocity_tol, energy_tolerance, max_steps,
-                history_rows
-    [environment] gravity
+Sections: [bar], [block], [mount], [[force]], [[spring]], [[rivet]], [[fixed]], [armature],
+[initial], [contact], [friction], [solver], [environment]; each key is a field of the
+section's dataclass in mech/parameters.py, declared there with its default, unit and meaning
+(``scene_key``), and listed in docs/scene_keys.md (written from those fields). An omitted key
+takes its field's default; ``DEFAULT_SCENE_TOML`` is one scene, not the defaults.
 
 Unknown sections or keys are errors that name them (a typo must not silently fall back
 to a default). A scene with an [armature] and no [bar] is an armature alone (no contact

@@ -11,6 +11,7 @@ values are checked"). coupling's own section dataclasses use these checks too, a
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import math
 import re
@@ -223,3 +224,25 @@ def check_keys(where: str, table: dict, allowed, kind: str = "key") -> dict:
         if key not in allowed:
             raise unknown(where, key, allowed, kind)
     return table
+
+
+# --- scene keys: each dataclass field that a scene key sets carries the key's description ---
+
+def scene_key(default=dataclasses.MISSING, *, unit: str, doc: str = "", default_factory=dataclasses.MISSING,
+        shown: str | None = None, name: str | None = None):
+    """A dataclass field that is a scene key: its default, its SI unit ("-": none) and a one-line
+    meaning, the row of docs/scene_keys.md (written by ``python -m coupling.app.keys_doc``).
+    ``shown``: the default column when the default is not one value (it depends on another key,
+    or it is computed); ``name``: the scene key when it differs from the field's name (bar.modes
+    sets axial_modes and bending_modes)."""
+    meta = {"unit": unit, "doc": doc}
+    if shown is not None:
+        meta["default"] = shown
+    if name is not None:
+        meta["key"] = name
+    return dataclasses.field(default=default, default_factory=default_factory, metadata=meta)
+
+
+def internal(default=dataclasses.MISSING, *, default_factory=dataclasses.MISSING):
+    """A dataclass field that no scene key sets (an entry's place in its list, for messages)."""
+    return dataclasses.field(default=default, default_factory=default_factory, metadata={"internal": True})

@@ -321,14 +321,14 @@ def _current_limit(scene):
     if source is None or wiring is None:
         return None
     if hasattr(source, "compliance_voltage"):  # a constant-current supply: I_set, plus at a make
-        rw = float(wiring.resistance)            # its output capacitor discharging into the wiring
+        rw = float(wiring.wiring_resistance)            # its output capacitor discharging into the wiring
         if rw <= 0.0:
             return None
         v = float(source.compliance_voltage)
         return (float(source.current) + v / rw,
                 f"the {float(source.current):.4g} A supply plus its output capacitor at {v:.4g} V through "
                 f"the {rw:.4g} ohm wiring")
-    r = float(source.internal_resistance) + float(wiring.resistance)
+    r = float(source.source_resistance) + float(wiring.wiring_resistance)
     if r <= 0.0:
         return None
     e = abs(float(source.voltage))

@@ -13,7 +13,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from mech.validation import (
-    check_bool, check_choice, check_keys, check_nonnegative, check_positive,
+    check_bool, check_choice, check_keys, check_nonnegative, check_positive, scene_key,
 )
 
 from coupling.laws.duty import (
@@ -60,10 +60,14 @@ class LifeLimits:
     "possible", or "never".
     """
 
-    gap_range: tuple[float, float] | None = None
-    min_force: float | None = None
-    max_resistance: float | None = None
-    stop_on_weld: str = "likely"
+    gap_range: tuple[float, float] | None = scene_key(
+        None, unit="m", doc="[low, high] of the contact gap as the caps wear", shown="[0.5, 1.5] x `initial.height`")
+    min_force: float | None = scene_key(
+        None, unit="N", doc="the least held normal force", shown="0.5 x the first sample's held force")
+    max_resistance: float | None = scene_key(
+        None, unit="ohm", doc="the largest held contact resistance", shown="10 x the first sample's held R_c")
+    stop_on_weld: str = scene_key(
+        "likely", unit="-", doc='stop at a make whose weld risk reaches it: "likely", "possible" or "never"')
 
     def __post_init__(self):
         if self.gap_range is not None:
@@ -102,17 +106,36 @@ class DutySettings:
     life: the end criteria of `switchsim life` ([duty.life]; None: its defaults).
     """
 
-    materials: tuple[str, str]
-    moving_node: str = "a"
-    repulsion: bool = True
-    conductor_radius: float | None = None
-    transition_gap: float = TRANSITION_GAP
-    transfer_fraction: float = 0.0
-    erosion_coefficient: tuple[float, float] | None = None
-    weld_margin: float = 2.0
-    melt_fraction: float = MELT_FRACTION
-    cap_height: tuple[float | None, float | None] = (None, None)
-    life: LifeLimits | None = None
+    materials: tuple[str, str] = scene_key(
+        unit="-", doc='`["moving", "fixed"]` (or one name for both) from the material library '
+        "(docs/contact_materials.md); without a Holm law: required",
+        shown='`[tribology]` `resistance = { law = "holm" }`\'s')
+    moving_node: str = scene_key(
+        "a", unit="-",
+        doc='the circuit node of the moving contact: "a" (the supply side) or "b"; the arc current is positive '
+            "from a to b, and its anode erodes in the anodic stage")
+    repulsion: bool = scene_key(
+        True, unit="-",
+        doc="Holm's repulsion acts on the mechanics' contact points (`repulsion.<i>`); a `[circuit.schedule]` "
+            "scene has no mechanics: off there (true is refused)")
+    conductor_radius: float | None = scene_key(
+        None, unit="m", doc="R of Holm's ln(R / a): where the current lines run parallel again",
+        shown="the first rivet's `radius` (no rivet: `bar.tip_radius`)")
+    transition_gap: float = scene_key(
+        TRANSITION_GAP, unit="m", doc="anodic to cathodic arc stage (Ben Jemaa et al.: 15-30 um)")
+    transfer_fraction: float = scene_key(0.0, unit="-", doc="of one electrode's loss that lands on the other, 0..1")
+    erosion_coefficient: tuple[float, float] | None = scene_key(
+        None, unit="m^3/J",
+        doc="one number, or [anodic stage, cathodic stage], for both electrodes instead of the library's (a "
+            "coefficient calibrated on a life test), >= 0")
+    weld_margin: float = scene_key(2.0, unit="-", doc='a weld ratio >= 1 / margin is "possible", >= 1 "likely"; >= 1')
+    melt_fraction: float = scene_key(
+        MELT_FRACTION, unit="-", doc="of a bounce arc's energy that melts metal at each root, (0, 1]")
+    cap_height: tuple[float | None, float | None] = scene_key(
+        (None, None), unit="m",
+        doc="one number or [moving, fixed]: the caps' heights `switchsim life` wears (each <= its sphere's radius)",
+        shown="the rivet's cap above the bar's face; a spherical block's radius")
+    life: LifeLimits | None = scene_key(None, unit="-", doc="`[duty.life]`: when `switchsim life` stops early")
 
     def __post_init__(self):
         mats = self.materials

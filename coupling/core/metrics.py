@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mech.validation import check_nonnegative, check_whole
+from mech.validation import check_nonnegative, check_whole, scene_key
 
 from coupling.core.logic import LogicInput
 
@@ -58,10 +58,19 @@ class MetricSettings:
     logic: a Schmitt-trigger input on a node (coupling.core.logic.LogicInput), or None.
     """
 
-    settle_window: float = DEFAULT_SETTLE_WINDOW
-    make_guard: float | None = None
-    arc_toggle_limit: int = DEFAULT_ARC_TOGGLE_LIMIT
-    logic: LogicInput | None = None
+    settle_window: float = scene_key(
+        DEFAULT_SETTLE_WINDOW, unit="s", doc="closed this long at the end of the run = settled")
+    make_guard: float | None = scene_key(
+        None, unit="s",
+        doc="samples this close after a make give no voltage metric; omitted: max(1e-12, 1e-9 t_end)")
+    arc_toggle_limit: int = scene_key(
+        DEFAULT_ARC_TOGGLE_LIMIT, unit="-", doc="more arc on/off changes give a warning")
+    logic: LogicInput | None = scene_key(
+        None, unit="-",
+        doc='a Schmitt-trigger input on a node: `{ node = "v(pin)", low = 0.99, high = 2.31 }` (a voltage probe '
+            "of the circuit, recorded if `[circuit] probes` does not; thresholds in V, low < high); summary.json "
+            '`logic` (docs/coupling.md, "Digital inputs"). Omitted: none, but with template "mcu_input" the pin '
+            "`v(pin)` at `logic_low` / `logic_high` (a table given there may set any of the three)")
 
     def __post_init__(self):
         check_nonnegative("metrics.settle_window", self.settle_window)

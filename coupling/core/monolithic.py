@@ -68,9 +68,9 @@ def series_loop(circuit) -> SeriesLoop:
         raise ValueError("monolithic reference: contact_capacitance must be > 0 (it carries the loop "
                          "current while the contact is open)")
     load = circuit.load
-    r = circuit.source.internal_resistance + circuit.wiring.resistance + load.resistance
-    inductance = circuit.wiring.inductance + (load.inductance if isinstance(load, ck.InductiveLoad) else 0.0)
-    cap = load.capacitance if isinstance(load, ck.CapacitiveLoad) else 0.0
+    r = circuit.source.source_resistance + circuit.wiring.wiring_resistance + load.load_resistance
+    inductance = circuit.wiring.wiring_inductance + (load.load_inductance if isinstance(load, ck.InductiveLoad) else 0.0)
+    cap = load.load_capacitance if isinstance(load, ck.CapacitiveLoad) else 0.0
     bleed = load.bleed_resistance if isinstance(load, ck.CapacitiveLoad) else 0.0
     return SeriesLoop(circuit.source.voltage, r, inductance, circuit.contact_capacitance,
                       circuit.leakage_conductance, cap, bleed)

@@ -5,37 +5,12 @@ A scene names only what it needs, and only that is built:
 - [circuit] with [circuit.schedule]: a prescribed make/break schedule, no mechanics;
 - mechanics + [tribology] + [circuit]: the co-simulation.
 
-    [tribology]   source = "illustrative" | fit = "fit.json" | data = "data.csv"
-                  | inline [tribology.mu] and [tribology.resistance] tables (docs/tribology.md)
-                  feedback = true (mu follows the contact current; false: mu = mu(0))
-    [circuit]     template = "resistive" | "inductive" | "capacitive" | "current_source" | "netlist"
-                  | "mcu_input" (voltage, pull, pull_resistance, series_resistance,
-                  input_capacitance, logic_low, logic_high, contact_capacitance, leakage_conductance)
-                  | "short_circuit" (resistive, shorted at fault_time: fault_resistance, fault_rise)
-                  | "bridge" (resistive, its switch a double-break bridge: two contacts in series,
-                  named as the scene's two electrical [[fixed]] contacts)
-                  voltage, source_resistance (voltage templates) | current, compliance_voltage,
-                  output_capacitance, output_resistance (current_source), wiring_resistance,
-                  wiring_inductance, load_resistance, load_inductance, load_capacitance,
-                  bleed_resistance, contact_capacitance, leakage_conductance,
-                  snubber = {resistance, capacitance} (both), flyback = true | {...},
-                  arc = true | false | {min_voltage, min_current, ...}, netlist = "file.cir",
-                  params = {NAME = number} (new values of the netlist's .param definitions),
-                  load_probe, max_step, reltol, abstol, vntol, chgtol, method, temperature,
-                  wall_timeout (each key one dataclass field; omitted: that field's default),
-                  probes = ["v(node)", "v(n1,n2)", "i(element)"] (recorded as waveform columns)
-    [circuit.schedule]  make = [...], break = [...], closed_resistance, opening_speed
-                        (s, s, ohm, m/s: the gap for an arc whose voltage grows with it)
-    [coupling]    scheme = "mechanics_first" | "jacobi", macro_step, max_macro_step (s),
-                  align_events = true, onset_penetration (m)
-    [output]      csv, parquet, plots, history, html = true | false, history_resolution (s),
-                  history_max_rows
-    [metrics]     settle_window (s), make_guard (s), arc_toggle_limit (coupling.core.metrics),
-                  logic = { node = "v(pin)", low, high } (V; coupling.core.logic)
-    [duty]        materials = ["moving", "fixed"], moving_node, repulsion, conductor_radius,
-                  transition_gap, transfer_fraction, erosion_coefficient, weld_margin,
-                  melt_fraction, cap_height, life = {gap_range, min_force, max_resistance,
-                  stop_on_weld} (coupling.core.duty; docs/contact_duty.md)
+Each key is a field of the dataclass its section maps onto, declared there with its
+default, unit and meaning (``scene_key``: mech's, circuit's and the coupling sections'
+below), and listed in docs/scene_keys.md, which ``python -m coupling.app.keys_doc`` writes
+from those fields. [circuit]'s keys are the fields of the dataclasses its template builds
+(template_classes), named as the keys; [tribology] chooses the contact laws
+(docs/tribology.md).
 
 SI units everywhere. File paths are relative to the scene file. Every error names the
 file, the section and key as written and says what is allowed, before any solver starts.
@@ -63,7 +38,8 @@ from mech.scene import SCENE_SECTIONS as MECH_SECTIONS
 from mech.scene import read_toml
 from mech.scene import scene_from_dict as mech_scene_from_dict
 from mech.validation import (
-    check_bool, check_choice, check_file, check_keys, check_nonnegative, check_positive, check_whole,
+    check_bool, check_choice, check_file, check_keys, check_nonnegative, check_positive, check_whole, internal,
+    scene_key,
 )
 
 COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output", "metrics", "duty", "coil", "magnet")
@@ -107,11 +83,11 @@ class CouplingOptions:
     that ngspice's truncation-error control cannot follow at tight RELTOL.
     """
 
-    scheme: str = "mechanics_first"
-    macro_step: float = 2e-6
-    max_macro_step: float | None = 1e-4
-    align_events: bool = True
-    onset_penetration: float = 10e-9
+    scheme: str = scene_key("mechanics_first", unit="-", doc='or "jacobi"')
+    macro_step: float = scene_key(2e-6, unit="s", doc="exchange interval while a tip touches")
+    max_macro_step: float | None = scene_key(1e-4, unit="s", doc="while both tips are free")
+    align_events: bool = scene_key(True, unit="-", doc="end a macro step at each make/break")
+    onset_penetration: float = scene_key(10e-9, unit="m", doc="conduction ramps in over this penetration")
 
     def __post_init__(self):
         check_choice("coupling.scheme", self.scheme, SCHEMES)
@@ -140,13 +116,18 @@ class OutputOptions:
     kept, at most [solver] history_rows besides those); docs/coupling.md, "Outputs".
     """
 
-    csv: bool = True
-    parquet: bool = True
-    plots: bool = False  # PNGs on request (`switchsim run --plots`, `switchsim plot DIR`): drawing them costs more than a run
-    history: bool = True
-    html: bool = True
-    history_resolution: float = 1e-6
-    history_max_rows: int = 50_000
+    csv: bool = scene_key(True, unit="-", doc="waveforms.csv")
+    parquet: bool = scene_key(True, unit="-", doc="waveforms.parquet")
+    # PNGs on request only: drawing them costs more than a run
+    plots: bool = scene_key(
+        False, unit="-", doc="PNG plots (`switchsim run --plots`, or `switchsim plot DIR` afterwards)")
+    history: bool = scene_key(True, unit="-", doc="mechanics history.csv")
+    html: bool = scene_key(True, unit="-", doc="waveforms.html (interactive)")
+    history_resolution: float = scene_key(
+        1e-6, unit="s", doc="history.csv rows at most this close, besides event rows")
+    history_max_rows: int = scene_key(
+        50_000, unit="-",
+        doc="and at most this many of them (0: every row the run kept, see `[solver] history_rows`); at most 1e7")
 
     def __post_init__(self):
         for name in ("csv", "parquet", "plots", "history", "html"):
@@ -175,11 +156,22 @@ class TribologySpec:
 class CircuitSpec:
     """The circuit, its ngspice options, and an optional prescribed contact schedule."""
 
-    circuit: Any  # circuit.SwitchCircuit | circuit.NetlistCircuit
-    options: Any  # circuit.SimulationOptions
-    schedule: Any = None  # circuit.ContactSchedule | None
-    template: str = "resistive"
-    probes: tuple = ()  # circuit.probes.UserProbe: [circuit] probes = ["v(node)", "i(element)"]
+    circuit: Any = internal()  # circuit.SwitchCircuit | circuit.NetlistCircuit, ...: its fields are [circuit] keys
+    options: Any = internal()  # circuit.SimulationOptions: likewise
+    schedule: Any = scene_key(  # circuit.ContactSchedule | None
+        None, unit="-", doc="`[circuit.schedule]`: a prescribed contact, no mechanics")
+    template: str = scene_key(
+        "resistive", unit="-",
+        doc='"inductive", "capacitive", "current_source", "netlist", "mcu_input" (a switch read by a '
+            'microcontroller pin: docs/circuit.md section 6), "short_circuit" (resistive, the load shorted at '
+            '`fault_time`: a fault current through the closed contact), "bridge" (resistive, its switch a '
+            "double-break bridge: two contacts in series, each its own circuit contact named as the scene's two "
+            "electrical `[[fixed]]` contacts, which it needs; docs/circuit.md section 6)")
+    probes: tuple = scene_key(  # circuit.probes.UserProbe
+        (), unit="-", doc='`["v(node)", "v(n1,n2)", "i(element)"]`: extra waveform columns')
+    netlist: str | None = scene_key(
+        None, unit="path", doc='template "netlist": your netlist with one `XCONTACT a b` line, or one '
+        "`XCONTACT_<name> a b` line per electrical `[[fixed]]` contact of that name (in series, one chain: a bridge)")
 
 
 @dataclass(frozen=True)
@@ -196,6 +188,7 @@ class Scene:
     name: str = "scene"
     metrics: Any = None  # coupling.core.metrics.MetricSettings
     duty: Any = None  # coupling.core.duty.DutySettings, when the scene has [duty]
+    schedule_t_end: float | None = None  # s: a schedule scene's run length ([solver] t_end, its one key there)
 
     @property
     def kind(self) -> str:
@@ -209,9 +202,7 @@ class Scene:
     @property
     def t_end(self) -> float:
         """s: length of the run ([solver] t_end)."""
-        if self.mech is not None:
-            return self.mech.solver.t_end
-        return SolverOptions(**self.raw.get("solver", {})).t_end  # a schedule scene: [solver] t_end alone
+        return self.mech.solver.t_end if self.mech is not None else self.schedule_t_end
 
     def set(self, key: str, value) -> "Scene":
         """A new scene with ``key`` set to value, re-validated: "section.key",
@@ -335,82 +326,69 @@ def _tribology_fitted(table: dict, base_dir: Path, feedback: bool) -> TribologyS
     return TribologySpec(laws, "inline laws", feedback)
 
 
-# --- [circuit]: scene keys mapped 1:1 onto the circuit dataclasses ------------------------
-# Each flat [circuit] key is one field of one dataclass; an omitted key takes that field's
-# default (the dataclasses are the only source of defaults). Sub-tables snubber, flyback,
-# arc and schedule map their keys onto the fields of the same name. Errors raised by a
-# dataclass ("DCSource.voltage = ...") are reported in the scene's words ("circuit.voltage").
+# --- [circuit]: each key one field of a circuit dataclass, named as the key ----------------
+# A template builds the dataclasses of template_classes; each flat [circuit] key is the field
+# of that name (declared with circuit.validation.scene_key), the sub-tables snubber, flyback,
+# arc and schedule the fields of theirs, and an omitted key takes its field's default. The
+# dataclasses name the keys in their errors themselves ("circuit.voltage = ...").
 
-_VOLTAGE_SOURCE = {"voltage": "voltage", "source_resistance": "internal_resistance"}
-_CURRENT_SOURCE = {"current": "current", "compliance_voltage": "compliance_voltage",
-                   "output_capacitance": "output_capacitance", "output_resistance": "output_resistance"}
-_WIRING = {"wiring_resistance": "resistance", "wiring_inductance": "inductance"}
-_LOADS = {
-    "resistive": {"load_resistance": "resistance"},
-    "inductive": {"load_resistance": "resistance", "load_inductance": "inductance"},
-    "capacitive": {"load_resistance": "resistance", "load_capacitance": "capacitance",
-                   "bleed_resistance": "bleed_resistance"},
-    "current_source": {"load_resistance": "resistance"},
-    "short_circuit": {"load_resistance": "resistance"},
-    "bridge": {"load_resistance": "resistance"},
-}
-_FAULT = {"fault_time": "fault_time", "fault_resistance": "fault_resistance", "fault_rise": "fault_rise"}
-_TEMPLATE_CIRCUIT = {"contact_capacitance": "contact_capacitance", "leakage_conductance": "leakage_conductance"}
-_NETLIST = {"netlist": None, "load_probe": "load_probe", "leakage_conductance": "leakage_conductance",
-            "params": "params"}
-_PARTS = ("snubber", "flyback", "arc")
-_OPTION_KEYS = ("max_step", "reltol", "abstol", "vntol", "chgtol", "method", "temperature", "wall_timeout")
-_MCU_INPUT = {k: k for k in ("voltage", "pull", "pull_resistance", "series_resistance", "input_capacitance",
-                              "logic_low", "logic_high", "contact_capacitance", "leakage_conductance")}
-_SCHEDULE = {"make": "intervals", "break": "intervals", "closed_resistance": "closed_resistance",
-             "edge_time": "edge_time", "opening_speed": "opening_speed"}
+_PARTS = ("snubber", "flyback", "arc")  # [circuit] keys that are sub-tables, each its own dataclass
+
+
+def template_classes(template: str) -> tuple:
+    """The circuit dataclasses a template builds, whose fields are its [circuit] keys (besides
+    the CircuitSpec's and the ngspice options' keys): (source, wiring, load, switch) or one."""
+    import circuit as ck
+
+    if template == "netlist":
+        return (ck.NetlistCircuit,)
+    if template == "mcu_input":
+        return (ck.McuInput,)
+    source = ck.CurrentSource if template == "current_source" else ck.DCSource
+    load = {"inductive": ck.InductiveLoad, "capacitive": ck.CapacitiveLoad}.get(template, ck.ResistiveLoad)
+    switch = {"short_circuit": ck.ShortCircuit, "bridge": ck.BridgeCircuit}.get(template, ck.SwitchCircuit)
+    return (source, ck.Wiring, load, switch)
+
+
+def key_fields(cls) -> list[str]:
+    """The fields of ``cls`` that scene keys of the same name set (declared scene_key)."""
+    return [f.name for f in dataclasses.fields(cls) if "unit" in f.metadata and "keys" not in f.metadata]
+
+
+def section_keys(cls) -> list[str]:
+    """Every scene key of ``cls``'s section it takes: its key fields and the keys a field of
+    several stands for (ContactSchedule's make and break)."""
+    return key_fields(cls) + [row[0] for f in dataclasses.fields(cls) for row in f.metadata.get("keys", ())]
 
 
 def template_keys(template: str) -> set:
-    """The [circuit] keys a template uses (besides template, schedule and the ngspice options)."""
-    if template == "netlist":
-        return set(_NETLIST) | {"arc"}
-    if template == "mcu_input":
-        return set(_MCU_INPUT)
-    source = _CURRENT_SOURCE if template == "current_source" else _VOLTAGE_SOURCE
-    fault = set(_FAULT) if template == "short_circuit" else set()
-    return set(source) | set(_WIRING) | set(_LOADS[template]) | set(_TEMPLATE_CIRCUIT) | set(_PARTS) | fault
+    """The [circuit] keys a template uses (besides template, schedule, probes and the ngspice options)."""
+    keys = set().union(*(key_fields(cls) for cls in template_classes(template)))
+    return keys | {"netlist"} if template == "netlist" else keys
 
 
-CIRCUIT_KEYS = frozenset({"template", "schedule", "probes", *_OPTION_KEYS}.union(*(template_keys(t) for t in TEMPLATES)))
+def common_keys() -> set:
+    """The [circuit] keys of every template: the CircuitSpec's and the ngspice options'."""
+    import circuit as ck
+
+    return (set(key_fields(CircuitSpec)) - {"netlist"}) | set(key_fields(ck.SimulationOptions))
 
 
-def circuit_key_names(ck) -> dict:
-    """'Class.field' of every dataclass behind [circuit] -> the scene key that sets it."""
-    names = {}
-    for cls, keys in ((ck.DCSource, _VOLTAGE_SOURCE), (ck.CurrentSource, _CURRENT_SOURCE), (ck.Wiring, _WIRING),
-                      (ck.ResistiveLoad, _LOADS["resistive"]), (ck.InductiveLoad, _LOADS["inductive"]),
-                      (ck.CapacitiveLoad, _LOADS["capacitive"]), (ck.SwitchCircuit, _TEMPLATE_CIRCUIT),
-                      (ck.NetlistCircuit, _NETLIST), (ck.McuInput, _MCU_INPUT), (ck.ShortCircuit, _FAULT),
-                      (ck.BridgeCircuit, _TEMPLATE_CIRCUIT)):
-        names.update({f"{cls.__name__}.{name}": f"circuit.{key}" for key, name in keys.items() if name})
-    for part, cls in zip(_PARTS, (ck.Snubber, ck.FlybackDiode, ck.ArcModel)):
-        names[f"SwitchCircuit.{part}"] = names[f"NetlistCircuit.{part}"] = f"circuit.{part}"
-        names.update({f"{cls.__name__}.{f.name}": f"circuit.{part}.{f.name}" for f in dataclasses.fields(cls)})
-    names.update({f"SimulationOptions.{k}": f"circuit.{k}" for k in _OPTION_KEYS})
-    names.update({f"ContactSchedule.{name}": f"circuit.schedule.{'make/break' if name == 'intervals' else key}"
-                  for key, name in _SCHEDULE.items()})
-    names["SwitchCircuit.load"] = "circuit.template"
-    for cls in ("ShortCircuit", "BridgeCircuit"):  # each a SwitchCircuit
-        names.update({f"{cls}.{k.split('.', 1)[1]}": v for k, v in list(names.items())
-                      if k.startswith("SwitchCircuit.")})
-    names["CircuitSpec.probes"] = "circuit.probes"  # what to record, beside the circuit itself
-    return names
+def circuit_keys() -> frozenset:
+    """Every key [circuit] may hold."""
+    return frozenset(common_keys().union(*(template_keys(t) for t in TEMPLATES)))
 
 
-def _in_scene_words(err: Exception, names: dict) -> str:
-    """The message of a dataclass's error with every 'Class.field' it names replaced by its scene key."""
-    return re.sub(r"\b[A-Z]\w*\.\w+", lambda m: names.get(m.group(0), m.group(0)), str(err))
+def __getattr__(name: str):
+    if name == "CIRCUIT_KEYS":  # (built on first use: reading them imports circuit)
+        return circuit_keys()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-def _fields(table: dict, keys: dict) -> dict:
-    """The dataclass keyword arguments of the scene keys present in ``table`` (scene key -> field)."""
-    return {name: table[key] for key, name in keys.items() if key in table and name}
+def _kwargs(table: dict, cls, skip=_PARTS) -> dict:
+    """The keyword arguments of ``cls`` that ``table`` gives: its key fields present (``skip``:
+    the sub-tables, built on their own)."""
+    return {k: table[k] for k in key_fields(cls) if k in table and k not in skip}
 
 
 def _part(table: dict, name: str, cls):
@@ -425,7 +403,7 @@ def _part(table: dict, name: str, cls):
         return cls()
     if not isinstance(value, dict):
         raise ValueError(f"circuit.{name} = {value!r}: expected true, false or a table of keys")
-    allowed = [f.name for f in dataclasses.fields(cls)]
+    allowed = key_fields(cls)
     check_keys(f"circuit.{name}", value, allowed)
     if name == "snubber" and len(value) != 2:
         missing = sorted(set(allowed) - set(value))
@@ -458,23 +436,23 @@ def _circuit(table: dict, base_dir: Path, current_factor: str | None, device=Non
     bridge template takes its contacts' names from the mechanics' (``mech``) [[fixed]]."""
     import circuit as ck
 
-    table = check_keys("[circuit]", _table("[circuit]", table), CIRCUIT_KEYS)
+    table = check_keys("[circuit]", _table("[circuit]", table), circuit_keys())
     template = check_choice("circuit.template", table.get("template", "resistive"), TEMPLATES)
     if "voltage" in table and "current" in table:
         raise ValueError("circuit.voltage and circuit.current both name a source: give one, current "
                          "(A) with template = \"current_source\", or voltage (V) with a voltage-source template")
-    usable = template_keys(template) | {"template", "schedule", "probes", *_OPTION_KEYS}
+    usable = template_keys(template) | common_keys()
     stray = sorted(set(table) - usable)
     if stray:
         hint = {"netlist": " (put it in the netlist)",
                 "current_source": " (a current source: current, compliance_voltage, output_capacitance, "
                                   "output_resistance)"}.get(template, "")
-        if template not in ("netlist", "current_source") and set(stray) & set(_CURRENT_SOURCE):
+        if template not in ("netlist", "current_source") and set(stray) & set(key_fields(ck.CurrentSource)):
             hint = " (a current source needs template = \"current_source\")"
         raise ValueError(f"circuit.{', circuit.'.join(stray)} do(es) not apply to template {template!r}"
                          f"{hint}; its keys: {', '.join(sorted(template_keys(template)))}")
     try:
-        options = ck.SimulationOptions(**{k: table[k] for k in _OPTION_KEYS if k in table})
+        options = ck.SimulationOptions(**_kwargs(table, ck.SimulationOptions))
         arc = _part(table, "arc", ck.ArcModel)
         if template == "netlist":
             if "netlist" not in table:
@@ -483,47 +461,41 @@ def _circuit(table: dict, base_dir: Path, current_factor: str | None, device=Non
             coil = {} if device is None else dict(coil_resistance=device.resistance,
                                                   coil_current=device.current_law())
             circ = ck.NetlistCircuit.from_file(path, arc=arc, contact_current_factor=current_factor,
-                                               **_fields(table, _NETLIST), **coil)
+                                               **_kwargs(table, ck.NetlistCircuit), **coil)
         elif template == "mcu_input":
             if device is not None:
                 raise ValueError("[coil] with circuit.template = \"mcu_input\": the coil's drive joins a switch "
                                  "template (resistive, inductive, capacitive, current_source) or a netlist")
-            circ = ck.McuInput(contact_current_factor=current_factor, **_fields(table, _MCU_INPUT))
+            circ = ck.McuInput(contact_current_factor=current_factor, **_kwargs(table, ck.McuInput))
         else:
-            if template == "current_source":
-                source = ck.CurrentSource(**_fields(table, _CURRENT_SOURCE))
-                load = ck.ResistiveLoad(**_fields(table, _LOADS[template]))
-            else:
-                source = ck.DCSource(**_fields(table, _VOLTAGE_SOURCE))
-                load = {"resistive": ck.ResistiveLoad, "inductive": ck.InductiveLoad, "capacitive": ck.CapacitiveLoad,
-                        "short_circuit": ck.ResistiveLoad, "bridge": ck.ResistiveLoad}[template](**_fields(table, _LOADS[template]))
-            cls, fault = (ck.ShortCircuit, _fields(table, _FAULT)) if template == "short_circuit" else (
-                ck.SwitchCircuit, {})
+            source, wiring, load, switch = template_classes(template)
+            names = {}
             if template == "bridge":
                 if "schedule" in table:
                     raise ValueError("circuit.schedule with template = \"bridge\": a bridge's two contacts are "
                                      "driven by the mechanics' [[fixed]] contacts, not by a schedule")
-                cls, fault = ck.BridgeCircuit, dict(contact_names=_bridge_names(mech))
-            circ = cls(source=source, load=load, wiring=ck.Wiring(**_fields(table, _WIRING)),
-                       snubber=_part(table, "snubber", ck.Snubber), flyback=_part(table, "flyback", ck.FlybackDiode),
-                       arc=arc, contact_current_factor=current_factor, coil=None if device is None else device.drive(),
-                       **_fields(table, _TEMPLATE_CIRCUIT), **fault)
+                names = dict(contact_names=_bridge_names(mech))
+            circ = switch(source=source(**_kwargs(table, source)), load=load(**_kwargs(table, load)),
+                          wiring=wiring(**_kwargs(table, wiring)), snubber=_part(table, "snubber", ck.Snubber),
+                          flyback=_part(table, "flyback", ck.FlybackDiode), arc=arc,
+                          contact_current_factor=current_factor, coil=None if device is None else device.drive(),
+                          **_kwargs(table, switch), **names)
         schedule = None
         if "schedule" in table:
-            st = check_keys("circuit.schedule", _table("circuit.schedule", table["schedule"]), _SCHEDULE)
+            st = check_keys("circuit.schedule", _table("circuit.schedule", table["schedule"]),
+                            section_keys(ck.ContactSchedule))
             if "make" not in st or "break" not in st:
                 raise ValueError("circuit.schedule needs make = [...] and break = [...] (s)")
-            schedule = ck.ContactSchedule.from_events(st["make"], st["break"], **_fields(st, {
-                k: k for k in ("closed_resistance", "edge_time", "opening_speed")}))
-    except (TypeError, ValueError) as err:  # TypeError: a value of a type no check foresaw
-        raise ValueError(_in_scene_words(err, circuit_key_names(ck))) from None
+            schedule = ck.ContactSchedule.from_events(st["make"], st["break"], **_kwargs(st, ck.ContactSchedule))
+    except TypeError as err:  # a value of a type no check foresaw
+        raise ValueError(str(err)) from None
     probes = ()
     if "probes" in table:  # validated against the deck's nodes and elements
         from circuit.deck import build_deck
         from circuit.probes import check_probes
 
         probes = check_probes(table["probes"], build_deck(circ, 1.0, options)[0], "[circuit] probes")
-    return CircuitSpec(circ, options, schedule, template, probes)
+    return CircuitSpec(circ, options, schedule, template, probes, table.get("netlist"))
 
 
 def scene_from_dict(doc: dict, *, base_dir: Path | str = ".", name: str = "scene") -> Scene:
@@ -569,9 +541,10 @@ def _build(doc: dict, base_dir: Path, name: str) -> Scene:
 
     tribology = _tribology(doc["tribology"], base_dir) if "tribology" in doc else None
 
-    mech = None
-    if schedule_given:
-        SolverOptions(**solver_table)  # [solver] t_end alone: the run's length
+    mech = schedule_t_end = None
+    if schedule_given:  # [solver] t_end alone: the run's length, checked as the key's field would
+        t_end = solver_table.get("t_end", _field_default(SolverOptions, "t_end"))
+        schedule_t_end = check_positive("solver.t_end", t_end, high=T_END_MAX)
     else:
         mech_doc = {k: v for k, v in doc.items() if k in MECH_SECTIONS}
         if tribology is not None:
@@ -611,9 +584,15 @@ def _build(doc: dict, base_dir: Path, name: str) -> Scene:
     metrics, circuit = _metrics(doc, circuit)
     duty = _duty(doc, mech, tribology, circuit)
     scene = Scene(raw=copy.deepcopy(doc), base_dir=base_dir, mech=mech, tribology=tribology, circuit=circuit,
-                  coupling=coupling, output=output, name=name, metrics=metrics, duty=duty)
+                  coupling=coupling, output=output, name=name, metrics=metrics, duty=duty,
+                  schedule_t_end=schedule_t_end)
     check_work(scene)
     return scene
+
+
+def _field_default(cls, name: str):
+    """The default of ``cls``'s field ``name``: the default of the key it is."""
+    return next(f.default for f in dataclasses.fields(cls) if f.name == name)
 
 
 def macro_steps(scene: Scene) -> float:

@@ -219,8 +219,8 @@ def _circuit_current_bound(scene) -> float | None:
     circ = getattr(spec, "circuit", None)
     try:
         voltage = circ.source.voltage
-        load = circ.load.resistance
-        series = circ.source.internal_resistance + circ.wiring.resistance + load
+        load = circ.load.load_resistance
+        series = circ.source.source_resistance + circ.wiring.wiring_resistance + load
     except AttributeError:  # a netlist circuit: its topology is the user's
         return None
     fault = getattr(circ, "fault_resistance", None)  # circuit.ShortCircuit: the load shorted by it

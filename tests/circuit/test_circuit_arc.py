@@ -137,7 +137,7 @@ def test_dc_arc_burns_while_open_and_dies_when_the_contact_recloses():
     [("min_voltage", 0.0), ("min_current", -1.0), ("resistance", 0.0), ("formation_time", 1.0), ("breakdown_voltage", 5.0)],
 )
 def test_bad_arc_parameters_are_rejected_before_anything_runs(field, value):
-    with pytest.raises(ValueError, match=f"ArcModel.{field}"):
+    with pytest.raises(ValueError, match=f"circuit.arc.{field}"):
         ArcModel(**{field: value})
 
 

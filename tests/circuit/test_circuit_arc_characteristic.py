@@ -147,9 +147,9 @@ def test_make_arc_strikes_where_the_closing_gap_breaks_down(case):
 
 
 @pytest.mark.parametrize("kwargs,match", [
-    (dict(characteristic="ayrtn"), r"ArcModel\.characteristic = 'ayrtn': allowed values are 'linear', 'ayrton'"),
+    (dict(characteristic="ayrtn"), r"circuit\.arc\.characteristic = 'ayrtn': allowed values are 'linear', 'ayrton'"),
     (dict(characteristic="ayrton", ayrton_c=-1.0), r"ayrton_c"),
-    (dict(ayrton_c=11.66), r"ArcModel\.ayrton_c = 11\.66 applies to characteristic = 'ayrton'"),
+    (dict(ayrton_c=11.66), r"circuit\.arc\.ayrton_c = 11\.66 applies to characteristic = 'ayrton'"),
     (dict(characteristic="ayrton", time_constant=0.0), r"time_constant"),
 ])
 def test_bad_characteristic_settings_give_one_line_errors(kwargs, match):

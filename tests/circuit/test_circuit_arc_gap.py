@@ -461,10 +461,10 @@ def _raise_in_gap(options):
 
 @pytest.mark.parametrize(
     "kwargs, match",
-    [({"column_gradient": -1.0}, "ArcModel.column_gradient"),
-     ({"column_gradient": 2e6}, "ArcModel.column_gradient"),
-     ({"column_gradient": math.nan}, "ArcModel.column_gradient"),
-     ({"breakdown_gradient": -1.0, "breakdown_voltage": 300.0}, "ArcModel.breakdown_gradient"),
+    [({"column_gradient": -1.0}, "circuit.arc.column_gradient"),
+     ({"column_gradient": 2e6}, "circuit.arc.column_gradient"),
+     ({"column_gradient": math.nan}, "circuit.arc.column_gradient"),
+     ({"breakdown_gradient": -1.0, "breakdown_voltage": 300.0}, "circuit.arc.breakdown_gradient"),
      ({"breakdown_gradient": 3e6}, "breakdown_gradient = 3e\\+06 V/m needs breakdown_voltage")],
 )
 def test_bad_gradients_are_rejected(kwargs, match):
@@ -473,9 +473,9 @@ def test_bad_gradients_are_rejected(kwargs, match):
 
 
 def test_bad_opening_speed_is_rejected():
-    with pytest.raises(ValueError, match="ContactSchedule.opening_speed"):
+    with pytest.raises(ValueError, match="circuit.schedule.opening_speed"):
         ContactSchedule(((0.0, 1e-3),), opening_speed=0.0)
-    with pytest.raises(ValueError, match="ContactSchedule.opening_speed"):
+    with pytest.raises(ValueError, match="circuit.schedule.opening_speed"):
         ContactSchedule((), opening_speed=1.0)
 
 

@@ -191,11 +191,11 @@ def test_arc_goes_out_where_its_voltage_meets_the_compliance():
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    ({"current": 0.0}, "CurrentSource.current = 0 A is out of range"),
-    ({"current": -1.0}, "CurrentSource.current"),
-    ({"compliance_voltage": 0.0}, "CurrentSource.compliance_voltage"),
-    ({"output_capacitance": 0.0}, "CurrentSource.output_capacitance"),
-    ({"output_resistance": -5.0}, "CurrentSource.output_resistance"),
+    ({"current": 0.0}, "circuit.current = 0 A is out of range"),
+    ({"current": -1.0}, "circuit.current"),
+    ({"compliance_voltage": 0.0}, "circuit.compliance_voltage"),
+    ({"output_capacitance": 0.0}, "circuit.output_capacitance"),
+    ({"output_resistance": -5.0}, "circuit.output_resistance"),
 ])
 def test_bad_current_source_values(kwargs, message):
     with pytest.raises(ValueError, match=message):

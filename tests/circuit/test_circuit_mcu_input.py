@@ -95,12 +95,12 @@ def test_netlist_places_the_contact_on_the_pull_side():
 
 
 @pytest.mark.parametrize("fields, words", [
-    (dict(logic_low=2.4), "McuInput.logic_low = 2.4 V must be below McuInput.logic_high = 2.31 V"),
-    (dict(logic_high=3.3), "McuInput.logic_high = 3.3 V must be below McuInput.voltage = 3.3 V"),
-    (dict(pull_resistance=0.0), "McuInput.pull_resistance = 0 ohm is out of range"),
-    (dict(series_resistance=-5.0), "McuInput.series_resistance = -5 ohm is out of range"),
-    (dict(input_capacitance=-1e-9), "McuInput.input_capacitance = -1e-09 F is out of range"),
-    (dict(pull="both"), "McuInput.pull = 'both': allowed values"),
+    (dict(logic_low=2.4), "circuit.logic_low = 2.4 V must be below circuit.logic_high = 2.31 V"),
+    (dict(logic_high=3.3), "circuit.logic_high = 3.3 V must be below circuit.voltage = 3.3 V"),
+    (dict(pull_resistance=0.0), "circuit.pull_resistance = 0 ohm is out of range"),
+    (dict(series_resistance=-5.0), "circuit.series_resistance = -5 ohm is out of range"),
+    (dict(input_capacitance=-1e-9), "circuit.input_capacitance = -1e-09 F is out of range"),
+    (dict(pull="both"), "circuit.pull = 'both': allowed values"),
 ])
 def test_bad_values_name_the_field(fields, words):
     with pytest.raises(ValueError) as err:

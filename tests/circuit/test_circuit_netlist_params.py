@@ -1,4 +1,4 @@
-"""A netlist's .param values set from outside (NetlistCircuit.params): the top-level
+"""A netlist's .param values set from outside (circuit.params): the top-level
 definitions take the new numbers, in included files too, before the netlist's checks run;
 a subcircuit's own parameters and names the netlist does not define are refused."""
 
@@ -44,10 +44,10 @@ def test_top_level_definitions_take_the_new_values(tmp_path):
 
 
 @pytest.mark.parametrize("params, fragments", [
-    ({"RS": 1.0}, ["NetlistCircuit.params.RS = 1.0", "no '.param RS' at its top level", "CF, RF, RL"]),
+    ({"RS": 1.0}, ["circuit.params.RS = 1.0", "no '.param RS' at its top level", "CF, RF, RL"]),
     ({"RIN": 1.0}, ["no '.param RIN' at its top level"]),  # a subcircuit's own
     ({"RX": 1.0}, ["no '.param RX'", "did you mean"]),
-    ({"RF": "1k"}, ["NetlistCircuit.params.RF = '1k'", "finite number"]),
+    ({"RF": "1k"}, ["circuit.params.RF = '1k'", "finite number"]),
     ({"RF": float("nan")}, ["finite number"]),
     ({"RF": 1e40}, ["|value| <= 1e+30"]),
     ({"RF": 1.0, "rf": 2.0}, ["given twice"]),

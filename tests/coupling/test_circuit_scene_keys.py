@@ -34,7 +34,7 @@ def _error(circuit: dict) -> str:
 @pytest.mark.parametrize("circuit, key, internal", [
     ({"voltage": -1.0}, "circuit.voltage = -1 V is out of range", "DCSource"),
     ({"load_resistance": 0.0}, "circuit.load_resistance = 0 ohm is out of range", "ResistiveLoad"),
-    ({"source_resistance": -1.0}, "circuit.source_resistance = -1 ohm", "internal_resistance"),
+    ({"source_resistance": -1.0}, "circuit.source_resistance = -1 ohm", "DCSource"),
     ({"wiring_inductance": 2.0}, "circuit.wiring_inductance = 2 H", "Wiring"),
     ({"template": "inductive", "load_inductance": 0.0}, "circuit.load_inductance = 0 H", "InductiveLoad"),
     ({"template": "capacitive", "bleed_resistance": 0.0}, "circuit.bleed_resistance = 0 ohm", "CapacitiveLoad"),
@@ -57,6 +57,21 @@ def test_value_errors_name_the_scene_key(circuit, key, internal):
     assert text.startswith("s.toml: ")
     assert key in text
     assert internal not in text
+
+
+def test_a_schedule_scene_runs_for_its_solver_t_end():
+    """A circuit-only scene's length is its [solver] t_end (its one key there), held by the
+    scene itself: the waveforms end there; left out, the key's documented default; a bad
+    value is refused naming the key, and any other [solver] key as well."""
+    schedule = {"schedule": {"make": [1e-4], "break": [3e-4]}, "max_step": 1e-5}
+    scene = scene_from_dict({"circuit": schedule, "solver": {"t_end": 6e-4}})
+    assert scene.mech is None and scene.t_end == 6e-4 and scene.set("solver.t_end", 8e-4).t_end == 8e-4
+    assert run(scene).waveforms["time"].iloc[-1] == pytest.approx(6e-4, rel=1e-12)
+    assert scene_from_dict({"circuit": schedule}).t_end == 0.05  # docs/scene_keys.md, [solver] t_end
+    with pytest.raises(ValueError, match=r"^s.toml: solver.t_end = -1.0: must be > 0$"):
+        scene_from_dict({"circuit": schedule, "solver": {"t_end": -1.0}}, name="s.toml")
+    with pytest.raises(ValueError, match=r"only \[solver\] t_end may stay"):
+        scene_from_dict({"circuit": schedule, "solver": {"t_end": 1e-3, "rtol": 1e-6}})
 
 
 def test_schedule_errors_name_the_scene_key():
@@ -84,14 +99,17 @@ def test_unknown_keys_list_the_allowed_ones_with_a_did_you_mean(circuit, expecte
     assert expected in _error(circuit)
 
 
-def test_every_circuit_key_is_listed_once_and_maps_to_a_dataclass_field():
-    from coupling.core.scene import circuit_key_names  # the map the errors are translated with (public)
+def test_every_circuit_key_is_a_field_of_the_same_name():
+    """Each [circuit] key is the field of that name of a dataclass a template builds (or the
+    scene's own, or the ngspice options'): no table translates names."""
+    from coupling.core.scene import TEMPLATES, CircuitSpec, template_classes
 
-    targets = set(circuit_key_names(ck).values())
-    top = {t.split(".")[1] for t in targets if t.count(".") == 1}
-    assert CIRCUIT_KEYS - {"template", "schedule", "netlist"} <= top | {"snubber", "flyback", "arc"}
+    classes = {CircuitSpec, ck.SimulationOptions}.union(*(template_classes(t) for t in TEMPLATES))
+    fields = set().union(*({f.name for f in dataclasses.fields(cls)} for cls in classes))
+    assert CIRCUIT_KEYS <= fields, CIRCUIT_KEYS - fields
     option_fields = {f.name for f in dataclasses.fields(ck.SimulationOptions)}
     assert option_fields <= CIRCUIT_KEYS  # every ngspice option a scene can set
+    assert {"template", "schedule", "probes", "snubber", "flyback", "arc"} <= CIRCUIT_KEYS
 
 
 def test_snubber_needs_both_values():

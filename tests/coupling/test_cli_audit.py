@@ -69,7 +69,7 @@ LATIN1_LINE = SHIPPED.encode()[:SHIPPED.encode().index(b"3,0,")].count(b"\n") + 
 @pytest.mark.parametrize("circuit, words, internal", [
     ("voltage = -1.0", ["circuit.voltage = -1 V is out of range: allowed 0 < value"], "DCSource"),
     ("load_resistance = 0.0", ["circuit.load_resistance = 0 ohm is out of range"], "ResistiveLoad"),
-    ("source_resistance = -1.0", ["circuit.source_resistance = -1 ohm"], "internal_resistance"),
+    ("source_resistance = -1.0", ["circuit.source_resistance = -1 ohm"], "DCSource"),
     ("arc = {min_voltag = 10.0}", ["circuit.arc: unknown key 'min_voltag' (did you mean 'min_voltage'?)",
                                    "allowed keys: ayrton_c, ayrton_d, breakdown_gradient, breakdown_voltage"], "unexpected keyword"),
     ("reltol = 0.5", ["circuit.reltol = 0.5 is out of range"], "SimulationOptions"),

@@ -67,7 +67,7 @@ def test_an_arc_model_without_breakdown_voltage_is_warned_of_with_the_setting_to
     res = run(sc)
     i_max = float(res.waveforms.load_current.abs().max())
     assert i_max < c.arc.min_current  # no arc can burn at any break
-    E, z = c.source.voltage, (c.wiring.inductance / c.contact_capacitance) ** 0.5
+    E, z = c.source.voltage, (c.wiring.wiring_inductance / c.contact_capacitance) ** 0.5
     assert 1000.0 < res.bounce["peak_contact_voltage"] <= E + (E * E + (i_max * z) ** 2) ** 0.5
     lines = [w for w in res.warnings if "exceeds air breakdown" in w]
     assert len(lines) == 1

@@ -35,7 +35,7 @@ def test_kinds_follow_the_sections():
 def test_set_revalidates_and_keeps_the_original():
     sc = builtin_scene("free_drop")
     changed = sc.set("initial.angle_deg", 45).set("circuit.load_resistance", 6.0)
-    assert changed.mech.initial.angle_deg == 45 and changed.circuit.circuit.load.resistance == 6.0
+    assert changed.mech.initial.angle_deg == 45 and changed.circuit.circuit.load.load_resistance == 6.0
     assert sc.mech.initial.angle_deg == 30.0
     with pytest.raises(ValueError, match="initial.height"):
         sc.set("initial.height", -1e-3)

@@ -54,9 +54,9 @@ def test_every_accepted_key_is_documented_and_nothing_else():
     expected["environment"] = set(ENVIRONMENT_KEYS)
     for name in LIST_SECTIONS:  # [[force]], [[spring]], [[rivet]], [[fixed]]
         expected[name] = set(entry_keys(name))  # (not the field holding the entry's place, force[0], ...)
-    expected["tribology"] = {"source", "fit", "data", "mu", "resistance", "feedback"}
+    expected["tribology"] = set(cs.TRIBOLOGY_KEYS)
     expected["circuit"] = set(cs.CIRCUIT_KEYS)
-    expected["circuit.schedule"] = {"make", "break", "closed_resistance", "edge_time", "opening_speed"}
+    expected["circuit.schedule"] = set(cs.section_keys(ck.ContactSchedule))  # the keys [circuit.schedule] takes
     for part, cls in (("snubber", ck.Snubber), ("flyback", ck.FlybackDiode), ("arc", ck.ArcModel)):
         expected[f"circuit.{part}"] = _fields(cls)
     expected["coupling"] = _fields(cs.CouplingOptions)
@@ -71,6 +71,32 @@ def test_every_accepted_key_is_documented_and_nothing_else():
         assert doc[section] == keys, f"[{section}]: missing {keys - doc[section]}, extra {doc[section] - keys}"
 
 
+def test_the_key_tables_are_written_from_the_dataclass_fields():
+    """Each generated table of the page is what coupling.app.keys_doc writes from the fields
+    now: a key added, renamed or redescribed in its dataclass without regenerating fails here."""
+    from coupling.app import keys_doc
+
+    text = DOC.read_text()
+    assert keys_doc.render(text) == text, f"docs/scene_keys.md is stale: run `{keys_doc.COMMAND}`"
+
+
+def test_a_field_without_its_key_description_is_named():
+    """A field added without scene_key(...) or internal(...) stops the generator, naming the
+    field and what to add (so that a new key gets its row)."""
+    from coupling.app.keys_doc import field_rows
+    from mech.validation import internal, scene_key
+
+    @dataclasses.dataclass(frozen=True)
+    class Widget:
+        width: float = scene_key(1e-3, unit="m", doc="how wide")
+        place: str = internal("widget[0]")
+        depth: float = 2e-3
+
+    with pytest.raises(ValueError, match=r"Widget\.depth: no scene-key description; declare it as "
+                                         r"`depth: \.\.\. = scene_key\(<default>, unit="):
+        field_rows(Widget)
+
+
 def test_readme_relay_quick_start_scene_is_valid():
     """The README's "model my relay" scene validates as written (and uses the material law)."""
     import tomllib
@@ -81,7 +107,7 @@ def test_readme_relay_quick_start_scene_is_valid():
     block = re.search(r"```toml\n(# relay\.toml.*?)```", text, re.S).group(1)
     scene = scene_from_dict(tomllib.loads(block), name="relay")
     assert scene.kind == "coupled" and scene.tribology.laws.resistance_law.materials == ("AgNi10", "Ag")
-    assert scene.mech.initial.height == 0.4e-3 and scene.circuit.circuit.load.resistance == 5.0
+    assert scene.mech.initial.height == 0.4e-3 and scene.circuit.circuit.load.load_resistance == 5.0
 
 
 # --- the default column ------------------------------------------------------------------
@@ -142,16 +168,17 @@ def _plain(value):
 
 
 def _circuit_value(spec, name: str):
-    """The field a circuit scene key ('circuit.voltage', 'circuit.arc.min_voltage') sets."""
-    if name in ("circuit.template", "circuit.probes"):
-        return getattr(spec, name.split(".")[1])
-    parts = [spec.circuit, spec.options, spec.schedule] + [getattr(spec.circuit, a, None) for a in (
-        "source", "load", "wiring", "snubber", "flyback", "arc")]
-    objects = {type(o).__name__: o for o in parts if o is not None}
-    for class_field, key in cs.circuit_key_names(ck).items():
-        owner, fld = class_field.split(".")
-        if key == name and owner in objects:
-            return getattr(objects[owner], fld)
+    """The field a circuit scene key ('circuit.voltage', 'circuit.arc.min_voltage') sets: the
+    field of that name of the built circuit's parts (the fields are named as the keys)."""
+    *section, key = name.split(".")
+    if section == ["circuit"]:
+        c = spec.circuit
+        parts = [spec, spec.options, c] + [getattr(c, a, None) for a in ("source", "load", "wiring")]
+    else:
+        parts = [{"circuit.schedule": spec.schedule}.get(".".join(section), getattr(spec.circuit, section[1], None))]
+    for part in parts:
+        if part is not None and key in {f.name for f in dataclasses.fields(part)}:
+            return getattr(part, key)
     raise AssertionError(f"{name}: no field of the built circuit is set by it")
 
 
