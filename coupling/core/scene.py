@@ -14,6 +14,9 @@ A scene names only what it needs, and only that is built:
                   | "short_circuit" (resistive, shorted at fault_time: fault_resistance, fault_rise)
                   | "bridge" (resistive, its switch a double-break bridge: two contacts in series,
                   named as the scene's two electrical [[fixed]] contacts)
+                  | "changeover" (form C: the supply on the moving contact, its NO and NC throws
+                  each with its own resistive load: load_resistance, nc_load_resistance; the
+                  scene's electrical [[fixed]] contacts named NO and NC)
                   voltage, source_resistance (voltage templates) | current, compliance_voltage,
                   output_capacitance, output_resistance (current_source), wiring_resistance,
                   wiring_inductance, load_resistance, load_inductance, load_capacitance,
@@ -79,7 +82,7 @@ WAVE_COPIES = 3
 MECH_WAVE_COLUMNS = 8  # normal_force_0/1, penetration_0/1, normal_force, gap, mu (+1 spare)
 MACRO_STEP_LOG_BYTES = 152  # the friction coefficient's log, one entry per macro step
 TEMPLATES = ("resistive", "inductive", "capacitive", "current_source", "netlist", "mcu_input", "short_circuit",
-             "bridge")
+             "bridge", "changeover")
 SCHEMES = ("mechanics_first", "jacobi")
 
 
@@ -353,8 +356,10 @@ _LOADS = {
     "current_source": {"load_resistance": "resistance"},
     "short_circuit": {"load_resistance": "resistance"},
     "bridge": {"load_resistance": "resistance"},
+    "changeover": {"load_resistance": "resistance"},
 }
 _FAULT = {"fault_time": "fault_time", "fault_resistance": "fault_resistance", "fault_rise": "fault_rise"}
+_CHANGEOVER = {"nc_load_resistance": "nc_load_resistance"}
 _TEMPLATE_CIRCUIT = {"contact_capacitance": "contact_capacitance", "leakage_conductance": "leakage_conductance"}
 _NETLIST = {"netlist": None, "load_probe": "load_probe", "leakage_conductance": "leakage_conductance",
             "params": "params"}
@@ -373,8 +378,9 @@ def template_keys(template: str) -> set:
     if template == "mcu_input":
         return set(_MCU_INPUT)
     source = _CURRENT_SOURCE if template == "current_source" else _VOLTAGE_SOURCE
-    fault = set(_FAULT) if template == "short_circuit" else set()
-    return set(source) | set(_WIRING) | set(_LOADS[template]) | set(_TEMPLATE_CIRCUIT) | set(_PARTS) | fault
+    fault = set(_FAULT) if template == "short_circuit" else set(_CHANGEOVER) if template == "changeover" else set()
+    parts = set(_PARTS) - {"flyback"} if template == "changeover" else set(_PARTS)  # (resistive throws)
+    return set(source) | set(_WIRING) | set(_LOADS[template]) | set(_TEMPLATE_CIRCUIT) | parts | fault
 
 
 CIRCUIT_KEYS = frozenset({"template", "schedule", "probes", *_OPTION_KEYS}.union(*(template_keys(t) for t in TEMPLATES)))
@@ -387,7 +393,8 @@ def circuit_key_names(ck) -> dict:
                       (ck.ResistiveLoad, _LOADS["resistive"]), (ck.InductiveLoad, _LOADS["inductive"]),
                       (ck.CapacitiveLoad, _LOADS["capacitive"]), (ck.SwitchCircuit, _TEMPLATE_CIRCUIT),
                       (ck.NetlistCircuit, _NETLIST), (ck.McuInput, _MCU_INPUT), (ck.ShortCircuit, _FAULT),
-                      (ck.BridgeCircuit, _TEMPLATE_CIRCUIT)):
+                      (ck.BridgeCircuit, _TEMPLATE_CIRCUIT), (ck.ChangeoverCircuit, _TEMPLATE_CIRCUIT),
+                      (ck.ChangeoverCircuit, _CHANGEOVER)):
         names.update({f"{cls.__name__}.{name}": f"circuit.{key}" for key, name in keys.items() if name})
     for part, cls in zip(_PARTS, (ck.Snubber, ck.FlybackDiode, ck.ArcModel)):
         names[f"SwitchCircuit.{part}"] = names[f"NetlistCircuit.{part}"] = f"circuit.{part}"
@@ -396,7 +403,7 @@ def circuit_key_names(ck) -> dict:
     names.update({f"ContactSchedule.{name}": f"circuit.schedule.{'make/break' if name == 'intervals' else key}"
                   for key, name in _SCHEDULE.items()})
     names["SwitchCircuit.load"] = "circuit.template"
-    for cls in ("ShortCircuit", "BridgeCircuit"):  # each a SwitchCircuit
+    for cls in ("ShortCircuit", "BridgeCircuit", "ChangeoverCircuit"):  # each a SwitchCircuit
         names.update({f"{cls}.{k.split('.', 1)[1]}": v for k, v in list(names.items())
                       if k.startswith("SwitchCircuit.")})
     names["CircuitSpec.probes"] = "circuit.probes"  # what to record, beside the circuit itself
@@ -452,6 +459,19 @@ def _bridge_names(mech) -> tuple[str, str]:
     return tuple(n for _, n in electrical)
 
 
+def _changeover_names(mech) -> tuple[str, str]:
+    """The changeover template's (NO, NC) contact names: the scene's electrical [[fixed]]
+    contacts named NO and NC (ignoring case), as written."""
+    fixed = list(getattr(mech, "fixed", ()) or ()) if mech is not None else []
+    names = mech.fixed_names() if fixed else ()
+    electrical = {names[k].lower(): names[k] for k, fx in enumerate(fixed) if fx.electrical}
+    if "no" not in electrical or "nc" not in electrical:
+        have = ", ".join(electrical.values()) or "none" if fixed else "none ([block] or no bar)"
+        raise ValueError("circuit.template = \"changeover\" needs two electrical [[fixed]] contacts named \"NO\" (struck "
+                         "when operated) and \"NC\" (the blade's rest); this scene's electrical fixed contacts: " + have)
+    return electrical["no"], electrical["nc"]
+
+
 def _circuit(table: dict, base_dir: Path, current_factor: str | None, device=None, mech=None):
     """[circuit] as its CircuitSpec; with the relay's ``device`` ([coil], [magnet]) the coil
     and its drive join the template's circuit (a netlist places it with an XCOIL line); the
@@ -496,7 +516,8 @@ def _circuit(table: dict, base_dir: Path, current_factor: str | None, device=Non
             else:
                 source = ck.DCSource(**_fields(table, _VOLTAGE_SOURCE))
                 load = {"resistive": ck.ResistiveLoad, "inductive": ck.InductiveLoad, "capacitive": ck.CapacitiveLoad,
-                        "short_circuit": ck.ResistiveLoad, "bridge": ck.ResistiveLoad}[template](**_fields(table, _LOADS[template]))
+                        "short_circuit": ck.ResistiveLoad, "bridge": ck.ResistiveLoad,
+                        "changeover": ck.ResistiveLoad}[template](**_fields(table, _LOADS[template]))
             cls, fault = (ck.ShortCircuit, _fields(table, _FAULT)) if template == "short_circuit" else (
                 ck.SwitchCircuit, {})
             if template == "bridge":
@@ -504,6 +525,12 @@ def _circuit(table: dict, base_dir: Path, current_factor: str | None, device=Non
                     raise ValueError("circuit.schedule with template = \"bridge\": a bridge's two contacts are "
                                      "driven by the mechanics' [[fixed]] contacts, not by a schedule")
                 cls, fault = ck.BridgeCircuit, dict(contact_names=_bridge_names(mech))
+            if template == "changeover":
+                if "schedule" in table:
+                    raise ValueError("circuit.schedule with template = \"changeover\": its NO and NC contacts are "
+                                     "driven by the mechanics' [[fixed]] contacts, not by a schedule")
+                cls, fault = ck.ChangeoverCircuit, dict(contact_names=_changeover_names(mech),
+                                                        **_fields(table, _CHANGEOVER))
             circ = cls(source=source, load=load, wiring=ck.Wiring(**_fields(table, _WIRING)),
                        snubber=_part(table, "snubber", ck.Snubber), flyback=_part(table, "flyback", ck.FlybackDiode),
                        arc=arc, contact_current_factor=current_factor, coil=None if device is None else device.drive(),
