@@ -311,3 +311,22 @@ def test_the_example_scene_loads_as_a_changeover():
     assert scene.circuit.template == "changeover" and [b.name for b in c.contacts] == ["NO", "NC"]
     assert c.load_resistances == (RAW["circuit"]["load_resistance"], RAW["circuit"]["nc_load_resistance"])
     assert math.isfinite(scene.t_end)
+
+
+def test_a_breaks_arc_ends_before_the_contacts_next_make():
+    """NC's operations in a changeover: it breaks at 1 ms (its arc burns 0.2 ms) and makes
+    again at 5 ms with a bounce whose opening arcs for 0.1 ms. The break's arc is the 0.2 ms
+    after the break alone: the later make's bounce arcs are that operation's (they used to
+    be counted into the break's arc, which looked to the end of the run). Samples every
+    1 us, so the durations are exact sums of sample intervals."""
+    from coupling.core.metrics import operations
+
+    t = np.round(np.arange(0.0, 8e-3 + 5e-7, 1e-6), 12)
+    arc = np.where(((t >= 1e-3) & (t < 1.2e-3)) | ((t >= 5.1e-3) & (t < 5.2e-3)), 0.5, 0.0)
+    v = np.where(arc > 0.0, 12.0, 0.0)
+    intervals = [(0.0, 1e-3), (5e-3, 5.1e-3), (5.2e-3, 8e-3)]
+    ops = operations(intervals, 8e-3, t, v, arc, np.zeros_like(t), arc)
+    assert [list(op) for op in ops] == [["break"], ["make"]]
+    assert ops[0]["break"]["arc_duration"] == pytest.approx(0.2e-3, rel=1e-9)
+    assert ops[0]["break"]["arc_energy"] == pytest.approx(12.0 * 0.5 * 0.2e-3, rel=1e-2)
+    assert ops[1]["make"]["bounces"] == 1
