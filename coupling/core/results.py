@@ -161,9 +161,10 @@ class CoupledResult:
     @property
     def contact_results(self) -> dict:
         """Per circuit contact of a circuit of several (summary.json ``per_contact``): its
-        name -> {"bounce": its bounce metrics, "operations": its operations}, from its own
-        closed intervals and its own columns (``contact_waves``: its current is its own
-        metallic plus arc current); {} for one contact."""
+        name -> {"closed_intervals": its own (s), "bounce": its bounce metrics, "operations":
+        its operations}, from its own closed intervals and its own columns
+        (``contact_waves``: its current is its own metallic plus arc current); {} for one
+        contact."""
         closed = self.contact_closed
         if not closed:
             return {}
@@ -182,7 +183,8 @@ class CoupledResult:
                     ops = _operations(intervals, self.scene.t_end, w["time"], w["contact_voltage"], loop,
                                       w["contact_current"], w["arc_current"], settings,
                                       min_arc_current=None if model is None else model.min_current)
-                out[block.name] = {"bounce": bounce, "operations": ops}
+                out[block.name] = {"closed_intervals": [list(iv) for iv in intervals], "bounce": bounce,
+                                   "operations": ops}
             self._cache["contact_results"] = out
         return self._cache["contact_results"]
 
@@ -336,6 +338,9 @@ class CoupledResult:
             out["bounce"] = _jsonable(self.bounce)
             out["operations"] = _jsonable(self.operations)
             if self.contact_results:
+                from coupling.core.arrangement import is_series
+
+                out["arrangement"] = "series" if is_series(self.scene.circuit.circuit) else "independent"
                 out["per_contact"] = _jsonable(self.contact_results)
             if self.changeover is not None:
                 out["changeover"] = _jsonable(self.changeover)
