@@ -8,7 +8,8 @@ channels (``<label>.conductance`` S, ``<label>.gap`` m) and result columns.
 - ``run_transient`` / ``run_pwl_reference``: one-shot runs.
 - ``ContactSchedule``: prescribed make/break instants.
 - ``SwitchCircuit`` and its parts, ``BridgeCircuit`` (a double-break bridge: two contacts
-  in series), ``McuInput`` (a switch read by a microcontroller pin),
+  in series), ``ChangeoverCircuit`` (form C: NO and NC, each throw with its own load),
+  ``McuInput`` (a switch read by a microcontroller pin),
   ``NetlistCircuit``: the circuit.
 - ``ArcModel``: arc/breakdown of the opening gap (optionally growing with the gap distance).
 """
@@ -37,6 +38,7 @@ from .schedule import ContactSchedule
 from .stepping import StepResult, Stepper
 from .templates import (
     BridgeCircuit,
+    ChangeoverCircuit,
     CapacitiveLoad,
     CurrentSource,
     DCSource,
@@ -54,6 +56,7 @@ from .transient import run_pwl_reference, run_transient
 __all__ = [
     "ArcModel",
     "BridgeCircuit",
+    "ChangeoverCircuit",
     "COLUMNS",
     "CapacitiveLoad",
     "CurrentSource",

@@ -154,7 +154,7 @@ class ResistiveLoad:
     """Resistive load: load_resistance, ohm."""
 
     SECTION: ClassVar[str] = "circuit"
-    load_resistance: float = scene_key(12.0, unit="ohm")
+    load_resistance: float = scene_key(12.0, unit="ohm", doc="changeover: NO's load")
 
     def __post_init__(self) -> None:
         check_range(self.SECTION, "load_resistance", self.load_resistance, "ohm", 1e-6, 1e9)
@@ -250,13 +250,13 @@ class SwitchCircuit:
     load: Load = internal(default_factory=ResistiveLoad)
     wiring: Wiring = internal(default_factory=Wiring)
     contact_capacitance: float = scene_key(
-        100e-12, unit="F", doc="across the contact (bridge: across each of its two)")
+        100e-12, unit="F", doc="across the contact (bridge, changeover: across each of its two)")
     snubber: Snubber | None = scene_key(
-        None, unit="-", doc="RC across the contact, `{resistance = 100.0, capacitance = 100e-9}` (ohm, F; give "
+        None, unit="-", doc="RC across the contact (changeover: one across each contact), `{resistance = 100.0, capacitance = 100e-9}` (ohm, F; give "
         "both): [circuit.snubber]; omitted or false: none")
     flyback: FlybackDiode | None = scene_key(
         None, unit="-", doc="a diode across an inductive load: true (its defaults) or a table: [circuit.flyback]; "
-        "omitted or false: none")
+        "omitted or false: none (not with changeover: its loads are resistive)")
     arc: ArcModel | None = scene_key(
         None, unit="-", doc="the arc model: true (its defaults) or a table: [circuit.arc]; omitted or false: none")
     leakage_conductance: float = scene_key(DEFAULT_LEAKAGE, unit="S", doc="open-contact insulation")
@@ -327,6 +327,36 @@ class SwitchCircuit:
         """The PySpice circuit (``print`` it for the netlist)."""
         c = Circuit(self.title)
         gnd = c.gnd
+        self._place_supply(c, NODE_A)
+        self._place_switch(c)
+        c.V(LOAD_PROBE[1:], NODE_B, "load", 0)
+        load = self.load
+        if isinstance(load, ResistiveLoad):
+            c.R("load", "load", gnd, float(load.load_resistance))
+        elif isinstance(load, InductiveLoad):
+            c.R("load", "load", "load_l", float(load.load_resistance))
+            c.L("load", "load_l", gnd, float(load.load_inductance))
+        else:
+            c.R("load", "load", "load_c", float(load.load_resistance))
+            c.C("load", "load_c", gnd, float(load.load_capacitance))
+            c.R("bleed", "load_c", gnd, float(load.bleed_resistance))
+        if self.flyback is not None:
+            d = self.flyback
+            c.D("flyback", gnd, NODE_B, model="switchsim_flyback")
+            c.model(
+                "switchsim_flyback",
+                "D",
+                IS=float(d.saturation_current),
+                N=float(d.emission_coefficient),
+                RS=float(d.series_resistance),
+            )
+        if self.coil is not None:
+            self.coil.add_to(c)
+        return c
+
+    def _place_supply(self, c: Circuit, end: str) -> None:
+        """The source and the wiring in series, from the supply to node ``end``."""
+        gnd = c.gnd
         source = self.source
         if isinstance(source, CurrentSource):
             c.I("source", gnd, "src", float(source.current))
@@ -354,34 +384,9 @@ class SwitchCircuit:
         inner_nodes = iter(("wire", "wire_l"))
         node = "src"
         for i, (kind, name, value) in enumerate(series):
-            next_node = NODE_A if i == len(series) - 1 else next(inner_nodes)
+            next_node = end if i == len(series) - 1 else next(inner_nodes)
             getattr(c, kind)(name, node, next_node, float(value))
             node = next_node
-        self._place_switch(c)
-        c.V(LOAD_PROBE[1:], NODE_B, "load", 0)
-        load = self.load
-        if isinstance(load, ResistiveLoad):
-            c.R("load", "load", gnd, float(load.load_resistance))
-        elif isinstance(load, InductiveLoad):
-            c.R("load", "load", "load_l", float(load.load_resistance))
-            c.L("load", "load_l", gnd, float(load.load_inductance))
-        else:
-            c.R("load", "load", "load_c", float(load.load_resistance))
-            c.C("load", "load_c", gnd, float(load.load_capacitance))
-            c.R("bleed", "load_c", gnd, float(load.bleed_resistance))
-        if self.flyback is not None:
-            d = self.flyback
-            c.D("flyback", gnd, NODE_B, model="switchsim_flyback")
-            c.model(
-                "switchsim_flyback",
-                "D",
-                IS=float(d.saturation_current),
-                N=float(d.emission_coefficient),
-                RS=float(d.series_resistance),
-            )
-        if self.coil is not None:
-            self.coil.add_to(c)
-        return c
 
     def _place_switch(self, c: Circuit) -> None:
         """What sits between NODE_A and NODE_B: the contact, its capacitance, the snubber, the arc."""
@@ -456,6 +461,99 @@ class BridgeCircuit(SwitchCircuit):
         if self.snubber is not None:
             c.R("snubber", NODE_A, "snubber", float(self.snubber.resistance))
             c.C("snubber", "snubber", NODE_B, float(self.snubber.capacitance))
+
+
+# --- a changeover (form C): the moving contact between a normally-open and a normally-closed ---
+
+COMMON_NODE = "common"  # the supply's end of the wiring, before the common's load probe
+
+
+@dataclass(frozen=True)
+class ChangeoverCircuit(SwitchCircuit):
+    """A ``SwitchCircuit`` whose switch is a changeover (form C): the supply feeds the moving
+    contact (the common), which connects it to the normally-open (NO) or the normally-closed
+    (NC) fixed contact, each throw with its own resistive load to ground, as a relay's form C
+    contact is wired and tested (SI units)::
+
+        ... Lwire -- common --Vload-- contact_a =CONTACT_<no>= throw_<no> --Vload_<no>-- load_<no> --Rload_<no>-- 0
+                                                |          =CONTACT_<nc>= throw_<nc> --Vload_<nc>-- load_<nc> --Rload_<nc>-- 0
+        across each contact: Ccontact_<n>, its arc path, the snubber (Rsnubber_<n>, Csnubber_<n>) when given
+
+    contact_names: (NO's name, NC's name): each contact a block name (circuit.names; the
+        coupled scene gives its two electrical [[fixed]] contacts named NO and NC, as
+        written), each its own ``ContactBlock`` with its own conductance and gap inputs, arc
+        and result columns (``contact_voltage_<name>``, ...). NO is the first contact.
+    load: NO's load, a ResistiveLoad (ohm).
+    nc_load_resistance: ohm, NC's load; None: the same as NO's.
+    contact_capacitance: F, across each contact; the snubber, when given, across each too.
+    The load probe ``Vload`` sits in the common's lead: ``load_current`` is the supply's
+    current through the moving contact, NO's and NC's together; each throw's own load current
+    is ``i(Vload_<name>)`` (a probe). Every other field is SwitchCircuit's; the arc model is
+    each contact's. Both throws open: the supply sees only the contacts' leakage and stray
+    capacitance.
+    """
+
+    contact_names: tuple = internal(("NO", "NC"))  # the scene's electrical [[fixed]] contacts NO and NC
+    nc_load_resistance: float | None = scene_key(None, unit="ohm", shown="`load_resistance`",
+                                                 doc="changeover: NC's load (NO's is `load_resistance`)")
+
+    #: how the contacts are arranged: each in its own branch, each closed while it touches
+    arrangement = "changeover"
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        name = "ChangeoverCircuit"
+        names = self.contact_names
+        if not isinstance(names, (tuple, list)) or len(names) != 2:
+            raise ValueError(f"{name}.contact_names = {names!r}: the changeover's two contacts, (NO, NC)")
+        for n in names:
+            check_block_name(f"{name}.contact_names", n)
+            if not n:
+                raise ValueError(f"{name}.contact_names: each of the changeover's contacts is named")
+        if names[0].lower() == names[1].lower():
+            raise ValueError(f"{name}.contact_names = {tuple(names)!r}: two distinct names (SPICE ignores case)")
+        object.__setattr__(self, "contact_names", tuple(names))
+        if not isinstance(self.load, ResistiveLoad):
+            raise ValueError(f"{name}.load is {type(self.load).__name__}: a changeover's throws each drive a "
+                             "ResistiveLoad")
+        if isinstance(self.source, CurrentSource):
+            raise ValueError(f"{name}.source is a CurrentSource: a changeover is fed by a voltage source (DCSource)")
+        if self.nc_load_resistance is not None:
+            check_range(self.SECTION, "nc_load_resistance", self.nc_load_resistance, "ohm", 0.0, 1e9, low_open=True)
+
+    @property
+    def load_resistances(self) -> tuple[float, float]:
+        """ohm: (NO's load, NC's load)."""
+        nc = self.load.load_resistance if self.nc_load_resistance is None else self.nc_load_resistance
+        return float(self.load.load_resistance), float(nc)
+
+    @property
+    def contacts(self) -> tuple[ContactBlock, ...]:
+        """(NO, NC): each from the common to its throw."""
+        args = (self.leakage_conductance, self.contact_current_factor, self.arc)
+        return tuple(ContactBlock(n, NODE_A, f"throw_{n.lower()}", *args) for n in self.contact_names)
+
+    def build(self) -> Circuit:
+        c = Circuit(self.title)
+        gnd = c.gnd
+        self._place_supply(c, COMMON_NODE)
+        c.V(LOAD_PROBE[1:], COMMON_NODE, NODE_A, 0)
+        for block, resistance in zip(self.contacts, self.load_resistances):
+            add_contact(c, block.node_a, block.node_b, self.leakage_conductance, self.contact_current_factor,
+                        block.name)
+            n = block.name.lower()
+            if self.contact_capacitance > 0:
+                c.C(block.element("Ccontact")[1:], block.node_a, block.node_b, float(self.contact_capacitance))
+            if self.snubber is not None:
+                c.R(f"snubber_{n}", block.node_a, f"snubber_{n}", float(self.snubber.resistance))
+                c.C(f"snubber_{n}", f"snubber_{n}", block.node_b, float(self.snubber.capacitance))
+            if self.arc is not None:
+                add_arc(c, self.arc, block.node_a, block.node_b, block.name)
+            c.V(f"load_{n}", block.node_b, f"load_{n}", 0)
+            c.R(f"load_{n}", f"load_{n}", gnd, resistance)
+        if self.coil is not None:
+            self.coil.add_to(c)
+        return c
 
 
 # --- a switch read by a microcontroller input ---------------------------------------------

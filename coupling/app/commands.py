@@ -161,6 +161,19 @@ def _result_lines(summary: dict) -> None:
         if energy.get("relative_residual") is not None:
             parts.append(f"coil energy residual {energy['relative_residual']:.2g}")
         print("switchsim: relay: " + ", ".join(p for p in parts if p))
+    co = summary.get("changeover")
+    if co:  # coupling.core.arrangement.changeover_metrics
+        no, nc = co["normally_open"], co["normally_closed"]
+        parts = [f"transfer time {_ms(co['transfer_time'])}" if co.get("transfer_time") is not None else
+                 f"{no} never made after {nc} broke"]
+        if co["operate"] and co["operate"][0].get("no_bounces") is not None:
+            parts.append(f"{no} make {co['operate'][0]['no_bounces']} bounce(s)")
+        if co["release"] and co["release"][0].get("nc_bounces") is not None:
+            parts.append(f"release transfer {_ms(co['release_transfer_time'])}, {nc} make "
+                         f"{co['release'][0]['nc_bounces']} bounce(s)")
+        parts.append({True: "break before make", False: "MAKES BEFORE IT BREAKS", None: "no transfer"}[
+            co.get("break_before_make")])
+        print("switchsim: changeover: " + ", ".join(parts))
     if "contacts" in summary and not (relay and not summary["contacts"]):  # (an actuator alone has no contact)
         residual = summary.get("energy", {}).get("relative_residual")
         e = summary.get("restitution") or {}

@@ -379,6 +379,8 @@ def write_files(result, folder: Path, summary_extra: dict | None = None) -> None
             write_parquet(folder / "waveforms.parquet", waves)
         if result.scene.circuit is not None:
             write_csv(folder / "openings.csv", result.opening_columns)
+            for name in result.contact_results:  # each contact of several: its own table
+                write_csv(folder / f"openings_{name}.csv", result.contact_opening_columns(name))
     m = result.mechanics
     if m is not None:
         if opts.history:

@@ -4,8 +4,9 @@ quantities, units and axis ranges.
 
 A panel is one axis: its quantity and unit (coupling.app.quantities), the columns it draws
 and the rule that scales it (``SCALES``). ``PANELS`` lists them in drawing order; a new
-panel (a coil's current, an armature's position) is one more entry, and a scene with
-several electrical contacts would repeat the contact's entries with its own columns.
+panel (a coil's current, an armature's position) is one more entry; a circuit of several
+contacts adds a panel of every contact's metallic current and one of every contact's
+resistance (one trace per contact, open samples left out).
 ``axis`` turns a panel's rule and the samples in view into the numbers both writers use:
 limits, samples clipped at the top (marked there with their peak), and for the contact
 resistance the band above the axis where an open contact is drawn.
@@ -92,6 +93,9 @@ PANELS = (
                                            Trace("arc_current", "arc", "#ff7f0e", "nonzero")), "spikes"),
     Panel("resistance", WAVEFORM["contact_resistance"],
           (Trace("contact_resistance", "contact resistance", "#9467bd"),), "resistance"),
+    # a circuit of several contacts (a bridge, a changeover): each contact's own, one trace each
+    Panel("contact_currents", WAVEFORM["current"], (Trace("contact_current_*"),), "spikes"),
+    Panel("contact_resistances", WAVEFORM["contact_resistance"], (Trace("contact_resistance_*"),), "log"),
     Panel("force", WAVEFORM["normal_force"], (Trace("normal_force_0", "contact point 0", "#2ca02c", "nonzero"),
                                               Trace("normal_force_1", "contact point 1", "#bcbd22", "nonzero")),
           "linear"),

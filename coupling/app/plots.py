@@ -101,6 +101,8 @@ def draw_panel(ax, panel, traces, cols, t_ms, rng, *, notes: bool = True, band_r
         if panel.scale == "resistance":
             shown = np.isfinite(y) & (y > 0) & (y <= rng.hi * factor)
             ax.semilogy(t_ms[shown], y[shown], ".", ms=1.5, color=color, label=label)
+        elif rng.log and panel.key == "contact_resistances":  # each contact's: broken where it is open
+            ax.semilogy(t_ms, np.where(np.isfinite(y) & (y > 0), y, np.nan), lw=0.8, color=color, label=label)
         elif rng.log:
             pos = np.isfinite(y) & (y > 0)
             ax.semilogy(t_ms[pos], y[pos], lw=0.8, color=color, label=label)
@@ -406,7 +408,15 @@ def stored_result(folder) -> types.SimpleNamespace:
         mechanics = types.SimpleNamespace(history=history, energy_table=history[energy])
     ends = [float(f.time.iloc[-1]) for f in (waves, mechanics and mechanics.history) if f is not None and len(f)]
     t_end = max(ends, default=0.0)
-    if "contacts" in summary:
+    if "per_contact" in summary:  # several circuit contacts: the switch's, as the run read them
+        from coupling.core.metrics import intersection
+
+        own = [merge_intervals(map(tuple, c["closed_intervals"])) for c in summary["per_contact"].values()]
+        closed = own[0]
+        if summary.get("arrangement") == "series":  # a bridge: while every one is closed
+            for other in own[1:]:
+                closed = intersection(closed, other)
+    elif "contacts" in summary:
         closed = merge_intervals((c["t_start"], c["t_end"] if c["t_end"] is not None else t_end)
                                  for c in summary["contacts"])
     else:  # a prescribed schedule: closed from the first make, between the openings

@@ -101,6 +101,10 @@ _SUMMARY = {
             "circuit.steps": ("circuit steps", "-"), "circuit.points": ("circuit points", "-"),
             "circuit.conductance_calls": ("conductance calls", "-"), "circuit.gap_calls": ("gap calls", "-"),
             "circuit.ngspice_seconds": ("ngspice time", "s"), "circuit.arc_switches": ("arc switches", "-")},
+    # a changeover's (coupling.core.arrangement.changeover_metrics)
+    "changeover": {"transfer_time": ("transfer time (NC break to NO make)", "s"),
+                   "release_transfer_time": ("release transfer time (NO break to NC make)", "s"),
+                   "overlap_time": ("both throws closed", "s")},
     "soundness": {"energy_scale": ("energy scale", "J"), "relative_residual": ("relative energy residual", "-"),
                   "max_kinetic": ("largest kinetic energy", "J"), "max_speed": ("largest speed", "m/s"),
                   "speed_bound": ("speed bound", "m/s"), "max_penetration": ("largest penetration", "m"),
@@ -177,6 +181,7 @@ SCENE = {
     "circuit": {"template": "-", "voltage": "V", "source_resistance": "ohm", "current": "A",
                 "compliance_voltage": "V", "output_capacitance": "F", "output_resistance": "ohm",
                 "wiring_resistance": "ohm", "wiring_inductance": "H", "load_resistance": "ohm",
+                "nc_load_resistance": "ohm",
                 "load_inductance": "H", "load_capacitance": "F", "bleed_resistance": "ohm",
                 "contact_capacitance": "F", "leakage_conductance": "S", "snubber": "-", "flyback": "-", "arc": "-",
                 "netlist": "path", "load_probe": "-", "probes": "-", "max_step": "s", "reltol": "-", "abstol": "A",

@@ -22,11 +22,12 @@ Each is one line that says what was seen, when, and what to add to the scene. Ch
    the run is unsound, coupling.core.soundness).
 6. The arc model on without a breakdown voltage, when an open gap's voltage passes air
    breakdown: that gap would re-ignite (item 1 names the setting to add).
-7. Fixed contacts ([[fixed]]) a circuit of one contact does not tell apart: its one
+7. Fixed contacts ([[fixed]]) a circuit of one unnamed contact does not tell apart: its one
    contact is fed by the mechanics' first two contact pairs in parallel (conductances
    summed, closed while either touches), whatever their fixed contacts are. Said whenever
-   that is not one electrical fixed contact; a circuit of several contacts (the bridge
-   template, a netlist naming each) has each fed by its own fixed contact and no line.
+   that is not one electrical fixed contact; a circuit of several contacts (the bridge and
+   changeover templates, a netlist naming each) or one named contact has each fed by its
+   own fixed contact and no line.
 8. A clamp's travel given by a linear table whose points ring the blade: each point is a
    jump of the clamp's velocity dv, which sets the blade's first mode ringing with a free-
    end amplitude of about 1.566 dv / omega_1 (a clamped-free beam's first-mode participation
@@ -173,10 +174,11 @@ def pairs_warning(scene) -> str | None:
     does not stand for (more than one electrical fixed contact, a stop feeding it, an
     electrical one left out), None otherwise (a [block] scene: its contact points all strike
     the one fixed contact, which the circuit's contact is; a circuit of several contacts,
-    a bridge: each is fed by the fixed contact of its name, which the scene checked)."""
+    a bridge, a changeover, or one named contact: each is fed by the fixed contact of its
+    name, which the scene checked)."""
     mech = scene.mech
     contacts = getattr(getattr(scene.circuit, "circuit", None), "contacts", ())
-    if mech is None or mech.bar is None or not mech.fixed or len(contacts) != 1:
+    if mech is None or mech.bar is None or not mech.fixed or len(contacts) != 1 or contacts[0].name:
         return None
     names = mech.fixed_names()
     pairs = [f"{i} ({fx.point} on {name})" for i, (fx, name) in enumerate(zip(mech.fixed, names))]
@@ -194,9 +196,9 @@ def pairs_warning(scene) -> str | None:
     left = [pairs[i] for i in sorted(electrical - fed)]
     if left:
         line += f"; the electrical pair {', '.join(left)} is not in the circuit"
-    return (line + "; for a bridge's two contacts in series use circuit.template = \"bridge\" (or a netlist "
-            "naming each contact, XCONTACT_<name>), while a changeover's NO and NC are not yet built: its waveforms, "
-            "bounce metrics and operations are those of that one parallel contact")
+    return (line + "; to give each fixed contact its own circuit contact use circuit.template = \"bridge\" (two "
+            "in series), \"changeover\" (NO and NC) or a netlist naming each contact, XCONTACT_<name>: as it is, "
+            "its waveforms, bounce metrics and operations are those of that one parallel contact")
 
 
 RINGING_FRACTION = 0.02  # of the contact gap: item 8

@@ -37,7 +37,7 @@ import numpy as np
 
 from mech import ImpactSolver
 
-from coupling.core.arrangement import contact_feeds, is_series, series_columns
+from coupling.core.arrangement import LEGACY_POINTS, contact_feeds, is_series, switch_columns
 from coupling.core.exchange import CONTACT_EVENTS, FLUX_FLOOR, CoilLink, ContactLink
 from coupling.core.policy import StepPolicy
 from coupling.core.results import CoupledResult, RunStatus
@@ -413,8 +413,8 @@ class CoSimulation:
         kept = waves["time"] <= mech.t + 1e-15
         waves = {name: values[kept] for name, values in waves.items()}
         circuit = self.scene.circuit.circuit
-        if is_series(circuit):  # the whole bridge beside its contacts' own columns
-            waves.update(series_columns(waves, circuit.contacts))
+        # the whole bridge's, or a changeover's first contact's, beside each contact's own
+        waves.update(switch_columns(waves, circuit))
         if self.contact is not None:
             self._contact_columns(mech, waves)
         if self.coil is not None:
@@ -439,13 +439,19 @@ class CoSimulation:
         waves["gap"] = np.where(waves["normal_force"] > 0.0, 0.0,
                                 np.maximum(0.0, -np.max(contact[:, :, 0], axis=1)))
         waves["mu"] = self.contact.mu_series(waves["time"])
-        if len(self.contacts) > 1:  # each contact's own: its arc's gap and its points' mu
+        own = len(self.contacts) > 1 or self.contacts[0].points != LEGACY_POINTS
+        if own:  # each contact's own: its arc's gap, its points' mu and force
             for link in self.contacts:
                 suffix = link.label[len("contact"):]
                 points = list(link.points)
                 touching = np.any(contact[:, points, 0] > 0.0, axis=1)
                 waves["gap" + suffix] = np.where(touching, 0.0, np.maximum(0.0, -np.max(contact[:, points, 0], axis=1)))
                 waves["mu" + suffix] = link.mu_series(waves["time"])
+                waves["normal_force" + suffix] = np.sum(contact[:, points, 2], axis=1)
+            if not is_series(self.scene.circuit.circuit):  # the unsuffixed ones: the first contact's
+                suffix = self.contacts[0].label[len("contact"):]
+                for name in ("gap", "mu", "normal_force"):
+                    waves[name] = waves[name + suffix]
 
 
 def run(scene: Scene, *, progress: bool = False, check: bool = False) -> CoupledResult:

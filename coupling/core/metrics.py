@@ -315,17 +315,19 @@ def _current_window(t, i, start, end) -> tuple[float, float]:
     return float(np.max(np.abs(i[sel]))), trapezoid(t[sel], i[sel] ** 2)
 
 
-def _arc_end(t, i_arc, start: float) -> float | None:
+def _arc_end(t, i_arc, start: float, stop: float = math.inf) -> float | None:
     """s: where the arc that burns after ``start`` goes out (its last burning sample's
-    successor), None when it still burns at the last sample."""
+    successor), looking no later than ``stop`` (the contact's next make: arcs of a later
+    operation are not this break's); ``stop`` when it burns up to there, None when it still
+    burns at the run's last sample."""
     if i_arc is None:
         return start
-    sel = t >= start
+    sel = (t >= start) & (t < stop)
     ts, burning = t[sel], np.abs(i_arc[sel]) > ARC_BURNING_CURRENT
     if not len(ts) or not burning.any():
         return start
     if burning[-1]:
-        return None
+        return None if math.isinf(stop) else stop
     last = int(np.flatnonzero(burning)[-1])
     return float(ts[last + 1])
 
@@ -383,7 +385,8 @@ def operations(intervals, t_end: float, t=None, v=None, i_loop=None, i_contact=N
         power = np.abs(v * i_arc) if i_arc is not None else None
         dissipated = v * (i_contact + (i_arc if i_arc is not None else 0.0))
     out = []
-    for group in episodes(intervals, window):
+    groups = episodes(intervals, window)
+    for g, group in enumerate(groups):
         held = [k for k, (a, b) in enumerate(group) if b - a >= settles(window)]
         starts_closed = group[0][0] <= t_start + guard
         ends_closed = group[-1][1] >= t_end - guard
@@ -413,7 +416,7 @@ def operations(intervals, t_end: float, t=None, v=None, i_loop=None, i_contact=N
             brk = dict(time=brk_time, current_at_break=None, arc_duration=None, arc_energy=None,
                        peak_voltage=None, complete=True)
             if have_waves:
-                arc_out = _arc_end(t, i_arc, group[-1][1])
+                arc_out = _arc_end(t, i_arc, group[-1][1], groups[g + 1][0][0] if g + 1 < len(groups) else math.inf)
                 end = t_end if arc_out is None else max(arc_out, group[-1][1])
                 brk["current_at_break"] = _left_value(t, i_loop, brk_time, guard)
                 if i_arc is not None:

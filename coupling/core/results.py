@@ -35,6 +35,17 @@ def _num(v):
     return v if math.isfinite(v) else None
 
 
+def contact_waves(waveforms: dict | None, suffix: str) -> dict | None:
+    """One contact's columns of a circuit of several, under the unsuffixed names the metrics
+    read (time, contact_voltage, contact_current, arc_current; SI), without a load current:
+    its loop current is then its own metallic plus arc current (a changeover's throws each
+    carry their own)."""
+    if waveforms is None:
+        return None
+    return {"time": waveforms["time"], **{name: waveforms[name + suffix] for name in
+                                          ("contact_voltage", "contact_current", "arc_current")}}
+
+
 def bounce_metrics(intervals, t_end: float, waveforms: dict | None, closed_at_end: bool,
                    settings: MetricSettings | None = None) -> dict:
     """The bounce summary (coupling.core.metrics.bounce_metrics) from closed intervals and a waveform frame."""
@@ -137,6 +148,70 @@ class CoupledResult:
         return bool(self.scene.circuit.schedule.is_closed(self.scene.t_end))
 
     @property
+    def contact_closed(self) -> dict:
+        """Per circuit contact of a circuit of several: its name -> (closed intervals s, closed
+        at the end), each the union of its own contact pairs' (coupling.core.arrangement);
+        {} for one contact or without mechanics."""
+        if self.mechanics is None or self.scene.circuit is None:
+            return {}
+        from coupling.core.arrangement import contact_closed
+
+        return contact_closed(self.scene, self.mechanics.contact_columns)
+
+    @property
+    def contact_results(self) -> dict:
+        """Per circuit contact of a circuit of several (summary.json ``per_contact``): its
+        name -> {"closed_intervals": its own (s), "bounce": its bounce metrics, "operations":
+        its operations}, from its own closed intervals and its own columns
+        (``contact_waves``: its current is its own metallic plus arc current); {} for one
+        contact."""
+        closed = self.contact_closed
+        if not closed:
+            return {}
+        if "contact_results" not in self._cache:
+            settings = getattr(self.scene, "metrics", None)
+            model = getattr(self.scene.circuit.circuit, "arc", None)
+            out = {}
+            for block in self.scene.circuit.circuit.contacts:
+                intervals, at_end = closed[block.name]
+                w = contact_waves(self.waveform_columns, block.suffix)
+                bounce = bounce_metrics(intervals, self.scene.t_end, w, at_end, settings)
+                if w is None or not len(w["time"]):
+                    ops = _operations(intervals, self.scene.t_end, settings=settings)
+                else:
+                    loop = w["contact_current"] + w["arc_current"]
+                    ops = _operations(intervals, self.scene.t_end, w["time"], w["contact_voltage"], loop,
+                                      w["contact_current"], w["arc_current"], settings,
+                                      min_arc_current=None if model is None else model.min_current)
+                out[block.name] = {"closed_intervals": [list(iv) for iv in intervals], "bounce": bounce,
+                                   "operations": ops}
+            self._cache["contact_results"] = out
+        return self._cache["contact_results"]
+
+    @property
+    def changeover(self) -> dict | None:
+        """A changeover's transfer times and break-before-make (summary.json ``changeover``;
+        coupling.core.arrangement.changeover_metrics), None for any other circuit."""
+        from coupling.core.arrangement import changeover_metrics, changeover_names
+
+        names = changeover_names(getattr(self.scene.circuit, "circuit", None)) if self.scene.circuit else None
+        if names is None or not self.contact_results:
+            return None
+        if "changeover" not in self._cache:
+            closed, res, w = self.contact_closed, self.contact_results, self.waveform_columns
+            no, nc = ({"intervals": closed[n][0], "operations": res[n]["operations"],
+                       "time": None if w is None else w["time"],
+                       "arc_current": None if w is None else w[f"arc_current_{n}"]} for n in names)
+            self._cache["changeover"] = dict(normally_open=names[0], normally_closed=names[1],
+                                             **changeover_metrics(no, nc))
+        return self._cache["changeover"]
+
+    def contact_opening_columns(self, name: str) -> dict:
+        """The per-opening table of one contact of several (``contact_results``; openings_<name>.csv)."""
+        rows = self.contact_results[name]["bounce"].get("openings", [])
+        return {k: [r.get(k) for r in rows] for k in OPENING_COLUMNS}
+
+    @property
     def has_contact(self) -> bool:
         """True when the circuit holds a contact (an actuator's coil drive alone holds none)."""
         return self.scene.circuit is not None and bool(getattr(self.scene.circuit.circuit, "contacts", (1,)))
@@ -230,9 +305,14 @@ class CoupledResult:
     def warnings(self) -> list[str]:
         """One-line warnings about physically doubtful states of the run (coupling.core.diagnostics)."""
         if "warnings" not in self._cache:
+            from coupling.core.arrangement import changeover_warnings
             from coupling.core.diagnostics import run_warnings
 
-            self._cache["warnings"] = run_warnings(self)
+            lines = run_warnings(self)
+            co = self.changeover
+            if co is not None:
+                lines = lines + changeover_warnings(co, (co["normally_open"], co["normally_closed"]))
+            self._cache["warnings"] = lines
         return self._cache["warnings"]
 
     @property
@@ -257,6 +337,13 @@ class CoupledResult:
         if self.has_contact:
             out["bounce"] = _jsonable(self.bounce)
             out["operations"] = _jsonable(self.operations)
+            if self.contact_results:
+                from coupling.core.arrangement import is_series
+
+                out["arrangement"] = "series" if is_series(self.scene.circuit.circuit) else "independent"
+                out["per_contact"] = _jsonable(self.contact_results)
+            if self.changeover is not None:
+                out["changeover"] = _jsonable(self.changeover)
         if self.scene.circuit is not None:
             if self.relay is not None:
                 out["relay"] = _jsonable(self.relay)

@@ -55,7 +55,7 @@ WAVE_COPIES = 3
 MECH_WAVE_COLUMNS = 8  # normal_force_0/1, penetration_0/1, normal_force, gap, mu (+1 spare)
 MACRO_STEP_LOG_BYTES = 152  # the friction coefficient's log, one entry per macro step
 TEMPLATES = ("resistive", "inductive", "capacitive", "current_source", "netlist", "mcu_input", "short_circuit",
-             "bridge")
+             "bridge", "changeover")
 SCHEMES = ("mechanics_first", "jacobi")
 
 
@@ -166,12 +166,17 @@ class CircuitSpec:
             'microcontroller pin: docs/circuit.md section 6), "short_circuit" (resistive, the load shorted at '
             '`fault_time`: a fault current through the closed contact), "bridge" (resistive, its switch a '
             "double-break bridge: two contacts in series, each its own circuit contact named as the scene's two "
-            "electrical `[[fixed]]` contacts, which it needs; docs/circuit.md section 6)")
+            "electrical `[[fixed]]` contacts, which it needs; docs/circuit.md section 6), \"changeover\" (form C: "
+            "the supply on the moving contact, its NO and NC throws each with its own resistive load; each its own "
+            "circuit contact fed by the electrical `[[fixed]]` contact named \"NO\" or \"NC\", which it needs; "
+            'docs/coupling.md, "A changeover")')
     probes: tuple = scene_key(  # circuit.probes.UserProbe
         (), unit="-", doc='`["v(node)", "v(n1,n2)", "i(element)"]`: extra waveform columns')
     netlist: str | None = scene_key(
         None, unit="path", doc='template "netlist": your netlist with one `XCONTACT a b` line, or one '
-        "`XCONTACT_<name> a b` line per electrical `[[fixed]]` contact of that name (in series, one chain: a bridge)")
+        "`XCONTACT_<name> a b` line per electrical `[[fixed]]` contact of that name (in series, one chain: a bridge, "
+        "closed while all touch; otherwise independent contacts, each closed while it touches: named NO and NC, a "
+        "changeover)")
 
 
 @dataclass(frozen=True)
@@ -346,7 +351,8 @@ def template_classes(template: str) -> tuple:
         return (ck.McuInput,)
     source = ck.CurrentSource if template == "current_source" else ck.DCSource
     load = {"inductive": ck.InductiveLoad, "capacitive": ck.CapacitiveLoad}.get(template, ck.ResistiveLoad)
-    switch = {"short_circuit": ck.ShortCircuit, "bridge": ck.BridgeCircuit}.get(template, ck.SwitchCircuit)
+    switch = {"short_circuit": ck.ShortCircuit, "bridge": ck.BridgeCircuit,
+              "changeover": ck.ChangeoverCircuit}.get(template, ck.SwitchCircuit)
     return (source, ck.Wiring, load, switch)
 
 
@@ -364,6 +370,8 @@ def section_keys(cls) -> list[str]:
 def template_keys(template: str) -> set:
     """The [circuit] keys a template uses (besides template, schedule, probes and the ngspice options)."""
     keys = set().union(*(key_fields(cls) for cls in template_classes(template)))
+    if template == "changeover":  # its throws are resistive: no flyback diode across a load
+        keys -= {"flyback"}
     return keys | {"netlist"} if template == "netlist" else keys
 
 
@@ -430,6 +438,19 @@ def _bridge_names(mech) -> tuple[str, str]:
     return tuple(n for _, n in electrical)
 
 
+def _changeover_names(mech) -> tuple[str, str]:
+    """The changeover template's (NO, NC) contact names: the scene's electrical [[fixed]]
+    contacts named NO and NC (ignoring case), as written."""
+    fixed = list(getattr(mech, "fixed", ()) or ()) if mech is not None else []
+    names = mech.fixed_names() if fixed else ()
+    electrical = {names[k].lower(): names[k] for k, fx in enumerate(fixed) if fx.electrical}
+    if "no" not in electrical or "nc" not in electrical:
+        have = ", ".join(electrical.values()) or "none" if fixed else "none ([block] or no bar)"
+        raise ValueError("circuit.template = \"changeover\" needs two electrical [[fixed]] contacts named \"NO\" (struck "
+                         "when operated) and \"NC\" (the blade's rest); this scene's electrical fixed contacts: " + have)
+    return electrical["no"], electrical["nc"]
+
+
 def _circuit(table: dict, base_dir: Path, current_factor: str | None, device=None, mech=None):
     """[circuit] as its CircuitSpec; with the relay's ``device`` ([coil], [magnet]) the coil
     and its drive join the template's circuit (a netlist places it with an XCOIL line); the
@@ -475,6 +496,11 @@ def _circuit(table: dict, base_dir: Path, current_factor: str | None, device=Non
                     raise ValueError("circuit.schedule with template = \"bridge\": a bridge's two contacts are "
                                      "driven by the mechanics' [[fixed]] contacts, not by a schedule")
                 names = dict(contact_names=_bridge_names(mech))
+            if template == "changeover":
+                if "schedule" in table:
+                    raise ValueError("circuit.schedule with template = \"changeover\": its NO and NC contacts are "
+                                     "driven by the mechanics' [[fixed]] contacts, not by a schedule")
+                names = dict(contact_names=_changeover_names(mech))
             circ = switch(source=source(**_kwargs(table, source)), load=load(**_kwargs(table, load)),
                           wiring=wiring(**_kwargs(table, wiring)), snubber=_part(table, "snubber", ck.Snubber),
                           flyback=_part(table, "flyback", ck.FlybackDiode), arc=arc,

@@ -845,3 +845,77 @@ def test_bridge_is_closed_only_while_both_rivets_touch(bridge):
     np.testing.assert_allclose(i[steady], circuit["voltage"] / loop[steady], rtol=2e-4)
     after = t > numbers["bridge"]["time"] + 50e-6
     assert np.max(np.abs(i[after])) < 1e-6
+
+
+# --- changeover_relay ----------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def changeover(tmp_path_factory):
+    return _run(tmp_path_factory, "changeover_relay")
+
+
+def _pair_intervals(out: Path, tip: int) -> list[tuple[float, float]]:
+    """Merged contact intervals (s) of contact pair ``tip`` from the mechanics' contacts.csv."""
+    c = pd.read_csv(out / "changeover" / "contacts.csv")
+    c = c[c.tip == tip].sort_values("t_start")
+    merged: list[list[float]] = []
+    for a, b in zip(c.t_start, c.t_end):
+        if merged and a <= merged[-1][1]:
+            merged[-1][1] = max(merged[-1][1], b)
+        else:
+            merged.append([a, b])
+    return [(a, b) for a, b in merged]
+
+
+def test_changeover_transfers_break_before_make_at_the_mechanics_instants(changeover):
+    """Form C on the coil-driven relay: from the mechanics' own contact table (contacts.csv,
+    pair 0 on NO, pair 1 on NC), NC holds until the operate break, NO makes after it (the
+    transfer time), bounces and holds; at release NO breaks and NC makes after it, with
+    bounces of its own. The example's numbers are those instants and counts; no instant has
+    both throws closed. The relay's operate and release times are NO's (the first contact:
+    the unsuffixed results), from the coil's switching times in the scene."""
+    numbers, out = changeover
+    coil = _toml("changeover_relay")["coil"]
+    assert numbers["status"] == "ok" and numbers["warnings"] == []
+    no, nc = _pair_intervals(out, 0), _pair_intervals(out, 1)
+    co = numbers["changeover"]
+    op, rel = co["operate"][0], co["release"][0]
+    assert nc[0][0] < 1e-9 and nc[0][1] == op["nc_break"] and no[0][0] == op["no_make"]
+    assert co["transfer_time"] == pytest.approx(no[0][0] - nc[0][1], rel=1e-12)
+    window = 1e-3  # the default settle window: the bounces are the closures before the held one
+    held = next(k for k, (a, b) in enumerate(no) if b - a >= window)
+    assert op["no_bounces"] == held > 0
+    assert rel["no_break"] == no[held][1] and rel["nc_make"] == nc[1][0]
+    held_nc = next(k for k, (a, b) in enumerate(nc[1:]) if b - a >= window)
+    assert rel["nc_bounces"] == held_nc > 0
+    assert co["break_before_make"] and all(b <= c or d <= a for a, b in no for c, d in nc)
+    assert numbers["relay"]["operate_time"] == pytest.approx(op["no_make"] - coil["on_time"], rel=1e-12)
+    assert numbers["relay"]["release_time"] == pytest.approx(rel["no_break"] - coil["off_time"], rel=1e-12)
+    for name in ("NO", "NC"):
+        assert (out / "changeover" / f"openings_{name}.csv").exists()
+    assert (out / "throws.png").exists()
+
+
+def test_changeover_arcs_go_out_at_their_throws_closed_form(changeover):
+    """Each break's arc (NC's at operate, NO's at release) goes out where its loop can no
+    longer hold I_min across U_min plus the column: d* = (V - U_min - I_min (R_s + R_w +
+    R_load + R_arc)) / E_col with that throw's own load (20 ohm on NC, 10 ohm on NO), to
+    1e-3 as the bridge's (the last burning sample lies within ngspice's last step of the
+    crossing)."""
+    numbers, out = changeover
+    c = _toml("changeover_relay")["circuit"]
+    arc = ArcModel(**c["arc"])
+    w = pd.read_csv(out / "changeover" / "waveforms.csv")
+    t = w.time.to_numpy()
+    co = numbers["changeover"]
+    for name, start, stop, load in (("NC", co["operate"][0]["nc_break"], co["operate"][0]["no_make"],
+                                     c["nc_load_resistance"]),
+                                    ("NO", co["release"][0]["no_break"], co["release"][0]["nc_make"],
+                                     c["load_resistance"])):
+        burning = np.flatnonzero((np.abs(w[f"arc_current_{name}"].to_numpy()) > 1e-3) & (t > start) & (t < stop))
+        assert len(burning) and t[burning[-1]] < stop  # out before the other throw makes
+        gap = w[f"gap_{name}"].to_numpy()[burning[-1]]
+        loop = c["source_resistance"] + c["wiring_resistance"] + load + arc.resistance
+        closed_form = (c["voltage"] - arc.min_voltage - arc.min_current * loop) / arc.column_gradient
+        assert gap == pytest.approx(closed_form, rel=1e-3), name

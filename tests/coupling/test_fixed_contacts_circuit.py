@@ -67,7 +67,8 @@ def test_one_fixed_contact_runs_the_block_scene_in_the_circuit_too(block_run):
 
 def test_a_changeover_in_the_circuit_warns_that_its_contacts_are_one_parallel_contact():
     """NO and NC both electrical: the run's warnings (summary.json's too) say the circuit's
-    one contact stands for both in parallel and that per-contact blocks are not built. The
+    one contact stands for both in parallel and names the templates that give each its own
+    circuit contact (template "changeover": tests/coupling/test_changeover.py). The
     run itself goes on as before the pairs: the blade goes down onto NO and bounces; NC is
     never struck."""
     res = run(scene_from_dict(changeover()))
@@ -75,7 +76,7 @@ def test_a_changeover_in_the_circuit_warns_that_its_contacts_are_one_parallel_co
     assert len(lines) == 1 and "\n" not in lines[0]
     line = lines[0]
     assert "pairs 0 (rivet0 on NO) and 1 (top on NC) in parallel, as one circuit contact" in line
-    assert "not yet built" in line
+    assert 'circuit.template = "bridge" (two in series), "changeover" (NO and NC)' in line
     assert line in res.summary["warnings"]
     w = res.waveform_columns
     assert res.summary["bounce"]["bounces"] > 0 and np.all(w["normal_force_1"] == 0.0)

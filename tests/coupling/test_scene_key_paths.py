@@ -292,6 +292,7 @@ EXAMPLES = {
     "magnet.fixed_gap": [{"tube": [{"shape": "axial", "length": 1e-4, "area": 2e-5}]}],
     "spring.travel": [-1e-3, 2e-3], "spring.force": [0.0, 2.0], "spring.release_force": [0.0, 0.5],
     "rivet.name": "mid", "fixed.name": "NO", "fixed.radius": 2e-3, "fixed.facing": "down", "fixed.gap": 2e-3,
+    "circuit.nc_load_resistance": 20.0,
 }
 RC_PLAIN = "net\n.param RS=1\nV1 a 0 24\nXCONTACT a b\nVLOAD b c 0\nR1 c 0 {RS}\n"
 COUPLED = {"tribology": {"source": "illustrative"}, "circuit": {}, "solver": {"t_end": 1e-3}}
@@ -356,6 +357,11 @@ def _base_and_key(section: str, key: str) -> tuple[dict, str]:
         table["template"] = templates[0]
         if templates[0] == "netlist":
             table["netlist"] = "net.cir"
+        if templates[0] == "changeover":  # coupled: its contacts are the [[fixed]] contacts NO and NC
+            del table["schedule"]
+            return {"circuit": table, "tribology": {"source": "illustrative"}, "solver": {"t_end": 1e-3},
+                    "fixed": [{"point": "tip0", "name": "NO", "gap": 1e-3},
+                              {"point": "tip1", "name": "NC", "gap": 1e-3}]}, f"{section}.{key}"
     elif section == "circuit.flyback":
         table.update(template="inductive", flyback={})
     elif section == "circuit.snubber":

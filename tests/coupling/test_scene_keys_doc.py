@@ -141,6 +141,9 @@ DUTY = {"tribology": {"resistance": {"law": "holm", "materials": ["Ag", "Ag"]}, 
 # two end caps over two of them
 BRIDGE = {"fixed": [{"point": "tip0", "name": "a", "gap": 1e-3}, {"point": "tip1", "name": "b", "gap": 1e-3}],
           "tribology": {"source": "illustrative"}}
+# the changeover template's contacts are the electrical [[fixed]] contacts named NO and NC
+CHANGEOVER = {"fixed": [{"point": "tip0", "name": "NO", "gap": 1e-3}, {"point": "tip1", "name": "NC", "gap": 1e-3}],
+              "tribology": {"source": "illustrative"}}
 OPTION_KEYS = {f.name for f in dataclasses.fields(ck.SimulationOptions)}
 CONTEXTS = {"initial": {"held bar": {"mount": {"kind": "clamp", "position": 0.3}}}}
 
@@ -226,9 +229,10 @@ def _field_without(section: str, key: str, patch: dict, folder: Path):
     if section != "circuit":  # a sub-table: [circuit.arc], [circuit.schedule], ...
         part = section.split(".")[1]
         table[part] = {k: v for k, v in table.get(part, {}).items() if k != key}
-    if table.get("template") == "bridge":  # a coupled scene: its mechanics name the contacts
+    if table.get("template") in ("bridge", "changeover"):  # a coupled scene: its mechanics name the contacts
         table.pop("schedule")
-        spec = cs.scene_from_dict({"circuit": table, **BRIDGE}, base_dir=folder).circuit
+        mech = BRIDGE if table["template"] == "bridge" else CHANGEOVER
+        spec = cs.scene_from_dict({"circuit": table, **mech}, base_dir=folder).circuit
         return _circuit_value(spec, f"{section}.{key}")
     spec = cs.scene_from_dict({"circuit": table}, base_dir=folder).circuit
     return _circuit_value(spec, f"{section}.{key}")
