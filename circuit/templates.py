@@ -494,8 +494,8 @@ class ChangeoverCircuit(SwitchCircuit):
     """
 
     contact_names: tuple = internal(("NO", "NC"))  # the scene's electrical [[fixed]] contacts NO and NC
-    nc_load_resistance: float | None = scene_key(None, unit="ohm", shown="`load_resistance`",
-                                                 doc="changeover: NC's load (NO's is `load_resistance`)")
+    nc_load_resistance: float | None = scene_key(
+        None, unit="ohm", doc="changeover: NC's load (> 0); omitted: the same as `load_resistance`")
 
     #: how the contacts are arranged: each in its own branch, each closed while it touches
     arrangement = "changeover"
