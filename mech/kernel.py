@@ -43,7 +43,7 @@ from .kernel_layout import (  # noqa: F401  (re-exported: the kernel's own names
     N_FPAR, I_N, I_PLANAR, I_FRICTION, I_MOUNT, I_NLOAD, I_INERTIA, N_IPAR, INERTIA_GRAM,
     INERTIA_SPARSE, FRICTION_NONE, FRICTION_EXACT, FRICTION_REGULARIZED, MOUNT_FREE, MOUNT_CLAMP,
     MOUNT_PIVOT, C_K, C_C, C_R, C_ON, LOAD_FORCE, LOAD_SPRING, LOAD_TRAVEL_SPRING, L_KIND, L_POINT, L_BODY, L_DX,
-    L_DY, L_DZ, L_T0, L_TN, L_AX, L_AY, L_AZ, L_K, L_C, L_L0, L_R0, L_KS, L_FLOOR, L_ZBACK, N_LOAD, FREE, SLIP, STICK,
+    L_DY, L_DZ, L_T0, L_TN, L_AX, L_AY, L_AZ, L_K, L_C, L_L0, L_R0, L_KS, L_FLOOR, L_ZBACK, L_S0, L_SN, N_LOAD, FREE, SLIP, STICK,
     Q_DNORMAL, Q_DFRICTION, Q_DMODAL, Q_WCOMP, Q_IMPULSE, Q_WIN, Q_DLOAD, NQ_FREE, NQ, A_Y,
     A_YDOT, A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_MARGIN, NAUX, EV_CONTACT, EV_CLIP, EV_SLIP,
     EV_STICK, EV_COMPRESSION, NEV_TIP, NEV, EA_REST, EA_POLE, EA_CARD, EA_SEAT, MOUNT_NONE, I_ARMATURE,
@@ -243,6 +243,9 @@ def _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r
             for a in range(3):
                 Fw[a] = mag * (R[a, 0] * d0 + R[a, 1] * d1 + R[a, 2] * d2)
         else:
+            if load[ld, L_SN] > 0.0:  # follows its travel along d (world frame only)
+                mag *= table_value(tabs, int(load[ld, L_S0]), int(load[ld, L_SN]),
+                                   d0 * x[0] + d1 * x[1] + d2 * x[2] - load[ld, L_L0])
             Fw[0] = mag * d0
             Fw[1] = mag * d1
             Fw[2] = mag * d2

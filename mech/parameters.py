@@ -454,6 +454,12 @@ class PointForce:
     ``frame`` "world" (fixed) or "body" (turning with the bar's frame). magnitude: N,
     constant; or ``time`` (s) and ``value`` (N) tables, linear between points, or with
     ``interpolation = "pchip"`` a monotone cubic through them (mech.table_smoothing).
+    ``travel`` (m, strictly increasing) and ``share`` (1, in [0, 1], one per travel): the
+    force follows the travel of its point, the magnitude times share(travel), linear
+    between the points and held beyond the ends; the travel is the point's displacement
+    along ``direction`` from its start (world frame only): a finger that presses to its
+    force and no further than the key's travel (docs/mechanics.md, "Forces that follow
+    their travel").
     """
 
     position: float = 0.0
@@ -463,6 +469,8 @@ class PointForce:
     time: tuple | None = None
     value: tuple | None = None
     interpolation: str = "linear"
+    travel: tuple | None = None
+    share: tuple | None = None
     name: str = "force"
 
     def __post_init__(self):
@@ -486,6 +494,18 @@ class PointForce:
             object.__setattr__(self, "time", ts)
             object.__setattr__(self, "value", vs)
         check_choice(f"{n}.interpolation", self.interpolation, INTERPOLATIONS)
+        if self.travel is not None or self.share is not None:
+            if self.frame != "world":
+                raise ValueError(f"{n}.travel: a force that follows its travel acts along a fixed direction; "
+                                 f"{n}.frame = {self.frame!r} is not allowed with it (use \"world\")")
+            xs, ss = share_table(n, self.travel, self.share)
+            object.__setattr__(self, "travel", xs)
+            object.__setattr__(self, "share", ss)
+
+    @property
+    def follows_travel(self) -> bool:
+        """True for a force scaled by a table over its point's travel (travel and share)."""
+        return self.travel is not None
 
     def table(self) -> tuple[tuple, tuple]:
         """(times s, values N) of the magnitude the mechanics follows, linear between them
@@ -502,6 +522,33 @@ class PointForce:
         # (mech.model.loads_ramping, load_change_times)
         ts, vs = smooth_samples(self.time, self.value)
         return tuple(float(t) for t in ts), tuple(float(v) for v in vs)
+
+
+def share_table(name: str, travel, share) -> tuple[tuple, tuple]:
+    """(travels m, shares 1) of force ``name``'s travel table checked: both lists of finite
+    numbers, at least two and at most TABLE_POINTS_MAX travels, strictly increasing and
+    within LENGTH_MAX, one share in [0, 1] per travel. Errors name the key."""
+    for key, items in (("travel", travel), ("share", share)):
+        if items is None:
+            other = "share" if key == "travel" else "travel"
+            raise ValueError(f"{name}.{key}: missing; a force that follows its travel needs both {name}.travel (m) "
+                             f"and {name}.share (1, in [0, 1]), one share per travel (it has {name}.{other})")
+        if isinstance(items, (str, dict)) or not hasattr(items, "__iter__") or \
+                any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in items):
+            raise ValueError(f"{name}.{key} = {items!r:.80}: expected a list of numbers")
+    if len(travel) > TABLE_POINTS_MAX:
+        raise ValueError(f"{name}.travel: {len(travel)} points; at most {TABLE_POINTS_MAX} allowed")
+    xs = tuple(check_magnitude(f"{name}.travel[{k}]", v, LENGTH_MAX) for k, v in enumerate(travel))
+    ss = tuple(check_range(f"{name}.share[{k}]", v, 0.0, 1.0, closed_low=True, closed_high=True) for k, v in enumerate(share))
+    if len(xs) < 2:
+        raise ValueError(f"{name}.travel = {list(xs)!r}: {len(xs)} point(s); give at least two travels")
+    if len(ss) != len(xs):
+        raise ValueError(f"{name}.share: {len(ss)} shares for {len(xs)} travels; give one share per travel")
+    for k in range(1, len(xs)):
+        if xs[k] <= xs[k - 1]:
+            raise ValueError(f"{name}.travel[{k}] = {xs[k]!r}: travels must increase strictly (previous "
+                             f"{xs[k - 1]!r} m); the table gives one share per travel")
+    return xs, ss
 
 
 @dataclass(frozen=True)

@@ -145,7 +145,7 @@ SCENE = {
     "mount": {"kind": "-", "position": "m", "base_motion": "s, m", "stiffness": "N m/rad",
               "preload_torque": "N m", "damping": "N m s/rad"},
     "force": {"position": "m", "direction": "-", "frame": "-", "magnitude": "N", "time": "s", "value": "N",
-              "interpolation": "-"},
+              "interpolation": "-", "travel": "m", "share": "-"},
     "spring": {"anchor": "m", "position": "m", "stiffness": "N/m", "preload": "N", "rest_length": "m",
                "damping": "N s/m", "travel": "m", "force": "N", "release_force": "N"},
     "rivet": {"position": "m", "offset": "m", "radius": "m", "mass": "kg", "youngs_modulus": "Pa",

@@ -291,6 +291,7 @@ EXAMPLES = {
     "magnet.iron": [{"shape": "prism", "length": 0.02, "area": 5e-5, "material": "9SMnPb28"}],
     "magnet.fixed_gap": [{"tube": [{"shape": "axial", "length": 1e-4, "area": 2e-5}]}],
     "spring.travel": [-1e-3, 2e-3], "spring.force": [0.0, 2.0], "spring.release_force": [0.0, 0.5],
+    "force.travel": [0.0, 2e-3], "force.share": [1.0, 0.5],
     "rivet.name": "mid", "fixed.name": "NO", "fixed.radius": 2e-3, "fixed.facing": "down", "fixed.gap": 2e-3,
 }
 RC_PLAIN = "net\n.param RS=1\nV1 a 0 24\nXCONTACT a b\nVLOAD b c 0\nR1 c 0 {RS}\n"
@@ -332,6 +333,8 @@ def _base_and_key(section: str, key: str) -> tuple[dict, str]:
                  "fixed": {"point": "tip0", "gap": 1e-3}}[section]
         if section == "spring" and key in ("travel", "force", "release_force"):  # a force-travel spring's keys
             entry = {"travel": [0.0, 1e-3], "force": [0.0, 1.0]}
+        if section == "force" and key in ("travel", "share"):  # a force that follows its travel
+            entry = {"magnitude": 1.0, "travel": [0.0, 1e-3], "share": [1.0, 0.0]}
         if section == "fixed" and key in ("radius", "offset"):
             entry = dict(entry, shape="sphere", radius=1e-3)
         # a [[fixed]] entry's point tip0: the bar clamped at tip 1 (every contact point strikes one)
