@@ -1,7 +1,7 @@
 """A tactile switch: a snap dome pressed and released by a finger, and the RC that gives one edge each way.
 
 The key of examples/tactile_switch.toml (a plunger on a snap dome, docs/mechanics.md
-sections 12 and 13) is pressed by a finger force rising to 3 N in 10 ms, held, and released
+section 12) is pressed by a finger force rising to 3 N in 10 ms, held, and released
 over 10 ms; its contact pulls a microcontroller pin low behind the mcu_input template's
 pull-up R to 3.3 V, a 100 ohm series resistor and the filter C. The script reports the make
 and break patterns the model gives (make when the dome snaps past its 1.6 N peak, break
