@@ -551,6 +551,11 @@ def share_table(name: str, travel, share) -> tuple[tuple, tuple]:
     return xs, ss
 
 
+# what a spring's ``anchor`` end is fixed to: the frame, or the armature's point that moves
+# with it (mech.kernel: its anchor moves down along world -z by lever x (q - q0))
+SPRING_ENDS = ("frame", "armature")
+
+
 @dataclass(frozen=True)
 class Spring:
     """A spring and dashpot from a fixed world ``anchor`` (m) to the bar at ``position`` (m
@@ -564,7 +569,11 @@ class Spring:
     without it, its length at the start (travel 0 there). ``release_force`` (N, one per
     travel, at or below ``force``): the release branch of a spring with hysteresis, which
     follows the press table while pressed, the release table while released
-    (mech/travel_spring.py; it starts on the press branch)."""
+    (mech/travel_spring.py; it starts on the press branch). ``between``: "frame" (the
+    anchor fixed) or "armature" (the anchor is the armature's point at the start and moves
+    with it down, along world -z, by ``lever`` (m per unit of q; default 1 for a plunger,
+    needed for a clapper) times q - q0: a spring between the actuator and the moving part,
+    its reaction on the armature)."""
 
     anchor: tuple[float, float, float] = (0.0, 0.0, 0.0)
     position: float = 0.0
@@ -575,11 +584,19 @@ class Spring:
     travel: tuple | None = None
     force: tuple | None = None
     release_force: tuple | None = None
+    between: str = "frame"
+    lever: float | None = None
     name: str = "spring"
 
     def __post_init__(self):
         n = self.name
         object.__setattr__(self, "anchor", check_vector3(f"{n}.anchor", self.anchor, LENGTH_MAX))
+        check_choice(f"{n}.between", self.between, SPRING_ENDS)
+        if self.lever is not None:
+            if self.between != "armature":
+                raise ValueError(f"{n}.lever = {self.lever!r}: the lever moves a spring's end with the armature; "
+                                 f"it needs {n}.between = \"armature\"")
+            check_positive(f"{n}.lever", self.lever, high=LENGTH_MAX)
         check_finite(f"{n}.position", self.position)
         check_nonnegative(f"{n}.damping", self.damping, high=DAMPING_MAX)
         if self.preload is not None and self.rest_length is not None:
@@ -1049,6 +1066,13 @@ class MechScene:
                                  "x-z plane; the force must have no y component")
         for sp in self.springs:
             check_position(f"{sp.name}.position", sp.position, L)
+            if sp.between == "armature":
+                if not self.armature.present:
+                    raise ValueError(f"{sp.name}.between = 'armature': needs an [armature] (kind = 'plunger' or "
+                                     "'clapper') to carry the spring's anchor end")
+                if self.armature.kind == "clapper" and sp.lever is None:
+                    raise ValueError(f"{sp.name}.lever: needed for a spring on a clapper (m of the anchor's travel "
+                                     "per rad of the armature)")
             if mnt.held and sp.anchor[1] != 0.0:
                 raise ValueError(f"{sp.name}.anchor = {list(sp.anchor)!r}: a held bar moves in the "
                                  "x-z plane; the anchor must have y = 0")
