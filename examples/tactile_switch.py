@@ -30,6 +30,7 @@ from __future__ import annotations
 import json
 import math
 import sys
+import tomllib
 from pathlib import Path
 
 import matplotlib
@@ -48,6 +49,11 @@ CAPACITANCES = (1e-9, 10e-9, 100e-9)  # F
 FAST_PULLUPS = (1e3, 10e3)
 FAST_CAPACITANCES = (1e-9, 10e-9)
 MEASURED_RELEASE_CHATTER = 1.2e-3  # s: the issue's measurement (32 presses, 10 k pull-up)
+
+
+def release_start() -> float:
+    """s: when the finger starts to let go (the third point of its time table)."""
+    return float(tomllib.loads(SCENE.read_text())["force"][0]["time"][2])
 
 
 def base_scene(fast: bool = False):
@@ -71,13 +77,16 @@ def sweep(scene, pullups, capacitances) -> list[dict]:
     return rows
 
 
-def patterns(intervals: list) -> dict:
-    """The make pattern (first make, bounce openings until the contact stays closed, s) and
-    the break (the last break, and the reclosures after the finger let go: none here)."""
-    openings = [b[0] - a[1] for a, b in zip(intervals[:-1], intervals[1:])]
-    return dict(first_make=intervals[0][0], make_bounces=len(intervals) - 1, bounce_openings=openings,
-                settled_make=intervals[-1][0], last_break=intervals[-1][1],
-                make_chatter=intervals[-1][0] - intervals[0][0], release_chatter=0.0)
+def patterns(intervals: list, release: float) -> dict:
+    """The make pattern (first make, bounce openings, s) among the contacts that begin
+    before the finger starts to let go at ``release`` (s), and the break: the first break
+    after that, the last break and the chatter between them (s)."""
+    pressed = [iv for iv in intervals if iv[0] < release]
+    openings = [b[0] - a[1] for a, b in zip(pressed[:-1], pressed[1:])]
+    first_break = min(b for _, b in intervals if b > release)
+    return dict(first_make=pressed[0][0], make_bounces=len(pressed) - 1, bounce_openings=openings,
+                settled_make=pressed[-1][0], make_chatter=pressed[-1][0] - pressed[0][0],
+                first_break=first_break, last_break=intervals[-1][1], release_chatter=intervals[-1][1] - first_break)
 
 
 def plot(rows: list[dict], out: Path) -> None:
@@ -119,7 +128,7 @@ def main(fast: bool = False, out: str | Path | None = None) -> dict:
     crossing = math.log(circ.voltage / (circ.voltage - circ.logic_high))  # time constants from 0 to V_high
     numbers = dict(
         voltage=circ.voltage, series_resistance=circ.series_resistance, logic_low=circ.logic_low,
-        logic_high=circ.logic_high, patterns=patterns(rows[0]["closed_intervals"]),
+        logic_high=circ.logic_high, patterns=patterns(rows[0]["closed_intervals"], release_start()),
         grid=[{k: v for k, v in r.items() if k != "result"} for r in rows],
         chosen=None if chosen is None else {k: v for k, v in chosen.items() if k != "result"},
         measured_release_chatter=MEASURED_RELEASE_CHATTER,
@@ -137,8 +146,9 @@ def _summary(n: dict) -> str:
     lines = [f"make: first at {p['first_make'] * 1e3:.3f} ms, {p['make_bounces']} bounce(s) "
              f"(openings {', '.join(f'{g * 1e6:.1f}' for g in p['bounce_openings'])} us), closed for good at "
              f"{p['settled_make'] * 1e3:.3f} ms",
-             f"break: at {p['last_break'] * 1e3:.3f} ms, clean (the measured switch: up to "
-             f"{n['measured_release_chatter'] * 1e3:g} ms of chatter, not in this model)",
+             f"break: first at {p['first_break'] * 1e3:.3f} ms, last at {p['last_break'] * 1e3:.3f} ms: "
+             f"{p['release_chatter'] * 1e6:.0f} us of chatter (the measured switch: up to "
+             f"{n['measured_release_chatter'] * 1e3:g} ms)",
              "edges the input sees per press and release (rows: pull-up R, columns: C; 2 is one each way)",
              "R \\ C      " + "".join(f"{c * 1e9:>9g} nF" for c in caps)]
     for r in pullups:

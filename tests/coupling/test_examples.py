@@ -876,7 +876,7 @@ def test_tactile_switch_snaps_breaks_at_the_return_force_and_its_rc_gives_one_ed
     # the break on the release branch (the press branch there is 0.85 N: 60 % off)
     released = float(np.interp(gap, dome["travel"], dome["release_force"]))
     assert finger_force(p["last_break"]) == pytest.approx(released, rel=0.01)
-    assert finger["time"][2] < p["last_break"] < finger["time"][3]
+    assert finger["time"][2] < p["last_break"] < finger["time"][3] and p["release_chatter"] == 0.0
     for row in numbers["grid"]:
         assert row["status"] == "ok" and row["final_level"] == "high"  # released: the input reads high
         assert row["closed_intervals"][-1][1] == pytest.approx(p["last_break"], abs=1e-6)
