@@ -43,7 +43,7 @@ from .kernel_layout import (  # noqa: F401  (re-exported: the kernel's own names
     N_FPAR, I_N, I_PLANAR, I_FRICTION, I_MOUNT, I_NLOAD, I_INERTIA, N_IPAR, INERTIA_GRAM,
     INERTIA_SPARSE, FRICTION_NONE, FRICTION_EXACT, FRICTION_REGULARIZED, MOUNT_FREE, MOUNT_CLAMP,
     MOUNT_PIVOT, C_K, C_C, C_R, C_ON, LOAD_FORCE, LOAD_SPRING, LOAD_TRAVEL_SPRING, L_KIND, L_POINT, L_BODY, L_DX,
-    L_DY, L_DZ, L_T0, L_TN, L_AX, L_AY, L_AZ, L_K, L_C, L_L0, L_R0, L_KS, L_FLOOR, L_ZBACK, N_LOAD, FREE, SLIP, STICK,
+    L_DY, L_DZ, L_T0, L_TN, L_AX, L_AY, L_AZ, L_K, L_C, L_L0, L_R0, L_KS, L_FLOOR, L_ZBACK, L_S0, L_SN, L_ARM, L_Q0, N_LOAD, FREE, SLIP, STICK,
     Q_DNORMAL, Q_DFRICTION, Q_DMODAL, Q_WCOMP, Q_IMPULSE, Q_WIN, Q_DLOAD, NQ_FREE, NQ, A_Y,
     A_YDOT, A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_MARGIN, NAUX, EV_CONTACT, EV_CLIP, EV_SLIP,
     EV_STICK, EV_COMPRESSION, NEV_TIP, NEV, EA_REST, EA_POLE, EA_CARD, EA_SEAT, MOUNT_NONE, I_ARMATURE,
@@ -210,20 +210,33 @@ def load_point_motion(p, xc, psi, r, R, q, V, w, eta, n, x, v):
 
 
 @njit(cache=True)
-def spring_length(ld, load, x):
-    """Length (m) of spring ``ld`` with its bar end at world point x."""
+def anchor_height(ld, load, qa):
+    """m: world z of spring ``ld``'s anchor end, for the armature at q = qa when the end is
+    on it (moved down by its lever times q - q0), else fixed."""
+    if load[ld, L_ARM] != 0.0:
+        return load[ld, L_AZ] - load[ld, L_ARM] * (qa - load[ld, L_Q0])
+    return load[ld, L_AZ]
+
+
+@njit(cache=True)
+def spring_length(ld, load, x, qa=0.0):
+    """Length (m) of spring ``ld`` with its bar end at world point x (the armature at q = qa)."""
     d0 = x[0] - load[ld, L_AX]
     d1 = x[1] - load[ld, L_AY]
-    d2 = x[2] - load[ld, L_AZ]
+    d2 = x[2] - anchor_height(ld, load, qa)
     return math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
 
 
 @njit(cache=True)
-def _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r, f_e, Fw, Mw, y, dy):
+def _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r, f_e, Fw, Mw, y, dy,
+                qa=0.0, va=0.0):
     """Add load ``ld`` (actuator force, spring-dashpot or force-travel spring) to the
     generalized forces; a spring with hysteresis writes its stick force's rate into dy.
+    qa, va: the armature's q and rate (a spring whose anchor end it carries).
 
-    Returns (power the actuator puts in, W; power the dashpot and the hysteresis dissipate, W).
+    Returns (power the actuator puts in, W; power the dashpot and the hysteresis dissipate,
+    W; the spring's reaction on the armature along q, N or N m: lever times the world z of
+    its force on the bar, 0 for a load on the frame).
     """
     p = int(load[ld, L_POINT])
     x = np.empty(3)
@@ -243,21 +256,26 @@ def _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r
             for a in range(3):
                 Fw[a] = mag * (R[a, 0] * d0 + R[a, 1] * d1 + R[a, 2] * d2)
         else:
+            if load[ld, L_SN] > 0.0:  # follows its travel along d (world frame only)
+                mag *= table_value(tabs, int(load[ld, L_S0]), int(load[ld, L_SN]),
+                                   d0 * x[0] + d1 * x[1] + d2 * x[2] - load[ld, L_L0])
             Fw[0] = mag * d0
             Fw[1] = mag * d1
             Fw[2] = mag * d2
         p_in = Fw[0] * v[0] + Fw[1] * v[1] + Fw[2] * v[2]
     else:
-        length = spring_length(ld, load, x)
+        length = spring_length(ld, load, x, qa)
         if length > 0.0:
             e0 = (x[0] - load[ld, L_AX]) / length
             e1 = (x[1] - load[ld, L_AY]) / length
-            e2 = (x[2] - load[ld, L_AZ]) / length
+            e2 = (x[2] - anchor_height(ld, load, qa)) / length
         else:
             e0 = 0.0
             e1 = 0.0
             e2 = 0.0
         ldot = v[0] * e0 + v[1] * e1 + v[2] * e2
+        if load[ld, L_ARM] != 0.0:  # the anchor end moves down with the armature at lever x va
+            ldot += load[ld, L_ARM] * va * e2
         if load[ld, L_KIND] == LOAD_SPRING:
             f = -(load[ld, L_K] * (length - load[ld, L_L0]) + load[ld, L_C] * ldot)
         else:
@@ -281,7 +299,8 @@ def _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r
         Fw[2] = f * e2
         p_diss += load[ld, L_C] * ldot * ldot
     _add_force_at(p, s0, s1, s2, Fw, Mw, R, psi, theta, n, F, f_r, f_e)
-    return p_in, p_diss
+    # the reaction -Fw on the anchor end, which moves by (0, 0, -lever) per unit of q
+    return p_in, p_diss, load[ld, L_ARM] * Fw[2]
 
 
 @njit(cache=True)
@@ -466,7 +485,22 @@ def armature_force(t, y, mdl, arm):
     open_stops[EA_CARD] = aclosed[EA_CARD]
     terms = np.empty(4)
     armature_terms(t, qa, va, pen_c, rate_c, ipar, apar, again, open_stops, drive, terms)
-    return terms[0]
+    f = terms[0]
+    load, tabs, theta = mdl[11], mdl[12], mdl[7]
+    for ld in range(ipar[I_NLOAD]):  # the reaction of the springs the armature carries
+        if load[ld, L_ARM] != 0.0:
+            r = np.empty(3)
+            R = np.empty((3, 3))
+            q = np.empty(n)
+            V = np.empty(3)
+            w = np.empty(3)
+            eta = np.empty(n)
+            unpack(y, n, planar, r, R, q, V, w, eta)
+            dy = np.empty(y.shape[0])
+            _, _, f_l = _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, np.zeros(3),
+                                    np.zeros(3), np.zeros(n), np.zeros(3), np.zeros(3), y, dy, qa, va)
+            f += f_l
+    return f
 
 
 @njit(cache=True)
@@ -749,17 +783,26 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
 
     w_in = w_drive
     nload = ipar[I_NLOAD]
+    qa = 0.0
+    va = 0.0
+    if arm is not None:
+        off = arm_offset(n, planar, mount)
+        qa = y[off]
+        va = y[off + 1]
+    f_arm = 0.0  # the reaction on the armature of the springs it carries
     for ld in range(nload):
-        w_in_l, d_l = _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r, f_e, Fw, Mw,
-                                  y, dy)
+        w_in_l, d_l, f_l = _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r, f_e,
+                                       Fw, Mw, y, dy, qa, va)
         w_in += w_in_l
         d_load += d_l
+        f_arm += f_l
 
     if arm is not None:
         w_arm, d_arm = _armature_on_bar(t, y, n, planar, mount, ipar, arm, drive, xc, psi, theta,
                                         r, R, q, V, w, eta, F, f_r, f_e, Fw, Mw, sv)
         w_in += w_arm
         d_load += d_arm
+        sv[6] += f_arm
 
     _solve_mounted(mount, F, f_r, f_e, Ainv, B, m, n, Vdot, wdot, etadot)
 
@@ -1189,14 +1232,17 @@ def energies(y, mdl, work, out, arm=None):
     sp = 0.0
     x = np.empty(3)
     v = np.empty(3)
+    qa = 0.0
+    if arm is not None:
+        qa = y[arm_offset(n, planar, ipar[I_MOUNT])]
     for ld in range(ipar[I_NLOAD]):
         if load[ld, L_KIND] == LOAD_SPRING:
             load_point_motion(int(load[ld, L_POINT]), xc, psi, r, R, q, V, w, eta, n, x, v)
-            ext = spring_length(ld, load, x) - load[ld, L_L0]
+            ext = spring_length(ld, load, x, qa) - load[ld, L_L0]
             sp += 0.5 * load[ld, L_K] * ext * ext
         elif load[ld, L_KIND] == LOAD_TRAVEL_SPRING:
             load_point_motion(int(load[ld, L_POINT]), xc, psi, r, R, q, V, w, eta, n, x, v)
-            travel = load[ld, L_L0] - spring_length(ld, load, x)
+            travel = load[ld, L_L0] - spring_length(ld, load, x, qa)
             t0 = int(load[ld, L_T0])
             tn = int(load[ld, L_TN])
             u = travel_work(travel, tabs, t0, tn) - travel_work(0.0, tabs, t0, tn)

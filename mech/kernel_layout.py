@@ -66,11 +66,16 @@ MAX_PAIRS = 4
 # hysteresis also its release table (L_R0, same travels), the stick spring's stiffness L_KS
 # (N/m), the floor of the band's half-width L_FLOOR (N) and its state, the stick force z
 # (N), at y[len(y) - L_ZBACK] (the springs' states close the state vector, after the
-# quadratures; L_ZBACK 0: none)
+# quadratures; L_ZBACK 0: none). An actuator force that follows its travel: its share
+# table (travels m, shares 1) at L_S0 (L_SN points; 0: none) and its point's start along
+# its world direction, d . x_P(0), at L_L0 (m; its travel is d . x_P - L_L0). A spring
+# whose anchor end is on the armature: the lever L_ARM (m of the anchor's travel down,
+# world -z, per unit of q; 0: on the frame) and q at the start L_Q0, its anchor at
+# (L_AX, L_AY, L_AZ - L_ARM (q - L_Q0))
 LOAD_FORCE, LOAD_SPRING, LOAD_TRAVEL_SPRING = 0, 1, 2
 (L_KIND, L_POINT, L_BODY, L_DX, L_DY, L_DZ, L_T0, L_TN, L_AX, L_AY, L_AZ, L_K, L_C, L_L0,
- L_R0, L_KS, L_FLOOR, L_ZBACK) = range(18)
-N_LOAD = 18
+ L_R0, L_KS, L_FLOOR, L_ZBACK, L_S0, L_SN, L_ARM, L_Q0) = range(22)
+N_LOAD = 22
 # the armature (mech/armature.py): a rigid body with one coordinate q (m or rad, the travel
 # from its rest stop), its parameters in ``apar`` (SI: kg or kg m^2; m or rad; N/m or
 # N m/rad; N or N m; N s/m or N m s/rad; the card's lever m per unit q, free travel m,

@@ -30,7 +30,7 @@ from .contact_laws import hertz_stiffness
 from .kernel_layout import (
     C_C, C_K, C_N, C_ON, C_R, C_Z, CONTACT_ROWS, L_AX, L_AY, L_AZ, L_BODY, L_C, L_DX, L_DY, L_DZ, L_FLOOR, L_K,
     L_KIND, L_KS, L_R0, L_ZBACK,
-    L_POINT, L_T0, L_TN, LOAD_FORCE, LOAD_SPRING, LOAD_TRAVEL_SPRING, N_CPAR, N_LOAD,
+    L_ARM, L_POINT, L_Q0, L_S0, L_SN, L_T0, L_TN, LOAD_FORCE, LOAD_SPRING, LOAD_TRAVEL_SPRING, N_CPAR, N_LOAD,
 )
 from .modal_basis import ModalBasis
 from .parameters import MechScene
@@ -217,6 +217,15 @@ def build_arrays(scene: MechScene, planar: bool) -> MechanismArrays:
             row[L_AX], row[L_AY], row[L_AZ] = ld.anchor
             row[L_K] = 0.0 if ld.from_table else ld.stiffness
             row[L_C] = ld.damping
+            if ld.between == "armature":  # its anchor end moves with the armature
+                row[L_ARM] = 1.0 if ld.lever is None else ld.lever
+                row[L_Q0] = scene.armature.start_position
+    for k, f in enumerate(scene.forces):  # share tables of forces that follow their travel, after the time tables
+        if f.follows_travel:
+            load[k, L_S0] = len(times)
+            load[k, L_SN] = len(f.travel)
+            times += list(f.travel)
+            values += list(f.share)
     hysteretic = [k for k, ld in enumerate(loads) if k >= len(scene.forces) and ld.hysteretic]
     for k, ld in enumerate(loads):  # force-travel tables after every time table
         if k >= len(scene.forces) and ld.from_table:

@@ -356,6 +356,7 @@ def _pivot_parameters(fpar: np.ndarray, scene: MechScene, xc: np.ndarray) -> Non
 
 def _spring_rest_lengths(model: "BarModel") -> np.ndarray:
     """The load table with each spring's rest length (m) from its preload or rest_length,
+    and each force that follows its travel with its point's start along its direction (m),
     measured on the model's initial state."""
     scene = model.scene
     load = model.load.copy()
@@ -379,6 +380,10 @@ def _spring_rest_lengths(model: "BarModel") -> np.ndarray:
         else:
             rest = length
         load[row, L_L0] = rest
+    for row, f in enumerate(scene.forces):  # a force that follows its travel: its point's start along d
+        if f.follows_travel:
+            x = r0 + R0 @ xc[int(load[row, 1])]
+            load[row, L_L0] = float(np.dot(f.direction, x))
     return load
 
 
@@ -959,9 +964,10 @@ def build_model(scene: MechScene, *, input_work: bool = False) -> BarModel:
     model = BarModel(scene, planar, basis, cs, fpar, ipar, math.radians(scene.initial.azimuth_deg), atol, rel,
                      max_step, sparse_invariants(basis), mode_count=mode_count, drive_names=names, cdrive=cdrive,
                      input_work=input_work, pairs=pairs, **parts)
-    if arr is not None and arr.spring_points:
-        # the springs' rest lengths are measured on the initial state, which the other
-        # arrays define: a second, complete model with them
+    if arr is not None and (arr.spring_points or any(f.follows_travel for f in scene.forces)):
+        # the springs' rest lengths (and where a force that follows its travel starts) are
+        # measured on the initial state, which the other arrays define: a second, complete
+        # model with them
         model = replace(model, load=_spring_rest_lengths(model))
     if arm.has_card:
         # so is the height of the bar's card point, which places the card

@@ -492,6 +492,12 @@ class PointForce:
     ``frame`` "world" (fixed) or "body" (turning with the bar's frame). magnitude: N,
     constant; or ``time`` (s) and ``value`` (N) tables, linear between points, or with
     ``interpolation = "pchip"`` a monotone cubic through them (mech.table_smoothing).
+    ``travel`` (m, strictly increasing) and ``share`` (1, in [0, 1], one per travel): the
+    force follows the travel of its point, the magnitude times share(travel), linear
+    between the points and held beyond the ends; the travel is the point's displacement
+    along ``direction`` from its start (world frame only): a finger that presses to its
+    force and no further than the key's travel (docs/mechanics.md, "Forces that follow
+    their travel").
     """
 
     position: float = scene_key(0.0, unit="m", doc="along the bar from tip 0")
@@ -504,6 +510,15 @@ class PointForce:
         "linear", unit="-",
         doc='"linear" or "pchip": a monotone cubic through the table\'s points, held flat at its ends '
             '(docs/mechanics.md, "Smooth tables")')
+    travel: tuple | None = scene_key(
+        None, unit="m",
+        doc="with `share`: the force follows the travel of its point (its displacement along `direction` from its "
+            "start), >= 2 points, strictly increasing; world frame only (docs/mechanics.md, \"Forces that follow "
+            "their travel\")")
+    share: tuple | None = scene_key(
+        None, unit="-",
+        doc="in [0, 1], one per `travel`: the force is its magnitude times the share at its point's travel, linear "
+            "between points, held beyond the ends")
     name: str = internal("force")
 
     def __post_init__(self):
@@ -527,6 +542,18 @@ class PointForce:
             object.__setattr__(self, "time", ts)
             object.__setattr__(self, "value", vs)
         check_choice(f"{n}.interpolation", self.interpolation, INTERPOLATIONS)
+        if self.travel is not None or self.share is not None:
+            if self.frame != "world":
+                raise ValueError(f"{n}.travel: a force that follows its travel acts along a fixed direction; "
+                                 f"{n}.frame = {self.frame!r} is not allowed with it (use \"world\")")
+            xs, ss = share_table(n, self.travel, self.share)
+            object.__setattr__(self, "travel", xs)
+            object.__setattr__(self, "share", ss)
+
+    @property
+    def follows_travel(self) -> bool:
+        """True for a force scaled by a table over its point's travel (travel and share)."""
+        return self.travel is not None
 
     def table(self) -> tuple[tuple, tuple]:
         """(times s, values N) of the magnitude the mechanics follows, linear between them
@@ -545,6 +572,38 @@ class PointForce:
         return tuple(float(t) for t in ts), tuple(float(v) for v in vs)
 
 
+def share_table(name: str, travel, share) -> tuple[tuple, tuple]:
+    """(travels m, shares 1) of force ``name``'s travel table checked: both lists of finite
+    numbers, at least two and at most TABLE_POINTS_MAX travels, strictly increasing and
+    within LENGTH_MAX, one share in [0, 1] per travel. Errors name the key."""
+    for key, items in (("travel", travel), ("share", share)):
+        if items is None:
+            other = "share" if key == "travel" else "travel"
+            raise ValueError(f"{name}.{key}: missing; a force that follows its travel needs both {name}.travel (m) "
+                             f"and {name}.share (1, in [0, 1]), one share per travel (it has {name}.{other})")
+        if isinstance(items, (str, dict)) or not hasattr(items, "__iter__") or \
+                any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in items):
+            raise ValueError(f"{name}.{key} = {items!r:.80}: expected a list of numbers")
+    if len(travel) > TABLE_POINTS_MAX:
+        raise ValueError(f"{name}.travel: {len(travel)} points; at most {TABLE_POINTS_MAX} allowed")
+    xs = tuple(check_magnitude(f"{name}.travel[{k}]", v, LENGTH_MAX) for k, v in enumerate(travel))
+    ss = tuple(check_range(f"{name}.share[{k}]", v, 0.0, 1.0, closed_low=True, closed_high=True) for k, v in enumerate(share))
+    if len(xs) < 2:
+        raise ValueError(f"{name}.travel = {list(xs)!r}: {len(xs)} point(s); give at least two travels")
+    if len(ss) != len(xs):
+        raise ValueError(f"{name}.share: {len(ss)} shares for {len(xs)} travels; give one share per travel")
+    for k in range(1, len(xs)):
+        if xs[k] <= xs[k - 1]:
+            raise ValueError(f"{name}.travel[{k}] = {xs[k]!r}: travels must increase strictly (previous "
+                             f"{xs[k - 1]!r} m); the table gives one share per travel")
+    return xs, ss
+
+
+# what a spring's ``anchor`` end is fixed to: the frame, or the armature's point that moves
+# with it (mech.kernel: its anchor moves down along world -z by lever x (q - q0))
+SPRING_ENDS = ("frame", "armature")
+
+
 @dataclass(frozen=True)
 class Spring:
     """A spring and dashpot from a fixed world ``anchor`` (m) to the bar at ``position`` (m
@@ -558,7 +617,11 @@ class Spring:
     without it, its length at the start (travel 0 there). ``release_force`` (N, one per
     travel, at or below ``force``): the release branch of a spring with hysteresis, which
     follows the press table while pressed, the release table while released
-    (mech/travel_spring.py; it starts on the press branch)."""
+    (mech/travel_spring.py; it starts on the press branch). ``between``: "frame" (the
+    anchor fixed) or "armature" (the anchor is the armature's point at the start and moves
+    with it down, along world -z, by ``lever`` (m per unit of q; default 1 for a plunger,
+    needed for a clapper) times q - q0: a spring between the actuator and the moving part,
+    its reaction on the armature)."""
 
     anchor: tuple[float, float, float] = scene_key((0.0, 0.0, 0.0), unit="m", doc="world point")
     position: float = scene_key(0.0, unit="m", doc="along the bar from tip 0")
@@ -578,11 +641,26 @@ class Spring:
         None, unit="N",
         doc="with hysteresis: the release branch at each `travel`, at or below `force` (the spring follows "
             "`force` while pressed, `release_force` while released)")
+    between: str = scene_key(
+        "frame", unit="-",
+        doc='what the `anchor` end is fixed to: "frame", or "armature": the anchor is the armature\'s point at the '
+            "start and moves down (world -z) with it by `lever` x (q - q0), the spring's reaction acting on the "
+            'armature (docs/mechanics.md, "Springs between the armature and the bar")')
+    lever: float | None = scene_key(
+        None, unit="m per m or rad",
+        doc='with `between = "armature"`: the anchor\'s travel per unit of the armature\'s q; omitted: 1 for a '
+            "plunger, needed for a clapper")
     name: str = internal("spring")
 
     def __post_init__(self):
         n = self.name
         object.__setattr__(self, "anchor", check_vector3(f"{n}.anchor", self.anchor, LENGTH_MAX))
+        check_choice(f"{n}.between", self.between, SPRING_ENDS)
+        if self.lever is not None:
+            if self.between != "armature":
+                raise ValueError(f"{n}.lever = {self.lever!r}: the lever moves a spring's end with the armature; "
+                                 f"it needs {n}.between = \"armature\"")
+            check_positive(f"{n}.lever", self.lever, high=LENGTH_MAX)
         check_finite(f"{n}.position", self.position)
         check_nonnegative(f"{n}.damping", self.damping, high=DAMPING_MAX)
         if self.preload is not None and self.rest_length is not None:
@@ -1077,6 +1155,13 @@ class MechScene:
                                  "x-z plane; the force must have no y component")
         for sp in self.springs:
             check_position(f"{sp.name}.position", sp.position, L)
+            if sp.between == "armature":
+                if not self.armature.present:
+                    raise ValueError(f"{sp.name}.between = 'armature': needs an [armature] (kind = 'plunger' or "
+                                     "'clapper') to carry the spring's anchor end")
+                if self.armature.kind == "clapper" and sp.lever is None:
+                    raise ValueError(f"{sp.name}.lever: needed for a spring on a clapper (m of the anchor's travel "
+                                     "per rad of the armature)")
             if mnt.held and sp.anchor[1] != 0.0:
                 raise ValueError(f"{sp.name}.anchor = {list(sp.anchor)!r}: a held bar moves in the "
                                  "x-z plane; the anchor must have y = 0")

@@ -919,3 +919,47 @@ def test_changeover_arcs_go_out_at_their_throws_closed_form(changeover):
         loop = c["source_resistance"] + c["wiring_resistance"] + load + arc.resistance
         closed_form = (c["voltage"] - arc.min_voltage - arc.min_current * loop) / arc.column_gradient
         assert gap == pytest.approx(closed_form, rel=1e-3), name
+
+
+# --- tactile_switch: a snap dome pressed and released by a finger ---------------------------
+
+
+def test_tactile_switch_snaps_breaks_at_the_return_force_and_its_rc_gives_one_edge_each_way(tmp_path_factory):
+    """The finger (a time table rising to 3 N, held, falling) on the dome (press and release
+    branches, examples/tactile_switch.toml): the make comes only once the finger has passed
+    the dome's peak (1.6 N at 5.33 ms: below it the press branch holds the plunger
+    quasi-statically, the 0.5 ms ramp steps being far slower than its ~0.2 ms period); the
+    break comes when the finger has fallen to the dome's return force at the pad, its
+    release branch at the contact gap (the contact's elastic recovery of ~1 um unloads the
+    dome across its band, k_s = 1000 max F_h / span; within 1 %: the dashpot and the smooth
+    element's lag); nothing recloses after it. The pin's edges on each (R, C) are the
+    mcu_input network's closed form on the run's own contact intervals (_pin_edges), and the
+    chosen R C is the smallest that gives one edge per press and one per release."""
+    numbers, out = _run(tmp_path_factory, "tactile_switch")
+    doc = _toml("tactile_switch")
+    finger, dome, c = doc["force"][0], doc["spring"][0], doc["circuit"]
+    gap = doc["initial"]["height"]
+    peak = max(dome["force"][:4])
+
+    def finger_force(t):
+        return float(np.interp(t, finger["time"], finger["value"]))
+
+    p = numbers["patterns"]
+    t_peak = float(np.interp(peak, finger["value"][:2], finger["time"][:2]))
+    assert t_peak < p["first_make"] < finger["time"][1]
+    # the break on the release branch (the press branch there is 0.85 N: 60 % off)
+    released = float(np.interp(gap, dome["travel"], dome["release_force"]))
+    assert finger_force(p["last_break"]) == pytest.approx(released, rel=0.01)
+    assert finger["time"][2] < p["last_break"] < finger["time"][3] and p["release_chatter"] == 0.0
+    for row in numbers["grid"]:
+        assert row["status"] == "ok" and row["final_level"] == "high"  # released: the input reads high
+        assert row["closed_intervals"][-1][1] == pytest.approx(p["last_break"], abs=1e-6)
+        expected, margin = _pin_edges(row["closed_intervals"], doc["solver"]["t_end"], c,
+                                      row["pull_resistance"], row["input_capacitance"])
+        assert margin > 0.02 * c["voltage"] and row["edges"] == expected, row
+    chosen = numbers["chosen"]
+    assert chosen is not None and chosen["edges"] == 2
+    assert chosen["rc"] == min(r["rc"] for r in numbers["grid"] if r["edges"] == 2)
+    assert any(r["edges"] > 2 for r in numbers["grid"])  # the make's bounce: the smallest R C sees it
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["logic"]["edges"] == 2

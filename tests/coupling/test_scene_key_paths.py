@@ -291,6 +291,8 @@ EXAMPLES = {
     "magnet.iron": [{"shape": "prism", "length": 0.02, "area": 5e-5, "material": "9SMnPb28"}],
     "magnet.fixed_gap": [{"tube": [{"shape": "axial", "length": 1e-4, "area": 2e-5}]}],
     "spring.travel": [-1e-3, 2e-3], "spring.force": [0.0, 2.0], "spring.release_force": [0.0, 0.5],
+    "force.travel": [0.0, 2e-3], "force.share": [1.0, 0.5],
+    "spring.between": "armature", "spring.lever": 2.0,
     "rivet.name": "mid", "fixed.name": "NO", "fixed.radius": 2e-3, "fixed.facing": "down", "fixed.gap": 2e-3,
     "circuit.nc_load_resistance": 20.0,
 }
@@ -333,6 +335,12 @@ def _base_and_key(section: str, key: str) -> tuple[dict, str]:
                  "fixed": {"point": "tip0", "gap": 1e-3}}[section]
         if section == "spring" and key in ("travel", "force", "release_force"):  # a force-travel spring's keys
             entry = {"travel": [0.0, 1e-3], "force": [0.0, 1.0]}
+        if section == "force" and key in ("travel", "share"):  # a force that follows its travel
+            entry = {"magnitude": 1.0, "travel": [0.0, 1e-3], "share": [1.0, 0.0]}
+        if section == "spring" and key in ("between", "lever"):  # a spring the armature carries (lever)
+            entry = dict(entry, between="armature") if key == "lever" else entry
+            armature = {"armature": {"kind": "plunger", "mass": 1e-3, "travel": 1e-3, "stop_stiffness": 1e6}}
+            return {section: [entry], **armature, "bar": {}, "solver": {"t_end": 1e-3}}, f"{section}[0].{key}"
         if section == "fixed" and key in ("radius", "offset"):
             entry = dict(entry, shape="sphere", radius=1e-3)
         # a [[fixed]] entry's point tip0: the bar clamped at tip 1 (every contact point strikes one)
