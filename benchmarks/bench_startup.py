@@ -11,12 +11,18 @@ Baselines measured in the same run: `python -c pass` and `python -c "import nump
 on a loaded machine everything scales, so the ratios to them are printed too.
 
 Then where the time goes: a fresh interpreter timing the steps of `switchsim run`
-(imports, scene, run, soundness, writing), with its start and exit timed from outside.
-The AOT module of this tree is built by the warm-up if missing. Not a test: run by hand,
+(imports, scene, run, soundness, writing), with its start and exit timed from outside,
+and inside them the model build, ngspice's start, the mechanics and the circuit of the
+co-simulation, and each output file. The AOT module of this tree is built by the warm-up
+if missing. Not a test: run by hand,
 
-    .venv/bin/python benchmarks/bench_startup.py [--repeat 5] [--no-write]
+    .venv/bin/python benchmarks/bench_startup.py [--repeat 5] [--no-write] [--baseline DIR]
 
 It rewrites the block between the bench_startup markers in docs/benchmarks.md.
+--baseline DIR: also time the default scene and the plunger example from another tree of
+the project (its own AOT module built by its warm-up), each repetition alternating the two
+trees, and print both ratios to `import numpy` (a before/after in one run; not written to
+the docs).
 """
 
 from __future__ import annotations
@@ -56,17 +62,17 @@ t_end = 0.0009
 NO_OUTPUT = "\n[output]\ncsv = false\nparquet = false\nplots = false\nhistory = false\nhtml = false\n"
 
 
-def _env() -> dict:
-    return dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""),
+def _env(root: Path = ROOT) -> dict:
+    return dict(os.environ, PYTHONPATH=str(root) + os.pathsep + os.environ.get("PYTHONPATH", ""),
                 MPLBACKEND="Agg")
 
 
-def whole_process(cmd: list[str], repeat: int) -> tuple[float, float, float]:
+def whole_process(cmd: list[str], repeat: int, root: Path = ROOT) -> tuple[float, float, float]:
     """(median wall s, min wall s, max peak RSS MiB) of a command started `repeat` times."""
     walls, rss = [], []
     for _ in range(repeat):
         tick = time.perf_counter()
-        proc = subprocess.Popen(cmd, env=_env(), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        proc = subprocess.Popen(cmd, env=_env(root), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         _, status, usage = os.wait4(proc.pid, 0)
         walls.append(time.perf_counter() - tick)
         if os.waitstatus_to_exitcode(status) != 0:
@@ -85,6 +91,23 @@ PHASES = textwrap.dedent("""
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # as coupling.app.cli.main sets it
     from coupling.core.master import run
     mark("import coupling.core.master (numpy, mech, the compiled module)")
+    parts = {}  # seconds inside the phases: the callables below, timed where they are called
+    def timed(owner, name, label=None):
+        inner = getattr(owner, name)
+        def wrapper(*args, **kw):
+            tick = time.perf_counter()
+            try:
+                return inner(*args, **kw)
+            finally:
+                key = label or (args[0].name if name in ("write_csv", "write_parquet") else name)
+                parts[key] = parts.get(key, 0.0) + time.perf_counter() - tick
+        setattr(owner, name, wrapper)
+    import mech.solver, circuit, coupling.app.output as output, coupling.app.waveview as waveview
+    timed(mech.solver, "build_model", "model build (modes, FE eigenproblem)")
+    timed(circuit.Stepper, "__init__", "ngspice start (netlist, operating point)")
+    for name in ("write_csv", "write_parquet"):
+        timed(output, name)
+    timed(waveview, "write_waveform_html", "waveforms.html")
     from coupling.app.output import ResultFolder, scene_identity
     from coupling.core.scene import default_scene, load_scene
     from coupling.core.soundness import assess
@@ -101,9 +124,10 @@ PHASES = textwrap.dedent("""
     import gc
     gc.freeze()  # as coupling.app.cli.main does when the process's own command line returns
     phases = [(b[0], b[1] - a[1]) for a, b in zip(marks, marks[1:])]
+    steps = result.mechanics.stats["steps"] if result.mechanics is not None else 0
     print(json.dumps(dict(phases=phases, wall_time=stats.get("wall_time", 0.0),
                           mech=stats.get("mech_seconds"), circuit=stats.get("circuit_seconds"),
-                          wall0=wall0, wall1=time.time())), flush=True)
+                          parts=parts, steps=steps, wall0=wall0, wall1=time.time())), flush=True)
 """)
 
 
@@ -119,6 +143,31 @@ def phases(scene: str, out: str) -> dict:
                      + [("exit (interpreter teardown)", end - doc["wall1"])])
     doc["whole"] = end - spawn
     return doc
+
+
+def compare_trees(baseline: Path, solenoid: Path, tmp: Path, repeat: int) -> None:
+    """The default scene and the plunger example whole process in this tree and in
+    ``baseline``, alternating repetition by repetition, with `import numpy` between them:
+    medians and ratios, printed."""
+    py = sys.executable
+    subprocess.run([py, "-c", "import coupling.core.master"], env=_env(baseline), check=True)  # its AOT build
+    cmds = {
+        "import numpy": ([py, "-c", "import numpy"], None),
+        "default scene": ([py, "-m", "coupling.app.cli", "run", "--out", str(tmp / "cmp"), "--quiet",
+                           "--overwrite"], "both"),
+        "plunger solenoid": ([py, "-m", "coupling.app.cli", "run", str(solenoid), "--out", str(tmp / "cmp"),
+                              "--quiet", "--overwrite"], "both"),
+    }
+    walls: dict = {}
+    for _ in range(repeat):
+        for label, (cmd, trees) in cmds.items():
+            for tree, root in (("this tree", ROOT), ("baseline", baseline)) if trees else (("", ROOT),):
+                walls.setdefault((label, tree), []).append(whole_process(cmd, 1, root)[0])
+    numpy = statistics.median(walls[("import numpy", "")])
+    print(f"\nthis tree against {baseline} (alternating, median of {repeat}; `import numpy` {numpy:.3f} s):")
+    for label in ("default scene", "plunger solenoid"):
+        a, b = (statistics.median(walls[(label, t)]) for t in ("baseline", "this tree"))
+        print(f"  {label:17s} baseline {a:.3f} s ({a / numpy:.1f}x)  this tree {b:.3f} s ({b / numpy:.1f}x)")
 
 
 def _bytecode_note() -> str:
@@ -138,6 +187,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--no-write", action="store_true", help="print only; leave docs/benchmarks.md alone")
+    parser.add_argument("--baseline", type=Path, help="another tree of the project to compare with (printed only)")
     args = parser.parse_args()
     py = sys.executable
     tmp = Path(tempfile.mkdtemp(prefix="bench_startup_"))
@@ -175,6 +225,8 @@ def main() -> None:
         rows.append((label, med, best, rss))
         print(f"{label:45s} {med:6.3f} s (best {best:.3f}), peak RSS {rss:.0f} MiB", flush=True)
     base = rows[1][1]
+    if args.baseline:
+        compare_trees(args.baseline.resolve(), solenoid, tmp, args.repeat)
     mech_phases = phases(str(mech), str(tmp / "pm"))
     coupled_phases = phases("default", str(tmp / "pc"))
     try:
@@ -213,6 +265,11 @@ def main() -> None:
                  f"{coupled_phases['wall_time']:.3f} s |")
     lines.append(f"| (of that: mechanics / circuit, coupled) | - | {coupled_phases['mech'] or 0:.3f} s / "
                  f"{coupled_phases['circuit'] or 0:.3f} s |")
+    mparts, cparts = mech_phases["parts"], coupled_phases["parts"]
+    for name in cparts:
+        m = f"{mparts[name]:.3f} s" if name in mparts else "-"
+        lines.append(f"| (inside: {name}) | {m} | {cparts[name]:.3f} s |")
+    lines.append(f"| (mechanics steps) | {mech_phases['steps']} | {coupled_phases['steps']} |")
     lines.append(f"| whole process, this measurement | {mech_phases['whole']:.3f} s | {coupled_phases['whole']:.3f} s |")
     block = "\n".join(lines)
     print("\n" + block)

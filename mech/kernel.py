@@ -49,7 +49,7 @@ from .kernel_layout import (  # noqa: F401  (re-exported: the kernel's own names
     EV_STICK, EV_COMPRESSION, NEV_TIP, NEV, EA_REST, EA_POLE, EA_CARD, EA_SEAT, MOUNT_NONE, I_ARMATURE,
     I_ARM_DRIVE,
     I_ARM_CARD, I_ARM_NGAIN, AP_MASS, AP_TRAVEL, AP_RATE, AP_PRELOAD, AP_STOP_K, AP_STOP_C, AP_DAMPING, AP_LEVER,
-    AP_FREE, AP_CARD_K, AP_CARD_C, AP_CARD_Z0, AP_HMAX, N_ARM, NEV_ARM, EA_TURN,
+    AP_FREE, AP_CARD_K, AP_CARD_C, AP_CARD_Z0, AP_HMAX, N_ARM, NEV_ARM, EA_TURN, BAR_HELD,
     state_sizes, armature_offset,
 )
 
@@ -852,6 +852,11 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
             dy[13 + n + j] = etadot[j]
     base = npos + nvel
     if arm is not None:
+        if arm[2].shape[0] > BAR_HELD and arm[2][BAR_HELD] != 0.0:
+            # held at rest in flight (its speeds zero, its accelerations the static
+            # equilibrium's residue): the bar's modes then set no step, the armature's do
+            for k in range(base):
+                dy[k] = 0.0
         _armature_rates(y, base, arm, sv, dy)
         base += N_ARM
     dy[base + Q_DNORMAL] = d_normal

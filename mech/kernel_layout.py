@@ -114,6 +114,12 @@ NEV_TIP = 5
 # stop (held there, its stop's force the reaction; docs/mechanics.md, "The armature")
 EA_REST, EA_POLE, EA_CARD, EA_TURN, EA_SEAT = range(5)
 NEV_ARM = 5
+# one more entry of that array, after the events' (``aclosed[BAR_HELD]``): 1.0 while the bar
+# is held at its static equilibrium in flight, nothing touching it, while the armature moves
+# (the kernel then gives the bar's positions and speeds zero rates; mech.solver, "held in
+# flight"); N_ACLOSED: the array's length
+BAR_HELD = NEV_ARM
+N_ACLOSED = NEV_ARM + 1
 NEV = CONTACT_ROWS * NEV_TIP + NEV_ARM  # events of a model of CONTACT_ROWS rows (event_count)
 
 

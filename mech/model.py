@@ -25,7 +25,7 @@ from .kernel_layout import (
     N_DRIVE, AP_CARD_C, AP_CARD_K, AP_CARD_Z0, AP_DAMPING, AP_FREE, AP_LEVER, AP_MASS, AP_PRELOAD, AP_RATE,
     AP_HMAX, AP_STOP_C, AP_STOP_K, AP_TRAVEL, I_ARMATURE, I_ARM_CARD, I_ARM_DRIVE, I_ARM_NGAIN, MOUNT_NONE, N_APAR,
     N_ARM,
-    NEV_ARM,
+    N_ACLOSED,
     armature_offset,
     F_VREG, FRICTION_EXACT, FRICTION_NONE, FRICTION_REGULARIZED, I_FRICTION, I_N,
     I_PLANAR, I_MOUNT, I_NLOAD, MOUNT_CLAMP, MOUNT_FREE, MOUNT_PIVOT, N_FPAR,
@@ -594,8 +594,9 @@ class BarModel:
 
     def kernel_armature(self, closed: np.ndarray):
         """The kernel's armature argument (kernel.dynamics: ``arm``): None without an
-        armature, else (apar, again, closed) with ``closed`` (float64[NEV_ARM], kernel_layout
-        EA_*) the states of its stops and card that the solver keeps."""
+        armature, else (apar, again, closed) with ``closed`` (float64[N_ACLOSED], kernel_layout
+        EA_* and BAR_HELD) the states of its stops and card, and the bar's hold in flight,
+        that the solver keeps."""
         if not self.has_armature:
             return None
         return (self.apar, self.again, closed)
@@ -604,7 +605,7 @@ class BarModel:
     def armature_arrays(self):
         """``kernel_armature`` with every stop and the card open, the same tuple on every call
         (for what follows from the state alone: energies, the armature's table)."""
-        return self.kernel_armature(np.zeros(NEV_ARM))
+        return self.kernel_armature(np.zeros(N_ACLOSED))
 
     @property
     def has_bar(self) -> bool:

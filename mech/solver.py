@@ -32,10 +32,10 @@ from .compiled import (
     energies, energy_table, event_values, make_work, project_to_stick,
 )
 from .kernel_layout import (
-    A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, BUFFER_FULL, C_N, C_ON, C_R, DONE, EV_CLIP,
+    A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, BAR_HELD, BUFFER_FULL, C_N, C_ON, C_R, DONE, EV_CLIP,
     EV_COMPRESSION, D_SLOPE, D_VALUE, EA_CARD, EA_POLE, EA_REST, EA_SEAT, EA_TURN, EV_CONTACT, EV_SLIP, EV_STICK,
-    EVENT, F_MASS, FREE, FRICTION_EXACT, I_FRICTION, NAUX, NEV_ARM, NEV_TIP, Q_WIN, SLIP, STATUS_TEXT, STICK,
-    state_sizes,
+    EVENT, F_MASS, FREE, FRICTION_EXACT, I_FRICTION, I_MOUNT, MOUNT_CLAMP, MOUNT_PIVOT, N_ACLOSED, NAUX,
+    NEV_TIP, Q_WIN, SLIP, STATUS_TEXT, STICK, state_sizes,
 )
 from .contact_laws import hertz_impact
 from .drives import set_step, step_targets, values_at
@@ -52,6 +52,7 @@ REGIME_NAMES = ("free", "slip", "stick")
 EVENT_KINDS = ("contact", "clip", "slip", "stick", "compression")
 ARMATURE_EVENTS = {EA_REST: ("armature_stop", "rest"), EA_POLE: ("armature_stop", "pole"), EA_CARD: ("card", "")}
 CHATTER_LIMIT = 200  # events at one instant (within round-off) before the run is stopped
+FLIGHT_RETRY = 0.125  # of the rest window: how soon a bar found not at rest in flight is looked at again
 
 
 class MechSolverError(RuntimeError):
@@ -115,6 +116,7 @@ class Segment:
     _pairs_last: np.ndarray = field(repr=False, default=None)
     _arm_t: float = field(repr=False, default=float("nan"))
     _arm_last: tuple = field(repr=False, default=(0.0, 0.0))
+    _arm_index: int = field(repr=False, default=-2)  # the model's armature_index, once asked (-2: not yet)
 
     def state(self, t: float) -> np.ndarray:
         """State vector at time t (s) in [t_start, t_end] (4th-order dense output)."""
@@ -153,7 +155,9 @@ class Segment:
         Repeated calls at the same t are cached."""
         if t == self._arm_t:
             return self._arm_last
-        a = self._model.armature_index
+        a = self._arm_index
+        if a == -2:  # (a property: asked once, not at each of the coil's samples)
+            a = self._arm_index = self._model.armature_index
         if a < 0:
             raise ValueError("Segment.armature: this model has no armature (the scene has no [armature])")
         if not (self.t_start - 1e-15 <= t <= self.t_end + 1e-15):
@@ -166,11 +170,13 @@ class Segment:
                                  "ImpactSolver(scene, keep_dense=True)")
             k = min(int(np.searchsorted(self._t_valid, t)), len(self._t_valid) - 1)
             c = self._coef[k]
-            th = (t - self._t0[k]) / self._h[k]
+            th = float((t - self._t0[k]) / self._h[k])
             t1 = 1.0 - th
             # (mech.integrator.dense_eval on the armature's two components only)
-            out = tuple(float(c[0, i] + th * (c[1, i] + t1 * (c[2, i] + th * (c[3, i] + t1 * c[4, i]))))
-                        for i in (a, a + 1))
+            c0, c1, c2, c3, c4 = c[:, a].tolist()
+            d0, d1, d2, d3, d4 = c[:, a + 1].tolist()
+            out = (c0 + th * (c1 + t1 * (c2 + th * (c3 + t1 * c4))),
+                   d0 + th * (d1 + t1 * (d2 + th * (d3 + t1 * d4))))
         self._arm_t, self._arm_last = t, out
         return out
 
@@ -229,12 +235,15 @@ class ImpactSolver:
     """Integrates one mechanics scene; see the module docstring for the regimes."""
 
     def __init__(self, scene: MechScene, *, keep_dense: bool = False, capacity: int = 4096,
-                 backend: str = "dopri5", coupled: CoupledStates | None = None, input_work: bool = False):
+                 backend: str = "dopri5", coupled: CoupledStates | None = None, input_work: bool = False,
+                 hold_in_flight: bool = True):
         """backend: "dopri5" (the compiled loop) or "scipy:<method>" (solve_ivp with
         RK45, DOP853, Radau, BDF or LSODA on the same right-hand side and events).
         input_work: keep the input-work quadrature (the audit's ``work_in``) on a free bar
         without loads too, so that a driven force ("repulsion.<i>") may act on it (a held
-        bar or one with loads always has it; without, a free bar's state is what it was)."""
+        bar or one with loads always has it; without, a free bar's state is what it was).
+        hold_in_flight: hold a clamped or pivoted bar at rest in flight (_watch_flight);
+        False integrates it throughout (to compare with)."""
         if backend != "dopri5" and not (backend.startswith("scipy:") and backend[6:] in SCIPY_METHODS):
             raise ValueError(f"backend = {backend!r}: allowed values are 'dopri5' or 'scipy:<method>' with "
                              f"<method> one of {', '.join(SCIPY_METHODS)}")
@@ -274,7 +283,7 @@ class ImpactSolver:
             self.drive[m.drive_rows("mu"), D_VALUE] = coupled.friction_coefficient(0.0, self.z)
         # which of the armature's stops and card are closed (kernel_layout EA_*): set at its
         # events from the watched sides (_armature_signs), read by the kernel
-        self.armature_closed = np.zeros(NEV_ARM)
+        self.armature_closed = np.zeros(N_ACLOSED)
         self.arrays = m.kernel_arrays(self.drive)
         self.arm = m.kernel_armature(self.armature_closed)  # (None without an armature)
         keep = scene.solver.history_rows
@@ -299,6 +308,13 @@ class ImpactSolver:
         self._rest_ke = 0.0
         self._rest_e = np.empty(5)
         self.holds: list[list[float]] = []  # [start, end] of each hold at rest (s)
+        # the bar held in flight while the armature moves (_watch_flight): until when (s),
+        # the step before it (s), the next time to look for it (s), [start, end] of each
+        self._flight_until = -math.inf
+        self._flight_h = 0.0
+        self._hold_in_flight = hold_in_flight
+        self._flight_next = 0.0 if hold_in_flight else math.inf
+        self.flight_holds: list[list[float]] = []
         if self._jumps and self._jumps[0][0] == 0.0:
             self._apply_base_jump(resolve=False)
         self._initial_state = self.y.copy()
@@ -314,6 +330,8 @@ class ImpactSolver:
         self._resolve(triggered=None)
         if m.has_armature:
             self._seat(start=True)  # at rest on a stop it is pressed onto: seated from the start
+        self._settle_start()
+        self._watch_flight()
         self._record_point()
 
     # --- public API -------------------------------------------------------------------
@@ -402,6 +420,11 @@ class ImpactSolver:
             jump_due = self._jump_index < len(self._jumps) and self._jumps[self._jump_index][0] <= t_target
             if jump_due:
                 goal = max(self._jumps[self._jump_index][0], self.t)
+            if self.armature_closed[BAR_HELD]:  # held in flight: until the next load change
+                if self._flight_until <= self.t:
+                    self._release_flight()
+                elif self._flight_until < goal:
+                    goal, jump_due = self._flight_until, False
             if self._hold_until > self.t:
                 # at rest: nothing changes until a load or the base does
                 self.t = min(goal, self._hold_until)
@@ -434,6 +457,8 @@ class ImpactSolver:
                 self.t = goal
             if status in (DONE, BUFFER_FULL, EVENT):
                 self._watch_rest(n0, n_rec)
+            if status in (DONE, BUFFER_FULL) and not self.armature_closed[BAR_HELD] and self._hold_until <= self.t:
+                self._watch_flight()
             if status == DONE:
                 if jump_due and self._jumps[self._jump_index][0] == goal:
                     self._apply_base_jump()
@@ -443,6 +468,8 @@ class ImpactSolver:
             if status == EVENT:
                 n_events = len(self.events)
                 self._handle_event(ev)
+                if not self.armature_closed[BAR_HELD] and self._hold_until <= self.t:
+                    self._watch_flight()  # (the card has left the bar, say)
                 if ev % NEV_TIP == EV_CONTACT:  # a contact made or broken: not at rest
                     self._restart_rest_window()
                     if stop_at_switch and t_new > t_start and any(
@@ -640,9 +667,14 @@ class ImpactSolver:
         self._initial_state = self.y.copy()
         self.recorder.truncate(0)
         self.armature_closed[:] = 0.0
+        self._hold_until = -math.inf
+        self.holds, self.flight_holds = [], []
+        self._flight_until = -math.inf
+        self._flight_next = 0.0 if self._hold_in_flight else math.inf
         self._resolve(triggered=None)
         if self.model.has_armature:
             self._seat(start=True)
+        self._watch_flight()
         self._record_point()
 
     def checkpoint(self) -> dict:
@@ -653,7 +685,9 @@ class ImpactSolver:
                     n_events=len(self.events), projection_energy=self.projection_energy,
                     drive=self.drive.copy(), jump_index=self._jump_index, armature=self.armature_closed.copy(),
                     rest=(self._hold_until, self._hold_regime.copy(), self._rest_t0, self._rest_ke,
-                          [list(h) for h in self.holds]))
+                          [list(h) for h in self.holds]),
+                    flight=(self._flight_until, self._flight_h, self._flight_next,
+                            [list(h) for h in self.flight_holds]))
 
     def restore(self, cp: dict) -> None:
         """Return to a ``checkpoint`` (e.g. to redo a coupling step so it ends at an event)."""
@@ -676,6 +710,8 @@ class ImpactSolver:
         self._hold_until, hold_regime, self._rest_t0, self._rest_ke, holds = cp["rest"]
         self._hold_regime = hold_regime.copy()
         self.holds = [list(h) for h in holds]
+        self._flight_until, self._flight_h, self._flight_next, flights = cp["flight"]
+        self.flight_holds = [list(h) for h in flights]
 
     def contact_series(self, times) -> np.ndarray:
         """(len(times), rows, 3): per contact row penetration (m), rate (m/s), normal force
@@ -716,6 +752,13 @@ class ImpactSolver:
         """True while the bar is held at rest (see _watch_rest): nothing in it changes before
         ``hold_until`` unless mu changes enough to unstick a contact or a repulsion changes."""
         return self._hold_until > self.t
+
+    @property
+    def held_in_flight(self) -> bool:
+        """True while the bar is held at its static equilibrium in flight while the armature
+        moves (see _watch_flight): the bar's state stays as it is until the card meets it or
+        a load changes; the armature is integrated as ever."""
+        return bool(self.armature_closed[BAR_HELD])
 
     @property
     def hold_until(self) -> float:
@@ -900,6 +943,124 @@ class ImpactSolver:
         self.projection_energy += float(e.sum()) - before
         return True
 
+    def _watch_flight(self) -> None:
+        """Hold a bar that is at rest in flight (nothing touches it) until the card meets it
+        or a load changes.
+
+        At rest in flight means: a clamped or pivoted bar, its base still, no contact
+        closed, the card open, no hysteretic spring, no load on a ramp, and its mechanical
+        energy above its static equilibrium under the loads acting (kinetic energy plus
+        the strain, gravity and spring energy above the equilibrium's) within what the run
+        resolves, rtol x the scene's energy scale (as a hold at rest: _watch_rest). Under
+        constant loads and with nothing touching it, a bar's mechanical energy can only
+        fall (its modal damping and dashpots dissipate, nothing does work on it), so one
+        look suffices: the energy above the equilibrium stays below that tolerance for as
+        long as the loads stay. The bar is moved to that equilibrium (found by
+        _static_equilibrium, which checks its residual acceleration), its speeds zero, and
+        the energy this removes is credited to the audit with the stick projections.
+
+        Held, with an armature: the kernel gives the bar's positions and speeds zero rates
+        (kernel_layout BAR_HELD) and the armature is integrated as ever, at the steps its own
+        motion needs instead of the bar's highest mode's stability limit; the card's event
+        (its gap to the bar's card point reaching zero) releases the bar there, at the
+        state it was held in. Without an armature nothing moves: the whole state is held as
+        at rest (``at_rest``, ``hold_until``). Either ends at the next load change (a force
+        table's breakpoint, a base velocity jump). A bar found not at rest is looked at again
+        FLIGHT_RETRY rest windows later.
+        """
+        m = self.model
+        if self.t < self._flight_next or not m.has_bar or m.hysteresis_count:
+            return
+        sl = m.slices()
+        mount = m.ipar[I_MOUNT]
+        base_still = np.all(self.y[sl["vel"]] == 0.0) and (mount == MOUNT_PIVOT or np.all(self.y[sl["omega"]] == 0.0))
+        if (mount not in (MOUNT_CLAMP, MOUNT_PIVOT) or not base_still or np.any(self.regime != FREE)
+                or (m.has_armature and self.armature_closed[EA_CARD]) or m.loads_ramping(self.t)):
+            return
+        aux = self._evaluate()
+        if np.any(aux[:, A_Y] > 0.0):
+            return
+        self._flight_next = self.t + FLIGHT_RETRY * m.rest_window
+        tol = self.scene.solver.rtol * m.contact.energy_scale
+        e = self._rest_e
+        energies(self.y, self.arrays, self.work, e, self.arm)
+        before = float(e.sum())
+        npos, nvel = state_sizes(m.n, m.planar)
+        pos, vel = slice(0, npos), slice(npos, npos + nvel)
+        saved = (self.y.copy(), self.regime.copy(), self.eref.copy(), self.ev_sign.copy(),
+                 self.armature_closed.copy())
+        self.y[vel] = 0.0
+        energies(self.y, self.arrays, self.work, e, self.arm)
+        held = before - float(e.sum()) <= tol  # its kinetic energy alone (cheap: no equilibrium sought)
+        if held:
+            held = self._static_equilibrium(pos, vel, armature=False)
+        if held:
+            energies(self.y, self.arrays, self.work, e, self.arm)
+            drop = before - float(e.sum())
+            aux = self._evaluate()
+            card_open = not m.has_armature or armature_table(self.y[None, :], self.arrays, self.arm)[0, 4] < 0.0
+            # (a negative drop beyond the tolerance: an equilibrium above the state, not one it rests in)
+            held = abs(drop) <= tol and card_open and not np.any(aux[:, A_Y] > 0.0)
+        if held:
+            self._resolve(triggered=None)
+            held = not np.any(self.regime != FREE) and np.all(self.armature_closed == saved[4])
+        if not held:
+            self.y[:], self.regime[:], self.eref[:], self.ev_sign[:], self.armature_closed[:] = saved
+            return
+        if self.recorder.n:  # (a hold before the first record, at the start: the audit starts after it)
+            self.projection_energy -= drop
+        later = [t for t in m.load_change_times if t > self.t]
+        later += [t for t, _ in self._jumps[self._jump_index:] if t > self.t]
+        until = min(later) if later else math.inf
+        if m.has_armature:
+            self.armature_closed[BAR_HELD] = 1.0
+            self._flight_until, self._flight_h = until, self.h
+            self.flight_holds.append([self.t, until])
+        else:
+            self._hold_until = until
+            self._hold_regime = self.regime.copy()
+            self.holds.append([self.t, until])
+
+    def _settle_start(self) -> None:
+        """A relay's contact spring (a clamped or pivoted bar beside an armature) given at
+        rest, touching nothing, starts at its static equilibrium under the loads acting at
+        t = 0 (gravity: its sag), not undeformed: it has rested under its weight before its
+        coil is switched on. Undeformed, it rang at the sag's amplitude (the default blade:
+        0.43 um in its first bending mode, 2e-10 J, decaying over ~10 ms) as if gravity were
+        switched on at t = 0, and that ringing, twice the energy the run resolves, kept the
+        bar from being held in flight (_watch_flight). A bar without an armature starts as
+        given: released straight, it is an experiment of its own (a blade swinging into its
+        sag: tests/mech/test_energy_scale.py). Nothing else of the state changes; a bar
+        given a speed, touching, or whose equilibrium would touch, starts as given."""
+        m = self.model
+        if (not m.has_bar or not m.has_armature or m.hysteresis_count
+                or m.ipar[I_MOUNT] not in (MOUNT_CLAMP, MOUNT_PIVOT)):
+            return
+        npos, nvel = state_sizes(m.n, m.planar)
+        if np.any(self.y[npos:npos + nvel] != 0.0) or np.any(self.regime != FREE) or m.loads_ramping(0.0):
+            return
+        if np.any(self._evaluate()[:, A_Y] > 0.0) or (m.has_armature and self.armature_closed[EA_CARD]):
+            return
+        saved = (self.y.copy(), self.regime.copy(), self.eref.copy(), self.ev_sign.copy(),
+                 self.armature_closed.copy())
+        found = self._static_equilibrium(slice(0, npos), slice(npos, npos + nvel), armature=False)
+        card_open = not m.has_armature or armature_table(self.y[None, :], self.arrays, self.arm)[0, 4] < 0.0
+        if found and card_open and not np.any(self._evaluate()[:, A_Y] > 0.0):
+            self._resolve(triggered=None)
+            if not np.any(self.regime != FREE) and np.all(self.armature_closed == saved[4]):
+                self._initial_state = self.y.copy()
+                return
+        self.y[:], self.regime[:], self.eref[:], self.ev_sign[:], self.armature_closed[:] = saved
+
+    def _release_flight(self) -> None:
+        """End a hold in flight (_watch_flight): the bar moves again, from the step it took before."""
+        self.armature_closed[BAR_HELD] = 0.0
+        self.flight_holds[-1][1] = self.t
+        if self._flight_h > 0.0:
+            self.h = min(self.h, self._flight_h)
+        self._flight_until = -math.inf
+        self._flight_next = self.t
+
     def _normalize_attitude(self) -> None:
         if not self.model.planar:
             quat = self.model.slices()["quat"]
@@ -918,7 +1079,7 @@ class ImpactSolver:
             return slice(0, npos), slice(npos, npos + nvel)
         return np.append(np.arange(npos), a), np.append(np.arange(npos, npos + nvel), a + 1)
 
-    def _static_equilibrium(self, pos, vel) -> bool:
+    def _static_equilibrium(self, pos, vel, armature: bool | None = None) -> bool:
         """Newton's method on the accelerations at zero speed, in the speed coordinates (a
         displacement du moves the positions by the state's own rates for speeds du), with
         the regimes held: stuck contacts keep their points (their holding forces adjust) and
@@ -927,14 +1088,24 @@ class ImpactSolver:
         step moves no coordinate by more than rtol x the Hertz penetration scale (angles:
         over the bar's length; an armature's q: rtol x its stops' penetration scale, its
         error control's). The finite-difference steps are 1e-6 of that scale. pos, vel: the
-        state indices of the positions and speeds (_rest_coordinates)."""
+        state indices of the positions and speeds (_rest_coordinates, or the bar's alone
+        with armature=False; default: the armature's too where the model has one).
+
+        Converged is not yet at rest: the residual acceleration there must be one the bar
+        does not feel within the rest window T (model.rest_window). Of the acceleration a
+        left at the converged state, the part a displacement cancels (J du = -a) must ask
+        for a displacement du within the convergence bound, and the rest (r = a + J du: in
+        directions nothing restores, e.g. a free bar's fall, or a slide along a
+        frictionless block) must move no coordinate by more than that bound in T:
+        r T^2 / 2 <= rtol x its scale. Otherwise the state is left where Newton's method
+        took it and False is returned (the caller restores it)."""
         m = self.model
         npos, nvel = state_sizes(m.n, m.planar)
         # each speed coordinate's length scale: penetration (m) or penetration / length (rad)
         atol_v = m.atol[npos:npos + nvel]
         scale = m.contact.penetration_scale * atol_v / np.max(atol_v)
         rtol = self.scene.solver.rtol
-        if m.has_armature:  # the armature's q (its error scale is rtol x that length)
+        if m.has_armature if armature is None else armature:  # the armature's q (its error scale is rtol x that length)
             scale = np.append(scale, m.atol[m.armature_index] / rtol)
             nvel += 1
 
@@ -964,7 +1135,11 @@ class ImpactSolver:
             self.y[pos] += displaced(step)
             self._normalize_attitude()
             if np.all(np.abs(step) <= rtol * scale):
-                return True
+                a = accel()
+                du = np.linalg.lstsq(J * scale, -a, rcond=1e-10)[0] * scale
+                window = self.model.rest_window
+                return bool(np.all(np.abs(du) <= rtol * scale)
+                            and np.all(0.5 * np.abs(a + J @ du) * window * window <= rtol * scale))
         return False
 
     def _apply_base_jump(self, resolve: bool = True) -> None:
@@ -1090,6 +1265,8 @@ class ImpactSolver:
         stop). The regimes of the contact points do not change: the card's force on the
         bar is a load like the others."""
         ev = self.model.armature_event_base + k
+        if k == EA_CARD and self.armature_closed[BAR_HELD]:
+            self._release_flight()  # the card meets the held bar: it moves again from here
         if k == EA_TURN:
             self.ev_sign[ev] = -self.ev_sign[ev]
             self._seat()

@@ -482,15 +482,39 @@ def _cells(values, names=None) -> tuple[list, bool]:
     if names is not None:
         return [names[v] for v in np.asarray(values).tolist()], not _NEEDS_QUOTES.search("".join(names))
     if isinstance(values, np.ndarray) and values.dtype.kind == "f":
-        out = list(map(float.__repr__, values.astype(float).tolist()))
-        for k in np.flatnonzero(np.isnan(values)).tolist():
-            out[k] = ""
-        return out, True
+        return _float_cells(values.astype(float)), True
     if isinstance(values, np.ndarray) and values.dtype.kind in "iub":
         return list(map(str, values.tolist())), True
     values = values.tolist() if isinstance(values, np.ndarray) else values
     return ["" if v is None or (isinstance(v, float) and math.isnan(v)) else
             (float.__repr__(v) if isinstance(v, float) else v) for v in values], False
+
+
+def _float_cells(v: np.ndarray) -> list:
+    """The cells of a float64 column: float.__repr__ of each value (its shortest exact form),
+    NaN blank. A value repeated (compared bit for bit: -0.0 is not 0.0) is formatted once: a
+    column that never changes (a planar run's out-of-plane states, a single contact's
+    switched-off second row: a third of a relay's history.csv) or the zeros of a force in
+    flight cost a list entry, not a conversion. (numpy's astype(str) gives the same text,
+    checked on 2e5 random bit patterns, but at 1.5 times the cost.)"""
+    n = len(v)
+    out = None
+    if n:
+        bits = v.view(np.int64)
+        if np.all(bits == bits[0]):
+            out = [float.__repr__(float(v[0]))] * n
+        else:
+            zero = bits == 0
+            if np.count_nonzero(zero) > n // 8:
+                out = ["0.0"] * n
+                rest = np.flatnonzero(~zero)
+                for k, cell in zip(rest.tolist(), map(float.__repr__, v[rest].tolist())):
+                    out[k] = cell
+    if out is None:
+        out = list(map(float.__repr__, v.tolist()))
+    for k in np.flatnonzero(np.isnan(v)).tolist():
+        out[k] = ""
+    return out
 
 
 def write_parquet(path: Path, columns: dict) -> None:

@@ -65,6 +65,28 @@ def test_csv_floats_round_trip_exactly_and_are_numpys_repr(tmp_path, seed):
         assert np.array([back]).view(np.uint64)[0] == np.array([value]).view(np.uint64)[0]  # bit for bit, -0.0 too
 
 
+MOSTLY_ZERO = np.zeros(64)
+MOSTLY_ZERO[[3, 9, 10, 40]] = [-0.0, 5e-324, 1.5, float("nan")]
+
+
+@pytest.mark.parametrize("column", [
+    np.zeros(50), np.full(50, -0.0), np.full(50, float("nan")), np.full(50, 0.1), np.full(1, 2.5),
+    MOSTLY_ZERO, np.where(np.arange(60) % 3 == 0, -0.0, 0.0), np.where(np.arange(60) % 2 == 0, 0.0, 1e-300),
+], ids=["zeros", "negative zeros", "nan", "constant", "one row", "mostly zeros", "zeros and negative zeros",
+        "half zeros"])
+def test_repeated_values_are_written_as_each_value_alone(tmp_path, column):
+    """A column that repeats a value (formatted once: a constant column, or the zeros of a
+    force in flight) is written as each of its values alone: -0.0 stays -0.0 beside 0.0
+    (the values are compared bit for bit), NaN stays blank."""
+    path = tmp_path / "t.csv"
+    write_csv(path, {"a": column, "b": column[::-1].copy()})
+    rows = read_back(path, 2)
+    for k, (value, row) in enumerate(zip(column.tolist(), rows[1:])):
+        assert row[0] == ("" if math.isnan(value) else repr(value))
+        back = column[::-1][k]
+        assert row[1] == ("" if math.isnan(back) else repr(float(back)))
+
+
 def test_float32_and_integer_and_boolean_columns(tmp_path):
     path = tmp_path / "t.csv"
     f32 = np.array([0.1, -2.5, np.nan], dtype=np.float32)
