@@ -710,6 +710,12 @@ class BarModel:
             out.append(self.contact_point_x(y0, 0 if pair.key == "block" else i) + pair.offset)
         return tuple(out)
 
+    @property
+    def armature_springs(self) -> bool:
+        """True if a spring joins the armature to the bar (``between = "armature"``): the bar's
+        loads then move with the armature, card open or not."""
+        return any(sp.between == "armature" for sp in self.scene.springs)
+
     def loads_ramping(self, t: float) -> bool:
         """True if some actuator force changes right after t (s): t lies inside a table
         interval whose two ends differ, so the loads are not constant until the next

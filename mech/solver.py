@@ -948,7 +948,8 @@ class ImpactSolver:
         or a load changes.
 
         At rest in flight means: a clamped or pivoted bar, its base still, no contact
-        closed, the card open, no hysteretic spring, no load on a ramp, and its mechanical
+        closed, the card open, no spring between it and the armature (whose moving end
+        would change its loads), no hysteretic spring, no load on a ramp, and its mechanical
         energy above its static equilibrium under the loads acting (kinetic energy plus
         the strain, gravity and spring energy above the equilibrium's) within what the run
         resolves, rtol x the scene's energy scale (as a hold at rest: _watch_rest). Under
@@ -975,7 +976,8 @@ class ImpactSolver:
         mount = m.ipar[I_MOUNT]
         base_still = np.all(self.y[sl["vel"]] == 0.0) and (mount == MOUNT_PIVOT or np.all(self.y[sl["omega"]] == 0.0))
         if (mount not in (MOUNT_CLAMP, MOUNT_PIVOT) or not base_still or np.any(self.regime != FREE)
-                or (m.has_armature and self.armature_closed[EA_CARD]) or m.loads_ramping(self.t)):
+                or (m.has_armature and (self.armature_closed[EA_CARD] or m.armature_springs))
+                or m.loads_ramping(self.t)):
             return
         aux = self._evaluate()
         if np.any(aux[:, A_Y] > 0.0):

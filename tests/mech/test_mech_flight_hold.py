@@ -231,3 +231,27 @@ def test_the_energy_audit_closes_with_the_blade_held_in_flight():
         assert solver.flight_holds  # the hold took part
     residuals = [abs(s.result().energy["relative_residual"]) for s in solvers]
     assert residuals[1] < 1e-7 and residuals[1] < residuals[0] / 30.0
+
+
+def test_a_blade_joined_to_the_armature_by_a_spring_is_never_held_in_flight():
+    """A spring from the clapper to the blade ([[spring]] between = "armature", moving with
+    the card's lever) changes the blade's load as the clapper swings, card open or not: the
+    blade is not at rest in flight and is never held. The run with the hold allowed is the
+    run without it (the same steps, so the same bits: the hold never starts), and the blade
+    follows the spring before the card meets it (its contact point lower at the card's touch
+    than in the run without the spring)."""
+    doc = default_relay()
+    lever = doc["armature"]["card_lever"]
+    p = doc["armature"]["card_position"]  # along the blade from tip 0; the clamp is the world origin in x
+    z = ImpactSolver(scene_from_dict(copy.deepcopy(doc))).result().history_columns["z"][0]  # the blade's axis
+    joined = copy.deepcopy(doc)
+    joined["spring"] = [{"anchor": [p - doc["mount"]["position"], 0.0, z + 0.002], "position": p,
+                         "stiffness": 20.0, "between": "armature", "lever": lever}]
+    held, free, alone = operate(joined, True), operate(joined, False), operate(doc, True)
+    assert not held.flight_holds and alone.flight_holds
+    card = first(held.events, "card_start")
+    assert card == first(free.events, "card_start")
+    assert np.array_equal(held.result().history_columns["tip_height_0"], free.result().history_columns["tip_height_0"])
+    h_joined, h_alone = held.result().history_columns, alone.result().history_columns
+    at = lambda h, t: float(np.interp(t, h["time"], h["tip_height_0"]))  # noqa: E731
+    assert at(h_joined, card) < at(h_alone, first(alone.events, "card_start")) - 1e-7
