@@ -176,7 +176,7 @@ def _bytecode_note() -> str:
     (~0.05-0.09 s of the import and scene phases here)."""
     import importlib.util
 
-    cached = os.path.exists(importlib.util.cache_from_source(str(ROOT / "coupling" / "cli.py")))
+    cached = os.path.exists(importlib.util.cache_from_source(str(ROOT / "coupling" / "app" / "cli.py")))
     if not sys.flags.dont_write_bytecode:
         return "bytecode caches on"
     return "PYTHONDONTWRITEBYTECODE set, " + ("bytecode caches present" if cached else
