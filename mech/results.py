@@ -237,20 +237,26 @@ class ImpactResult:
     def contact_columns(self) -> dict:
         """One entry per contact interval (numpy arrays, by t_start): tip, t_start, t_end (s),
         peak_force (N), impulse (N s), normal speeds in/out (m/s), kinematic and energetic
-        (Stronge) restitution, complete."""
+        (Stronge) restitution, complete. A pair's first contact that was there from the start
+        (touching or at gap 0 at t = 0, not approaching: a preloaded NC contact) is no
+        impact: its restitutions are nan."""
         if "contact_columns" in self._cache:
             return self._cache["contact_columns"]
         rows = []
         quad0 = self.model.slices()["quad"].start
         for i in range(self.model.rows):
             start = None
+            # touching or at gap 0 at the start, not approaching: the pair's first contact was
+            # there from the start (a preloaded NC contact, a bar set down), not an impact
+            resting = self.aux[0, i, A_Y] >= 0.0 and self.aux[0, i, A_YDOT] <= 0.0
             if self.aux[0, i, A_Y] > 0.0:
-                start = dict(time=self.t[0], penetration_rate=self.aux[0, i, A_YDOT])
+                start = dict(time=self.t[0], penetration_rate=self.aux[0, i, A_YDOT], from_start=resting)
             for ev in self.events:
                 if ev["tip"] != i:
                     continue
                 if ev["kind"] == "contact_start":
-                    start = ev
+                    start = dict(ev, from_start=resting)
+                    resting = False
                 elif ev["kind"] == "contact_end" and start is not None:
                     rows.append(self._contact_row(i, start, ev, quad0))
                     start = None
@@ -286,11 +292,12 @@ class ImpactResult:
         v_in = float(start["penetration_rate"])
         v_out = float(-end["penetration_rate"])
         complete = not end.get("open", False)
+        impact = complete and not start.get("from_start", False)  # restitution is an impact's
         return dict(
             tip=tip, t_start=float(t0), t_end=float(t1), peak_force=peak, impulse=float(impulse),
             normal_speed_in=v_in, normal_speed_out=v_out,
-            kinematic_restitution=v_out / v_in if (complete and v_in > 0) else float("nan"),
-            energetic_restitution=math.sqrt(max(-w_rest, 0.0) / w_comp) if (complete and w_comp > 0) else float("nan"),
+            kinematic_restitution=v_out / v_in if (impact and v_in > 0) else float("nan"),
+            energetic_restitution=math.sqrt(max(-w_rest, 0.0) / w_comp) if (impact and w_comp > 0) else float("nan"),
             complete=complete,
         )
 
@@ -329,12 +336,14 @@ class ImpactResult:
 
     @property
     def restitution(self) -> dict:
-        """Kinematic and energetic restitution of the first complete contact (nan if none)."""
+        """Kinematic and energetic restitution of the first impact: the first complete contact
+        that was not there from the start (nan if none)."""
         return self._first_restitution(np.ones(len(self.contact_columns["tip"]), bool))
 
     def _first_restitution(self, which: np.ndarray) -> dict:
         c = self.contact_columns
-        done = np.flatnonzero(c["complete"] & which)
+        impacts = np.isfinite(c["kinematic_restitution"]) | np.isfinite(c["energetic_restitution"])
+        done = np.flatnonzero(c["complete"] & which & impacts)
         if not len(done):
             return {"kinematic": float("nan"), "energetic": float("nan")}
         k = done[0]

@@ -14,6 +14,7 @@ results) and bad input.
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -413,3 +414,28 @@ def test_bad_fixed_contacts_are_one_line_naming_the_key(doc, message):
         ImpactSolver(scene_from_dict(doc))
     text = str(err.value)
     assert message in text and "\n" not in text
+
+
+def test_a_contact_there_from_the_start_is_no_impact_and_has_no_restitution():
+    """NC touches the blade at the start (gap 0) and the press loads it from rest: that
+    contact is no impact, its restitutions are nan (the approach speed the event sees, the
+    press's first nanoseconds, gave a 'kinematic restitution' of 1e6), and the run's first
+    restitution is its first impact's: NO's, when the force reverses and the blade strikes
+    it. With NC 10 um above the blade at the start, lifted into it by a constant force, the
+    same pair's first contact is an impact with a restitution in (0, 1]."""
+    press, t_flip = 0.2, 3e-3
+    doc = changeover(dict(time=[0.0, 1e-3, t_flip, t_flip + 1e-4, 8e-3], value=[0.0, press, press, -2.0, -2.0]),
+                     solver=dict(t_end=8e-3))
+    res = ImpactSolver(scene_from_dict(doc)).run()
+    c = res.contacts
+    nc, no = c[c.tip == 1].iloc[0], c[c.tip == 0].iloc[0]
+    assert nc.t_start < 1e-6 and nc.complete and no.t_start > nc.t_end  # (the press loads it in its first ns)
+    assert math.isnan(nc.kinematic_restitution) and math.isnan(nc.energetic_restitution)
+    assert 0.0 < no.kinematic_restitution <= 1.0
+    assert res.restitution["kinematic"] == no.kinematic_restitution
+    moving = copy.deepcopy(doc)
+    moving["fixed"][1]["gap"] = 1e-5  # NC 10 um above the blade
+    moving["force"] = [dict(position=XR, direction=[0.0, 0.0, 1.0], magnitude=0.05)]
+    hit = ImpactSolver(scene_from_dict(moving)).run().contacts
+    first = hit[hit.tip == 1].iloc[0]
+    assert first.t_start > 0.0 and 0.0 < first.kinematic_restitution <= 1.0
