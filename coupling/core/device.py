@@ -22,15 +22,17 @@ line and takes only resistance and turns from [coil] (its drive is the netlist's
 from __future__ import annotations
 
 import dataclasses
-import re
 from dataclasses import dataclass
 from typing import Any
 
+from circuit.blocks import CoilBlock
+from circuit.coil_drive import DRIVER_NODE, SUPPLY_NODE, CoilDrive
 from mech.validation import check_choice, check_keys, check_positive
 
-DRIVE_KEYS = ("voltage", "on_time", "off_time", "suppression", "zener_voltage", "rc_resistance", "rc_capacitance",
-              "switch_resistance", "switch_capacitance", "switch_breakdown", "edge_time")
-COIL_KEYS = DRIVE_KEYS + ("resistance", "turns")
+# [coil]'s keys as CoilDrive's fields declare them: its drive's own, then the winding's
+# (resistance, turns), which its ``coil`` field (a CoilBlock, with the magnet) is made of
+DRIVE_KEYS = tuple(f.name for f in dataclasses.fields(CoilDrive) if "unit" in f.metadata and "keys" not in f.metadata)
+COIL_KEYS = DRIVE_KEYS + tuple(key for f in dataclasses.fields(CoilDrive) for key, _, _ in f.metadata.get("keys", ()))
 MAGNET_MODELS = ("flux_tubes", "table", "plunger_solenoid")
 PLACEMENT_KEYS = ("model", "rest_gap", "lever")
 FLUX_TUBE_KEYS = ("working_gap", "pole_leakage", "iron", "fixed_gap")
@@ -61,15 +63,10 @@ class DeviceSpec:
         return self.magnet.current_expression("PSI", "GAP")
 
     def drive(self):
-        """The coil with its drive and suppression (circuit.coil_drive.CoilDrive)."""
-        from circuit.blocks import CoilBlock
-        from circuit.coil_drive import DRIVER_NODE, SUPPLY_NODE, CoilDrive
-
-        try:
-            coil = CoilBlock("", SUPPLY_NODE, DRIVER_NODE, self.resistance, self.current_law())
-            return CoilDrive(coil, **{k: v for k, v in self.coil.items() if k in DRIVE_KEYS})
-        except (TypeError, ValueError) as err:  # in the scene's words: CoilDrive.voltage -> coil.voltage
-            raise ValueError(re.sub(r"\bCoil(Drive|Block)\.", "coil.", str(err))) from None
+        """The coil with its drive and suppression (circuit.coil_drive.CoilDrive; its errors
+        name the keys as [coil] writes them, coil.voltage)."""
+        coil = CoilBlock("", SUPPLY_NODE, DRIVER_NODE, self.resistance, self.current_law())
+        return CoilDrive(coil, **{k: v for k, v in self.coil.items() if k in DRIVE_KEYS})
 
 
 def _table(where: str, value) -> dict:

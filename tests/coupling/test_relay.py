@@ -128,6 +128,8 @@ def _with(doc: dict, section: str, key: str, value) -> dict:
     (lambda d: _with(d, "coil", "suppression", "varistor"), "coil.suppression = 'varistor': allowed values are"),
     (lambda d: _with(d, "coil", "off_time", 5e-4), "coil.off_time = 0.0005 s: must come after on_time"),
     (lambda d: _with(d, "coil", "voltage", 200.0), "coil.switch_breakdown = 100 V: must exceed the supply"),
+    # (edge_time is checked before off_time's comparison uses it)
+    (lambda d: _with(d, "coil", "edge_time", "fast"), "coil.edge_time = 'fast': must be a real number in s"),
     (lambda d: _with(d, "magnet", "model", "horseshoe"), "magnet.model"),
     (lambda d: {k: v for k, v in d.items() if k != "magnet"}, "[coil] needs [magnet]"),
 ])
