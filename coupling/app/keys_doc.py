@@ -34,7 +34,9 @@ def section_classes() -> dict[str, tuple]:
     from mech.parameters import MechScene
     from mech.scene import LIST_SECTIONS, SECTIONS
 
+    from coupling.core.device import DeviceSpec
     from coupling.core.duty import DutySettings, LifeLimits
+    from coupling.laws.magnet import FluxTubeMagnet, TableMagnet
     from coupling.core.metrics import MetricSettings
     from coupling.core.scene import CouplingOptions, OutputOptions
 
@@ -44,6 +46,7 @@ def section_classes() -> dict[str, tuple]:
     out["circuit"] = _circuit_classes()
     out.update({cls.SECTION: (cls,) for cls in (ck.Snubber, ck.FlybackDiode, ck.ArcModel, ck.ContactSchedule)})
     out["coil"] = (CoilDrive,)  # (and the winding's resistance and turns, which make its CoilBlock)
+    out["magnet"] = (DeviceSpec, FluxTubeMagnet, TableMagnet)  # its own keys, then each model's
     out["duty"] = (DutySettings,)
     out["duty.life"] = (LifeLimits,)
     out["coupling"] = (CouplingOptions,)
