@@ -186,7 +186,14 @@ def _fields(where: str, table, cls) -> dict:
     """The keyword arguments of ``cls`` a table gives (its name field set by the caller)."""
     table = _table(where, table)
     allowed = [f.name for f in dataclasses.fields(cls) if f.name != "name"]
-    return dict(check_keys(where if where.startswith("[") else f"[{where}]", table, allowed))
+    section = where if where.startswith("[") else f"[{where}]"
+    check_keys(section, table, allowed)
+    for f in dataclasses.fields(cls):  # a needed key left out: named, not the constructor's TypeError
+        needed = f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+        if needed and f.name not in table and f.name != "material":  # (the caller sets the material)
+            unit = f.metadata.get("unit", "-")
+            raise ValueError(f"{section} needs {f.name}" + (f" ({unit})" if unit != "-" else ""))
+    return dict(table)
 
 
 def _list(where: str, value) -> list:
