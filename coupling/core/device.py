@@ -19,7 +19,7 @@ from typing import Any
 
 from circuit.blocks import CoilBlock
 from circuit.coil_drive import DRIVER_NODE, SUPPLY_NODE, CoilDrive
-from coupling.core.scene import key_fields, section_keys
+from coupling.core.scene import _field_default, key_fields, section_keys
 from coupling.laws.magnet import FluxTubeMagnet, TableMagnet
 from mech.validation import check_choice, check_keys, check_positive, internal, scene_key
 
@@ -89,7 +89,7 @@ def device(doc: dict) -> DeviceSpec | None:
                          "armature through the magnet (docs/magnet.md)")
     coil = dict(check_keys("[coil]", _table("[coil]", doc["coil"]), COIL_KEYS))
     table = _table("[magnet]", doc["magnet"])
-    model = check_choice("magnet.model", table.get("model", _default(DeviceSpec, "model")), MAGNET_MODELS)
+    model = check_choice("magnet.model", table.get("model", _field_default(DeviceSpec, "model")), MAGNET_MODELS)
     if model == "plunger_solenoid":
         from coupling.laws.magnet import plunger_solenoid
 
@@ -118,13 +118,8 @@ def device(doc: dict) -> DeviceSpec | None:
             magnet = table_magnet(table)
     check_positive("coil.resistance", coil["resistance"])
     rest = check_positive("magnet.rest_gap", rest)
-    lever = check_positive("magnet.lever", table.get("lever", _default(DeviceSpec, "lever")))
+    lever = check_positive("magnet.lever", table.get("lever", _field_default(DeviceSpec, "lever")))
     return DeviceSpec(coil=coil, magnet=magnet, model=model, rest_gap=float(rest), lever=float(lever))
-
-
-def _default(cls, key: str):
-    """The default a key's field declares (one place for it)."""
-    return next(f.default for f in dataclasses.fields(cls) if f.name == key)
 
 
 def flux_tube_magnet(table: dict, turns: float):

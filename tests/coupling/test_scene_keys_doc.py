@@ -121,7 +121,8 @@ ENTRIES = {"force": {"magnitude": 1.0}, "spring": {"stiffness": 1e3}, "rivet": {
 # and the rest of the scene such an entry needs: [[fixed]] on a blade clamped at tip 1 (its
 # one contact point tip 0: every contact point must strike a fixed contact)
 ENTRY_SCENES = {"fixed": {"mount": {"kind": "clamp", "position": 0.3}}}
-# keys no dataclass field holds: the alternatives choosing the laws or the contact, file names
+# keys that set one field together, so none has a default of its own: the alternatives choosing
+# the contact laws (TribologySpec.laws) or the contact (the schedule), file names
 NO_FIELD = {("tribology", k) for k in ("source", "fit", "data", "mu", "resistance")} | {
     ("circuit", "netlist"), ("circuit", "schedule"), ("circuit.schedule", "make"), ("circuit.schedule", "break")}
 # keys whose default follows from the scene's other sections or from a life study's first sample,
