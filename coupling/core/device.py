@@ -17,17 +17,27 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
-from circuit.blocks import CoilBlock
-from circuit.coil_drive import DRIVER_NODE, SUPPLY_NODE, CoilDrive
 from coupling.core.scene import _field_default, key_fields, section_keys
 from coupling.laws.magnet import FluxTubeMagnet, TableMagnet
 from mech.validation import check_choice, check_keys, check_positive, internal, scene_key
 
-# [coil]'s keys as CoilDrive's fields declare them: its drive's own, then the winding's
-# (resistance, turns), which its ``coil`` field (a CoilBlock, with the magnet) is made of
-DRIVE_KEYS = tuple(key_fields(CoilDrive))
-COIL_KEYS = tuple(section_keys(CoilDrive))
 MAGNET_MODELS = ("flux_tubes", "table", "plunger_solenoid")
+
+
+def drive_keys() -> tuple[str, ...]:
+    """[coil]'s keys of the drive: CoilDrive's scene-key fields. (A function: circuit brings
+    PySpice, which a scene without a coil does not import.)"""
+    from circuit.coil_drive import CoilDrive
+
+    return tuple(key_fields(CoilDrive))
+
+
+def coil_keys() -> tuple[str, ...]:
+    """[coil]'s keys: the drive's, then the winding's (resistance, turns), which CoilDrive's
+    ``coil`` field (a CoilBlock, with the magnet) is made of."""
+    from circuit.coil_drive import CoilDrive
+
+    return tuple(section_keys(CoilDrive))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -63,8 +73,11 @@ class DeviceSpec:
     def drive(self):
         """The coil with its drive and suppression (circuit.coil_drive.CoilDrive; its errors
         name the keys as [coil] writes them, coil.voltage)."""
+        from circuit.blocks import CoilBlock
+        from circuit.coil_drive import DRIVER_NODE, SUPPLY_NODE, CoilDrive
+
         coil = CoilBlock("", SUPPLY_NODE, DRIVER_NODE, self.resistance, self.current_law())
-        return CoilDrive(coil, **{k: v for k, v in self.coil.items() if k in DRIVE_KEYS})
+        return CoilDrive(coil, **{k: v for k, v in self.coil.items() if k in drive_keys()})
 
 
 # [magnet]'s keys as the fields declare them: its own (DeviceSpec's), then each model's
@@ -87,7 +100,7 @@ def device(doc: dict) -> DeviceSpec | None:
         missing = "coil" if "coil" not in doc else "magnet"
         raise ValueError(f"[{'magnet' if missing == 'coil' else 'coil'}] needs [{missing}]: the coil drives the "
                          "armature through the magnet (docs/magnet.md)")
-    coil = dict(check_keys("[coil]", _table("[coil]", doc["coil"]), COIL_KEYS))
+    coil = dict(check_keys("[coil]", _table("[coil]", doc["coil"]), coil_keys()))
     table = _table("[magnet]", doc["magnet"])
     model = check_choice("magnet.model", table.get("model", _field_default(DeviceSpec, "model")), MAGNET_MODELS)
     if model == "plunger_solenoid":
