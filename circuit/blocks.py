@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import ClassVar
 
 from PySpice.Spice.Netlist import Circuit
 
@@ -169,6 +170,7 @@ class CoilBlock:
     current: the current law, an ngspice expression of PSI (Wb) and GAP (m), in A.
     """
 
+    SECTION: ClassVar[str] = "coil"  # resistance is [coil] resistance: errors name coil.resistance, coil.current
     name: str
     node_p: str
     node_n: str
@@ -176,13 +178,13 @@ class CoilBlock:
     current: str
 
     def __post_init__(self) -> None:
-        check_block_name("CoilBlock.name", self.name)
+        check_block_name(f"{self.SECTION}.name", self.name)
         for node in ("node_p", "node_n"):
             value = getattr(self, node)
             if not (isinstance(value, str) and value and value.split() == [value]):
-                raise ValueError(f"CoilBlock.{node} = {value!r}: a node name (one word)")
-        check_range("CoilBlock", "resistance", self.resistance, "ohm", 0.0, 1e7, low_open=True)
-        check_coil_current("CoilBlock.current", self.current)
+                raise ValueError(f"{self.SECTION}.{node} = {value!r}: a node name (one word)")
+        check_range(self.SECTION, "resistance", self.resistance, "ohm", 0.0, 1e7, low_open=True)
+        check_coil_current(f"{self.SECTION}.current", self.current)
 
     @property
     def suffix(self) -> str:

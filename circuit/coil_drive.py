@@ -27,7 +27,7 @@ current falls ~(V_z + V_d)/L, fast; an RC rings.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Optional
+from typing import ClassVar, Optional
 
 from PySpice.Spice.Netlist import Circuit
 
@@ -59,6 +59,7 @@ class CoilDrive:
     diode_saturation_current: A, IS of the suppression diodes (N = 1.8, RS = 0.05 ohm).
     """
 
+    SECTION: ClassVar[str] = "coil"  # the scene section of its keys: [coil] voltage, ... (errors name coil.<key>)
     coil: CoilBlock = scene_key(keys=(  # [coil] resistance and turns make the coil (with [magnet])
         ("resistance", "ohm", 'the winding; needed except with `magnet.model = "plunger_solenoid"` (10)'),
         ("turns", "-", 'the winding; needed with `magnet.model = "flux_tubes"` (plunger_solenoid: 957); not with '
@@ -80,7 +81,7 @@ class CoilDrive:
     diode_saturation_current: float = internal(1e-9)
 
     def __post_init__(self) -> None:
-        name = "CoilDrive"
+        name = self.SECTION
         if not isinstance(self.coil, CoilBlock):
             raise ValueError(f"{name}.coil = {self.coil!r}: must be a CoilBlock")
         if (self.coil.node_p, self.coil.node_n) != (SUPPLY_NODE, DRIVER_NODE):
@@ -88,6 +89,7 @@ class CoilDrive:
                              f"{self.coil.node_p!r}, {self.coil.node_n!r})")
         check_range(name, "voltage", self.voltage, "V", 0.0, 1e4, low_open=True)
         check_range(name, "on_time", self.on_time, "s", 0.0, 1e3)
+        check_range(name, "edge_time", self.edge_time, "s", 0.0, 1e-2, low_open=True)  # (off_time needs it)
         if self.off_time is not None:
             check_range(name, "off_time", self.off_time, "s", 0.0, 1e3)
             if self.off_time < self.on_time + self.edge_time:
@@ -105,7 +107,6 @@ class CoilDrive:
         if self.switch_breakdown <= self.voltage:
             raise ValueError(f"{name}.switch_breakdown = {self.switch_breakdown:g} V: must exceed the supply "
                              f"{name}.voltage = {self.voltage:g} V (the driver would conduct while off)")
-        check_range(name, "edge_time", self.edge_time, "s", 0.0, 1e-2, low_open=True)
         check_range(name, "diode_saturation_current", self.diode_saturation_current, "A", 1e-20, 1e-3,
                     low_open=True)
 

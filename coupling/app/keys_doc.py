@@ -34,16 +34,20 @@ def section_classes() -> dict[str, tuple]:
     from mech.parameters import MechScene
     from mech.scene import LIST_SECTIONS, SECTIONS
 
+    from coupling.core.device import DeviceSpec
     from coupling.core.duty import DutySettings, LifeLimits
+    from coupling.laws.magnet import FluxTubeMagnet, TableMagnet
     from coupling.core.metrics import MetricSettings
-    from coupling.core.scene import CouplingOptions, OutputOptions
+    from coupling.core.scene import CouplingOptions, OutputOptions, TribologySpec
 
     out = {name: (cls,) for name, cls in SECTIONS.items()}
     out.update({name: (cls,) for name, (_, cls) in LIST_SECTIONS.items()})
     out["environment"] = (MechScene,)  # gravity; its other fields are the sections
     out["circuit"] = _circuit_classes()
     out.update({cls.SECTION: (cls,) for cls in (ck.Snubber, ck.FlybackDiode, ck.ArcModel, ck.ContactSchedule)})
+    out["tribology"] = (TribologySpec,)
     out["coil"] = (CoilDrive,)  # (and the winding's resistance and turns, which make its CoilBlock)
+    out["magnet"] = (DeviceSpec, FluxTubeMagnet, TableMagnet)  # its own keys, then each model's
     out["duty"] = (DutySettings,)
     out["duty.life"] = (LifeLimits,)
     out["coupling"] = (CouplingOptions,)

@@ -1,18 +1,10 @@
 """The relay's own sections: [coil] (its drive, a contract) and [magnet], mapped 1:1 onto
 circuit.coil_drive.CoilDrive and the magnets of coupling.laws.magnet (SI units).
 
-    [coil]    voltage (V), on_time, off_time (s: the supply switched on and off),
-              resistance (ohm, the winding), turns, suppression = "none" | "diode" |
-              "zener" | "rc", zener_voltage (V), rc_resistance (ohm), rc_capacitance (F),
-              switch_resistance (ohm), switch_capacitance (F), switch_breakdown (V),
-              edge_time (s)
-    [magnet]  model = "flux_tubes" | "table" | "plunger_solenoid" (built in); rest_gap (m,
-              the working gap with the armature on its rest stop), lever (m of pole-face
-              travel per unit of the armature's travel: 1 for a plunger, the pole's
-              distance from the hinge for a clapper); the model's own keys
-              (docs/magnet.md, "Scene section"): working_gap, pole_leakage, [[iron]],
-              [[fixed_gap]] with [[fixed_gap.tube]] (flux_tubes); currents, gaps,
-              flux_linkages, forces, force_tolerance (table)
+Each key is a field's (docs/scene_keys.md, written from them): [coil]'s are CoilDrive's,
+the winding's resistance and turns included; [magnet]'s are DeviceSpec's (model, rest_gap,
+lever), then the model's magnet's (FluxTubeMagnet's sub-tables, docs/magnet.md "Scene
+section"; TableMagnet's tables).
 
 The coil's turns are the magnet's: a flux-tube magnet takes [coil] turns (the table's
 flux linkages include them already). A netlist circuit places the coil with an XCOIL
@@ -22,35 +14,53 @@ line and takes only resistance and turns from [coil] (its drive is the netlist's
 from __future__ import annotations
 
 import dataclasses
-import re
 from dataclasses import dataclass
 from typing import Any
 
-from mech.validation import check_choice, check_keys, check_positive
+from coupling.core.scene import _field_default, key_fields, section_keys
+from coupling.laws.magnet import FluxTubeMagnet, TableMagnet
+from mech.validation import check_choice, check_keys, check_positive, internal, scene_key
 
-DRIVE_KEYS = ("voltage", "on_time", "off_time", "suppression", "zener_voltage", "rc_resistance", "rc_capacitance",
-              "switch_resistance", "switch_capacitance", "switch_breakdown", "edge_time")
-COIL_KEYS = DRIVE_KEYS + ("resistance", "turns")
 MAGNET_MODELS = ("flux_tubes", "table", "plunger_solenoid")
-PLACEMENT_KEYS = ("model", "rest_gap", "lever")
-FLUX_TUBE_KEYS = ("working_gap", "pole_leakage", "iron", "fixed_gap")
-TABLE_KEYS = ("currents", "gaps", "flux_linkages", "forces", "force_tolerance")
 
 
-@dataclass(frozen=True)
+def drive_keys() -> tuple[str, ...]:
+    """[coil]'s keys of the drive: CoilDrive's scene-key fields. (A function: circuit brings
+    PySpice, which a scene without a coil does not import.)"""
+    from circuit.coil_drive import CoilDrive
+
+    return tuple(key_fields(CoilDrive))
+
+
+def coil_keys() -> tuple[str, ...]:
+    """[coil]'s keys: the drive's, then the winding's (resistance, turns), which CoilDrive's
+    ``coil`` field (a CoilBlock, with the magnet) is made of."""
+    from circuit.coil_drive import CoilDrive
+
+    return tuple(section_keys(CoilDrive))
+
+
+@dataclass(frozen=True, kw_only=True)
 class DeviceSpec:
-    """The relay's coil and magnet as a scene gives them.
+    """The relay's coil and magnet as a scene gives them; its scene-key fields are [magnet]'s
+    own keys, whatever the model (the model's keys are its magnet's fields).
 
     coil: the [coil] table, checked (keys; the values are CoilDrive's and CoilBlock's to check).
     magnet: a coupling.laws.magnet magnet (its ngspice current law and force).
+    model: the magnet's model, one of MAGNET_MODELS.
     rest_gap: m, the working gap with the armature on its rest stop.
     lever: m of pole-face travel per unit of the armature's travel q (m or rad).
     """
 
-    coil: dict
-    magnet: Any
-    rest_gap: float
-    lever: float = 1.0
+    coil: dict = internal()
+    magnet: Any = internal()
+    model: str = scene_key("flux_tubes", unit="-", doc='"flux_tubes", "table" or "plunger_solenoid" (built in)')
+    rest_gap: float = scene_key(
+        unit="m", shown="-", doc="the working gap with the armature on its rest stop (plunger_solenoid: 5e-3)")
+    lever: float = scene_key(
+        1.0, unit="m/m or m/rad",
+        doc="pole-face travel per unit of the armature's q: 1 for a plunger, the pole's distance from the hinge for "
+            "a clapper")
 
     @property
     def resistance(self) -> float:
@@ -61,15 +71,19 @@ class DeviceSpec:
         return self.magnet.current_expression("PSI", "GAP")
 
     def drive(self):
-        """The coil with its drive and suppression (circuit.coil_drive.CoilDrive)."""
+        """The coil with its drive and suppression (circuit.coil_drive.CoilDrive; its errors
+        name the keys as [coil] writes them, coil.voltage)."""
         from circuit.blocks import CoilBlock
         from circuit.coil_drive import DRIVER_NODE, SUPPLY_NODE, CoilDrive
 
-        try:
-            coil = CoilBlock("", SUPPLY_NODE, DRIVER_NODE, self.resistance, self.current_law())
-            return CoilDrive(coil, **{k: v for k, v in self.coil.items() if k in DRIVE_KEYS})
-        except (TypeError, ValueError) as err:  # in the scene's words: CoilDrive.voltage -> coil.voltage
-            raise ValueError(re.sub(r"\bCoil(Drive|Block)\.", "coil.", str(err))) from None
+        coil = CoilBlock("", SUPPLY_NODE, DRIVER_NODE, self.resistance, self.current_law())
+        return CoilDrive(coil, **{k: v for k, v in self.coil.items() if k in drive_keys()})
+
+
+# [magnet]'s keys as the fields declare them: its own (DeviceSpec's), then each model's
+PLACEMENT_KEYS = tuple(key_fields(DeviceSpec))
+FLUX_TUBE_KEYS = tuple(key_fields(FluxTubeMagnet))
+TABLE_KEYS = tuple(key_fields(TableMagnet))
 
 
 def _table(where: str, value) -> dict:
@@ -86,9 +100,9 @@ def device(doc: dict) -> DeviceSpec | None:
         missing = "coil" if "coil" not in doc else "magnet"
         raise ValueError(f"[{'magnet' if missing == 'coil' else 'coil'}] needs [{missing}]: the coil drives the "
                          "armature through the magnet (docs/magnet.md)")
-    coil = dict(check_keys("[coil]", _table("[coil]", doc["coil"]), COIL_KEYS))
+    coil = dict(check_keys("[coil]", _table("[coil]", doc["coil"]), coil_keys()))
     table = _table("[magnet]", doc["magnet"])
-    model = check_choice("magnet.model", table.get("model", "flux_tubes"), MAGNET_MODELS)
+    model = check_choice("magnet.model", table.get("model", _field_default(DeviceSpec, "model")), MAGNET_MODELS)
     if model == "plunger_solenoid":
         from coupling.laws.magnet import plunger_solenoid
 
@@ -117,8 +131,8 @@ def device(doc: dict) -> DeviceSpec | None:
             magnet = table_magnet(table)
     check_positive("coil.resistance", coil["resistance"])
     rest = check_positive("magnet.rest_gap", rest)
-    lever = check_positive("magnet.lever", table.get("lever", 1.0))
-    return DeviceSpec(coil=coil, magnet=magnet, rest_gap=float(rest), lever=float(lever))
+    lever = check_positive("magnet.lever", table.get("lever", _field_default(DeviceSpec, "lever")))
+    return DeviceSpec(coil=coil, magnet=magnet, model=model, rest_gap=float(rest), lever=float(lever))
 
 
 def flux_tube_magnet(table: dict, turns: float):
@@ -180,7 +194,14 @@ def _fields(where: str, table, cls) -> dict:
     """The keyword arguments of ``cls`` a table gives (its name field set by the caller)."""
     table = _table(where, table)
     allowed = [f.name for f in dataclasses.fields(cls) if f.name != "name"]
-    return dict(check_keys(where if where.startswith("[") else f"[{where}]", table, allowed))
+    section = where if where.startswith("[") else f"[{where}]"
+    check_keys(section, table, allowed)
+    for f in dataclasses.fields(cls):  # a needed key left out: named, not the constructor's TypeError
+        needed = f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+        if needed and f.name not in table and f.name != "material":  # (the caller sets the material)
+            unit = f.metadata.get("unit", "-")
+            raise ValueError(f"{section} needs {f.name}" + (f" ({unit})" if unit != "-" else ""))
+    return dict(table)
 
 
 def _list(where: str, value) -> list:

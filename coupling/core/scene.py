@@ -144,12 +144,22 @@ class OutputOptions:
 
 @dataclass(frozen=True)
 class TribologySpec:
-    """The contact laws (mu(I), gamma, R_c(F_n, I)), where they came from, and the fit if any."""
+    """The contact laws (mu(I), gamma, R_c(F_n, I)), where they came from, and the fit if any;
+    its fields declare [tribology]'s keys (TRIBOLOGY_KEYS)."""
 
-    laws: Any  # coupling.laws.tribology.ContactLaws
-    source: str
-    feedback: bool = True
-    fit: Any = None  # coupling.laws.tribology.TribometerFit, when the laws come from a fit
+    # coupling.laws.tribology.ContactLaws: the keys but feedback choose them together (one of
+    # source / fit / data, or mu and resistance), so they are rows of this one field, declared
+    # as circuit.validation.scene_key(keys=...) declares a field several keys set
+    laws: Any = field(metadata={"unit": "-", "doc": "", "keys": (
+        ("source", "-", '"illustrative": the shipped, not measured, fit'),
+        ("fit", "path", "a fit.json from `switchsim fit`"),
+        ("data", "path", "a tribometer CSV, fitted on the fly"),
+        ("mu", "N^gamma", "a number (Coulomb, with a material `resistance`) or an inline mu-law table"),
+        ("resistance", "-", '`{law = "holm" | "constant", ...}` (docs/contact_materials.md) or an inline '
+                            "fitted-law table (docs/tribology.md)"))})
+    source: str = internal()  # where the laws came from, in words (not the key source)
+    feedback: bool = scene_key(True, unit="-", doc="mu follows the contact current")
+    fit: Any = internal(None)  # coupling.laws.tribology.TribometerFit, when the laws come from a fit
 
 
 @dataclass(frozen=True)
@@ -259,9 +269,6 @@ class Scene:
 # ------------------------------------------------------------------------------------
 
 
-TRIBOLOGY_KEYS = ("source", "fit", "data", "mu", "resistance", "feedback")
-
-
 def _input_file(key: str, value, base_dir: Path) -> Path:
     """The file a scene key names, relative to the scene's folder (mech.validation.check_file)."""
     if not isinstance(value, str) or not value:
@@ -274,7 +281,7 @@ def _tribology(table: dict, base_dir: Path) -> TribologySpec:
     contact materials (coupling.laws.materials) instead of a fit, with mu from the fit or
     ``mu = number`` (Coulomb, gamma = 0)."""
     table = check_keys("[tribology]", _table("[tribology]", table), TRIBOLOGY_KEYS)
-    feedback = check_bool("tribology.feedback", table.get("feedback", True))
+    feedback = check_bool("tribology.feedback", table.get("feedback", _field_default(TribologySpec, "feedback")))
     resistance = table.get("resistance")
     if not (isinstance(resistance, dict) and "law" in resistance):
         return _tribology_fitted(table, base_dir, feedback)
@@ -365,6 +372,9 @@ def section_keys(cls) -> list[str]:
     """Every scene key of ``cls``'s section it takes: its key fields and the keys a field of
     several stands for (ContactSchedule's make and break)."""
     return key_fields(cls) + [row[0] for f in dataclasses.fields(cls) for row in f.metadata.get("keys", ())]
+
+
+TRIBOLOGY_KEYS = tuple(section_keys(TribologySpec))
 
 
 def template_keys(template: str) -> set:

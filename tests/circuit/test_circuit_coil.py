@@ -112,11 +112,11 @@ def test_a_moving_armature_closes_the_energy_balance():
 
 
 def test_coil_inputs_and_checks():
-    with pytest.raises(ValueError, match="CoilDrive.suppression = 'varistor': allowed values are"):
+    with pytest.raises(ValueError, match="coil.suppression = 'varistor': allowed values are"):
         CoilDrive(CoilBlock("", SUPPLY_NODE, DRIVER_NODE, R_COIL, LAW), suppression="varistor")
-    with pytest.raises(ValueError, match="CoilBlock.current = 'GAP': the coil current must depend on the flux"):
+    with pytest.raises(ValueError, match="coil.current = 'GAP': the coil current must depend on the flux"):
         CoilBlock("", SUPPLY_NODE, DRIVER_NODE, R_COIL, "GAP")
-    with pytest.raises(ValueError, match="CoilBlock.resistance = -1 ohm is out of range"):
+    with pytest.raises(ValueError, match="coil.resistance = -1 ohm is out of range"):
         CoilBlock("", SUPPLY_NODE, DRIVER_NODE, -1.0, LAW)
     with Stepper(relay(), 1e-5, OPTIONS) as stepper:
         with pytest.raises(TypeError, match="needs the input coil.gap"):

@@ -128,7 +128,15 @@ def _with(doc: dict, section: str, key: str, value) -> dict:
     (lambda d: _with(d, "coil", "suppression", "varistor"), "coil.suppression = 'varistor': allowed values are"),
     (lambda d: _with(d, "coil", "off_time", 5e-4), "coil.off_time = 0.0005 s: must come after on_time"),
     (lambda d: _with(d, "coil", "voltage", 200.0), "coil.switch_breakdown = 100 V: must exceed the supply"),
+    # (edge_time is checked before off_time's comparison uses it)
+    (lambda d: _with(d, "coil", "edge_time", "fast"), "coil.edge_time = 'fast': must be a real number in s"),
     (lambda d: _with(d, "magnet", "model", "horseshoe"), "magnet.model"),
+    # a needed key of a sub-table or of a table magnet left out: named (it was the constructor's TypeError)
+    (lambda d: _with(d, "magnet", "working_gap", {}), "[magnet.working_gap] needs area"),
+    (lambda d: _with(d, "magnet", "iron", [{"shape": "prism", "area": 1e-5, "material": "9SMnPb28"}]),
+     "[magnet.iron[0]] needs length"),
+    (lambda d: {**_without(d, "coil", "turns"), "magnet": {"model": "table", "rest_gap": 1e-3, "gaps": [1e-3, 2e-3]}},
+     "[magnet] needs currents (A)"),
     (lambda d: {k: v for k, v in d.items() if k != "magnet"}, "[coil] needs [magnet]"),
 ])
 def test_bad_coil_and_magnet_keys_are_one_line_naming_the_key(change, message):

@@ -12,7 +12,7 @@ import pytest
 
 import circuit as ck
 from coupling.core import scene as cs
-from coupling.core.device import COIL_KEYS, FLUX_TUBE_KEYS, PLACEMENT_KEYS, TABLE_KEYS
+from coupling.core.device import FLUX_TUBE_KEYS, PLACEMENT_KEYS, TABLE_KEYS, coil_keys
 from coupling.core.duty import DUTY_KEYS, LIFE_KEYS
 from coupling.core.metrics import MetricSettings
 from mech.scene import ENVIRONMENT_KEYS, LIST_SECTIONS, SECTIONS, entry_keys
@@ -64,7 +64,7 @@ def test_every_accepted_key_is_documented_and_nothing_else():
     expected["metrics"] = _fields(MetricSettings)
     expected["duty"] = set(DUTY_KEYS)
     expected["duty.life"] = set(LIFE_KEYS)
-    expected["coil"] = set(COIL_KEYS)
+    expected["coil"] = set(coil_keys())
     expected["magnet"] = set(PLACEMENT_KEYS + FLUX_TUBE_KEYS + TABLE_KEYS)
     assert set(doc) == set(expected), "sections of docs/scene_keys.md differ from the scene's"
     for section, keys in expected.items():
@@ -121,7 +121,8 @@ ENTRIES = {"force": {"magnitude": 1.0}, "spring": {"stiffness": 1e3}, "rivet": {
 # and the rest of the scene such an entry needs: [[fixed]] on a blade clamped at tip 1 (its
 # one contact point tip 0: every contact point must strike a fixed contact)
 ENTRY_SCENES = {"fixed": {"mount": {"kind": "clamp", "position": 0.3}}}
-# keys no dataclass field holds: the alternatives choosing the laws or the contact, file names
+# keys that set one field together, so none has a default of its own: the alternatives choosing
+# the contact laws (TribologySpec.laws) or the contact (the schedule), file names
 NO_FIELD = {("tribology", k) for k in ("source", "fit", "data", "mu", "resistance")} | {
     ("circuit", "netlist"), ("circuit", "schedule"), ("circuit.schedule", "make"), ("circuit.schedule", "break")}
 # keys whose default follows from the scene's other sections or from a life study's first sample,
@@ -129,10 +130,17 @@ NO_FIELD = {("tribology", k) for k in ("source", "fit", "data", "mu", "resistanc
 # test_duty_needs_materials_a_circuit_and_a_gap; tests/coupling/test_life.py, the limits)
 DERIVED = {("duty", k) for k in ("materials", "conductor_radius", "cap_height")} | {
     ("duty.life", k) for k in ("gap_range", "min_force", "max_resistance")} | {
-    # the winding and the magnet's model keys: needed or not by the model chosen (documented
-    # in words, checked in tests/coupling/test_relay.py, bad input)
-    ("coil", "resistance"), ("coil", "turns"), ("magnet", "model"), ("magnet", "rest_gap"),
-    ("magnet", "force_tolerance")} | {("magnet", k) for k in FLUX_TUBE_KEYS + TABLE_KEYS}
+    # the winding: needed or not by the magnet's model (documented in words, checked in
+    # tests/coupling/test_relay.py, bad input); a magnet's lists of tubes: "-", none
+    ("coil", "resistance"), ("coil", "turns"), ("magnet", "iron"), ("magnet", "fixed_gap")}
+# [coil] and [magnet] of each magnet model that needs its keys (a key checked is left out): a
+# flux-tube magnet of one working gap, and the table of an ideal gap, psi = k i / g and
+# F = k i^2 / (2 g^2) with k = N^2 mu0 A = 1e-6 H m (consistent: F = -dW'/dg exactly)
+MAGNETS = {"flux_tubes": {"coil": {"resistance": 10.0, "turns": 100},
+                          "magnet": {"rest_gap": 1e-3, "working_gap": {"area": 1e-4}}},
+           "table": {"coil": {"resistance": 10.0},
+                     "magnet": {"model": "table", "rest_gap": 1e-3, "currents": [0.0, 1.0], "gaps": [1e-3, 2e-3],
+                                "flux_linkages": [[0.0, 0.0], [1e-3, 5e-4]], "forces": [[0.0, 0.0], [0.5, 0.125]]}}}
 # an actuator alone: the built-in solenoid's magnet, its armature, the coil's drive as the circuit
 ACTUATOR = {"armature": {"kind": "plunger", "mass": 0.026, "travel": 4.75e-3, "stop_stiffness": 1e11},
             "magnet": {"model": "plunger_solenoid"}, "coil": {}}
@@ -219,9 +227,11 @@ def _field_without(section: str, key: str, patch: dict, folder: Path):
     if section == "coil":
         return getattr(cs.scene_from_dict(ACTUATOR).circuit.circuit, key)
     if section == "magnet":
-        from coupling.core.device import device
+        from coupling.core.device import PLACEMENT_KEYS, device
 
-        return getattr(device(ACTUATOR), key)
+        doc = MAGNETS["table" if key in TABLE_KEYS else "flux_tubes"]
+        spec = device({"coil": doc["coil"], "magnet": {k: v for k, v in doc["magnet"].items() if k != key}})
+        return getattr(spec if key in PLACEMENT_KEYS else spec.magnet, key)
     table = {"schedule": {"make": [1e-4], "break": []}, **patch}
     if table.get("template") == "netlist":
         (folder / "net.cir").write_text(NETLIST)

@@ -35,6 +35,7 @@ from coupling.laws.magnet.tubes import (
     working_gap_permeance, working_gap_permeance_slope,
 )
 from coupling.laws.magnet.validation import check_instance, check_positive
+from mech.validation import internal, scene_key
 
 
 def _out(x):
@@ -153,12 +154,16 @@ class FluxTubeMagnet(Magnet):
 
     The gap g is held at ``working_gap.minimum`` below it (force 0 there)."""
 
-    turns: float
-    working_gap: WorkingGap
-    iron: tuple = ()
-    fixed_gap: tuple = ()
-    pole_leakage: PoleLeakage | None = None
-    name: str = "magnet"
+    # the fields a [magnet] with model = "flux_tubes" sets (docs/scene_keys.md; turns is coil.turns)
+    turns: float = internal()
+    working_gap: WorkingGap = scene_key(unit="-", shown="-", doc="flux_tubes: `{area, minimum}` (m^2, m)")
+    iron: tuple = scene_key((), unit="-", shown="-",
+                            doc="flux_tubes: `[[magnet.iron]]` tubes, each a shape with its material")
+    fixed_gap: tuple = scene_key(
+        (), unit="-", shown="-", doc="flux_tubes: `[[magnet.fixed_gap]]`, each with `[[magnet.fixed_gap.tube]]` in parallel")
+    pole_leakage: PoleLeakage | None = scene_key(
+        None, unit="-", doc="flux_tubes: `{width, radius}` (m); omitted: no leakage")
+    name: str = internal("magnet")
 
     def __post_init__(self):
         n = self.name

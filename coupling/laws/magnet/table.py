@@ -31,6 +31,7 @@ import numpy as np
 from coupling.laws.magnet.law import Magnet
 from coupling.laws.magnet.pwl import OddPwl, number
 from coupling.laws.magnet.validation import check_finite, check_increasing, check_numbers, check_positive
+from mech.validation import internal, scene_key
 
 
 def power_law_work(gap0: float, gap1: float, force0: float, force1: float) -> float:
@@ -81,12 +82,13 @@ class TableMagnet(Magnet):
     as the gap opens. ``force_tolerance``: the allowed mismatch between the force table and
     the flux table's co-energy (module docstring), a fraction."""
 
-    currents: tuple
-    gaps: tuple
-    flux_linkages: tuple
-    forces: tuple
-    force_tolerance: float = 0.05
-    name: str = "magnet"
+    # the fields a [magnet] with model = "table" sets (docs/scene_keys.md)
+    currents: tuple = scene_key(unit="A", shown="-", doc="table: the current grid")
+    gaps: tuple = scene_key(unit="m", shown="-", doc="table: the gap grid")
+    flux_linkages: tuple = scene_key(unit="Wb", shown="-", doc="table: psi, one row per current")
+    forces: tuple = scene_key(unit="N", shown="-", doc="table: F closing the gap, one row per current")
+    force_tolerance: float = scene_key(0.05, unit="-", doc="table: allowed mismatch of F against dW'/dg, checked on load")
+    name: str = internal("magnet")
 
     def __post_init__(self):
         n = self.name
