@@ -51,7 +51,7 @@ from .stepping import CompiledStepper, Stepper
 REGIME_NAMES = ("free", "slip", "stick")
 EVENT_KINDS = ("contact", "clip", "slip", "stick", "compression")
 ARMATURE_EVENTS = {EA_REST: ("armature_stop", "rest"), EA_POLE: ("armature_stop", "pole"), EA_CARD: ("card", "")}
-CHATTER_LIMIT = 200  # events at one instant (within round-off) before the run is stopped
+CHATTER_LIMIT = 200  # events at one instant (within round-off, or picoseconds apart) before the run is stopped
 FLIGHT_RETRY = 0.125  # of the rest window: how soon a bar found not at rest in flight is looked at again
 
 
@@ -1173,7 +1173,12 @@ class ImpactSolver:
     def _handle_event(self, ev: int) -> None:
         tip, kind = divmod(ev, NEV_TIP)
         base = self.model.armature_event_base
-        same_instant = abs(self.t - self._last_event_time) <= 1e-12 * max(abs(self.t), 1e-6)
+        # one instant: within round-off, or within 1e-4 of the contact onset's first step (a
+        # few ps): switching that creeps on by 0.1 ps per event (a slip reversing over and
+        # over) is no more progress than switching at one instant, and ran without end
+        onset = self._onset_step if math.isfinite(self._onset_step) else 0.0
+        spacing = max(1e-12 * max(abs(self.t), 1e-6), 1e-4 * onset)
+        same_instant = abs(self.t - self._last_event_time) <= spacing
         self._chatter = self._chatter + 1 if same_instant else 0
         self._last_event_time = self.t
         if self._chatter > CHATTER_LIMIT:

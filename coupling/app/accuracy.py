@@ -234,7 +234,8 @@ def tip_intervals(result) -> dict:
     if result.mechanics is None:
         return {0: list(result.closed_intervals)}
     c = result.mechanics.contacts
-    return {i: [(float(a), float(b)) for a, b in zip(c.t_start[c.tip == i], c.t_end[c.tip == i])] for i in (0, 1)}
+    pairs = sorted({0, 1} | {int(t) for t in c.tip})  # (a [[fixed]] scene may have up to four)
+    return {i: [(float(a), float(b)) for a, b in zip(c.t_start[c.tip == i], c.t_end[c.tip == i])] for i in pairs}
 
 
 def metrics_of(result) -> dict:

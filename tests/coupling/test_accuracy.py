@@ -13,7 +13,7 @@ import pytest
 from coupling import run, scene_from_dict
 from coupling.app.accuracy import (
     TOLERANCES, agreeing_contacts, compare, contact_metrics, intersection, measure,
-    metrics_of, mismatch_allowance, mismatch_time, refined_count, status_of, time_tolerance, verdict,
+    metrics_of, mismatch_allowance, mismatch_time, refined_count, status_of, time_tolerance, tip_intervals, verdict,
 )
 
 
@@ -312,3 +312,30 @@ def test_pushbutton_at_auto_brackets_twice_its_mode_count():
         lo, hi = ranges.get(key, (base[key], base[key]))
         assert lo - slack <= double[key] <= hi + slack, (key, double[key], ranges.get(key))
     assert min(e["agreeing_contacts"] for e in acc["refinements"] + acc["sensitivity"]) >= 1
+
+
+def test_the_check_reads_every_contact_pair_of_a_fixed_scene():
+    """A blade with three contact pairs (NO below, NC above, a stop under it nearer the
+    clamp), pushed onto NO and the stop and released onto NC: the check's intervals hold
+    every pair's contacts (the third pair's too), as contacts.csv lists them, and its
+    contact count is theirs."""
+    blade = dict(length=0.02, width=0.003, thickness=0.0003, tip_radius=0.0016, modes={"axial": 1, "bending": 4},
+                 modal_damping=0.05, youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0)
+    doc = {"bar": blade, "mount": dict(kind="clamp", position=0.02),
+           "rivet": [dict(position=0.0015, offset=-3e-4, radius=0.001, name="low"),
+                     dict(position=0.0015, offset=3e-4, radius=0.001, name="high"),
+                     dict(position=0.006, offset=-3e-4, radius=0.0008, name="aux")],
+           "fixed": [dict(point="low", name="NO", gap=5e-5),
+                     dict(point="high", name="NC", facing="down", gap=0.0, shape="sphere", radius=0.003),
+                     dict(point="aux", name="stop", gap=2e-5, electrical=False, youngs_modulus=70e9)],
+           "force": [dict(position=0.0015, direction=[0.0, 0.0, 1.0], time=[0.0, 1e-3, 2e-3, 2.2e-3, 4e-3, 4.1e-3],
+                          value=[0.0, 0.5, 0.5, -3.0, -3.0, 1.0])],
+           "friction": dict(mu=0.3), "contact": dict(restitution=0.6), "environment": dict(gravity=0.0),
+           "solver": dict(t_end=6e-3, rtol=1e-7)}
+    res = run(scene_from_dict(doc, name="three_pairs"))
+    c = res.mechanics.contacts
+    assert set(c.tip) == {0, 1, 2}
+    tips = tip_intervals(res)
+    for i in (0, 1, 2):
+        assert tips[i] == list(zip(c.t_start[c.tip == i], c.t_end[c.tip == i]))
+    assert metrics_of(res)["contacts"] == len(c)
