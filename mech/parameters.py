@@ -576,27 +576,11 @@ def share_table(name: str, travel, share) -> tuple[tuple, tuple]:
     """(travels m, shares 1) of force ``name``'s travel table checked: both lists of finite
     numbers, at least two and at most TABLE_POINTS_MAX travels, strictly increasing and
     within LENGTH_MAX, one share in [0, 1] per travel. Errors name the key."""
-    for key, items in (("travel", travel), ("share", share)):
-        if items is None:
-            other = "share" if key == "travel" else "travel"
-            raise ValueError(f"{name}.{key}: missing; a force that follows its travel needs both {name}.travel (m) "
-                             f"and {name}.share (1, in [0, 1]), one share per travel (it has {name}.{other})")
-        if isinstance(items, (str, dict)) or not hasattr(items, "__iter__") or \
-                any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in items):
-            raise ValueError(f"{name}.{key} = {items!r:.80}: expected a list of numbers")
-    if len(travel) > TABLE_POINTS_MAX:
-        raise ValueError(f"{name}.travel: {len(travel)} points; at most {TABLE_POINTS_MAX} allowed")
-    xs = tuple(check_magnitude(f"{name}.travel[{k}]", v, LENGTH_MAX) for k, v in enumerate(travel))
-    ss = tuple(check_range(f"{name}.share[{k}]", v, 0.0, 1.0, closed_low=True, closed_high=True) for k, v in enumerate(share))
-    if len(xs) < 2:
-        raise ValueError(f"{name}.travel = {list(xs)!r}: {len(xs)} point(s); give at least two travels")
-    if len(ss) != len(xs):
-        raise ValueError(f"{name}.share: {len(ss)} shares for {len(xs)} travels; give one share per travel")
-    for k in range(1, len(xs)):
-        if xs[k] <= xs[k - 1]:
-            raise ValueError(f"{name}.travel[{k}] = {xs[k]!r}: travels must increase strictly (previous "
-                             f"{xs[k - 1]!r} m); the table gives one share per travel")
-    return xs, ss
+    return _travel_table(
+        name, travel, share, "share",
+        lambda where, v: check_range(where, v, 0.0, 1.0, closed_low=True, closed_high=True),
+        needs=f"a force that follows its travel needs both {name}.travel (m) and {name}.share (1, in [0, 1])",
+        noun="share", table="the table")
 
 
 # what a spring's ``anchor`` end is fixed to: the frame, or the armature's point that moves
@@ -744,28 +728,37 @@ def force_travel_table(name: str, travel, force, force_key: str = "force") -> tu
     """(travels m, forces N) of the force-travel spring ``name`` checked: both lists of
     finite numbers, at least two and at most TABLE_POINTS_MAX travels, strictly increasing
     and within LENGTH_MAX, one force (within FORCE_MAX) per travel. Errors name the key."""
-    numbers = (int, float)
-    for key, items in (("travel", travel), (force_key, force)):
+    return _travel_table(
+        name, travel, force, force_key, lambda where, v: check_magnitude(where, v, FORCE_MAX),
+        needs=f"a force-travel spring needs both {name}.travel (m) and {name}.{force_key} (N)",
+        noun="force", table="a force-travel table")
+
+
+def _travel_table(name: str, travel, values, key: str, check_value, *, needs: str, noun: str,
+                  table: str) -> tuple[tuple, tuple]:
+    """(travels m, values) of a table over travel (``name``.travel and ``name``.``key``)
+    checked as share_table and force_travel_table say; ``check_value(where, v)`` checks one
+    value, ``needs``, ``noun`` and ``table`` word the one-line errors."""
+    for k, items in (("travel", travel), (key, values)):
         if items is None:
-            other = force_key if key == "travel" else "travel"
-            raise ValueError(f"{name}.{key}: missing; a force-travel spring needs both {name}.travel (m) "
-                             f"and {name}.{force_key} (N), one force per travel (it has {name}.{other})")
+            other = key if k == "travel" else "travel"
+            raise ValueError(f"{name}.{k}: missing; {needs}, one {noun} per travel (it has {name}.{other})")
         if isinstance(items, (str, dict)) or not hasattr(items, "__iter__") or \
-                any(isinstance(v, bool) or not isinstance(v, numbers) for v in items):
-            raise ValueError(f"{name}.{key} = {items!r:.80}: expected a list of numbers")
+                any(isinstance(v, bool) or not isinstance(v, (int, float)) for v in items):
+            raise ValueError(f"{name}.{k} = {items!r:.80}: expected a list of numbers")
     if len(travel) > TABLE_POINTS_MAX:
         raise ValueError(f"{name}.travel: {len(travel)} points; at most {TABLE_POINTS_MAX} allowed")
     xs = tuple(check_magnitude(f"{name}.travel[{k}]", v, LENGTH_MAX) for k, v in enumerate(travel))
-    fs = tuple(check_magnitude(f"{name}.{force_key}[{k}]", v, FORCE_MAX) for k, v in enumerate(force))
+    vs = tuple(check_value(f"{name}.{key}[{k}]", v) for k, v in enumerate(values))
     if len(xs) < 2:
         raise ValueError(f"{name}.travel = {list(xs)!r}: {len(xs)} point(s); give at least two travels")
-    if len(fs) != len(xs):
-        raise ValueError(f"{name}.{force_key}: {len(fs)} forces for {len(xs)} travels; give one force per travel")
+    if len(vs) != len(xs):
+        raise ValueError(f"{name}.{key}: {len(vs)} {noun}s for {len(xs)} travels; give one {noun} per travel")
     for k in range(1, len(xs)):
         if xs[k] <= xs[k - 1]:
             raise ValueError(f"{name}.travel[{k}] = {xs[k]!r}: travels must increase strictly (previous "
-                             f"{xs[k - 1]!r} m); a force-travel table gives one force per travel")
-    return xs, fs
+                             f"{xs[k - 1]!r} m); {table} gives one {noun} per travel")
+    return xs, vs
 
 
 @dataclass(frozen=True)
