@@ -466,19 +466,24 @@ def armature_force(t, y, mdl, arm):
     off = arm_offset(n, planar, ipar[I_MOUNT])
     qa = y[off]
     va = y[off + 1]
+    load, tabs, theta = mdl[11], mdl[12], mdl[7]
+    pc = ipar[I_ARM_CARD]
+    carried = False  # springs the armature carries (L_ARM): their reaction is on it too
+    for ld in range(ipar[I_NLOAD]):
+        carried = carried or load[ld, L_ARM] != 0.0
+    r = np.empty(3)
+    R = np.empty((3, 3))
+    q = np.empty(n)
+    V = np.empty(3)
+    w = np.empty(3)
+    eta = np.empty(n)
+    if pc >= 0 or carried:  # (both need the bar's state; an armature alone has none)
+        unpack(y, n, planar, r, R, q, V, w, eta)
     pen_c = 0.0
     rate_c = 0.0
-    pc = ipar[I_ARM_CARD]
     if pc >= 0:
-        r = np.empty(3)
-        R = np.empty((3, 3))
-        q = np.empty(n)
-        V = np.empty(3)
-        w = np.empty(3)
-        eta = np.empty(n)
         x = np.empty(3)
         v = np.empty(3)
-        unpack(y, n, planar, r, R, q, V, w, eta)
         load_point_motion(pc, xc, psi, r, R, q, V, w, eta, n, x, v)
         pen_c, rate_c = card_penetration(qa, va, x[2], v[2], apar)
     open_stops = np.zeros(NEV_ARM)
@@ -486,20 +491,13 @@ def armature_force(t, y, mdl, arm):
     terms = np.empty(4)
     armature_terms(t, qa, va, pen_c, rate_c, ipar, apar, again, open_stops, drive, terms)
     f = terms[0]
-    load, tabs, theta = mdl[11], mdl[12], mdl[7]
-    for ld in range(ipar[I_NLOAD]):  # the reaction of the springs the armature carries
-        if load[ld, L_ARM] != 0.0:
-            r = np.empty(3)
-            R = np.empty((3, 3))
-            q = np.empty(n)
-            V = np.empty(3)
-            w = np.empty(3)
-            eta = np.empty(n)
-            unpack(y, n, planar, r, R, q, V, w, eta)
-            dy = np.empty(y.shape[0])
-            _, _, f_l = _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, np.zeros(3),
-                                    np.zeros(3), np.zeros(n), np.zeros(3), np.zeros(3), y, dy, qa, va)
-            f += f_l
+    if carried:
+        dy = np.empty(y.shape[0])
+        for ld in range(ipar[I_NLOAD]):
+            if load[ld, L_ARM] != 0.0:
+                _, _, f_l = _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, np.zeros(3),
+                                        np.zeros(3), np.zeros(n), np.zeros(3), np.zeros(3), y, dy, qa, va)
+                f += f_l
     return f
 
 
