@@ -44,9 +44,11 @@ def _run(tmp_path_factory, name: str):
     return numbers, out
 
 
-def _closed(out: Path) -> list[tuple[float, float]]:
-    """Merged contact intervals (s) from the mechanics' contacts.csv."""
-    c = pd.read_csv(out / "contacts.csv").sort_values("t_start")
+def _closed(out: Path, tip: int | None = None) -> list[tuple[float, float]]:
+    """Merged contact intervals (s) from the mechanics' contacts.csv in folder ``out``, of
+    every contact pair or of pair ``tip``."""
+    c = pd.read_csv(out / "contacts.csv")
+    c = (c if tip is None else c[c.tip == tip]).sort_values("t_start")
     merged: list[list[float]] = []
     for a, b in zip(c.t_start, c.t_end):
         if merged and a <= merged[-1][1]:
@@ -855,19 +857,6 @@ def changeover(tmp_path_factory):
     return _run(tmp_path_factory, "changeover_relay")
 
 
-def _pair_intervals(out: Path, tip: int) -> list[tuple[float, float]]:
-    """Merged contact intervals (s) of contact pair ``tip`` from the mechanics' contacts.csv."""
-    c = pd.read_csv(out / "changeover" / "contacts.csv")
-    c = c[c.tip == tip].sort_values("t_start")
-    merged: list[list[float]] = []
-    for a, b in zip(c.t_start, c.t_end):
-        if merged and a <= merged[-1][1]:
-            merged[-1][1] = max(merged[-1][1], b)
-        else:
-            merged.append([a, b])
-    return [(a, b) for a, b in merged]
-
-
 def test_changeover_transfers_break_before_make_at_the_mechanics_instants(changeover):
     """Form C on the coil-driven relay: from the mechanics' own contact table (contacts.csv,
     pair 0 on NO, pair 1 on NC), NC holds until the operate break, NO makes after it (the
@@ -878,7 +867,7 @@ def test_changeover_transfers_break_before_make_at_the_mechanics_instants(change
     numbers, out = changeover
     coil = _toml("changeover_relay")["coil"]
     assert numbers["status"] == "ok" and numbers["warnings"] == []
-    no, nc = _pair_intervals(out, 0), _pair_intervals(out, 1)
+    no, nc = _closed(out / "changeover", 0), _closed(out / "changeover", 1)
     co = numbers["changeover"]
     op, rel = co["operate"][0], co["release"][0]
     assert nc[0][0] < 1e-9 and nc[0][1] == op["nc_break"] and no[0][0] == op["no_make"]

@@ -4,7 +4,6 @@ allowed, raised where the dataclass is built."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 from coupling.laws.magnet.bh_curves import STEEL_9SMNPB28, LinearMaterial, TabulatedMaterial, magnetic_material
 from coupling.laws.magnet.law import FluxTubeMagnet
@@ -13,18 +12,9 @@ from coupling.laws.magnet.table import TableMagnet, tabulate
 from coupling.laws.magnet.tubes import (
     AxialGap, AxialIron, FixedGap, IronPath, PoleLeakage, QuarterHollowCylinder, RadialGap, RadialIron, WorkingGap,
 )
+from value_errors import one_line_value_error as _raises
 
 STEEL = STEEL_9SMNPB28
-
-
-def _raises(build, *fragments):
-    with pytest.raises(ValueError) as err:
-        build()
-    msg = str(err.value)
-    assert "\n" not in msg, msg
-    for fragment in fragments:
-        assert fragment in msg, msg
-    return msg
 
 
 def test_flux_tube_magnet_fields():

@@ -15,6 +15,7 @@ import pytest
 
 from coupling.app.sweep import load_sweep
 from coupling.core.scene import key_steps, load_scene, scene_from_dict
+from value_errors import one_line_value_error as _one_line
 
 # A mechanics scene with two entries in each list of tables (the two rivets are the contact).
 LISTS = {
@@ -154,16 +155,6 @@ def test_magnet_list_entries(key, new, path, tmp_path):
     for f in dataclasses.fields(magnets[0]):
         if f.name != section:
             assert getattr(magnets[0], f.name) == getattr(magnets[1], f.name), f"{key} changed magnet.{f.name}"
-
-
-def _one_line(call, *fragments):
-    with pytest.raises(ValueError) as err:
-        call()
-    msg = str(err.value)
-    assert "\n" not in msg, msg
-    for fragment in fragments:
-        assert fragment in msg, msg
-    return msg
 
 
 def test_bad_keys_are_one_line_naming_the_key(tmp_path):
