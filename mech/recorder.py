@@ -133,7 +133,7 @@ class Recorder:
                 cap *= 2
             if self.row_limit is not None and self.n >= self.row_limit:
                 cap = need  # past the limit (thinning freed too little): no more than needed
-            self._grow(cap)
+            self.grow(cap)
         if self.keep_dense:
             used = self.n - self.dense_base
             span = used + self.room_end - self.recorded
@@ -147,7 +147,9 @@ class Recorder:
                 self.dense_h = _grown(self.dense_h, cap, used)
                 self.dense_coef = _grown(self.dense_coef, cap, used)
 
-    def _grow(self, cap: int) -> None:
+    def grow(self, cap: int) -> None:
+        """Make room for ``cap`` history rows (the rows held kept; numpy's MemoryError, when
+        it cannot allocate them, propagates: the solver ends the run with its partial result)."""
         n = self.n
         self.t, self.y, self.aux = _grown(self.t, cap, n), _grown(self.y, cap, n), _grown(self.aux, cap, n)
         self.fmax, self.regime, self.ext = _grown(self.fmax, cap, n), _grown(self.regime, cap, n), _grown(self.ext, cap, n)

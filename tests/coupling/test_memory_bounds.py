@@ -74,7 +74,7 @@ class OutOfMemory:
         self.rows = rows
 
     def __enter__(self):
-        self.grow = Recorder._grow
+        self.grow = Recorder.grow
         rows, grow = self.rows, self.grow
 
         def limited(rec, cap):
@@ -82,11 +82,11 @@ class OutOfMemory:
                 raise MemoryError(f"Unable to allocate {cap * 8 / 2**20:.3g} MiB for an array")
             grow(rec, cap)
 
-        Recorder._grow = limited
+        Recorder.grow = limited
         return self
 
     def __exit__(self, *exc):
-        Recorder._grow = self.grow
+        Recorder.grow = self.grow
 
 
 MECH = "[bar]\nmodes = 3\n[solver]\nt_end = 0.05\n"  # the default drop, ~6 000 steps

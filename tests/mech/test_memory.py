@@ -96,14 +96,14 @@ def test_after_a_release_the_dense_buffer_holds_only_the_later_steps():
 def test_running_out_of_memory_is_a_failed_run_with_its_partial_result(monkeypatch):
     """The recorder cannot grow past 8 192 rows: the run ends in one line and keeps what it
     computed (a default drop takes ~9 600 steps)."""
-    grow = Recorder._grow
+    grow = Recorder.grow
 
     def limited(self, cap):
         if cap > 8192:
             raise MemoryError("Unable to allocate 128. MiB for an array")
         grow(self, cap)
 
-    monkeypatch.setattr(Recorder, "_grow", limited)
+    monkeypatch.setattr(Recorder, "grow", limited)
     solver = ImpactSolver(drop(100_000))
     with pytest.raises(MechSolverError) as info:
         solver.run()
