@@ -30,6 +30,7 @@ Rules (docs/coupling.md, "Plots"):
 from __future__ import annotations
 
 import fnmatch
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -226,12 +227,26 @@ def sample_weights(t: np.ndarray) -> np.ndarray:
     return 0.5 * (np.r_[dt, 0.0] + np.r_[0.0, dt])
 
 
+def quantile(values: np.ndarray, q: float) -> float:
+    """``np.quantile(values, q)`` (its default, linear interpolation between order statistics,
+    the same arithmetic) of finite values, without the import of numpy.ma that np.quantile
+    makes (~10 ms of a run's start)."""
+    a = np.sort(np.asarray(values, dtype=float))
+    v = (len(a) - 1) * q
+    if v >= len(a) - 1:
+        return float(a[-1])
+    i = max(math.floor(v), 0)
+    gamma = v - i
+    diff = a[i + 1] - a[i]
+    return float(a[i + 1] - diff * (1.0 - gamma) if gamma >= 0.5 else a[i] + diff * gamma)
+
+
 def weighted_quantile(values: np.ndarray, weights: np.ndarray, q: float) -> float:
     """The value below which the fraction q of the total weight lies."""
     order = np.argsort(values)
     cum = np.cumsum(weights[order])
     if cum[-1] <= 0.0:
-        return float(np.quantile(values, q))
+        return quantile(values, q)
     return float(values[order][min(np.searchsorted(cum, q * cum[-1]), len(order) - 1)])
 
 
@@ -282,7 +297,7 @@ def resistance_ticks(axis: Axis) -> list[tuple[float, str | None]]:
 def _spikes_axis(series, sel, floor=1e-12) -> Axis:
     ref = series[0][1][sel]
     a = np.abs(ref[np.isfinite(ref)])
-    top = max(1.15 * float(np.percentile(a, 99.5)) if len(a) else 0.0, floor)
+    top = max(1.15 * quantile(a, 99.5 / 100) if len(a) else 0.0, floor)
     lows = [np.nanmin(y[sel]) for _, y in series if sel.any() and np.isfinite(y[sel]).any()]
     lo = -0.1 * top if lows and min(lows) < 0.0 else 0.0
     return Axis(lo, top, clipped=_beyond(series, sel, lo, top))

@@ -7,7 +7,8 @@ element modes are numpy or compiled); pandas never for a run with its default ou
 (tables written from arrays, the waveforms kept as arrays, the tribology laws read without
 it); pyarrow only to write waveforms.parquet; matplotlib only when plotting; plotly's
 Python side never (waveforms.html is written directly); PySpice only with a circuit; Dask
-never.
+never; numpy.ma never (np.unique and np.quantile import it, ~10 ms of a start: the magnet's
+points and the waveform page's axes use their own, tests/coupling/test_sorted_values.py).
 """
 
 from __future__ import annotations
@@ -24,7 +25,8 @@ import pytest
 from fit_compare import assert_same_fit
 
 ROOT = Path(__file__).resolve().parents[2]
-HEAVY = ("numba", "scipy", "pandas", "pyarrow", "matplotlib", "plotly", "PySpice", "dask", "distributed")
+HEAVY = ("numba", "scipy", "pandas", "pyarrow", "matplotlib", "plotly", "PySpice", "dask", "distributed",
+         "numpy.ma")
 
 MECH = """
 [bar]
@@ -92,7 +94,7 @@ def test_mechanics_only_scene_with_its_default_outputs_imports_nothing_heavy(tmp
 
 def test_plots_bring_matplotlib_and_pandas_only(tmp_path):
     _requires_aot()
-    assert _loaded(tmp_path, MECH.format(plots="true")) - {"pyarrow"} == {"matplotlib", "pandas"}
+    assert _loaded(tmp_path, MECH.format(plots="true")) - {"pyarrow", "numpy.ma"} == {"matplotlib", "pandas"}
     assert (tmp_path / "out" / "normal_force.png").stat().st_size > 0
 
 

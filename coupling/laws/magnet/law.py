@@ -29,7 +29,7 @@ from functools import cached_property
 import numpy as np
 
 from coupling.laws.magnet.bh_curves import MU0
-from coupling.laws.magnet.pwl import Linear, OddPwl, merged, number
+from coupling.laws.magnet.pwl import Linear, OddPwl, merged, number, union
 from coupling.laws.magnet.tubes import (
     FixedGap, PoleLeakage, WorkingGap, _Iron, pole_leakage_permeance, pole_leakage_permeance_slope,
     working_gap_permeance, working_gap_permeance_slope,
@@ -127,7 +127,7 @@ class Magnet:
     @cached_property
     def breakpoints(self) -> np.ndarray:
         """The psi >= 0 (Wb) where some term's slope changes: i is linear in psi between them."""
-        xs = np.unique(np.concatenate([t.xs for t in self.terms]))
+        xs = union([t.xs for t in self.terms])
         return xs if xs.size >= 2 else np.array([0.0, 1.0])
 
     def current_expression(self, psi: str, gap: str) -> str:
