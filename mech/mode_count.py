@@ -7,6 +7,15 @@ impacting tip, the scene's impact speed, the contact stiffness), counted per fam
 [FLOOR, CAP]. Modes well above 1/t_c respond quasi-statically to a contact pulse and
 change neither the contact intervals nor the forces; the factor SAFETY was chosen by
 measurement (benchmarks/bench_mode_count.py, table in docs/accuracy-modes.md).
+
+The floor is for a family the impact loads: above the cutoff a mode still adds its static
+compliance at the contact point (1/k^2 of the first's, for a free-free bar's axial modes at
+its tip), and a bar struck on its end converges slowly in its axial count. A family the
+first impact's normal does not load (the axial modes of a blade or lever struck across its
+axis) keeps the cutoff's count where the other family reaches the floor: raising it adds
+nothing the contact feels, and its highest mode would set the explicit integrator's
+stability-limited step. Where both families fall short, both are raised as before.
+Measured in docs/accuracy-modes.md.
 """
 
 from __future__ import annotations
@@ -33,6 +42,8 @@ class ModeCount:
     safety: float
     capped: tuple[str, ...] = ()
     floored: tuple[str, ...] = ()
+    # families short of the floor left at the cutoff's count: the impact does not load them
+    unloaded: tuple[str, ...] = ()
     # Hz: the lowest frequency of each family left out (inf: none known, or capped): a
     # faster impact than the estimate changes the count only once its cutoff passes one
     next_frequencies: tuple[float, float] = (math.inf, math.inf)
@@ -45,6 +56,7 @@ class ModeCount:
                 f"= {self.safety:g} / t_c (t_c = {self.contact_time * 1e6:.3g} us at {self.impact_speed:.3g} m/s)")
         notes = [f"{fam} capped at {CAP}" for fam in self.capped]
         notes += [f"{fam} raised to the floor {FLOOR}" for fam in self.floored]
+        notes += [f"{fam} not raised to the floor (the impact's normal does not load it)" for fam in self.unloaded]
         return text + ("; " + ", ".join(notes) if notes else "")
 
 
@@ -56,8 +68,10 @@ def count_below(frequencies, cutoff: float) -> int:
 
 def choose_mode_count(axial_frequencies, bending_frequencies, contact_time: float, *,
                       impact_speed: float = math.nan, safety: float = SAFETY, cap: int = CAP,
-                      floor: int = FLOOR) -> ModeCount:
-    """Modes per family below f_cut = safety / contact_time, held within [floor, cap].
+                      floor: int = FLOOR, unloaded: tuple[str, ...] = ()) -> ModeCount:
+    """Modes per family below f_cut = safety / contact_time, held within [floor, cap]; a
+    family named in ``unloaded`` ("axial", "bending") keeps the cutoff's count below the
+    floor where the other family reaches the floor below the cutoff.
 
     axial_frequencies, bending_frequencies: Hz, ascending, the first ``cap`` (at least)
     of each family. contact_time: s, > 0. impact_speed: m/s, only reported.
@@ -67,12 +81,17 @@ def choose_mode_count(axial_frequencies, bending_frequencies, contact_time: floa
     if not safety > 0.0:
         raise ValueError(f"safety = {safety!r}: must be > 0")
     cutoff = safety / contact_time
-    counts, capped, floored, following = {}, [], [], []
-    for fam, freqs in (("axial", axial_frequencies), ("bending", bending_frequencies)):
-        k = count_below(freqs, cutoff)
+    families = (("axial", axial_frequencies), ("bending", bending_frequencies))
+    admitted = {fam: count_below(freqs, cutoff) for fam, freqs in families}
+    counts, capped, floored, below, following = {}, [], [], [], []
+    for fam, freqs in families:
+        k = admitted[fam]
+        other = admitted["bending" if fam == "axial" else "axial"]
         if k >= cap:
             k = cap
             capped.append(fam)
+        elif k < floor and fam in unloaded and other >= floor:
+            below.append(fam)
         elif k < floor:
             k = floor
             floored.append(fam)
@@ -81,4 +100,5 @@ def choose_mode_count(axial_frequencies, bending_frequencies, contact_time: floa
         following.append(float(f[k]) if k < min(cap, len(f)) else math.inf)
     return ModeCount(axial=counts["axial"], bending=counts["bending"], cutoff=cutoff,
                      contact_time=contact_time, impact_speed=impact_speed, safety=safety,
-                     capped=tuple(capped), floored=tuple(floored), next_frequencies=tuple(following))
+                     capped=tuple(capped), floored=tuple(floored), unloaded=tuple(below),
+                     next_frequencies=tuple(following))

@@ -1116,8 +1116,11 @@ def resolve_auto_modes(scene: MechScene, safety: float | None = None, impact_spe
         speed = cs.reference_speed if impact_speed is None else impact_speed
         t_c = hertz_impact(cs.reference_mass, cs.stiffness, speed).contact_time
         axial, bend = family_frequencies(bar, CAP)
+    # a bar lying along the surface (a blade, a lever) is struck across its axis: the normal
+    # gives its axial modes no force, so the floor does not raise them (mech/mode_count.py)
+    unloaded = ("axial",) if abs(scene.initial.angle_deg) < 1e-9 else ()
     choice = choose_mode_count(axial, bend, t_c, impact_speed=speed,
-                               safety=SAFETY if safety is None else safety)
+                               safety=SAFETY if safety is None else safety, unloaded=unloaded)
     bar = dataclasses.replace(
         bar,
         axial_modes=choice.axial if bar.axial_modes == "auto" else bar.axial_modes,

@@ -38,6 +38,47 @@ def test_counts_are_the_modes_below_the_cutoff_with_floor_and_cap():
         choose_mode_count(axial, bend, 0.0)
 
 
+def test_the_floor_leaves_a_family_the_impact_does_not_load_below_the_cutoff():
+    # A steel strip 20 mm long: its axial modes k c / (2 L) lie 129 kHz apart, its bending
+    # modes far below. A cutoff of 1.5 c / (2 L) admits one axial mode and many bending ones.
+    L, E, rho, h, w = 0.02, 210e9, 7850.0, 2e-4, 3e-3
+    c = math.sqrt(E / rho)
+    axial = axial_frequencies(CAP, L, E, rho)
+    bend = bending_frequencies(CAP, L, E, w * h**3 / 12, w * h, rho)
+    t_c = 3.0 / (1.5 * c / (2 * L))
+    loaded = choose_mode_count(axial, bend, t_c)
+    across = choose_mode_count(axial, bend, t_c, unloaded=("axial",))
+    n_bend = sum(1 for f in bend if f < 1.5 * c / (2 * L))
+    assert n_bend >= FLOOR and (loaded.bending, across.bending) == (n_bend, n_bend)
+    # loaded (struck on its end): the floor adds axial modes 2 and 3, above the cutoff
+    assert loaded.axial == FLOOR and loaded.floored == ("axial",)
+    # struck across its axis: the cutoff's one axial mode, and no kept mode above the cutoff
+    # (the highest one sets the explicit integrator's stability-limited step)
+    assert across.axial == 1 and across.unloaded == ("axial",) and across.floored == ()
+    assert max(axial[across.axial - 1], bend[across.bending - 1]) < across.cutoff < axial[FLOOR - 1]
+    assert "not raised to the floor" in across.reason
+    assert across.next_frequencies[0] == pytest.approx(c / L, rel=1e-12)  # the 2nd axial mode, k = 2
+    # both families short of the floor (a contact long against every mode): both raised
+    slow = choose_mode_count(axial, bend, 1.0, unloaded=("axial",))
+    assert (slow.axial, slow.bending) == (FLOOR, FLOOR) and slow.unloaded == ()
+
+
+def test_a_bar_lying_along_the_surface_keeps_the_axial_modes_below_its_cutoff():
+    # The stocky 12 mm bar at 0.1 m/s: lying flat (angle 0) its axial modes take no normal
+    # force; standing (90) they take all of it and the floor holds. Axial frequencies are
+    # k c / (2 L) on a free-free bar, so the counts follow from the chosen cutoff alone.
+    bar = Bar(diameter=0.012, tip_radius=0.006)
+    axial = axial_frequencies(CAP, bar.length, bar.youngs_modulus, bar.density)
+    for angle, raised in ((0.0, False), (90.0, True)):
+        scene = MechScene(bar=bar, initial=Initial(height=1e-4, angle_deg=angle, velocity=(0.0, 0.0, -0.1)),
+                          gravity=0.0)
+        resolved, ch = resolve_auto_modes(scene)
+        below = sum(1 for f in axial if f < ch.cutoff)
+        assert 0 < below < FLOOR and ch.bending >= FLOOR  # the case the rule is about
+        assert resolved.bar.axial_modes == (FLOOR if raised else below)
+        assert ("axial" in ch.floored) == raised and ("axial" in ch.unloaded) == (not raised)
+
+
 def test_contact_time_of_a_vertical_drop_is_the_hertz_closed_form():
     # Vertical bar: the impacting tip's effective mass is the bar's mass.
     bar = Bar(diameter=0.012, tip_radius=0.006)
@@ -116,6 +157,37 @@ def test_a_third_of_the_cutoff_misses_the_bounce_pattern():
     # The same check fails for f_cut = 1 / t_c on the stocky tilted bar: it can tell.
     d = _compare(SCENES[0], 1.0)
     assert d["contacts"][0] != d["contacts"][1] or d["mismatch"] > 2e-6 + 0.05 * d["total"]
+
+
+def test_the_floors_axial_modes_change_the_contact_only_where_the_impact_loads_them():
+    """What the rule rests on (docs/accuracy-modes.md, the floor): against 10 axial modes, a
+    bar struck on its end needs the floor's 3 (the cutoff's 1 misses its contact's end by
+    more than the tolerance of 'agrees'), a bar lying flat does not (2 and 3 give the same
+    contacts, though sliding with friction along its axis loads its axial modes a little).
+    Tolerances as in test_auto_agrees_with_twice_its_count."""
+
+    def run(angle, speed, modes, sliding=False):
+        return ImpactSolver(MechScene(
+            bar=Bar(diameter=0.012, tip_radius=0.006, axial_modes=modes[0], bending_modes=modes[1]),
+            contact=Contact(restitution=0.8) if sliding else Contact(damping=0.0, restitution=None),
+            friction=Friction(mu=0.3, gamma=0.7) if sliding else Friction(mu=0.0),
+            initial=Initial(height=1e-4, angle_deg=angle, velocity=(0.2 * speed if sliding else 0.0, 0.0, -speed)),
+            solver=SolverOptions(t_end=1.0e-3))).run()
+
+    # standing, 1 m/s: auto is (3, 7), the cutoff alone admits 1 axial mode
+    ref, floor, cut = (run(90.0, 1.0, m) for m in ((10, 7), (3, 7), (1, 7)))
+    total = float((ref.contacts.t_end - ref.contacts.t_start).sum())
+    allowed = 1e-6 + 0.03 * total
+    assert abs(floor.contacts.t_end.max() - ref.contacts.t_end.max()) <= allowed
+    assert abs(cut.contacts.t_end.max() - ref.contacts.t_end.max()) > allowed
+    # lying flat, 0.1 m/s down and 0.02 m/s along: auto is (2, 7); the floor's third axial
+    # mode changes nothing
+    ref, floor, cut = (run(0.0, 0.1, m, sliding=True) for m in ((10, 7), (3, 7), (2, 7)))
+    total = float((ref.contacts.t_end - ref.contacts.t_start).sum())
+    for run_ in (floor, cut):
+        assert len(run_.contacts) == len(ref.contacts)
+        assert _mismatch(_intervals(run_), _intervals(ref)) <= 2e-6 + 0.05 * total
+        assert abs(run_.contacts.peak_force.max() / ref.contacts.peak_force.max() - 1.0) <= 0.05
 
 
 def test_scene_files_take_auto_counts_and_name_a_bad_value():
