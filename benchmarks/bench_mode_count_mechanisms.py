@@ -7,15 +7,17 @@ closure is more: a held blade or lever, an actuator, a bounce sequence of 5-10 c
 ending in micro-bounces, an arc at each opening. For the coil-driven default relay (an
 armature's card drives the clamped CuBe blade), the force-driven relay (relay_force), the
 pushbutton example (pivoted steel lever), each run coupled as shipped, and the correct-by-
-default audit's driven wire (a clamp lowered along an S-curve, mechanics only), this runs the auto count and a ladder of explicit counts (modes per family, axial and
-bending) and reports, per count, the metrics of `switchsim run --check` against the finest
+default audit's driven wire (a clamp lowered along an S-curve, mechanics only), this runs
+the auto count, the count the floor would give where auto left a family the impact does
+not load below it, and a ladder of explicit counts (modes per family, axial and bending)
+and reports, per count, the metrics of `switchsim run --check` against the finest
 count of the ladder: contact-state mismatch time, contacts, bounces, last make, total
 bounce time, peak contact force, first contact's kinematic restitution, arc energy; and
-the run's wall time. It then runs `switchsim run --check` on the auto count (its
-refinements and its four reruns with the contact gap and restitution changed by 1 %) and says, per
-row, whether the row's bounce count and last make lie inside the range that check
-reports: whether what auto's check tells a user brackets the converged answer. Writes the
-block between the mode-count-mechanisms markers of docs/accuracy-modes.md.
+the mechanics' accepted steps and the run's wall time. It then runs `switchsim run --check`
+on the auto count (its refinements and its four reruns with the contact gap and restitution
+changed by 1 %) and says, per row, whether the row's bounce count and last make lie inside
+the range that check reports: whether what auto's check tells a user brackets the converged
+answer. Writes the block between the mode-count-mechanisms markers of docs/accuracy-modes.md.
 """
 
 from __future__ import annotations
@@ -36,6 +38,7 @@ sys.path.insert(0, str(ROOT))
 from coupling import builtin_scene, run, scene_from_dict  # noqa: E402
 from coupling.app.accuracy import check, metrics_of, mismatch_time, mode_counts, time_tolerance, tip_intervals  # noqa: E402
 from coupling.core.scene import load_scene  # noqa: E402
+from mech.mode_count import FLOOR  # noqa: E402
 
 DOC = ROOT / "docs" / "accuracy-modes.md"
 BEGIN, END = "<!-- mode-count-mechanisms:begin -->", "<!-- mode-count-mechanisms:end -->"
@@ -90,10 +93,22 @@ def inside(m: dict, auto: dict, ranges: dict, key: str) -> bool:
     return abs(m[key] - auto[key]) <= time_tolerance(auto)
 
 
+def floor_row(base, auto_res) -> list:
+    """("floor (a, b)", scene) when auto left a family the impact does not load below the
+    floor (mech/mode_count.py): the count with that family raised to it, as before; else []."""
+    chosen = auto_res.mechanics.model.mode_count
+    if chosen is None or not chosen.unloaded:
+        return []
+    a, b = (max(FLOOR, n) if fam in chosen.unloaded else n
+            for fam, n in (("axial", chosen.axial), ("bending", chosen.bending)))
+    return [(f"floor ({a}, {b})", base.update({"bar.modes": {"axial": a, "bending": b}}))]
+
+
 def table(name: str, base) -> tuple[list[str], dict]:
-    rows = [("auto", base)] + [(f"{a}, {b}", base.update({"bar.modes": {"axial": a, "bending": b}}))
-                               for a, b in LADDER]
-    results = [(label, *one(sc)) for label, sc in rows]
+    auto = ("auto", *one(base))
+    rows = floor_row(base, auto[5]) + [(f"{a}, {b}", base.update({"bar.modes": {"axial": a, "bending": b}}))
+                                       for a, b in LADDER]
+    results = [auto] + [(label, *one(sc)) for label, sc in rows]
     ref_m, ref_iv = results[-1][1], results[-1][2]
     auto_m, auto_res = results[0][1], results[0][5]
     acc = check(base, auto_res)
@@ -103,9 +118,10 @@ def table(name: str, base) -> tuple[list[str], dict]:
     lines = [f"**{name}**: auto chose \"{rule}\"; the run's fastest impact {fastest:.3g} m/s. Against the finest "
              f"count ({results[-1][0]}):", "",
              "| modes (axial, bending) | mismatch (us) | contacts | bounces | last make (ms) | total bounce time (ms) "
-             "| peak force (N) | first restitution | arc energy (mJ) | bounces, last make inside auto's range | wall (s) |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
-    for label, m, iv, wall, counts, _ in results:
+             "| peak force (N) | first restitution | arc energy (mJ) | bounces, last make inside auto's range "
+             "| mechanics steps | wall (s) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for label, m, iv, wall, counts, res in results:
         mism = sum(mismatch_time(iv.get(k, []), ref_iv.get(k, [])) for k in set(iv) | set(ref_iv))
         shown = label if label != "auto" else f"auto ({counts['axial']}, {counts['bending']})"
         arc = m.get("arc_energy")
@@ -113,7 +129,7 @@ def table(name: str, base) -> tuple[list[str], dict]:
         lines.append(
             f"| {shown} | {mism * 1e6:.0f} | {m['contacts']} | {m['bounces']} | {m['last_make'] * 1e3:.3f} | "
             f"{m['total_bounce_time'] * 1e3:.3f} | {m['peak_force']:.2f} | {m['restitution']:.3f} | "
-            f"{'-' if arc is None else f'{arc * 1e3:.2f}'} | {ins} | {wall:.2f} |")
+            f"{'-' if arc is None else f'{arc * 1e3:.2f}'} | {ins} | {res.mechanics.stats['steps']} | {wall:.2f} |")
         print(lines[-1], flush=True)
     spans = ", ".join(f"{k} {lo:.4g}-{hi:.4g}" if k in ("contacts", "bounces") else f"{k} {lo * 1e3:.4g}-{hi * 1e3:.4g} ms"
                       for k, (lo, hi) in ranges.items() if k in ("contacts", "bounces", "last_make", "total_bounce_time"))
