@@ -173,9 +173,11 @@ class NgspiceSession(NgSpiceShared):
         self._exit_status: tuple[int, bool, bool] | None = None
         # The input channels: each EXTERNAL voltage source of the loaded circuit gets its
         # value from a Python function of time; ngspice passes the instance's own name
-        # string, so each source is found by its name once and by the pointer after that.
+        # string, so each source is found by its name once and by the pointer after that
+        # (the char * cdata itself as the key: cffi hashes and compares a pointer by its
+        # address, a third of the cost of int(ffi.cast(...)) at ~75k callbacks a run).
         self._channels: dict[str, Channel] = {}
-        self._by_pointer: dict[int, Channel] = {}
+        self._by_pointer: dict[object, Channel] = {}
         self._target = math.inf
         self._deadline = math.inf
         self._failure: BaseException | None = None
@@ -183,7 +185,7 @@ class NgspiceSession(NgSpiceShared):
         # (the analysis ended first): the next run of any circuit would pause at its start
         self._stale_pause = False
         self._arcs: dict[str, object] = {}  # the ArcState of each arc, by its EXTERNAL current source
-        self._arc_by_pointer: dict[int, object] = {}
+        self._arc_by_pointer: dict[object, object] = {}
         self._arc_from = math.nan  # accepted time the arc's step bounds below apply from
         self._arc_step = math.inf
         self._arc_land = math.inf
@@ -260,7 +262,7 @@ class NgspiceSession(NgSpiceShared):
     def _on_vsrc(self, out, t, name, ident, user):
         # Called at every Newton iteration and on rejected trial points: the value must
         # depend on t only. Repeated calls at the same t skip the Python function.
-        channel = self._by_pointer.get(int(ffi.cast("uintptr_t", name)))
+        channel = self._by_pointer.get(name)
         if channel is None:
             channel = self._learn(name)
         if t == channel.last_t or self._failure is not None:
@@ -290,7 +292,7 @@ class NgspiceSession(NgSpiceShared):
             channel = Channel(text, _zero)
             if self._failure is None:
                 self._failure = NgspiceError(f"EXTERNAL source {text!r} has no input channel")
-        self._by_pointer[int(ffi.cast("uintptr_t", name))] = channel
+        self._by_pointer[name] = channel
         return channel
 
     def _on_callback_error(self, exc_type, exc_value, traceback):
@@ -301,13 +303,13 @@ class NgspiceSession(NgSpiceShared):
     def _on_isrc(self, out, t, name, ident, user):
         # The EXTERNAL current sources are the arcs' states (arc.py): constant over a
         # step, ArcState changes them only between accepted points.
-        arc = self._arc_by_pointer.get(int(ffi.cast("uintptr_t", name)))
+        arc = self._arc_by_pointer.get(name)
         if arc is None:
             arc = self._arcs.get(ffi.string(name).decode("ascii", "replace").lower())
             if arc is None:
                 out[0] = 0.0
                 return 0
-            self._arc_by_pointer[int(ffi.cast("uintptr_t", name))] = arc
+            self._arc_by_pointer[name] = arc
         out[0] = arc.value
         return 0
 

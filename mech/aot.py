@@ -188,8 +188,12 @@ def argument_checks(folder: Path) -> dict:
     misread (numba.pycc's wrappers do not check an array's dtype, rank or layout).
 
     The checks run before every compiled call (thousands per coupled run), so passing is
-    kept cheap: a test per argument with no string built unless it fails, and the model and
-    work tuples, passed unchanged on every call, checked once."""
+    kept cheap: a test per argument with no string built unless it fails, the model and
+    work tuples, passed unchanged on every call, checked once, and an argument that is the
+    very object the previous call of the same function passed there (a segment's dense
+    output at each of the circuit's times) not checked again: what is checked -- an
+    array's dtype, rank and layout -- stays as it was for an object that is still held
+    (nothing here reassigns an array's dtype, shape or strides in place)."""
     ndarray = np.ndarray
 
     def checker(kind):
@@ -236,10 +240,14 @@ def argument_checks(folder: Path) -> dict:
     for name, kinds in json.loads((folder / SIGNATURES).read_text()).items():
         checks = tuple((k, c) for k, c in enumerate(checker(kind) for kind in kinds) if c is not None)
 
-        def check_all(args, name=name, checks=checks, kinds=kinds):
+        def check_all(args, name=name, checks=checks, kinds=kinds, last=[None] * len(kinds)):
             for k, ok in checks:
-                if not ok(args[k]):
-                    raise TypeError(describe(kinds[k], args[k], f"{name} argument {k}"))
+                a = args[k]
+                if a is last[k]:
+                    continue
+                if not ok(a):
+                    raise TypeError(describe(kinds[k], a, f"{name} argument {k}"))
+                last[k] = a  # (held until another object replaces it: one argument set per function)
         out[name] = check_all
     return out
 

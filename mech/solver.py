@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 import time
+from bisect import bisect_left
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -117,6 +118,9 @@ class Segment:
     _arm_t: float = field(repr=False, default=float("nan"))
     _arm_last: tuple = field(repr=False, default=(0.0, 0.0))
     _arm_index: int = field(repr=False, default=-2)  # the model's armature_index, once asked (-2: not yet)
+    # the step ends as a list and, per dense step once asked, the armature's (t0, h, its two
+    # components' coefficients): the coil asks at every new circuit time (thousands a run)
+    _arm_steps: tuple = field(repr=False, default=None)
 
     def state(self, t: float) -> np.ndarray:
         """State vector at time t (s) in [t_start, t_end] (4th-order dense output)."""
@@ -162,19 +166,27 @@ class Segment:
             raise ValueError("Segment.armature: this model has no armature (the scene has no [armature])")
         if not (self.t_start - 1e-15 <= t <= self.t_end + 1e-15):
             raise ValueError(f"t = {t!r}: outside the segment [{self.t_start!r}, {self.t_end!r}] s")
-        if len(self._t_valid) == 0 or t <= self.t_start:
+        steps = self._arm_steps
+        if steps is None:
+            steps = self._arm_steps = (self._t_valid.tolist(), [None] * len(self._t_valid))
+        ends, pieces = steps
+        if not ends or t <= self.t_start:
             out = (float(self._start_state[a]), float(self._start_state[a + 1]))
         else:
             if not len(self._coef):
                 raise ValueError("Segment.armature: the dense output is kept only with "
                                  "ImpactSolver(scene, keep_dense=True)")
-            k = min(int(np.searchsorted(self._t_valid, t)), len(self._t_valid) - 1)
-            c = self._coef[k]
-            th = float((t - self._t0[k]) / self._h[k])
+            # (bisect_left on the list is np.searchsorted's side="left" without numpy's
+            # per-call overhead; the arithmetic is the same double arithmetic)
+            k = min(bisect_left(ends, t), len(ends) - 1)
+            piece = pieces[k]
+            if piece is None:
+                c = self._coef[k]
+                piece = pieces[k] = (float(self._t0[k]), float(self._h[k]), *c[:, a].tolist(), *c[:, a + 1].tolist())
+            t0, h, c0, c1, c2, c3, c4, d0, d1, d2, d3, d4 = piece
+            th = float((t - t0) / h)
             t1 = 1.0 - th
             # (mech.integrator.dense_eval on the armature's two components only)
-            c0, c1, c2, c3, c4 = c[:, a].tolist()
-            d0, d1, d2, d3, d4 = c[:, a + 1].tolist()
             out = (c0 + th * (c1 + t1 * (c2 + th * (c3 + t1 * c4))),
                    d0 + th * (d1 + t1 * (d2 + th * (d3 + t1 * d4))))
         self._arm_t, self._arm_last = t, out
@@ -226,7 +238,7 @@ class Segment:
                       float(c[0, 0]), float(c[1, 0]))
         else:
             dense_tip_forces(t, self._t_valid, self._t0, self._h, self._coef, self._arrays, self._out)
-            forces = tuple(float(v) for v in self._out)
+            forces = tuple(self._out.tolist())
         self._last_t, self._last_forces = t, forces
         return forces
 

@@ -167,21 +167,27 @@ class ContactLink:
 
         first_two = points == (0, 1)  # the one circuit contact: the compiled tip_forces' nearest gap
         near = max(points) < 2  # rows tip_forces gives (F_0, F_1, gap, y_0, y_1), else pair_forces'
+        # ngspice calls these at every new trial time (thousands of times a run): plain loops
+        # over the few intervals, no generator per call
+        spans = [span for i in points for span in intervals[i]]  # any point's
+        touching = [(i, intervals[i]) for i in points if intervals[i]]
+        tip_forces, pair_forces = seg.tip_forces, seg.pair_forces
 
         def gap(s: float) -> float:
             """m: the arc's length, the smaller point height; 0 while a point touches."""
             s = lo if s < lo else (hi if s > hi else s)
-            if any(a <= s <= b for i in points for a, b in intervals[i]):
-                return 0.0
+            for a, b in spans:
+                if a <= s <= b:
+                    return 0.0
             if first_two:
-                return seg.tip_forces(s)[2]
-            rows = seg.pair_forces(s)
+                return tip_forces(s)[2]
+            rows = pair_forces(s)
             return float(min(rows[i, 2] for i in points))
 
         out = {}
         if gap_wanted:
             out[f"{self.label}.gap"] = gap
-        if not any(intervals[i] for i in points):
+        if not touching:
             out[f"{self.label}.conductance"] = 0.0  # open throughout: no conductance callback needed
             return out
 
@@ -189,15 +195,19 @@ class ContactLink:
             s = lo if s < lo else (hi if s > hi else s)
             total = 0.0
             forces = None
-            for i in points:
-                if any(a <= s <= b for a, b in intervals[i]):
-                    if near:
-                        if forces is None:
-                            forces = seg.tip_forces(s)
-                        total += force(forces[i]) * conduction_onset(forces[3 + i], onset)
-                    else:
-                        row = seg.pair_forces(s)[i]
-                        total += force(float(row[0])) * conduction_onset(float(row[1]), onset)
+            for i, spans_i in touching:
+                for a, b in spans_i:
+                    if a <= s <= b:
+                        break
+                else:
+                    continue  # point i is open at s
+                if near:
+                    if forces is None:
+                        forces = tip_forces(s)
+                    total += force(forces[i]) * conduction_onset(forces[3 + i], onset)
+                else:
+                    row = pair_forces(s)[i]
+                    total += force(float(row[0])) * conduction_onset(float(row[1]), onset)
             return total
 
         out[f"{self.label}.conductance"] = g
@@ -321,10 +331,11 @@ class CoilLink:
     def inputs(self, seg) -> dict:
         """The coil's gap channel over the segment, from the armature's dense output."""
         lo, hi = seg.t_start, seg.t_end
+        rest, lever, armature = self.rest_gap, self.lever, seg.armature
 
         def gap(s: float) -> float:
             s = lo if s < lo else (hi if s > hi else s)
-            return max(self.gap(seg.armature(s)[0]), 0.0)
+            return max(rest - lever * armature(s)[0], 0.0)  # (self.gap, inlined: called per trial time)
 
         return {f"{self.label}.gap": gap}
 

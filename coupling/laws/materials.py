@@ -291,6 +291,28 @@ class HolmResistance(_ForceLaw):
         if self.regime == "elastic" and self.spots > 1:
             raise ValueError(f"{where}: spots = {self.spots} applies to the plastic regime only")
         object.__setattr__(self, "_m", (m1, m2))
+        # scalar_force_conductance's constants: rho1 + rho2 (ohm m), H and pi H (Pa)
+        h = min(m1.hardness, m2.hardness)
+        object.__setattr__(self, "_plastic", (m1.resistivity + m2.resistivity, h, math.pi * h))
+
+    def scalar_force_conductance(self, normal_force_N: float) -> float:
+        """``force_conductance`` for one float, S (0 for F_n <= 0): a closed contact's
+        conductance channel asks it at every trial time of ngspice. The plastic single-spot
+        law in plain floats, the array route's operations in its order (math.sqrt is
+        correctly rounded, as np.sqrt is; ~0.15 us against ~3 us through numpy's scalars);
+        the other regimes, and a force so small that a quotient underflows to 0, by the
+        array route."""
+        if normal_force_N <= 0.0:
+            return 0.0
+        if self.regime != "plastic" or self.spots != 1:
+            return super().scalar_force_conductance(normal_force_N)
+        f = float(normal_force_N)
+        rho, h, pi_h = self._plastic
+        try:
+            a = math.sqrt(f / pi_h)  # plastic_radius
+            return 1.0 / (rho / (4.0 * a) + self.film_resistivity / (f / h))
+        except ZeroDivisionError:
+            return super().scalar_force_conductance(normal_force_N)
 
     @property
     def rho(self) -> tuple[float, float]:

@@ -31,6 +31,23 @@ def test_plastic_single_spot_is_holm_with_the_softer_hardness():
     assert 1e-4 < float(HolmResistance(("Ag", "Ag")).resistance(1.0)) < 1e-3
 
 
+@pytest.mark.parametrize("law", [
+    HolmResistance(("Ag", "Ag")),
+    HolmResistance(("Ag", "Cu"), film_resistivity=1e-12),  # the softer side's hardness, a film
+    HolmResistance(("Cu", "Cu"), regime="elastic", radius=1e-3, film_resistivity=1e-12),
+    HolmResistance(("Cu", "Cu"), spots=4, radius=1e-3),
+])
+def test_scalar_conductance_is_the_array_route(law):
+    """The one-float route the circuit's conductance channel calls (plain floats for the
+    plastic single spot) against the array route at forces over eight decades: the same
+    operations in the same order and a correctly rounded sqrt in both, so equal to a few
+    ulp (rtol 1e-15: one or two roundings apart at most on any IEEE machine); 0 when open."""
+    forces = np.geomspace(1e-4, 1e4, 97)
+    scalar = np.array([law.scalar_force_conductance(float(f)) for f in forces])
+    np.testing.assert_allclose(scalar, law.force_conductance(forces), rtol=1e-15, atol=0.0)
+    assert law.scalar_force_conductance(0.0) == 0.0 and law.scalar_force_conductance(-1.0) == 0.0
+
+
 def test_resistivities_add():
     """Same hardness on both sides: R(1, 2) = (R(1, 1) + R(2, 2)) / 2 at the same force."""
     one, two = HolmResistance(("Au", "Au")), HolmResistance(("AuCo", "AuCo"))

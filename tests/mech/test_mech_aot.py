@@ -96,6 +96,28 @@ def test_an_argument_of_another_type_goes_to_the_jit_function_with_a_warning():
     np.testing.assert_allclose(expected, closed_form, rtol=1e-15)
 
 
+def test_an_argument_passed_before_is_checked_again_where_it_is_wrong():
+    """The checks skip an argument that is the very object the previous call passed at the
+    same place (a segment's dense output at each circuit time); the same object at another
+    place is checked there, and an argument that failed fails again."""
+    import mech.aot as aot
+    import mech.compiled as compiled
+
+    if compiled.ROUTE != "aot":
+        pytest.skip("the ahead-of-time module is not in use here")
+    check = aot.argument_checks(aot.module_folder())["dense_eval"]
+    coef, out = np.arange(15.0).reshape(5, 3), np.empty(3)
+    check((coef, 0.3, out))
+    check((coef, 0.3, out))  # the same objects: passed
+    with pytest.raises(TypeError, match="dense_eval argument 0"):
+        check((out, 0.3, out))  # out, passed at place 2, is 1-d: not a coefficient table
+    fortran = np.asfortranarray(coef)
+    for _ in range(2):
+        with pytest.raises(TypeError, match="dense_eval argument 0"):
+            check((fortran, 0.3, out))
+    check((coef, 0.3, out))
+
+
 def test_a_wrong_array_inside_a_tuple_argument_is_named_and_goes_to_the_jit_function():
     """The model and work tuples are checked element by element (once per tuple object):
     a float32 scratch array in the work tuple is named by its place, and the result is the

@@ -376,6 +376,21 @@ def test_the_dense_output_gives_the_armature_between_the_steps():
     assert segment.armature(6e-3) == pytest.approx(solver.armature_now(), rel=1e-13)
 
 
+def test_the_armature_in_any_order_of_times_is_the_dense_state():
+    """Segment.armature keeps each dense step's coefficients once asked: at times asked back
+    and forth across the steps (as ngspice's rejected trial points and the coil's samples
+    ask), and again in order, it is the armature's two components of Segment.state, the
+    compiled evaluation of the same polynomial (rtol 1e-14: a few roundings apart)."""
+    solver = ImpactSolver(scene_from_dict(solenoid(spring_preload=1.5, spring_rate=400.0, initial_position=0.0)),
+                          keep_dense=True)
+    segment = solver.advance(6e-3, {"armature.force": 5.0})
+    a = solver.model.armature_index
+    times = np.random.default_rng(7).permutation(np.linspace(0.0, 6e-3, 301))
+    for t in np.concatenate([times, np.sort(times)]):
+        want = segment.state(float(t))[a:a + 2]
+        np.testing.assert_allclose(segment.armature(float(t)), want, rtol=1e-14, atol=1e-30)
+
+
 def test_channels_history_summary_and_events_name_the_armature():
     blade = ImpactSolver(scene_from_dict(relay(PLUNGER)))
     assert blade.drive_names == ("mu.0", "repulsion.0", "armature.force")
