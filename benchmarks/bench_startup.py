@@ -66,8 +66,10 @@ NO_OUTPUT = "\n[output]\ncsv = false\nparquet = false\nplots = false\nhistory = 
 
 
 def _env(root: Path = ROOT) -> dict:
+    # PYTHONSAFEPATH: `python -m`/`-c` would put the working directory first on sys.path, so
+    # run from inside a tree both "trees" of --baseline imported that one
     return dict(os.environ, PYTHONPATH=str(root) + os.pathsep + os.environ.get("PYTHONPATH", ""),
-                MPLBACKEND="Agg")
+                MPLBACKEND="Agg", PYTHONSAFEPATH="1")
 
 
 def whole_process(cmd: list[str], repeat: int, root: Path = ROOT) -> tuple[float, float, float]:
