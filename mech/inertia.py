@@ -30,13 +30,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import njit
+from .jit import njit, njit_borrowing
 
 # sections of the sparse invariant list
 SEC_J1, SEC_J2, SEC_S, SEC_K, SEC_C, SEC_LAYOUT, SEC_NORM, SEC_GRAM = range(8)
 
 
-@njit(cache=True)
+@njit_borrowing
 def inverse3(A, out):
     """Inverse of a 3x3 matrix by cofactors (the Schur complement is symmetric positive definite)."""
     c00 = A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1]
@@ -55,7 +55,7 @@ def inverse3(A, out):
     out[2, 2] = (A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]) * inv
 
 
-@njit(cache=True)
+@njit_borrowing
 def _gram_products(n, q, eta, w, sp_ptr, sp_idx, sp_val, Jm, B, f_e, sv, forces):
     """J(q) into Jm, B(q) into B; with ``forces``, also the centrifugal and gyroscopic
     modal forces added to f_e and dJ/dt w into sv (f_e and sv must hold their other
@@ -201,7 +201,7 @@ def _gram_products(n, q, eta, w, sp_ptr, sp_idx, sp_val, Jm, B, f_e, sv, forces)
             f_e[j] += y2 * ww - w2 * (y0 * w0 + y1 * w1 + y2 * w2)
 
 
-@njit(cache=True)
+@njit_borrowing
 def _linear_and_modal(n, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, f_e, sv):
     """Jm = J0 + J1 q; f_e = 1/2 w' J1 w - K q - C eta; sv = J1(eta) w. Returns the modal
     damping power eta' C eta (W)."""
@@ -229,7 +229,7 @@ def _linear_and_modal(n, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, f_e, sv):
     return d_modal
 
 
-@njit(cache=True)
+@njit_borrowing
 def _rotational_rhs(n, m, w, eta, Jm, B, sv, f_r, Amat, Ainv):
     """f_r = -w x (J w + B eta) - dJ/dt w; Schur complement J - B B'/m and its inverse."""
     h0 = Jm[0, 0] * w[0] + Jm[0, 1] * w[1] + Jm[0, 2] * w[2]
@@ -245,7 +245,7 @@ def _rotational_rhs(n, m, w, eta, Jm, B, sv, f_r, Amat, Ainv):
     schur_complement(n, m, Jm, B, Amat, Ainv)
 
 
-@njit(cache=True)
+@njit_borrowing
 def schur_complement(n, m, Jm, B, Amat, Ainv):
     """Amat = J - B B'/m (kg m^2, symmetric) and its inverse into Ainv."""
     inv_m = 1.0 / m
@@ -259,7 +259,7 @@ def schur_complement(n, m, Jm, B, Amat, Ainv):
     inverse3(Amat, Ainv)
 
 
-@njit(cache=True)
+@njit_borrowing
 def inertia_terms(n, m, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, B, f_e, sv, f_r, Amat, Ainv):
     """Inertia and modal terms of the equations of motion at (q, eta, w).
 
@@ -285,7 +285,7 @@ def inertia_matrix(n, q, J0, sp_ptr, sp_idx, sp_val, Jm, B):
     _gram_products(n, q, np.zeros(n), np.zeros(3), sp_ptr, sp_idx, sp_val, Jm, B, np.zeros(n), np.zeros(3), False)
 
 
-@njit(cache=True)
+@njit_borrowing
 def inertia_terms_sparse(n, m, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, B, f_e, sv, f_r, Amat, Ainv):
     """The same as ``inertia_terms`` by walking the J2 and S tensors' non-zero entries
     (O(n^2): every axial-bending pair). The route the kernel used before; kept as the
