@@ -35,7 +35,7 @@ from . import (
     travel_spring as _travel_spring,
 )
 from .jit import njit, njit_borrowing
-from .inertia import inertia_matrix, inertia_terms, inertia_terms_sparse, schur_complement
+from .inertia import inertia_matrix, inertia_matrix_sparse, inertia_terms, inertia_terms_sparse, schur_complement
 from .kernel_layout import (  # noqa: F401  (re-exported: the kernel's own names)
     F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MAX_RATIO, F_RTIP, D_VALUE, D_SLOPE, D_T0, K_MU, K_REPULSION,
     F_VREG, F_BAUM, F_VBOUND, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN, C_Z, C_N, MAX_PAIRS,
@@ -131,20 +131,6 @@ def make_work(n):
         # load or card point's world position and velocity (12-14, 15-17); Schur complement
         np.zeros(18), np.zeros((3, 3)),
     )
-
-
-@njit_borrowing
-def tip_offset(i, xc, psi, modal, n, out):
-    """Body-frame offset of point i (a contact cap's centre or a load point) from the frame
-    origin, xc_i + sum_j Psi_ij modal_j (with modal = q: the position; with modal = eta and
-    xc zero: its rate)."""
-    out[0] = xc[i, 0]
-    out[1] = xc[i, 1]
-    out[2] = xc[i, 2]
-    for j in range(n):
-        out[0] += psi[i, j, 0] * modal[j]
-        out[1] += psi[i, j, 1] * modal[j]
-        out[2] += psi[i, j, 2] * modal[j]
 
 
 @njit_borrowing
@@ -1160,12 +1146,12 @@ def armature_energy(qa, va, pen_card, apar, has_card):
     return 0.5 * apar[AP_MASS] * va * va, stored
 
 
-@njit(cache=True)
+@njit_borrowing
 def energies(y, mdl, work, out, arm=None):
     """out = (kinetic, elastic strain, gravity potential, stored Hertz energy, stored
     energy of springs and the pivot's torsion spring incl. its preload), all J; an
     armature's kinetic energy counts in the first, its return spring's, stops' and card's
-    stored energy in the last.
+    stored energy in the last. work: ``make_work``'s scratch (its contents overwritten).
 
     Kinetic energy about a frame origin that is not the centroid (held bars):
     1/2 m V.V + V . R (w x (c + L q) + L eta) + 1/2 w J w + w B eta + 1/2 m eta.eta.
@@ -1182,23 +1168,14 @@ def energies(y, mdl, work, out, arm=None):
         out[4] = stored
         return
     r, R, q, V, w, eta, Jm, B = work[0], work[1], work[2], work[3], work[4], work[5], work[6], work[7]
+    x = work[22][12:15]  # a point's world position and velocity
+    v = work[22][15:18]
     unpack(y, n, planar, r, R, q, V, w, eta)
     m = fpar[F_MASS]
     if ipar[I_INERTIA] == INERTIA_GRAM:
         inertia_matrix(n, q, J0, sp_ptr, sp_idx, sp_val, Jm, B)
     else:
-        for a in range(3):
-            for b in range(3):
-                Jm[a, b] = J0[a, b]
-        for j in range(n):
-            for a in range(3):
-                B[a, j] = 0.0
-        for e in range(sp_ptr[0], sp_ptr[1]):
-            Jm[sp_idx[e, 1], sp_idx[e, 2]] += sp_val[e] * q[sp_idx[e, 0]]
-        for e in range(sp_ptr[1], sp_ptr[2]):
-            Jm[sp_idx[e, 2], sp_idx[e, 3]] += sp_val[e] * q[sp_idx[e, 0]] * q[sp_idx[e, 1]]
-        for e in range(sp_ptr[2], sp_ptr[3]):
-            B[sp_idx[e, 2], sp_idx[e, 1]] += sp_val[e] * q[sp_idx[e, 0]]
+        inertia_matrix_sparse(n, q, J0, sp_ptr, sp_idx, sp_val, Jm, B)
     for j in range(n):  # H_j, the q-independent coupling of a held bar's modes (0 when free)
         for a in range(3):
             B[a, j] += cL[a, n + 1 + j]
@@ -1209,34 +1186,36 @@ def energies(y, mdl, work, out, arm=None):
     for j in range(n):
         kin += (w[0] * B[0, j] + w[1] * B[1, j] + w[2] * B[2, j]) * eta[j] + 0.5 * m * eta[j] ** 2
     # first moment c + L q and its body rate L eta
-    cq = np.empty(3)
-    le = np.empty(3)
-    for a in range(3):
-        cq[a] = cL[a, 0]
-        le[a] = 0.0
-        for j in range(n):
-            cq[a] += cL[a, j + 1] * q[j]
-            le[a] += cL[a, j + 1] * eta[j]
-    ub0 = w[1] * cq[2] - w[2] * cq[1] + le[0]
-    ub1 = w[2] * cq[0] - w[0] * cq[2] + le[1]
-    ub2 = w[0] * cq[1] - w[1] * cq[0] + le[2]
+    cq0 = cL[0, 0]
+    cq1 = cL[1, 0]
+    cq2 = cL[2, 0]
+    le0 = 0.0
+    le1 = 0.0
+    le2 = 0.0
+    for j in range(n):
+        cq0 += cL[0, j + 1] * q[j]
+        cq1 += cL[1, j + 1] * q[j]
+        cq2 += cL[2, j + 1] * q[j]
+        le0 += cL[0, j + 1] * eta[j]
+        le1 += cL[1, j + 1] * eta[j]
+        le2 += cL[2, j + 1] * eta[j]
+    ub0 = w[1] * cq2 - w[2] * cq1 + le0
+    ub1 = w[2] * cq0 - w[0] * cq2 + le1
+    ub2 = w[0] * cq1 - w[1] * cq0 + le2
     for a in range(3):
         kin += V[a] * (R[a, 0] * ub0 + R[a, 1] * ub1 + R[a, 2] * ub2)
     el = 0.0
     for e in range(sp_ptr[3], sp_ptr[4]):
         el += 0.5 * q[sp_idx[e, 0]] * sp_val[e] * q[sp_idx[e, 1]]
     hz = 0.0
-    s = np.empty(3)
     for i in range(cpar.shape[0]):
         if cpar[i, C_ON] == 0.0:
             continue
-        tip_offset(i, xc, psi, q, n, s)
-        pen = cpar[i, C_R] - cpar[i, C_N] * (r[2] + R[2, 0] * s[0] + R[2, 1] * s[1] + R[2, 2] * s[2] - cpar[i, C_Z])
+        load_point_motion(i, xc, psi, r, R, q, V, w, eta, n, x, v)  # (contact row i is point i)
+        pen = cpar[i, C_R] - cpar[i, C_N] * (x[2] - cpar[i, C_Z])
         if pen > 0.0:
             hz += 0.4 * cpar[i, C_K] * pen * pen * math.sqrt(pen)
     sp = 0.0
-    x = np.empty(3)
-    v = np.empty(3)
     qa = 0.0
     if arm is not None:
         qa = y[arm_offset(n, planar, ipar[I_MOUNT])]
@@ -1274,7 +1253,7 @@ def energies(y, mdl, work, out, arm=None):
         sp += ua
     out[0] = kin
     out[1] = el
-    out[2] = fpar[F_G] * (m * r[2] + R[2, 0] * cq[0] + R[2, 1] * cq[1] + R[2, 2] * cq[2])
+    out[2] = fpar[F_G] * (m * r[2] + R[2, 0] * cq0 + R[2, 1] * cq1 + R[2, 2] * cq2)
     out[3] = hz
     out[4] = sp
 
