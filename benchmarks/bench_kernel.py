@@ -6,9 +6,11 @@ The default scene (the coil-driven relay) is run once, coupled, in a child proce
 tree, recording every call the co-simulation makes on its mechanics (``advance`` with its
 drives, ``checkpoint``, ``restore``). Each tree then replays that recording in fresh child
 processes (its own ahead-of-time module, as `switchsim run` loads it; built first if
-missing), alternating tree by tree --repeat times, so both see the same machine load:
-- the mechanics phase: the replay's wall time (the solver's Python side and the compiled
-  ``integrate``), the best of --replays per process, per accepted step;
+missing), alternating tree by tree --repeat times, so both see the same machine load;
+each figure is the CPU time of the process's thread (time.thread_time: a shared machine's
+other processes add less to it than to the wall time), the best of --replays:
+- the mechanics phase: the replay (the solver's Python side and the compiled
+  ``integrate``), and per accepted step;
 - the right-hand side alone: ``contact_series`` at 20000 points of the run (the compiled
   ``dense_contact`` loop: one ``dynamics`` per point), per call;
 - the energy table of the run's history (the compiled ``energy_table`` loop: one

@@ -303,7 +303,7 @@ def _added(k, x, s0, s1, s2):
 # stored to the arrays, which numba must assume may alias q, eta and w, every sum waited
 # for its previous store and every entry reloaded its inputs. Measured on the default
 # scene's states (3 axial + 11 bending finite-element modes, 436 entries): 1.8 -> 0.9 us
-# per call (the history in docs/mechanics.md, "Cost of the sparse route").
+# per call (docs/mechanics.md, "Cost of the compiled kernel").
 
 
 @njit_borrowing

@@ -12,7 +12,8 @@ such operations per right-hand side (its 47 arrays at ``dynamics`` alone) took ~
 whole `switchsim run`. A function so compiled only borrows the arrays its caller holds
 for the call: it must not allocate (numba refuses to compile an allocation without the
 reference counts) and must return no array (its caller would release a reference it was
-never given); tests/mech/test_mech_kernel.py checks every one's compiled return types.
+never given): ``borrowing_violations`` finds one that does, and the ahead-of-time build,
+which compiles every function afresh, refuses to build while it finds any.
 """
 
 from __future__ import annotations
@@ -39,4 +40,19 @@ def njit_borrowing(fn):
     return compiled
 
 
-__all__ = ["njit", "njit_borrowing", "BORROWING"]
+def borrowing_violations(functions=None) -> list[str]:
+    """Each compiled signature of ``functions`` (default: every njit_borrowing function,
+    as far as this process has compiled them) whose return value holds a reference-counted
+    value (an array, or a tuple with one): "module.name: signature" for each."""
+    from numba.core.registry import cpu_target
+
+    models = cpu_target.target_context.data_model_manager
+    bad = []
+    for fn in BORROWING if functions is None else functions:
+        for sig in fn.nopython_signatures:
+            if models[sig.return_type].contains_nrt_meminfo():
+                bad.append(f"{fn.py_func.__module__}.{fn.py_func.__name__}: {sig}")
+    return bad
+
+
+__all__ = ["njit", "njit_borrowing", "BORROWING", "borrowing_violations"]
