@@ -20,6 +20,7 @@ from numba.core import types  # (the build child loads numba anyway: it compiles
 from . import compiled as jit
 from .aot import FORCE_JIT, MODULE, SIGNATURES
 from .damping_calibration import calibrate_damping
+from .jit import borrowing_violations
 from .kernel_layout import NAUX
 from .scene import scene_from_dict
 from .solver import ImpactSolver
@@ -175,6 +176,10 @@ def compile_into(dest) -> None:
     if jit.ROUTE != "jit":
         raise RuntimeError(f"the build must run on the just-in-time route (set {FORCE_JIT}=1)")
     warm_up()
+    leaks = borrowing_violations()
+    if leaks:
+        raise RuntimeError("compiled without reference counts (mech.jit.njit_borrowing) but returning a "
+                           "reference-counted value: " + "; ".join(leaks))
     cc = CC(MODULE, source_module=__name__)
     cc.output_dir = str(dest)
     cc.target_cpu = "host"  # built where it runs: the same instructions the JIT would use

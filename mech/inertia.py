@@ -30,13 +30,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import njit
+from .jit import njit, njit_borrowing
 
 # sections of the sparse invariant list
 SEC_J1, SEC_J2, SEC_S, SEC_K, SEC_C, SEC_LAYOUT, SEC_NORM, SEC_GRAM = range(8)
 
 
-@njit(cache=True)
+@njit_borrowing
 def inverse3(A, out):
     """Inverse of a 3x3 matrix by cofactors (the Schur complement is symmetric positive definite)."""
     c00 = A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1]
@@ -55,7 +55,7 @@ def inverse3(A, out):
     out[2, 2] = (A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]) * inv
 
 
-@njit(cache=True)
+@njit_borrowing
 def _gram_products(n, q, eta, w, sp_ptr, sp_idx, sp_val, Jm, B, f_e, sv, forces):
     """J(q) into Jm, B(q) into B; with ``forces``, also the centrifugal and gyroscopic
     modal forces added to f_e and dJ/dt w into sv (f_e and sv must hold their other
@@ -201,7 +201,7 @@ def _gram_products(n, q, eta, w, sp_ptr, sp_idx, sp_val, Jm, B, f_e, sv, forces)
             f_e[j] += y2 * ww - w2 * (y0 * w0 + y1 * w1 + y2 * w2)
 
 
-@njit(cache=True)
+@njit_borrowing
 def _linear_and_modal(n, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, f_e, sv):
     """Jm = J0 + J1 q; f_e = 1/2 w' J1 w - K q - C eta; sv = J1(eta) w. Returns the modal
     damping power eta' C eta (W)."""
@@ -229,7 +229,7 @@ def _linear_and_modal(n, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, f_e, sv):
     return d_modal
 
 
-@njit(cache=True)
+@njit_borrowing
 def _rotational_rhs(n, m, w, eta, Jm, B, sv, f_r, Amat, Ainv):
     """f_r = -w x (J w + B eta) - dJ/dt w; Schur complement J - B B'/m and its inverse."""
     h0 = Jm[0, 0] * w[0] + Jm[0, 1] * w[1] + Jm[0, 2] * w[2]
@@ -245,7 +245,7 @@ def _rotational_rhs(n, m, w, eta, Jm, B, sv, f_r, Amat, Ainv):
     schur_complement(n, m, Jm, B, Amat, Ainv)
 
 
-@njit(cache=True)
+@njit_borrowing
 def schur_complement(n, m, Jm, B, Amat, Ainv):
     """Amat = J - B B'/m (kg m^2, symmetric) and its inverse into Ainv."""
     inv_m = 1.0 / m
@@ -259,7 +259,7 @@ def schur_complement(n, m, Jm, B, Amat, Ainv):
     inverse3(Amat, Ainv)
 
 
-@njit(cache=True)
+@njit_borrowing
 def inertia_terms(n, m, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, B, f_e, sv, f_r, Amat, Ainv):
     """Inertia and modal terms of the equations of motion at (q, eta, w).
 
@@ -285,53 +285,114 @@ def inertia_matrix(n, q, J0, sp_ptr, sp_idx, sp_val, Jm, B):
     _gram_products(n, q, np.zeros(n), np.zeros(3), sp_ptr, sp_idx, sp_val, Jm, B, np.zeros(n), np.zeros(3), False)
 
 
-@njit(cache=True)
+@njit_borrowing
+def _added(k, x, s0, s1, s2):
+    """(s0, s1, s2) with x added to component k (0, 1 or 2): a 3-vector summed in registers."""
+    if k == 0:
+        return s0 + x, s1, s2
+    if k == 1:
+        return s0, s1 + x, s2
+    return s0, s1, s2 + x
+
+
+# The sparse route's loops below are written for their cost per entry, every sum taken in
+# the list's order (so to the last bit what the plain loops gave): the indices are read as
+# unsigned (numba then does not test each for Python's negative indexing), each entry's
+# inputs are read once into locals, and dJ/dt w and each mode's force are summed in locals
+# (sv0..2; fj, the force of the mode the entries are at: the list is ordered by mode) --
+# stored to the arrays, which numba must assume may alias q, eta and w, every sum waited
+# for its previous store and every entry reloaded its inputs. Measured on the default
+# scene's states (3 axial + 11 bending finite-element modes, 436 entries): 1.8 -> 0.9 us
+# per call (docs/mechanics.md, "Cost of the compiled kernel").
+
+
+@njit_borrowing
+def inertia_matrix_sparse(n, q, J0, sp_ptr, sp_idx, sp_val, Jm, B):
+    """J(q) into Jm (kg m^2) and B(q) into B (kg m, 3 x n) from the J1, J2 and S entries of
+    the sparse list: ``inertia_matrix`` for a finite-element basis (mech.kernel.energies)."""
+    for a in range(3):
+        for b in range(3):
+            Jm[a, b] = J0[a, b]
+    for j in range(n):
+        for a in range(3):
+            B[a, j] = 0.0
+    for e in range(np.uint64(sp_ptr[SEC_J1]), np.uint64(sp_ptr[SEC_J1 + 1])):
+        Jm[np.uint64(sp_idx[e, 1]), np.uint64(sp_idx[e, 2])] += sp_val[e] * q[np.uint64(sp_idx[e, 0])]
+    for e in range(np.uint64(sp_ptr[SEC_J2]), np.uint64(sp_ptr[SEC_J2 + 1])):
+        Jm[np.uint64(sp_idx[e, 2]), np.uint64(sp_idx[e, 3])] += (sp_val[e] * q[np.uint64(sp_idx[e, 0])]
+                                                                * q[np.uint64(sp_idx[e, 1])])
+    for e in range(np.uint64(sp_ptr[SEC_S]), np.uint64(sp_ptr[SEC_S + 1])):
+        B[np.uint64(sp_idx[e, 2]), np.uint64(sp_idx[e, 1])] += sp_val[e] * q[np.uint64(sp_idx[e, 0])]
+
+
+@njit_borrowing
 def inertia_terms_sparse(n, m, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, B, f_e, sv, f_r, Amat, Ainv):
     """The same as ``inertia_terms`` by walking the J2 and S tensors' non-zero entries
-    (O(n^2): every axial-bending pair). The route the kernel used before; kept as the
-    independent reference of the tests and the baseline of benchmarks/bench_rhs_cost.py."""
+    (O(n^2): every axial-bending pair): the kernel's route for a finite-element basis
+    (mech.kernel.dynamics, I_INERTIA), and the Gram route's independent reference in the
+    tests and benchmarks/bench_rhs_cost.py."""
     inv_m = 1.0 / m
     for a in range(3):
         for b in range(3):
             Jm[a, b] = J0[a, b]
-        sv[a] = 0.0
     for j in range(n):
         f_e[j] = 0.0
         for a in range(3):
             B[a, j] = 0.0
-    for e in range(sp_ptr[0], sp_ptr[1]):
-        j = sp_idx[e, 0]
-        a = sp_idx[e, 1]
-        b = sp_idx[e, 2]
+    sv0 = 0.0
+    sv1 = 0.0
+    sv2 = 0.0
+    for e in range(np.uint64(sp_ptr[SEC_J1]), np.uint64(sp_ptr[SEC_J1 + 1])):
+        j = np.uint64(sp_idx[e, 0])
+        a = np.uint64(sp_idx[e, 1])
+        b = np.uint64(sp_idx[e, 2])
         v = sp_val[e]
+        wb = w[b]
         Jm[a, b] += v * q[j]
-        f_e[j] += 0.5 * v * w[a] * w[b]
-        sv[a] += v * eta[j] * w[b]
-    for e in range(sp_ptr[1], sp_ptr[2]):
-        j = sp_idx[e, 0]
-        kk = sp_idx[e, 1]
-        a = sp_idx[e, 2]
-        b = sp_idx[e, 3]
+        f_e[j] += 0.5 * v * w[a] * wb
+        sv0, sv1, sv2 = _added(a, v * eta[j] * wb, sv0, sv1, sv2)
+    jf = np.uint64(n)  # the mode whose force fj holds (n: none yet)
+    fj = 0.0
+    for e in range(np.uint64(sp_ptr[SEC_J2]), np.uint64(sp_ptr[SEC_J2 + 1])):
+        j = np.uint64(sp_idx[e, 0])
+        kk = np.uint64(sp_idx[e, 1])
+        a = np.uint64(sp_idx[e, 2])
+        b = np.uint64(sp_idx[e, 3])
         v = sp_val[e]
-        Jm[a, b] += v * q[j] * q[kk]
-        f_e[j] += v * q[kk] * w[a] * w[b]
-        ve = v * q[kk] * eta[j]
-        sv[a] += ve * w[b]
-        sv[b] += ve * w[a]
-    for e in range(sp_ptr[2], sp_ptr[3]):
-        j = sp_idx[e, 0]
-        kk = sp_idx[e, 1]
-        a = sp_idx[e, 2]
+        qk = q[kk]
+        wa = w[a]
+        wb = w[b]
+        Jm[a, b] += v * q[j] * qk
+        if j != jf:
+            if jf < n:
+                f_e[jf] = fj
+            jf = j
+            fj = f_e[j]
+        vq = v * qk
+        fj += vq * wa * wb
+        ve = vq * eta[j]
+        sv0, sv1, sv2 = _added(a, ve * wb, sv0, sv1, sv2)
+        sv0, sv1, sv2 = _added(b, ve * wa, sv0, sv1, sv2)
+    if jf < n:
+        f_e[jf] = fj
+    sv[0] = sv0
+    sv[1] = sv1
+    sv[2] = sv2
+    for e in range(np.uint64(sp_ptr[SEC_S]), np.uint64(sp_ptr[SEC_S + 1])):
+        j = np.uint64(sp_idx[e, 0])
+        kk = np.uint64(sp_idx[e, 1])
+        a = np.uint64(sp_idx[e, 2])
         v = sp_val[e]
         B[a, kk] += v * q[j]
         f_e[j] += 2.0 * v * w[a] * eta[kk]
-    for e in range(sp_ptr[3], sp_ptr[4]):
-        f_e[sp_idx[e, 0]] -= sp_val[e] * q[sp_idx[e, 1]]
+    for e in range(np.uint64(sp_ptr[SEC_K]), np.uint64(sp_ptr[SEC_K + 1])):
+        f_e[np.uint64(sp_idx[e, 0])] -= sp_val[e] * q[np.uint64(sp_idx[e, 1])]
     d_modal = 0.0
-    for e in range(sp_ptr[4], sp_ptr[5]):
-        ce = sp_val[e] * eta[sp_idx[e, 1]]
-        f_e[sp_idx[e, 0]] -= ce
-        d_modal += eta[sp_idx[e, 0]] * ce
+    for e in range(np.uint64(sp_ptr[SEC_C]), np.uint64(sp_ptr[SEC_C + 1])):
+        j = np.uint64(sp_idx[e, 0])
+        ce = sp_val[e] * eta[np.uint64(sp_idx[e, 1])]
+        f_e[j] -= ce
+        d_modal += eta[j] * ce
     h0 = Jm[0, 0] * w[0] + Jm[0, 1] * w[1] + Jm[0, 2] * w[2]
     h1 = Jm[1, 0] * w[0] + Jm[1, 1] * w[1] + Jm[1, 2] * w[2]
     h2 = Jm[2, 0] * w[0] + Jm[2, 1] * w[1] + Jm[2, 2] * w[2]

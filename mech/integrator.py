@@ -15,12 +15,12 @@ import math
 
 import numpy as np
 
-from .jit import njit
+from .jit import njit, njit_borrowing
 from .kernel import (
     A_FN, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, EV_CLIP, EV_COMPRESSION, EV_CONTACT, EV_SLIP, EV_STICK,
     C_C, C_K, C_N, C_ON, C_R, C_Z, F_BETA, F_VBOUND, F_VREG, FRICTION_EXACT, I_FRICTION, I_N, I_PLANAR, NAUX,
     NEV_TIP, SLIP, STICK, AP_HMAX, AP_TRAVEL, EA_CARD, EA_POLE, EA_REST, EA_SEAT, EA_TURN, I_ARM_CARD, I_MOUNT,
-    MOUNT_NONE, NEV_ARM, arm_offset, dynamics, normal_force, tip_offset, unpack,
+    MOUNT_NONE, NEV_ARM, arm_offset, dynamics, load_point_motion, normal_force, unpack,
 )
 from .friction import REVERSAL_DEADBAND
 from .kernel_layout import (  # noqa: F401  (re-exported: the integrator's status codes)
@@ -40,7 +40,7 @@ D1, D3, D4 = -12715105075.0 / 11282082432.0, 87487479700.0 / 32700410799.0, -106
 D5, D6, D7 = 701980252875.0 / 199316789632.0, -1453857185.0 / 822651844.0, 69997945.0 / 29380423.0
 
 
-@njit(cache=True)
+@njit_borrowing
 def dense_eval(coef, theta, out):
     """State at fraction ``theta`` of a step from its 5 x N continuous-extension coefficients."""
     t1 = 1.0 - theta
@@ -48,7 +48,7 @@ def dense_eval(coef, theta, out):
         out[i] = coef[0, i] + theta * (coef[1, i] + t1 * (coef[2, i] + theta * (coef[3, i] + t1 * coef[4, i])))
 
 
-@njit(cache=True)
+@njit_borrowing
 def _dense_coefficients(y, ynew, h, k1, k3, k4, k5, k6, k7, coef):
     """Continuous-extension coefficients of a step from y to ynew (Hairer's contd5)."""
     for i in range(y.shape[0]):
@@ -59,7 +59,7 @@ def _dense_coefficients(y, ynew, h, k1, k3, k4, k5, k6, k7, coef):
         coef[4, i] = h * (D1 * k1[i] + D3 * k3[i] + D4 * k4[i] + D5 * k5[i] + D6 * k6[i] + D7 * k7[i])
 
 
-@njit(cache=True)
+@njit_borrowing
 def event_values(y, aux, sv, eref, mdl, g, arm=None):
     """Event function values into g (kernel_layout.event_count of the model's contact rows):
     the contact rows' (events_from_aux) from a dynamics evaluation's aux, then the
@@ -74,7 +74,7 @@ def event_values(y, aux, sv, eref, mdl, g, arm=None):
             g[k] = 1.0
 
 
-@njit(cache=True)
+@njit_borrowing
 def armature_events(y, sv, mdl, arm, g):
     """The armature's event functions into g[rows NEV_TIP:], each positive while open (1 where
     the model has none of it, never crossing): the rest stop q, the pole stop travel - q
@@ -103,7 +103,7 @@ def armature_events(y, sv, mdl, arm, g):
         g[base + EA_CARD] = -sv[10]
 
 
-@njit(cache=True)
+@njit_borrowing
 def events_from_aux(aux, eref, mdl, g):
     """The contact rows' event function values into g[:rows NEV_TIP] from a dynamics
     evaluation's aux."""
@@ -125,7 +125,7 @@ def events_from_aux(aux, eref, mdl, g):
         g[NEV_TIP * i + EV_COMPRESSION] = aux[i, A_YDOT]
 
 
-@njit(cache=True)
+@njit_borrowing
 def _active(k, g_old, g_new, regime, fmodel):
     """Whether event k is watched in a step with end values g_old, g_new."""
     if k >= regime.shape[0] * NEV_TIP:
@@ -144,7 +144,7 @@ def _active(k, g_old, g_new, regime, fmodel):
     return regime[i] == STICK
 
 
-@njit(cache=True)
+@njit_borrowing
 def armature_step_bound(arm, hcap):
     """The step bound (s) with the armature's stop or card closed and the armature not seated:
     within the explicit method's accurate range, AP_HMAX = 1 / their highest rate (beyond
@@ -157,7 +157,7 @@ def armature_step_bound(arm, hcap):
     return hcap
 
 
-@njit(cache=True)
+@njit_borrowing
 def _rk_stages(t, y, h, k1, k2, k3, k4, k5, k6, k7, ytmp, ynew, mdl,
                regime, eref, aux_stage, aux_new, work, arm):
     """One Dormand-Prince step of size h from (t, y) with k1 = f(t, y): ynew and the stages;
@@ -228,6 +228,8 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
     g_new = np.empty(nev)
     g_mid = np.empty(nev)
     ymid = np.empty(N)
+    yrec = np.empty(N)  # the record's interior states (_record)
+    frec = np.empty((rows, 2))
     max_rec = rec_t.shape[0]
     n_rec = 0
     facold = 1e-4
@@ -415,14 +417,16 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
                 first_theta = 1.0
             dynamics(tev, ymid, mdl, regime, eref, ytmp, aux_new, work, arm)
             stats[2] += 1
-            _record(n_rec, t, h, tev, ymid, aux_new, aux_old, coef, rec, dense, store_dense, mdl, first_theta)
+            _record(n_rec, t, h, tev, ymid, aux_new, aux_old, coef, rec, dense, store_dense, mdl, first_theta,
+                    yrec, frec, work)
             n_rec += 1
             for i in range(N):
                 y[i] = ymid[i]
             stats[0] += 1
             stats[3] += 1
             return EVENT, tev, h_continue, n_rec, first_k
-        _record(n_rec, t, h, t + h, ynew, aux_new, aux_old, coef, rec, dense, store_dense, mdl, 1.0)
+        _record(n_rec, t, h, t + h, ynew, aux_new, aux_old, coef, rec, dense, store_dense, mdl, 1.0,
+                yrec, frec, work)
         n_rec += 1
         stats[0] += 1
         for k in range(nev):
@@ -448,10 +452,12 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
         h = hnew
 
 
-@njit(cache=True)
-def _record(n_rec, t_start, h, t_end, y_end, aux_end, aux_start, coef, rec, dense, store_dense, mdl, theta_end):
+@njit_borrowing
+def _record(n_rec, t_start, h, t_end, y_end, aux_end, aux_start, coef, rec, dense, store_dense, mdl, theta_end,
+            ymid, forces, work):
     """Store an accepted step in row n_rec of rec (and its dense-output coefficients in
-    dense when kept); its peak normal force is sampled at both ends and 3 interior points."""
+    dense when kept); its peak normal force is sampled at both ends and 3 interior points.
+    ymid (N,), forces (rows, 2) and the dynamics' work tuple: scratch for those points."""
     rec_t, rec_y, rec_aux, rec_fmax = rec
     dense_t0, dense_h, dense_coef = dense
     if store_dense:
@@ -473,11 +479,12 @@ def _record(n_rec, t_start, h, t_end, y_end, aux_end, aux_start, coef, rec, dens
         if aux_end[i, A_Y] > 0.0 or aux_start[i, A_Y] > 0.0:
             touching = True
     if touching:
-        ymid = np.empty(N)
-        forces = np.empty((rows, 2))
+        sv = work[22]
         for f in (0.25, 0.5, 0.75):
             dense_eval(coef, f * theta_end, ymid)
-            pair_forces(ymid, mdl, forces)  # the normal forces alone: no right-hand side
+            # the normal forces alone: no right-hand side
+            pair_forces_into(ymid, mdl, forces, work[0], work[1], work[2], work[3], work[4], work[5],
+                             sv[12:15], sv[15:18])
             for i in range(rows):
                 if forces[i, 0] > rec_fmax[n_rec, i]:
                     rec_fmax[n_rec, i] = forces[i, 0]
@@ -568,6 +575,16 @@ def pair_forces(y, mdl, out):
     negative: its gap to its fixed contact), from the kinematics alone (the normal force
     follows the penetration and its rate; no accelerations, so a fraction of a right-hand
     side's cost). A switched-off row, and every row of a model without a bar: 0 and -1e3."""
+    n = mdl[1][I_N]
+    pair_forces_into(y, mdl, out, np.empty(3), np.empty((3, 3)), np.empty(n), np.empty(3), np.empty(3),
+                     np.empty(n), np.empty(3), np.empty(3))
+
+
+@njit_borrowing
+def pair_forces_into(y, mdl, out, r, R, q, V, w, eta, x, v):
+    """``pair_forces`` with the bar's state unpacked into r, R, q, V, w, eta (kernel.unpack's
+    arrays) and each contact point's world position and velocity into x, v (3,): scratch
+    its caller holds (the step's record samples three interior points without allocating)."""
     fpar, ipar, psi, xc, cpar = mdl[0], mdl[1], mdl[6], mdl[8], mdl[9]
     rows = cpar.shape[0]
     if ipar[I_MOUNT] == MOUNT_NONE:  # no bar: no contact point
@@ -576,30 +593,15 @@ def pair_forces(y, mdl, out):
             out[i, 1] = -1e3
         return
     n = ipar[I_N]
-    planar = ipar[I_PLANAR]
-    r = np.empty(3)
-    R = np.empty((3, 3))
-    q = np.empty(n)
-    V = np.empty(3)
-    w = np.empty(3)
-    eta = np.empty(n)
-    unpack(y, n, planar, r, R, q, V, w, eta)
-    s = np.empty(3)
-    d = np.empty(3)
-    no_axis = np.zeros((rows, 3))
+    unpack(y, n, ipar[I_PLANAR], r, R, q, V, w, eta)
     for i in range(rows):
         if cpar[i, C_ON] == 0.0:
             out[i, 0] = 0.0
             out[i, 1] = -1e3
             continue
-        tip_offset(i, xc, psi, q, n, s)
-        tip_offset(i, no_axis, psi, eta, n, d)
-        zc = r[2] + R[2, 0] * s[0] + R[2, 1] * s[1] + R[2, 2] * s[2]
-        vb0 = w[1] * s[2] - w[2] * s[1] + d[0]
-        vb1 = w[2] * s[0] - w[0] * s[2] + d[1]
-        vb2 = w[0] * s[1] - w[1] * s[0] + d[2]
-        vz = V[2] + R[2, 0] * vb0 + R[2, 1] * vb1 + R[2, 2] * vb2
+        # the cap centre's world height x[2] and its rate v[2] (contact row i is point i)
+        load_point_motion(i, xc, psi, r, R, q, V, w, eta, n, x, v)
         sg = cpar[i, C_N]
-        pen = cpar[i, C_R] - sg * (zc - cpar[i, C_Z])
-        out[i, 0] = normal_force(pen, -sg * vz, cpar[i, C_K], cpar[i, C_C], fpar[F_BETA])
+        pen = cpar[i, C_R] - sg * (x[2] - cpar[i, C_Z])
+        out[i, 0] = normal_force(pen, -sg * v[2], cpar[i, C_K], cpar[i, C_C], fpar[F_BETA])
         out[i, 1] = pen

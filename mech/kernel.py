@@ -34,8 +34,8 @@ from . import (
     armature as _armature, contact_laws as _contact_laws, friction as _friction, rotations as _rotations,
     travel_spring as _travel_spring,
 )
-from .jit import njit
-from .inertia import inertia_matrix, inertia_terms, inertia_terms_sparse, schur_complement
+from .jit import njit, njit_borrowing
+from .inertia import inertia_matrix, inertia_matrix_sparse, inertia_terms, inertia_terms_sparse, schur_complement
 from .kernel_layout import (  # noqa: F401  (re-exported: the kernel's own names)
     F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MAX_RATIO, F_RTIP, D_VALUE, D_SLOPE, D_T0, K_MU, K_REPULSION,
     F_VREG, F_BAUM, F_VBOUND, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN, C_Z, C_N, MAX_PAIRS,
@@ -64,16 +64,16 @@ slip_direction = njit(cache=True)(_friction.slip_direction)
 scaled_rebound = njit(cache=True)(_contact_laws.scaled_rebound)  # the damping calibration's impact
 stop_force = njit(cache=True)(_armature.stop_force)
 return_force = njit(cache=True)(_armature.return_force)
-travel_force = njit(cache=True)(_travel_spring.travel_force)
-travel_work = njit(cache=True)(_travel_spring.travel_work)
+travel_force = njit_borrowing(_travel_spring.travel_force)
+travel_work = njit_borrowing(_travel_spring.travel_work)
 stick_rate = njit(cache=True)(_travel_spring.stick_rate)
-gain_at = njit(cache=True)(_armature.gain_at)
+gain_at = njit_borrowing(_armature.gain_at)
 
 
-quat_to_matrix = njit(cache=True)(_rotations.quat_to_matrix)
+quat_to_matrix = njit_borrowing(_rotations.quat_to_matrix)
 
 
-@njit(cache=True)
+@njit_borrowing
 def unpack(y, n, planar, r, R, q, V, w, eta):
     """Fill 3D position r, rotation R, q, V, body w and eta from the state y."""
     if planar:
@@ -127,38 +127,26 @@ def make_work(n):
         np.zeros((MAX_PAIRS, 3)),
         # unit responses wdot etadot Vdot: 2 tangential directions per sticking row
         np.zeros((2 * MAX_PAIRS, 3)), np.zeros((2 * MAX_PAIRS, n)), np.zeros((2 * MAX_PAIRS, 3)),
-        np.zeros(12), np.zeros((3, 3)),  # small vectors (an armature's terms at 6-10), Schur complement
+        # small vectors: a point force and moment (0-2, 3-5), an armature's terms (6-10), a
+        # load or card point's world position and velocity (12-14, 15-17); Schur complement
+        np.zeros(18), np.zeros((3, 3)),
     )
 
 
-@njit(cache=True)
-def tip_offset(i, xc, psi, modal, n, out):
-    """Body-frame offset of point i (a contact cap's centre or a load point) from the frame
-    origin, xc_i + sum_j Psi_ij modal_j (with modal = q: the position; with modal = eta and
-    xc zero: its rate)."""
-    out[0] = xc[i, 0]
-    out[1] = xc[i, 1]
-    out[2] = xc[i, 2]
-    for j in range(n):
-        out[0] += psi[i, j, 0] * modal[j]
-        out[1] += psi[i, j, 1] * modal[j]
-        out[2] += psi[i, j, 2] * modal[j]
-
-
-@njit(cache=True)
+@njit_borrowing
 def drive_at(t, drive, row):
     """Value of the drive channel in row ``row`` at t (s): linear in time within a step."""
     return drive[row, D_VALUE] + drive[row, D_SLOPE] * (t - drive[row, D_T0])
 
 
-@njit(cache=True)
+@njit_borrowing
 def mu_at(t, drive, row):
     """N^gamma: the friction coefficient in drive row ``row`` at t (s), clipped at zero."""
     mu = drive_at(t, drive, row)
     return mu if mu > 0.0 else 0.0
 
 
-@njit(cache=True)
+@njit_borrowing
 def _add_force_at(p, s0, s1, s2, Fw, Mw, R, psi, theta, n, F, f_r, f_e):
     """Generalized forces of world force Fw at point p (body position s) plus world moment Mw."""
     for a in range(3):
@@ -178,13 +166,13 @@ def _add_force_at(p, s0, s1, s2, Fw, Mw, R, psi, theta, n, F, f_r, f_e):
                    + theta[p, j, 0] * mb0 + theta[p, j, 1] * mb1 + theta[p, j, 2] * mb2)
 
 
-@njit(cache=True)
+@njit_borrowing
 def _add_point_force(i, Fw, Mw, R, s_tip, psi, theta, n, F, f_r, f_e):
     """Generalized forces of world force Fw at contact cap centre i plus world moment Mw."""
     _add_force_at(i, s_tip[i, 0], s_tip[i, 1], s_tip[i, 2], Fw, Mw, R, psi, theta, n, F, f_r, f_e)
 
 
-@njit(cache=True)
+@njit_borrowing
 def load_point_motion(p, xc, psi, r, R, q, V, w, eta, n, x, v):
     """World position x (m) and velocity v (m/s) of load point p; returns nothing."""
     s0 = xc[p, 0]
@@ -209,7 +197,7 @@ def load_point_motion(p, xc, psi, r, R, q, V, w, eta, n, x, v):
     return s0, s1, s2
 
 
-@njit(cache=True)
+@njit_borrowing
 def anchor_height(ld, load, qa):
     """m: world z of spring ``ld``'s anchor end, for the armature at q = qa when the end is
     on it (moved down by its lever times q - q0), else fixed."""
@@ -218,7 +206,7 @@ def anchor_height(ld, load, qa):
     return load[ld, L_AZ]
 
 
-@njit(cache=True)
+@njit_borrowing
 def spring_length(ld, load, x, qa=0.0):
     """Length (m) of spring ``ld`` with its bar end at world point x (the armature at q = qa)."""
     d0 = x[0] - load[ld, L_AX]
@@ -227,20 +215,19 @@ def spring_length(ld, load, x, qa=0.0):
     return math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
 
 
-@njit(cache=True)
-def _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r, f_e, Fw, Mw, y, dy,
+@njit_borrowing
+def _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r, f_e, Fw, Mw, x, v, y, dy,
                 qa=0.0, va=0.0):
     """Add load ``ld`` (actuator force, spring-dashpot or force-travel spring) to the
     generalized forces; a spring with hysteresis writes its stick force's rate into dy.
-    qa, va: the armature's q and rate (a spring whose anchor end it carries).
+    qa, va: the armature's q and rate (a spring whose anchor end it carries); x, v (3,):
+    scratch for the load point's world position and velocity.
 
     Returns (power the actuator puts in, W; power the dashpot and the hysteresis dissipate,
     W; the spring's reaction on the armature along q, N or N m: lever times the world z of
     its force on the bar, 0 for a load on the frame).
     """
     p = int(load[ld, L_POINT])
-    x = np.empty(3)
-    v = np.empty(3)
     s0, s1, s2 = load_point_motion(p, xc, psi, r, R, q, V, w, eta, n, x, v)
     Mw[0] = 0.0
     Mw[1] = 0.0
@@ -303,7 +290,7 @@ def _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r
     return p_in, p_diss, load[ld, L_ARM] * Fw[2]
 
 
-@njit(cache=True)
+@njit_borrowing
 def _solve_accel(f_r, f_e, Ainv, B, m, n, wdot, etadot):
     """[J B; B' mI] [wdot; etadot] = [f_r; f_e] by the 3x3 Schur complement."""
     r0 = f_r[0]
@@ -320,7 +307,7 @@ def _solve_accel(f_r, f_e, Ainv, B, m, n, wdot, etadot):
         etadot[j] = (f_e[j] - B[0, j] * wdot[0] - B[1, j] * wdot[1] - B[2, j] * wdot[2]) / m
 
 
-@njit(cache=True)
+@njit_borrowing
 def _add_rotational_coupling(n, m, w, eta, cL, Jm, B, f_r, Amat, Ainv):
     """Add a held bar's H_j (cL[:, n+1:], kg m) to B(q): the angular momentum gains H eta,
     f_r = -w x h - dJ/dt w gains -w x (H eta), and the Schur complement J - B B'/m is redone.
@@ -341,7 +328,7 @@ def _add_rotational_coupling(n, m, w, eta, cL, Jm, B, f_r, Amat, Ainv):
     schur_complement(n, m, Jm, B, Amat, Ainv)
 
 
-@njit(cache=True)
+@njit_borrowing
 def _solve_mounted(mount, F, f_r, f_e, Ainv, B, m, n, Vdot, wdot, etadot):
     """Accelerations from generalized forces for the bar as held by ``mount``.
 
@@ -364,7 +351,7 @@ def _solve_mounted(mount, F, f_r, f_e, Ainv, B, m, n, Vdot, wdot, etadot):
         _solve_accel(f_r, f_e, Ainv, B, m, n, wdot, etadot)
 
 
-@njit(cache=True)
+@njit_borrowing
 def table_value(tabs, start, count, t):
     """Linear interpolation in a time table stored as tabs[0, start:start+count] (times,
     s) and tabs[1, ...] (values); constant beyond its ends."""
@@ -385,7 +372,7 @@ def table_value(tabs, start, count, t):
     return tabs[1, lo] + f * (tabs[1, hi] - tabs[1, lo])
 
 
-@njit(cache=True)
+@njit_borrowing
 def _tip_accel(k, R, s_tip, psi, theta, n, Rtip, Vdot, wdot, etadot, out):
     """World acceleration of contact row k's contact point from (Vdot, wdot, etadot), no
     velocity terms; Rtip: the point's signed offset from the cap's centre along -z (the
@@ -414,7 +401,7 @@ def _tip_accel(k, R, s_tip, psi, theta, n, Rtip, Vdot, wdot, etadot, out):
     out[1] += ow0 * Rtip
 
 
-@njit(cache=True)
+@njit_borrowing
 def armature_terms(t, qa, va, pen_card, pen_card_rate, ipar, apar, again, closed, drive, out):
     """The armature's generalized force and powers, into out (4,): the force along q (N, or
     N m for a clapper: the drive times the gain table, the return spring, the viscous
@@ -496,12 +483,13 @@ def armature_force(t, y, mdl, arm):
         for ld in range(ipar[I_NLOAD]):
             if load[ld, L_ARM] != 0.0:
                 _, _, f_l = _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, np.zeros(3),
-                                        np.zeros(3), np.zeros(n), np.zeros(3), np.zeros(3), y, dy, qa, va)
+                                        np.zeros(3), np.zeros(n), np.zeros(3), np.zeros(3), np.empty(3),
+                                        np.empty(3), y, dy, qa, va)
                 f += f_l
     return f
 
 
-@njit(cache=True)
+@njit_borrowing
 def card_penetration(qa, va, z, vz, apar):
     """(m, m/s): how far the card has pressed past the bar's card point, and its rate. The card
     hangs card_free_travel above the point's height at the start (AP_CARD_Z0) when q = 0
@@ -509,7 +497,7 @@ def card_penetration(qa, va, z, vz, apar):
     return apar[AP_LEVER] * qa - apar[AP_FREE] - (apar[AP_CARD_Z0] - z), apar[AP_LEVER] * va + vz
 
 
-@njit(cache=True)
+@njit_borrowing
 def _armature_alone(t, y, ipar, arm, drive, dy, aux, sv):
     """dynamics of a model without a bar: the armature's two states, its quadratures (the
     drive's work, the dissipation), its terms into sv[6:11] as beside a bar
@@ -534,7 +522,7 @@ def _armature_alone(t, y, ipar, arm, drive, dy, aux, sv):
     dy[N_ARM + Q_DLOAD] = terms[3]
 
 
-@njit(cache=True)
+@njit_borrowing
 def _armature_on_bar(t, y, n, planar, mount, ipar, arm, drive, xc, psi, theta,
                      r, R, q, V, w, eta, F, f_r, f_e, Fw, Mw, sv):
     """The armature beside a bar (dynamics): its terms into sv[6:10] (armature_terms) and the
@@ -552,8 +540,8 @@ def _armature_on_bar(t, y, n, planar, mount, ipar, arm, drive, xc, psi, theta,
     s1 = 0.0
     s2 = 0.0
     if pc >= 0:
-        xcard = np.empty(3)
-        vcard = np.empty(3)
+        xcard = sv[12:15]
+        vcard = sv[15:18]
         s0, s1, s2 = load_point_motion(pc, xc, psi, r, R, q, V, w, eta, n, xcard, vcard)
         pen_c, pen_c_rate = card_penetration(qa, va, xcard[2], vcard[2], apar)
     terms = sv[6:10]
@@ -570,7 +558,7 @@ def _armature_on_bar(t, y, n, planar, mount, ipar, arm, drive, xc, psi, theta,
     return terms[2], terms[3]
 
 
-@njit(cache=True)
+@njit_borrowing
 def _armature_rates(y, base, arm, sv, dy):
     """The armature's two rates into dy[base:base + 2] (its force in sv[6], _armature_on_bar);
     held while seated."""
@@ -583,7 +571,7 @@ def _armature_rates(y, base, arm, sv, dy):
         dy[base + 1] = sv[6] / apar[AP_MASS]
 
 
-@njit(cache=True)
+@njit_borrowing
 def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
     """Time derivative of the state into ``dy``; per-contact-row quantities into ``aux`` (rows, NAUX).
 
@@ -790,7 +778,7 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
     f_arm = 0.0  # the reaction on the armature of the springs it carries
     for ld in range(nload):
         w_in_l, d_l, f_l = _load_force(t, ld, load, tabs, r, R, q, V, w, eta, psi, theta, xc, n, F, f_r, f_e,
-                                       Fw, Mw, y, dy, qa, va)
+                                       Fw, Mw, sv[12:15], sv[15:18], y, dy, qa, va)
         w_in += w_in_l
         d_load += d_l
         f_arm += f_l
@@ -1158,12 +1146,12 @@ def armature_energy(qa, va, pen_card, apar, has_card):
     return 0.5 * apar[AP_MASS] * va * va, stored
 
 
-@njit(cache=True)
+@njit_borrowing
 def energies(y, mdl, work, out, arm=None):
     """out = (kinetic, elastic strain, gravity potential, stored Hertz energy, stored
     energy of springs and the pivot's torsion spring incl. its preload), all J; an
     armature's kinetic energy counts in the first, its return spring's, stops' and card's
-    stored energy in the last.
+    stored energy in the last. work: ``make_work``'s scratch (its contents overwritten).
 
     Kinetic energy about a frame origin that is not the centroid (held bars):
     1/2 m V.V + V . R (w x (c + L q) + L eta) + 1/2 w J w + w B eta + 1/2 m eta.eta.
@@ -1180,23 +1168,14 @@ def energies(y, mdl, work, out, arm=None):
         out[4] = stored
         return
     r, R, q, V, w, eta, Jm, B = work[0], work[1], work[2], work[3], work[4], work[5], work[6], work[7]
+    x = work[22][12:15]  # a point's world position and velocity
+    v = work[22][15:18]
     unpack(y, n, planar, r, R, q, V, w, eta)
     m = fpar[F_MASS]
     if ipar[I_INERTIA] == INERTIA_GRAM:
         inertia_matrix(n, q, J0, sp_ptr, sp_idx, sp_val, Jm, B)
     else:
-        for a in range(3):
-            for b in range(3):
-                Jm[a, b] = J0[a, b]
-        for j in range(n):
-            for a in range(3):
-                B[a, j] = 0.0
-        for e in range(sp_ptr[0], sp_ptr[1]):
-            Jm[sp_idx[e, 1], sp_idx[e, 2]] += sp_val[e] * q[sp_idx[e, 0]]
-        for e in range(sp_ptr[1], sp_ptr[2]):
-            Jm[sp_idx[e, 2], sp_idx[e, 3]] += sp_val[e] * q[sp_idx[e, 0]] * q[sp_idx[e, 1]]
-        for e in range(sp_ptr[2], sp_ptr[3]):
-            B[sp_idx[e, 2], sp_idx[e, 1]] += sp_val[e] * q[sp_idx[e, 0]]
+        inertia_matrix_sparse(n, q, J0, sp_ptr, sp_idx, sp_val, Jm, B)
     for j in range(n):  # H_j, the q-independent coupling of a held bar's modes (0 when free)
         for a in range(3):
             B[a, j] += cL[a, n + 1 + j]
@@ -1207,34 +1186,36 @@ def energies(y, mdl, work, out, arm=None):
     for j in range(n):
         kin += (w[0] * B[0, j] + w[1] * B[1, j] + w[2] * B[2, j]) * eta[j] + 0.5 * m * eta[j] ** 2
     # first moment c + L q and its body rate L eta
-    cq = np.empty(3)
-    le = np.empty(3)
-    for a in range(3):
-        cq[a] = cL[a, 0]
-        le[a] = 0.0
-        for j in range(n):
-            cq[a] += cL[a, j + 1] * q[j]
-            le[a] += cL[a, j + 1] * eta[j]
-    ub0 = w[1] * cq[2] - w[2] * cq[1] + le[0]
-    ub1 = w[2] * cq[0] - w[0] * cq[2] + le[1]
-    ub2 = w[0] * cq[1] - w[1] * cq[0] + le[2]
+    cq0 = cL[0, 0]
+    cq1 = cL[1, 0]
+    cq2 = cL[2, 0]
+    le0 = 0.0
+    le1 = 0.0
+    le2 = 0.0
+    for j in range(n):
+        cq0 += cL[0, j + 1] * q[j]
+        cq1 += cL[1, j + 1] * q[j]
+        cq2 += cL[2, j + 1] * q[j]
+        le0 += cL[0, j + 1] * eta[j]
+        le1 += cL[1, j + 1] * eta[j]
+        le2 += cL[2, j + 1] * eta[j]
+    ub0 = w[1] * cq2 - w[2] * cq1 + le0
+    ub1 = w[2] * cq0 - w[0] * cq2 + le1
+    ub2 = w[0] * cq1 - w[1] * cq0 + le2
     for a in range(3):
         kin += V[a] * (R[a, 0] * ub0 + R[a, 1] * ub1 + R[a, 2] * ub2)
     el = 0.0
     for e in range(sp_ptr[3], sp_ptr[4]):
         el += 0.5 * q[sp_idx[e, 0]] * sp_val[e] * q[sp_idx[e, 1]]
     hz = 0.0
-    s = np.empty(3)
     for i in range(cpar.shape[0]):
         if cpar[i, C_ON] == 0.0:
             continue
-        tip_offset(i, xc, psi, q, n, s)
-        pen = cpar[i, C_R] - cpar[i, C_N] * (r[2] + R[2, 0] * s[0] + R[2, 1] * s[1] + R[2, 2] * s[2] - cpar[i, C_Z])
+        load_point_motion(i, xc, psi, r, R, q, V, w, eta, n, x, v)  # (contact row i is point i)
+        pen = cpar[i, C_R] - cpar[i, C_N] * (x[2] - cpar[i, C_Z])
         if pen > 0.0:
             hz += 0.4 * cpar[i, C_K] * pen * pen * math.sqrt(pen)
     sp = 0.0
-    x = np.empty(3)
-    v = np.empty(3)
     qa = 0.0
     if arm is not None:
         qa = y[arm_offset(n, planar, ipar[I_MOUNT])]
@@ -1272,7 +1253,7 @@ def energies(y, mdl, work, out, arm=None):
         sp += ua
     out[0] = kin
     out[1] = el
-    out[2] = fpar[F_G] * (m * r[2] + R[2, 0] * cq[0] + R[2, 1] * cq[1] + R[2, 2] * cq[2])
+    out[2] = fpar[F_G] * (m * r[2] + R[2, 0] * cq0 + R[2, 1] * cq1 + R[2, 2] * cq2)
     out[3] = hz
     out[4] = sp
 
