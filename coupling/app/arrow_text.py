@@ -61,14 +61,16 @@ def _load() -> dict:
     import pyarrow as pa
 
     try:
-        from pyarrow._compute import CastOptions, JoinOptions, ReplaceSubstringOptions, SliceOptions, call_function
+        from pyarrow._compute import (CastOptions, JoinOptions, ReplaceSliceOptions, ReplaceSubstringOptions,
+                                      call_function)
     except ImportError:  # a pyarrow laid out otherwise: the public module (its wrappers cost ~20 ms)
-        from pyarrow.compute import CastOptions, JoinOptions, ReplaceSubstringOptions, SliceOptions, call_function
+        from pyarrow.compute import (CastOptions, JoinOptions, ReplaceSliceOptions, ReplaceSubstringOptions,
+                                     call_function)
     import pyarrow.csv
 
     return {"pa": pa, "call": call_function, "to_text": CastOptions(pa.string()), "csv": pyarrow.csv,
             "csv_options": pyarrow.csv.WriteOptions(include_header=False, quoting_style="none"),
-            "join": JoinOptions("replace", ""), "slice": SliceOptions,
+            "join": JoinOptions("replace", ""), "splice": ReplaceSliceOptions,
             "dot_e": ReplaceSubstringOptions(".e", "e")}
 
 
@@ -127,7 +129,7 @@ def float_text(values: np.ndarray):
     """Each float64 as ``float.__repr__`` writes it (the module docstring), NaN null: a
     pyarrow string array."""
     A = _ARROW
-    call, join, cut = A["call"], A["join"], A["slice"]
+    call, join, splice = A["call"], A["join"], A["splice"]
     v = np.ascontiguousarray(values, np.float64)
     n = len(v)
     nan = np.isnan(v)
@@ -137,8 +139,7 @@ def float_text(values: np.ndarray):
     cls = np.searchsorted(_EDGES, size, side="right")  # NaN sorts last: class 6, left as it is
     with np.errstate(invalid="ignore"):
         whole = (v == np.trunc(v)) & (size < _WHOLE_BELOW)
-    sep = strings([".0", "0", ".", "", "e-06", "e-05", "-"])
-    dot0, zero, dot, empty, e06, e05, minus = (sep[k] for k in range(7))
+    sep = strings([".0", "", "e-06", "e-05"])
     pieces, order, count = [text], np.arange(n, dtype=np.int64), n
 
     def put(idx, piece):  # these rows' text is `piece`, in their order
@@ -150,27 +151,31 @@ def float_text(values: np.ndarray):
     def part(idx):
         return call("take", [text, _indices(idx)])
 
-    def sliced(s, start, stop=None):
-        return call("utf8_slice_codeunits", [s], cut(start, stop))
-
     if len(idx := np.flatnonzero(whole)):
-        put(idx, call("binary_join_element_wise", [part(idx), dot0, empty], join))
+        put(idx, call("binary_join_element_wise", [part(idx), sep[0], sep[1]], join))
     if len(idx := np.flatnonzero(cls == 1)):  # "1.5e-7": a 0 before the exponent's one digit
-        s = part(idx)
-        put(idx, call("binary_join_element_wise", [sliced(s, 0, -1), sliced(s, -1), zero], join))
-    for k, tail in ((2, e06), (3, e05)):  # "0.00000123" / "0.0000123" of |x|: its digits, a point after the first
+        put(idx, call("binary_replace_slice", [part(idx)], splice(-1, -1, "0")))
+    for k, tail in ((2, sep[2]), (3, sep[3])):  # "0.00000123" / "0.0000123" of |x|: its digits, a point after the first
         if len(idx := np.flatnonzero(cls == k)):
-            digits = sliced(call("cast", [_numbers(size[idx])], A["to_text"]), 9 - k)
-            body = call("binary_join_element_wise", [sliced(digits, 0, 1), sliced(digits, 1), dot], join)
-            body = call("replace_substring", [call("binary_join_element_wise", [body, tail, empty], join)],
-                        A["dot_e"])  # one digit: "1.e-05" -> "1e-05"
-            signs = call("take", [strings(["", "-"]), _indices(v[idx] < 0)])
-            put(idx, call("binary_join_element_wise", [signs, body, empty], join))
+            digits = call("binary_replace_slice", [call("cast", [_numbers(size[idx])], A["to_text"])],
+                          splice(0, 9 - k, ""))
+            body = call("binary_replace_slice", [digits], splice(1, 1, "."))
+            body = call("binary_join_element_wise", [_signs(v[idx] < 0), body, tail, sep[1]], join)
+            put(idx, call("replace_substring", [body], A["dot_e"]))  # one digit: "1.e-05" -> "1e-05"
     if len(idx := np.flatnonzero(cls == 5)):
         put(idx, strings(list(map(float.__repr__, v[idx].tolist()))))
     if len(pieces) == 1:
         return text
     return call("take", [A["pa"].concat_arrays(pieces), _indices(order)])
+
+
+def _signs(negative: np.ndarray):
+    """A string array of "-" where ``negative``, "" elsewhere, from its buffers."""
+    pa = _ARROW["pa"]
+    offsets = np.zeros(len(negative) + 1, np.int32)
+    np.cumsum(negative, out=offsets[1:])
+    return pa.Array.from_buffers(pa.string(), len(negative), [None, pa.py_buffer(offsets),
+                                                             pa.py_buffer(b"-" * int(offsets[-1]))])
 
 
 def write_rows(fh, columns: list, codes: list) -> None:
