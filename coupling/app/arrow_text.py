@@ -62,6 +62,12 @@ def available() -> bool:
     return bool(_ARROW)
 
 
+def ready() -> bool:
+    """Whether ``available`` was asked in this process and said yes (the route's first-use
+    costs are paid)."""
+    return bool(_ARROW)
+
+
 def _load() -> dict:
     import pyarrow as pa
 

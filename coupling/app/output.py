@@ -478,11 +478,14 @@ def write_csv(path: Path, columns: dict, codes: dict | None = None) -> None:
             fh.write("\n".join(map(",".join, chunk)) + "\n")
 
 
-# write_csv's Arrow route, in cells (rows x columns): with pyarrow loaded, from this size on
-# (below it the route's fixed cost, ~0.3 ms, is what the Python route spends); without,
-# from where formatting saves more than importing pyarrow costs (~35 ms at ~0.2 us a cell)
-ARROW_MIN_CELLS = 2_000
-ARROW_IMPORT_MIN_CELLS = 200_000
+# write_csv's Arrow route from these sizes on, in cells (rows x columns), where it saves
+# more than it costs: a cell costs ~0.35 us by the Python route, ~0.11 us by Arrow's (the
+# default scene's history.csv and waveforms.csv, CPU time); its first use in a process
+# costs ~8 ms (pyarrow._compute and pyarrow.csv imported, the layout checked, the kernels'
+# first calls), importing pyarrow ~40 ms more
+ARROW_MIN_CELLS = 2_000  # the route in use already
+ARROW_FIRST_MIN_CELLS = 30_000  # pyarrow loaded (waveforms.parquet is written first)
+ARROW_IMPORT_MIN_CELLS = 200_000  # pyarrow not loaded
 
 
 def _write_numbers(path: Path, names: list, columns: dict, codes: dict) -> bool:
@@ -496,7 +499,11 @@ def _write_numbers(path: Path, names: list, columns: dict, codes: dict) -> bool:
     n = len(arrays[0])
     if any(len(a) != n for a in arrays) or not "".join(names).isascii():
         return False
-    if n * len(arrays) < (ARROW_MIN_CELLS if "pyarrow" in sys.modules else ARROW_IMPORT_MIN_CELLS):
+    from coupling.app import arrow_text
+
+    least = (ARROW_MIN_CELLS if arrow_text.ready() else
+             ARROW_FIRST_MIN_CELLS if "pyarrow" in sys.modules else ARROW_IMPORT_MIN_CELLS)
+    if n * len(arrays) < least:
         return False
     for name, a in zip(names, arrays):
         label = codes.get(name)
@@ -507,8 +514,6 @@ def _write_numbers(path: Path, names: list, columns: dict, codes: dict) -> bool:
                     or a.min() < 0 or a.max() >= len(label)):
                 return False
         labels.append(label)
-    from coupling.app import arrow_text
-
     if not arrow_text.available():
         return False
     with open(path, "wb") as fh:

@@ -77,8 +77,8 @@ def big_table(rows: int = 3000) -> tuple[dict, dict]:
 
 def python_route(monkeypatch, path: Path, columns: dict, codes: dict | None = None) -> bytes:
     with monkeypatch.context() as m:
-        m.setattr(output, "ARROW_MIN_CELLS", 10**12)
-        m.setattr(output, "ARROW_IMPORT_MIN_CELLS", 10**12)
+        for name in ("ARROW_MIN_CELLS", "ARROW_FIRST_MIN_CELLS", "ARROW_IMPORT_MIN_CELLS"):
+            m.setattr(output, name, 10**12)
         output.write_csv(path, columns, codes)
     return path.read_bytes()
 
@@ -190,18 +190,18 @@ def test_the_outputs_import_neither_pandas_nor_pyarrow_parquet_nor_compute(tmp_p
         import numpy as np
         from pathlib import Path
         from coupling.app import arrow_text, output
-        columns = {{"t": np.arange(5000) * 1e-6, "x": np.sin(np.arange(5000.0)), "n": np.arange(5000)}}
+        columns = {{"t": np.arange(12000) * 1e-6, "x": np.sin(np.arange(12000.0)), "n": np.arange(12000)}}
         output.write_parquet(Path({str(tmp_path)!r}) / "w.parquet", columns)
         output.write_csv(Path({str(tmp_path)!r}) / "w.csv", columns)
-        print(json.dumps([arrow_text.available(), sorted(sys.modules)]))
+        print(json.dumps([arrow_text.ready(), sorted(sys.modules)]))  # ready: the Arrow route wrote
     """)
     env = dict(os.environ, PYTHONPATH=str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", ""))
     done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
-    available, modules = json.loads(done.stdout.strip().splitlines()[-1])
-    assert available
+    took_arrow, modules = json.loads(done.stdout.strip().splitlines()[-1])
+    assert took_arrow
     assert not {"pandas", "pyarrow.parquet", "pyarrow.compute", "pyarrow.fs"} & set(modules)
-    assert pd.read_csv(tmp_path / "w.csv")["x"].tolist() == np.sin(np.arange(5000.0)).tolist()
+    assert pd.read_csv(tmp_path / "w.csv")["x"].tolist() == np.sin(np.arange(12000.0)).tolist()
 
 
 def test_rows_are_written_through_a_binary_file():
