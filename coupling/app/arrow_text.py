@@ -45,7 +45,7 @@ CHUNK_CELLS = 1 << 16
 _EDGES = np.array([1e-9, 1e-6, 1e-5, 1e-4, 1e9, 1e17])
 _WHOLE_BELOW = 1e9  # Arrow writes whole numbers below 1e10 positionally; 1e9.. goes to repr
 
-_ARROW = None  # (pyarrow, call_function, options...) once imported; False: not usable here
+_ARROW = None  # pyarrow and the kernels' options once checked (_load); False: not usable here
 
 
 def available() -> bool:
@@ -116,7 +116,7 @@ def _probe() -> bool:
             and sink.getvalue() == "".join(lines).encode())
 
 
-def strings(texts: list[str]):
+def _strings(texts: list[str]):
     """A pyarrow string array of ``texts``, built from its buffers (see the module docstring)."""
     pa = _ARROW["pa"]
     data = [t.encode() for t in texts]
@@ -155,7 +155,7 @@ def float_text(values: np.ndarray):
     cls = np.searchsorted(_EDGES, size, side="right")  # NaN sorts last: class 6, left as it is
     with np.errstate(invalid="ignore"):
         whole = (v == np.trunc(v)) & (size < _WHOLE_BELOW)
-    sep = strings([".0", "", "e-06", "e-05"])
+    sep = _strings([".0", "", "e-06", "e-05"])
     pieces, order, count = [text], np.arange(n, dtype=np.int64), n
 
     def put(idx, piece):  # these rows' text is `piece`, in their order
@@ -179,7 +179,7 @@ def float_text(values: np.ndarray):
             body = call("binary_join_element_wise", [_signs(v[idx] < 0), body, tail, sep[1]], join)
             put(idx, call("replace_substring", [body], A["dot_e"]))  # one digit: "1.e-05" -> "1e-05"
     if len(idx := np.flatnonzero(cls == 5)):
-        put(idx, strings(list(map(float.__repr__, v[idx].tolist()))))
+        put(idx, _strings(list(map(float.__repr__, v[idx].tolist()))))
     if len(pieces) == 1:
         return text
     return call("take", [A["pa"].concat_arrays(pieces, A["pool"]), _indices(order)])
@@ -203,7 +203,7 @@ def write_rows(fh, columns: list, codes: list) -> None:
     ``available()``."""
     A = _ARROW
     call, pa = A["call"], A["pa"]
-    names = [None if c is None else strings(list(c)) for c in codes]
+    names = [None if c is None else _strings(list(c)) for c in codes]
     n = len(columns[0])
     step = max(1, CHUNK_CELLS // len(columns))
     for start in range(0, n, step):
@@ -220,7 +220,7 @@ def write_rows(fh, columns: list, codes: list) -> None:
                 v = np.ascontiguousarray(v, np.float64)
                 bits = v.view(np.int64)
                 if np.all(bits == bits[0]):  # a constant column (a third of a relay's history): one cell
-                    cell = strings(["" if v[0] != v[0] else float.__repr__(float(v[0]))])
+                    cell = _strings(["" if v[0] != v[0] else float.__repr__(float(v[0]))])
                     parts.append(call("take", [cell, _indices(np.zeros(m, np.int64))]))
                 else:
                     where.append(len(parts))

@@ -490,11 +490,13 @@ ARROW_IMPORT_MIN_CELLS = 200_000  # pyarrow not loaded
 
 def _write_numbers(path: Path, names: list, columns: dict, codes: dict) -> bool:
     """write_csv's Arrow route: writes the file and returns True where every column is a
-    1-D numpy array of floats or integers (codes: integers within their names, which need
-    no quoting), of one length, names and codes ASCII (the bytes do not depend on the
-    locale's encoding), and the table large enough (see the constants above)."""
+    1-D numpy array of floats or integers in the machine's byte order (codes: integers
+    within their names, which need no quoting), all of one length, the names and codes
+    ASCII (the bytes then do not depend on the locale's encoding), and the table is large
+    enough (the constants above)."""
     arrays, labels = [columns[name] for name in names], []
-    if not all(isinstance(a, np.ndarray) and a.ndim == 1 and a.dtype.kind in "iuf" for a in arrays):
+    if not all(isinstance(a, np.ndarray) and a.ndim == 1 and a.dtype.kind in "iuf" and a.dtype.isnative
+               for a in arrays):
         return False
     n = len(arrays[0])
     if any(len(a) != n for a in arrays) or not "".join(names).isascii():
@@ -509,9 +511,8 @@ def _write_numbers(path: Path, names: list, columns: dict, codes: dict) -> bool:
         label = codes.get(name)
         if label is not None:
             label = tuple(label)
-            text = "".join(label) if all(type(x) is str for x in label) else ","
-            if (a.dtype.kind == "f" or _NEEDS_QUOTES.search(text) or not text.isascii()
-                    or a.min() < 0 or a.max() >= len(label)):
+            if (a.dtype.kind == "f" or a.min() < 0 or a.max() >= len(label)
+                    or not all(type(x) is str and x.isascii() and not _NEEDS_QUOTES.search(x) for x in label)):
                 return False
         labels.append(label)
     if not arrow_text.available():

@@ -151,7 +151,8 @@ def test_a_pyarrow_laying_floats_out_otherwise_is_refused(tmp_path, monkeypatch)
     {"a": np.arange(3000.0), "b": np.arange(3000) % 2 == 0},  # booleans: True/False
     {"a": np.arange(3000.0), "b": np.arange(2999.0)},  # lengths differ: zip stops at the shortest
     {"a": np.arange(3000.0), "\u00e4": np.arange(3000.0)},  # a name not ASCII: the locale's encoding
-], ids=["list", "booleans", "lengths", "name"])
+    {"a": np.arange(3000.0), "b": np.arange(3000).astype(">i8")},  # not the machine's byte order
+], ids=["list", "booleans", "lengths", "name", "byte order"])
 def test_tables_the_arrow_route_does_not_take_are_written_as_before(tmp_path, monkeypatch, columns):
     expected = python_route(monkeypatch, tmp_path / "p.csv", columns)
     monkeypatch.setattr(arrow_text, "write_rows", None)  # a call would fail
