@@ -48,12 +48,13 @@ _WHOLE_BELOW = 1e9  # Arrow writes whole numbers below 1e10 positionally; 1e9.. 
 _ARROW = None  # pyarrow and the kernels' options once checked (_load); False: not usable here
 
 
-def available() -> bool:
+def available(*, again: bool = False) -> bool:
     """Whether pyarrow is importable and lays floats out as the module docstring says,
-    checked once per process against ``float.__repr__`` (a pyarrow that formats otherwise
-    leaves write_csv on its Python route)."""
+    checked once per process (``again``: anew) against ``float.__repr__``: ``float_text``
+    and ``write_rows`` on ``probe_values()``; a pyarrow that formats otherwise leaves
+    write_csv on its Python route."""
     global _ARROW
-    if _ARROW is None:
+    if _ARROW is None or again:
         try:
             _ARROW = _load()
             _ARROW = _ARROW if _probe() else False
