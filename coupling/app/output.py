@@ -373,10 +373,10 @@ def write_files(result, folder: Path, summary_extra: dict | None = None) -> None
             html = write_waveform_html(result, folder / "waveforms.html")
             summary["waveforms_html"] = "waveforms.html" if html == "written" else html
         waves = result.waveform_columns
+        if opts.parquet:  # first: with pyarrow loaded, the large CSVs take write_csv's Arrow route
+            write_parquet(folder / "waveforms.parquet", waves)
         if opts.csv:
             write_csv(folder / "waveforms.csv", waves)
-        if opts.parquet:
-            write_parquet(folder / "waveforms.parquet", waves)
         if result.scene.circuit is not None:
             write_csv(folder / "openings.csv", result.opening_columns)
             for name in result.contact_results:  # each contact of several: its own table
@@ -444,15 +444,21 @@ def write_csv(path: Path, columns: dict, codes: dict | None = None) -> None:
     blank, booleans True/False; a column named in ``codes`` holds indices into its names.
     Written from the arrays: the command line needs no pandas to write its tables.
 
-    The lines are joined here, not by the csv module, when no field needs quoting (numbers
-    never do; the names and text cells are checked): csv.writer's per-field quoting scan
-    cost ~30 ms of a default run's history.csv (2 900 rows x 61 columns) for the same bytes.
-    Otherwise, and for a single column (where csv writes an empty field as ""), csv.writer
-    writes the file."""
+    A large table of numbers (floats, integers, codes) is written through Arrow's kernels
+    (coupling.app.arrow_text), the same bytes at about a fifth of the cost, where pyarrow
+    is loaded already (the default coupled run writes waveforms.parquet first) or the
+    table is large enough to pay for importing it (``ARROW_IMPORT_MIN_CELLS``).
+    Otherwise the lines are joined here, not by the csv module, when no field needs
+    quoting (numbers never do; the names and text cells are checked): csv.writer's
+    per-field quoting scan cost ~30 ms of a default run's history.csv (2 900 rows x 61
+    columns) for the same bytes. Otherwise, and for a single column (where csv writes an
+    empty field as ""), csv.writer writes the file."""
     codes = codes or {}
     names = list(columns)
-    cells = []
     plain = len(names) > 1 and not _NEEDS_QUOTES.search("".join(names))
+    if plain and _write_numbers(path, names, columns, codes):
+        return
+    cells = []
     for name in names:
         col, numeric = _cells(columns[name], codes.get(name))
         if plain and not numeric:
@@ -470,6 +476,51 @@ def write_csv(path: Path, columns: dict, codes: dict | None = None) -> None:
         # in pieces of 200 lines: the whole text is never held (peak RSS as with csv.writer)
         while chunk := list(itertools.islice(rows, 200)):
             fh.write("\n".join(map(",".join, chunk)) + "\n")
+
+
+# write_csv's Arrow route from these sizes on, in cells (rows x columns), where it saves
+# more than it costs: a cell costs ~0.35 us by the Python route, ~0.11 us by Arrow's (the
+# default scene's history.csv and waveforms.csv, CPU time); its first use in a process
+# costs ~8 ms (pyarrow._compute and pyarrow.csv imported, the layout checked, the kernels'
+# first calls), importing pyarrow ~40 ms more
+ARROW_MIN_CELLS = 2_000  # the route in use already
+ARROW_FIRST_MIN_CELLS = 30_000  # pyarrow loaded (waveforms.parquet is written first)
+ARROW_IMPORT_MIN_CELLS = 200_000  # pyarrow not loaded
+
+
+def _write_numbers(path: Path, names: list, columns: dict, codes: dict) -> bool:
+    """write_csv's Arrow route: writes the file and returns True where every column is a
+    1-D numpy array of floats or integers in the machine's byte order (codes: integers
+    within their names, which need no quoting), all of one length, the names and codes
+    ASCII (the bytes then do not depend on the locale's encoding), and the table is large
+    enough (the constants above)."""
+    arrays, labels = [columns[name] for name in names], []
+    if not all(isinstance(a, np.ndarray) and a.ndim == 1 and a.dtype.kind in "iuf" and a.dtype.isnative
+               for a in arrays):
+        return False
+    n = len(arrays[0])
+    if any(len(a) != n for a in arrays) or not "".join(names).isascii():
+        return False
+    from coupling.app import arrow_text
+
+    least = (ARROW_MIN_CELLS if arrow_text.ready() else
+             ARROW_FIRST_MIN_CELLS if "pyarrow" in sys.modules else ARROW_IMPORT_MIN_CELLS)
+    if n * len(arrays) < least:
+        return False
+    for name, a in zip(names, arrays):
+        label = codes.get(name)
+        if label is not None:
+            label = tuple(label)
+            if (a.dtype.kind == "f" or a.min() < 0 or a.max() >= len(label)
+                    or not all(type(x) is str and x.isascii() and not _NEEDS_QUOTES.search(x) for x in label)):
+                return False
+        labels.append(label)
+    if not arrow_text.available():
+        return False
+    with open(path, "wb") as fh:
+        fh.write((",".join(names) + "\n").encode())
+        arrow_text.write_rows(fh, arrays, labels)
+    return True
 
 
 # what makes csv.writer (QUOTE_MINIMAL, "," and '"', "\n" line ends) quote a field
@@ -522,9 +573,12 @@ def write_parquet(path: Path, columns: dict) -> None:
 
     Numeric columns become Arrow arrays over their own memory: ``pa.array`` on a numpy
     array imports pandas to ask whether it is a pandas object (0.17 s, more than the rest
-    of the file); NaN stays NaN (not null), as pa.array would keep it."""
+    of the file); NaN stays NaN (not null), as pa.array would keep it. The file is written
+    by the writer ``pyarrow.parquet.write_table`` uses, with its defaults, imported from
+    ``pyarrow._parquet``: importing ``pyarrow.parquet`` also imports pyarrow.fs and ssl
+    (~20 ms); the bytes are the same (tests/coupling/test_output_arrow.py). Where that
+    writer is not there or takes other arguments, ``pyarrow.parquet`` writes the file."""
     import pyarrow as pa
-    import pyarrow.parquet as pq
 
     def arrow(values):
         values = np.ascontiguousarray(values)
@@ -532,7 +586,26 @@ def write_parquet(path: Path, columns: dict) -> None:
             return pa.Array.from_buffers(pa.from_numpy_dtype(values.dtype), len(values), [None, pa.py_buffer(values)])
         return pa.array(values)  # booleans (bit-packed in Arrow), strings: pyarrow's own conversion
 
-    pq.write_table(pa.Table.from_arrays([arrow(v) for v in columns.values()], names=list(columns)), path)
+    table = pa.Table.from_arrays([arrow(v) for v in columns.values()], names=list(columns))
+    try:
+        from pyarrow._parquet import ParquetWriter
+
+        writer = ParquetWriter(str(path), table.schema, **PARQUET_DEFAULTS)
+    except (ImportError, TypeError):
+        import pyarrow.parquet as pq
+
+        pq.write_table(table, path)
+        return
+    try:
+        writer.write_table(table)
+    finally:
+        writer.close()
+
+
+# pyarrow.parquet.write_table's defaults for its writer (pyarrow 26; the test compares the bytes)
+PARQUET_DEFAULTS = {"version": "2.6", "compression": "snappy", "use_dictionary": True, "write_statistics": True,
+                    "writer_engine_version": "V2", "data_page_version": "1.0", "use_compliant_nested_type": True,
+                    "store_schema": True}
 
 
 def _write_text(path: Path, text: str) -> None:
