@@ -53,6 +53,14 @@ spread. The status is "converged" when no refinement moves a
 metric; "within sensitivity" when every metric a refinement moves, it moves no more than
 the input perturbations do (the numerical error is not what limits it); else "not
 converged".
+
+A circuit of several contacts (a changeover's NO and NC, a bridge's two breaks) is also
+judged contact by contact (``per_contact``: each contact's status and verdict line): the
+same reruns, the contact metrics (mismatch, contacts, bounces, makes) of the contact pairs
+that feed it alone, a perturbed run's sequence shifted onto that contact's own first make.
+An ill-conditioned tail of one contact (a changeover's NC bouncing back at release) then
+no longer sets the scale the other contact's refinements are judged against. The overall
+status still judges every contact pair together.
 """
 
 from __future__ import annotations
@@ -254,6 +262,19 @@ def metrics_of(result) -> dict:
             out["operate_time"] = relay.get("operate_time")
             out["release_time"] = relay.get("release_time")
     return out
+
+
+def contact_groups(result) -> dict:
+    """{circuit contact name: indices of the contact pairs that feed it} of a coupled result
+    whose circuit has several contacts (coupling.core.arrangement.contact_feeds); {} else."""
+    circuit = getattr(getattr(result.scene, "circuit", None), "circuit", None)
+    contacts = getattr(circuit, "contacts", ())
+    if len(contacts) < 2 or result.mechanics is None:
+        return {}
+    from coupling.core.arrangement import contact_feeds
+
+    return {c.name: tuple(int(i) for i in pairs) for c, pairs in zip(contacts, contact_feeds(result.scene.mech,
+                                                                                                 contacts))}
 
 
 def _settle_window(result) -> float:
@@ -481,13 +502,57 @@ def check(scene, base_result, *, run_fn=None, sensitivity: bool = True) -> dict:
         m.update(contact_metrics(tips, res.closed_at_end, _settle_window(res)))
         return dict(compare(base, m, base_tips, tips), shift=dt, closed=closed(tips))
 
+    groups = contact_groups(base_result)
+
+    def by_contact(res, align: bool) -> dict:
+        """Each contact's comparison, of the pairs that feed it alone; ``align``: its sequence
+        shifted onto its own first make in the base run (a perturbed input delays each
+        contact's sequence by its own travel)."""
+        tips, out = tip_intervals(res), {}
+        for name, pairs in groups.items():
+            mine = {i: tips.get(i, []) for i in pairs}
+            at_end, settle = res.contact_closed[name][1], _settle_window(res)
+            m = contact_metrics(mine, at_end, settle)
+            base_c = base_by_contact[name]
+            dt = 0.0
+            if align and base_c["first_make"] is not None and m["first_make"] is not None:
+                dt = base_c["first_make"] - m["first_make"]
+                mine = shifted(mine, dt)
+                m = contact_metrics(mine, at_end, settle)
+            out[name] = dict(compare(base_c, m, {i: base_tips.get(i, []) for i in pairs}, mine), shift=dt)
+        return out
+
+    base_by_contact = {name: contact_metrics({i: base_tips.get(i, []) for i in pairs},
+                                             base_result.contact_closed[name][1], _settle_window(base_result))
+                       for name, pairs in groups.items()}
+    if groups:
+        compare_refined, compare_aligned = refined, aligned
+
+        def refined(res):
+            out = compare_refined(res)
+            return dict(out, per_contact=by_contact(res, align=False))
+
+        def aligned(res):
+            out = compare_aligned(res)
+            return dict(out, per_contact=by_contact(res, align=True))
+
     entries = [_rerun(n, d, sc, run_fn, refined) for n, d, sc in refinements(scene, base_result)]
     sens = ([_rerun(n, d, sc, run_fn, aligned) for n, d, sc in perturbations(scene)] if sensitivity else [])
     status, line = verdict(entries, sens)
-    return dict(converged=status == "converged", status=status, verdict=line, closed=closed(base_tips),
-                tolerances=dict(TOLERANCES),
-                sensitivity_change=SENSITIVITY, refinements=entries, sensitivity=sens,
-                sensitivity_ranges={k: list(v) for k, v in sensitivity_ranges(sens).items()})
+    out = dict(converged=status == "converged", status=status, verdict=line, closed=closed(base_tips),
+               tolerances=dict(TOLERANCES),
+               sensitivity_change=SENSITIVITY, refinements=entries, sensitivity=sens,
+               sensitivity_ranges={k: list(v) for k, v in sensitivity_ranges(sens).items()})
+    if groups:
+        out["per_contact"] = {}
+        for name in groups:
+            own = [dict(e, **e["per_contact"][name]) if "per_contact" in e else e for e in entries]
+            own_sens = [dict(e, **e["per_contact"][name]) if "per_contact" in e else e for e in sens]
+            status_c, line_c = verdict(own, own_sens)
+            out["per_contact"][name] = dict(status=status_c, verdict=line_c,
+                                            sensitivity_ranges={k: list(v) for k, v in
+                                                                sensitivity_ranges(own_sens).items()})
+    return out
 
 
 def run_checked(scene, *, progress: bool = False):

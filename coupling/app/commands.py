@@ -186,6 +186,8 @@ def _result_lines(summary: dict) -> None:
         print(f"switchsim: warning: {line}")
     if "accuracy" in summary:  # --check
         print(f"switchsim: accuracy: {summary['accuracy']['verdict']}")
+        for name, own in summary["accuracy"].get("per_contact", {}).items():
+            print(f"switchsim: accuracy of contact {name}: {own['verdict']}")
     sys.stdout.flush()
 
 
