@@ -132,7 +132,8 @@ PHASES = textwrap.dedent("""
     steps = result.mechanics.stats["steps"] if result.mechanics is not None else 0
     print(json.dumps(dict(phases=phases, wall_time=stats.get("wall_time", 0.0),
                           mech=stats.get("mech_seconds"), circuit=stats.get("circuit_seconds"),
-                          parts=parts, steps=steps, wall0=wall0, wall1=time.time())), flush=True)
+                          parts=parts, steps=steps, macro_steps=stats.get("macro_steps", 0), wall0=wall0,
+                          wall1=time.time())), flush=True)
 """)
 
 
@@ -298,6 +299,7 @@ def main() -> None:
         compare_trees(args.baseline.resolve(), solenoid, tmp, args.repeat)
     mech_phases = phases(str(mech), str(tmp / "pm"))
     coupled_phases = phases("default", str(tmp / "pc"))
+    plunger_phases = phases(str(solenoid), str(tmp / "pp"))
     try:
         load = os.getloadavg()[0]
     except OSError:
@@ -323,23 +325,22 @@ def main() -> None:
               f"- Scaled to this run's `import numpy` ({base:.3f} s): mechanics-only {mech_run / base:.1f}x, "
               f"default {coupled_run / base:.1f}x.",
               "", "Where the time goes (one fresh interpreter timing its own phases):", "",
-              "| phase | mechanics-only | default (coil relay) |", "|---|---|---|"]
-    names = [n for n, _ in coupled_phases["phases"]]
-    mp = dict(mech_phases["phases"])
-    cp = dict(coupled_phases["phases"])
-    for name in names:
-        m = f"{mp[name]:.3f} s" if name in mp else "-"
-        lines.append(f"| {name} | {m} | {cp[name]:.3f} s |")
-    lines.append(f"| (of the run: its own wall_time) | {mech_phases['wall_time']:.3f} s | "
-                 f"{coupled_phases['wall_time']:.3f} s |")
-    lines.append(f"| (of that: mechanics / circuit, coupled) | - | {coupled_phases['mech'] or 0:.3f} s / "
-                 f"{coupled_phases['circuit'] or 0:.3f} s |")
-    mparts, cparts = mech_phases["parts"], coupled_phases["parts"]
-    for name in cparts:
-        m = f"{mparts[name]:.3f} s" if name in mparts else "-"
-        lines.append(f"| (inside: {name}) | {m} | {cparts[name]:.3f} s |")
-    lines.append(f"| (mechanics steps) | {mech_phases['steps']} | {coupled_phases['steps']} |")
-    lines.append(f"| whole process, this measurement | {mech_phases['whole']:.3f} s | {coupled_phases['whole']:.3f} s |")
+              "| phase | mechanics-only | default (coil relay) | plunger solenoid |", "|---|---|---|---|"]
+    runs = (mech_phases, coupled_phases, plunger_phases)
+
+    def cells(values) -> str:
+        return " | ".join("-" if v is None else (f"{v:.3f} s" if isinstance(v, float) else str(v)) for v in values)
+
+    for name in [n for n, _ in coupled_phases["phases"]]:
+        lines.append(f"| {name} | {cells(dict(r['phases']).get(name) for r in runs)} |")
+    lines.append(f"| (of the run: its own wall_time) | {cells(r['wall_time'] for r in runs)} |")
+    lines.append("| (of that: mechanics / circuit, coupled) | - | " + " | ".join(
+        f"{r['mech'] or 0:.3f} s / {r['circuit'] or 0:.3f} s" for r in runs[1:]) + " |")
+    for name in coupled_phases["parts"]:
+        lines.append(f"| (inside: {name}) | {cells(r['parts'].get(name) for r in runs)} |")
+    lines.append(f"| (mechanics steps) | {cells(r['steps'] for r in runs)} |")
+    lines.append(f"| (macro steps of the co-simulation) | - | {cells(r['macro_steps'] for r in runs[1:])} |")
+    lines.append(f"| whole process, this measurement | {cells(r['whole'] for r in runs)} |")
     lines += step_limit()
     block = "\n".join(lines)
     print("\n" + block)
