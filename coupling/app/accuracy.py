@@ -166,6 +166,18 @@ def shifted(tips: dict, dt: float) -> dict:
     return {k: [(a + dt, b + dt) for a, b in v] for k, v in tips.items()}
 
 
+def aligned_on_first_make(base_first_make, metrics: dict, tips: dict, closed_at_end: bool,
+                          settle_window: float) -> tuple[float, dict, dict]:
+    """(dt in s, the tips shifted by dt, ``metrics`` with the contact metrics of the shifted
+    tips): a perturbed run's contact sequence moved onto the base run's first make (s; none
+    in either run: not moved)."""
+    if base_first_make is None or metrics["first_make"] is None:
+        return 0.0, tips, metrics
+    dt = base_first_make - metrics["first_make"]
+    tips = shifted(tips, dt)
+    return dt, tips, dict(metrics, **contact_metrics(tips, closed_at_end, settle_window))
+
+
 def compare(base: dict, refined: dict, base_tips: dict, refined_tips: dict, tol: dict = TOLERANCES) -> dict:
     """Per metric {base, refined, change, within} and the mismatch time, for two runs'
     metric dicts (see ``metrics_of``) and per-tip intervals; ``moved`` lists the metrics
@@ -490,51 +502,40 @@ def check(scene, base_result, *, run_fn=None, sensitivity: bool = True) -> dict:
     def closed(tips):  # the contact's closed intervals (both tips), for the plot
         return [[a, b] for a, b in merge_intervals(iv for v in tips.values() for iv in v)]
 
-    def refined(res):
-        tips = tip_intervals(res)
-        return dict(compare(base, metrics_of(res), base_tips, tips), closed=closed(tips))
-
-    def aligned(res):  # the perturbed sequence moved onto the base run's first make
-        m = metrics_of(res)
-        dt = (base["first_make"] - m["first_make"]) if (base["first_make"] is not None
-                                                         and m["first_make"] is not None) else 0.0
-        tips = shifted(tip_intervals(res), dt)
-        m.update(contact_metrics(tips, res.closed_at_end, _settle_window(res)))
-        return dict(compare(base, m, base_tips, tips), shift=dt, closed=closed(tips))
-
     groups = contact_groups(base_result)
+    base_by_contact = {name: contact_metrics({i: base_tips.get(i, []) for i in pairs},
+                                             base_result.contact_closed[name][1], _settle_window(base_result))
+                       for name, pairs in groups.items()}
 
-    def by_contact(res, align: bool) -> dict:
-        """Each contact's comparison, of the pairs that feed it alone; ``align``: its sequence
-        shifted onto its own first make in the base run (a perturbed input delays each
-        contact's sequence by its own travel)."""
-        tips, out = tip_intervals(res), {}
+    def by_contact(res, tips, align: bool) -> dict:
+        """{"per_contact": each contact's comparison, of the pairs that feed it alone} ({} for
+        one contact); ``align``: its sequence shifted onto its own first make in the base run
+        (a perturbed input delays each contact's sequence by its own travel)."""
+        if not groups:
+            return {}
+        out = {}
         for name, pairs in groups.items():
             mine = {i: tips.get(i, []) for i in pairs}
             at_end, settle = res.contact_closed[name][1], _settle_window(res)
             m = contact_metrics(mine, at_end, settle)
-            base_c = base_by_contact[name]
             dt = 0.0
-            if align and base_c["first_make"] is not None and m["first_make"] is not None:
-                dt = base_c["first_make"] - m["first_make"]
-                mine = shifted(mine, dt)
-                m = contact_metrics(mine, at_end, settle)
-            out[name] = dict(compare(base_c, m, {i: base_tips.get(i, []) for i in pairs}, mine), shift=dt)
-        return out
+            if align:
+                dt, mine, m = aligned_on_first_make(base_by_contact[name]["first_make"], m, mine, at_end, settle)
+            out[name] = dict(compare(base_by_contact[name], m, {i: base_tips.get(i, []) for i in pairs}, mine),
+                             shift=dt)
+        return {"per_contact": out}
 
-    base_by_contact = {name: contact_metrics({i: base_tips.get(i, []) for i in pairs},
-                                             base_result.contact_closed[name][1], _settle_window(base_result))
-                       for name, pairs in groups.items()}
-    if groups:
-        compare_refined, compare_aligned = refined, aligned
+    def refined(res):
+        tips = tip_intervals(res)
+        return dict(compare(base, metrics_of(res), base_tips, tips), closed=closed(tips),
+                    **by_contact(res, tips, align=False))
 
-        def refined(res):
-            out = compare_refined(res)
-            return dict(out, per_contact=by_contact(res, align=False))
-
-        def aligned(res):
-            out = compare_aligned(res)
-            return dict(out, per_contact=by_contact(res, align=True))
+    def aligned(res):  # the perturbed sequence moved onto the base run's first make
+        tips = tip_intervals(res)
+        dt, moved, m = aligned_on_first_make(base["first_make"], metrics_of(res), tips, res.closed_at_end,
+                                             _settle_window(res))
+        return dict(compare(base, m, base_tips, moved), shift=dt, closed=closed(moved),
+                    **by_contact(res, tips, align=True))
 
     entries = [_rerun(n, d, sc, run_fn, refined) for n, d, sc in refinements(scene, base_result)]
     sens = ([_rerun(n, d, sc, run_fn, aligned) for n, d, sc in perturbations(scene)] if sensitivity else [])
@@ -546,8 +547,9 @@ def check(scene, base_result, *, run_fn=None, sensitivity: bool = True) -> dict:
     if groups:
         out["per_contact"] = {}
         for name in groups:
-            own = [dict(e, **e["per_contact"][name]) if "per_contact" in e else e for e in entries]
-            own_sens = [dict(e, **e["per_contact"][name]) if "per_contact" in e else e for e in sens]
+            # each rerun's entry as that contact alone sees it (a rerun that did not run has none)
+            own, own_sens = ([dict(e, **e["per_contact"][name]) if "per_contact" in e else e for e in runs]
+                             for runs in (entries, sens))
             status_c, line_c = verdict(own, own_sens)
             out["per_contact"][name] = dict(status=status_c, verdict=line_c,
                                             sensitivity_ranges={k: list(v) for k, v in
