@@ -331,11 +331,11 @@ class CoilLink:
     def inputs(self, seg) -> dict:
         """The coil's gap channel over the segment, from the armature's dense output."""
         lo, hi = seg.t_start, seg.t_end
-        rest, lever, armature = self.rest_gap, self.lever, seg.armature
+        working_gap, armature = self.gap, seg.armature  # (bound once: called per trial time)
 
         def gap(s: float) -> float:
             s = lo if s < lo else (hi if s > hi else s)
-            return max(rest - lever * armature(s)[0], 0.0)  # (self.gap, inlined: called per trial time)
+            return max(working_gap(armature(s)[0]), 0.0)
 
         return {f"{self.label}.gap": gap}
 
