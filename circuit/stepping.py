@@ -133,6 +133,9 @@ class Stepper:
         self._last_names = tuple(dict.fromkeys(n.lower() for n in names if n and n.lower() not in ("0", "gnd")))
         self._scalar_plan = self._plan_scalars()
         self._columns = self.probes.column_names  # (a property that builds its tuple: once, not per step)
+        # the columns that are one ngspice vector as it stands, by its (lower-case) name
+        self._direct = {column: name.lower() for column in self._columns
+                        if (name := self.probes.vector_of(column)) is not None}
         session = get_session()
         with session.exclusive():
             session.claim(self)
@@ -306,7 +309,7 @@ class Stepper:
         # ask (the exchange reads time three times a macro step); each call returns its own copy
         vectors: dict[str, np.ndarray] = {}
         columns: dict[str, np.ndarray] = {}
-        probes = self.probes
+        probes, direct = self.probes, self._direct
 
         def vector(name: str) -> np.ndarray:
             values = vectors.get(name)
@@ -320,7 +323,9 @@ class Stepper:
             self._active()
             values = columns.get(column)
             if values is None:
-                values = columns[column] = probes.columns(vector, (column,))[column]
+                name = direct.get(column)
+                values = columns[column] = (vector(name) if name is not None
+                                            else probes.columns(vector, (column,))[column])
             return values.copy()
 
         return read
