@@ -31,6 +31,9 @@ CONTACT_EVENTS = ("contact_start", "contact_end")
 # coil's rated current: changes far below the rated force do not shorten the steps (the
 # coil's ringing after an unsuppressed release, at a thousandth of its rated flux)
 FLUX_FLOOR = 1.0
+# the coil's time scale is at most the time the working gap takes to change by this fraction
+# of itself while the armature moves (CoilLink.observe)
+GAP_CHANGE_FRACTION = 1.0
 
 
 def conduction_onset(penetration: float, onset: float) -> float:
@@ -371,7 +374,7 @@ class CoilLink:
             # equation holds the gap, and its force 1/g^2, while the armature flies (the flux
             # itself changes little then: at 240 us steps the default relay's coil audit left
             # 3e-3 of its energy to ngspice's coarse points)
-            self.scale = min(self.scale, max(self.gap(float(q)), 0.0) / closing)
+            self.scale = min(self.scale, GAP_CHANGE_FRACTION * max(self.gap(float(q)), 0.0) / closing)
         new = times[1:] if self._sampled else times
         self._sampled = True
         lo, hi = seg.t_start, seg.t_end
