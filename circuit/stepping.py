@@ -306,7 +306,7 @@ class Stepper:
 
     def _reader(self, start: int, stop: int) -> Callable[[str], np.ndarray]:
         # the step's vectors, each read from ngspice once however many columns and callers
-        # ask (the exchange reads time three times a macro step); each call returns its own copy
+        # ask (a coupled step's callers read time three times); each call returns its own copy
         vectors: dict[str, np.ndarray] = {}
         columns: dict[str, np.ndarray] = {}
         probes, direct = self.probes, self._direct

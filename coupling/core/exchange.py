@@ -88,7 +88,8 @@ class Tail:
     def observe(self, t: np.ndarray, v: np.ndarray, jumped: bool) -> None:
         times = (self.t + t.tolist())[-TAIL_POINTS:]
         values = (self.v + v.tolist())[-TAIL_POINTS:]
-        # a point no later than the one before it (ngspice's landing repeats a time) is dropped
+        # a point no later than the one before it is dropped (a step's first point is the
+        # previous step's last)
         keep = [k for k in range(1, len(times)) if times[k] - times[k - 1] > 0.0]
         if len(keep) < len(times) - 1:
             times = [times[0]] + [times[k] for k in keep]
