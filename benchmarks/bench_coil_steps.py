@@ -35,7 +35,7 @@ PLUNGER = ROOT / "examples" / "plunger_solenoid.toml"
 REFINE = 4.0  # the reference: every step rule at 1 / REFINE ...
 RELTOL_REFINE = 10.0  # ... and ngspice RELTOL / RELTOL_REFINE
 # (label, COIL_TIME_SCALE_FRACTION, GAP_CHANGE_FRACTION, max_macro_step factor, ngspice's
-# largest step in s or None: its own choice)
+# largest step in s, None: its own choice, or "reltol": RELTOL / RELTOL_REFINE)
 VARIANTS = (
     ("current rules", 0.1, 1.0, 1.0, None),
     ("fraction 0.05", 0.05, 1.0, 1.0, None),
@@ -46,6 +46,7 @@ VARIANTS = (
     ("gap rule x2", 0.1, 2.0, 1.0, None),
     ("gap rule x4", 0.1, 4.0, 1.0, None),
     ("max_macro_step x2", 0.1, 1.0, 2.0, None),
+    ("RELTOL / 10", 0.1, 1.0, 1.0, "reltol"),
     ("ngspice max step 5 us", 0.1, 1.0, 1.0, 5e-6),
     ("fraction 0.3, ngspice max step 5 us", 0.3, 1.0, 1.0, 5e-6),
 )
@@ -83,6 +84,36 @@ def run(scene, fraction: float, gap: float, repeat: int = 1) -> dict:
                 residual=relay["energy"]["relative_residual"], steps=result.stats["macro_steps"],
                 points=result.stats["circuit"]["points"],
                 wall=statistics.median(walls))
+
+
+def binding_rules(scene) -> list[tuple[float, float, str]]:
+    """(step start s, step length s, the rule that set the coil's time scale after it:
+    "curvature", "size" or "gap") of each macro step of a run of ``scene``, by watching
+    CoilLink.observe (the three candidate scales recomputed as it computes them)."""
+    import math
+
+    from coupling.core import exchange, master
+    from coupling.core.policy import end_rate
+
+    log = []
+    observe = exchange.CoilLink.observe
+
+    def watched(self, step, seg, span):
+        observe(self, step, seg, span)
+        curvature = end_rate(self.tail.t, self.tail.v, span)[1]
+        size = (abs(self.value) + self.floor) / abs(self.rate) if self.rate else math.inf
+        q, q_dot = seg.armature(seg.t_end)[:2]
+        closing = self.lever * abs(float(q_dot))
+        gap = exchange.GAP_CHANGE_FRACTION * max(self.gap(float(q)), 0.0) / closing if closing > 0 else math.inf
+        log.append((seg.t_start, seg.t_end - seg.t_start, min((curvature, "curvature"), (size, "size"),
+                                                               (gap, "gap"))[1]))
+
+    exchange.CoilLink.observe = watched
+    try:
+        master.run(scene)
+    finally:
+        exchange.CoilLink.observe = observe
+    return log
 
 
 def difference(m: dict, ref: dict) -> dict:
@@ -130,10 +161,23 @@ def main() -> None:
              "| rules | macro steps | ngspice points | run time | arrival at the pole | coil current at 50 ms "
              "| bounces at the pole | energy residual |",
              "|---|---|---|---|---|---|---|---|"]
+    log = binding_rules(base)
+    early = [h for t, h, _ in log if t < ref["arrival"]]
+    late = [(h, rule) for t, h, rule in log if t >= ref["arrival"]]
+    share = {rule: sum(r == rule for _, r in late) / len(late) for rule in ("curvature", "gap", "size")}
+    lines[1:1] = ["", f"The current rules' steps: {len(early)} before the arrival at the pole (median "
+                      f"{statistics.median(early) * 1e6:.0f} us), {len(late)} after (median "
+                      f"{statistics.median(h for h, _ in late) * 1e6:.0f} us, the coil's time scale set by "
+                      f"the curvature rule after {share['curvature']:.0%} of them, the gap rule "
+                      f"{share['gap']:.0%}, the change-by-its-size rule {share['size']:.0%})."]
     rows, scenes = {}, {}
     for label, fraction, gap, free, max_step in VARIANTS:
         scene = base if free == 1.0 else base.set("coupling.max_macro_step", opts.max_macro_step * free)
-        scenes[label] = (scene if max_step is None else with_options(scene, max_step=max_step), fraction, gap)
+        if max_step == "reltol":
+            scene = with_options(scene, reltol=base.circuit.options.reltol / RELTOL_REFINE)
+        elif max_step is not None:
+            scene = with_options(scene, max_step=max_step)
+        scenes[label] = (scene, fraction, gap)
         rows[label] = run(*scenes[label])
     # the run times: the rows interleaved, repeat times, so that the shared machine's load
     # falls on every row alike
