@@ -154,7 +154,8 @@ def test_a_steps_values_are_its_last_points_and_each_read_is_its_own_copy():
         times = step.reader("time")
         times[:] = -1.0
         assert step.reader("time")[0] == frame.time.iloc[0] > 0.0
+    # at ten time constants e^-10 = 4.5e-5 of the rise is left (and RELTOL 1e-6 on top)
     i = step.values["coil_current"]
-    assert i == pytest.approx(V / (R_COIL + 1e-3), rel=1e-3)
-    assert step.values["coil_voltage"] == pytest.approx(R_COIL * i, rel=1e-3)
-    assert step.values["coil_flux_linkage"] == pytest.approx(inductance * i, rel=1e-6)
+    assert i == pytest.approx(V / (R_COIL + 1e-3), rel=1e-4)
+    assert step.values["coil_voltage"] == pytest.approx(R_COIL * i, rel=1e-4)
+    assert step.values["coil_flux_linkage"] == pytest.approx(inductance * i, rel=1e-6)  # the law, to RELTOL
