@@ -229,11 +229,11 @@ class NgspiceSession(NgSpiceShared):
             raise NgspiceError(f"ngSpice_Init_Sync returned {rc}")
         self.library = library_path
 
-    # -- PySpice callback overrides (static: PySpice registers them through a handle) --
+    # -- PySpice callback overrides (static but _send_char: PySpice registers them through a handle) --
 
-    @staticmethod
-    def _send_char(message_c, ngspice_id, user_data):
-        self = ffi.from_handle(user_data)
+    def _send_char(self, message_c, ngspice_id, user_data):
+        # A method, not static as PySpice's: PySpice makes its callback of self._send_char,
+        # so the instance comes bound instead of through the handle (4 lines a macro step).
         # Lines arrive as "stdout ..." / "stderr ..."; kept whole, parsed only on failure.
         message = ffi.string(message_c).decode("utf-8", "replace").rstrip()
         self._lines.append(message)
@@ -551,10 +551,14 @@ class NgspiceSession(NgSpiceShared):
 
     # -- results --
 
+    def _encode(self, name: str) -> bytes:
+        encoded = self._encoded[name] = name.encode("ascii")
+        return encoded
+
     def vector_info(self, name: str):
         encoded = self._encoded.get(name)
         if encoded is None:
-            encoded = self._encoded[name] = name.encode("ascii")
+            encoded = self._encode(name)
         info = self._ngspice_shared.ngGet_Vec_Info(encoded)
         return None if info == ffi.NULL else info
 
@@ -562,9 +566,11 @@ class NgspiceSession(NgSpiceShared):
         """Number of points and the last value of each named vector (one look-up each)."""
         values = []
         length = 0
+        encoded, look_up = self._encoded, self._ngspice_shared.ngGet_Vec_Info
         for name in names:
-            info = self.vector_info(name)
-            if info is None or info.v_length == 0:
+            key = encoded.get(name)
+            info = look_up(key if key is not None else self._encode(name))
+            if info == ffi.NULL or info.v_length == 0:
                 raise KeyError(f"ngspice has no data for {name!r}")
             length = info.v_length
             data = info.v_realdata

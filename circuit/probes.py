@@ -88,8 +88,9 @@ class Probes:
         time = vec("time")
         out: dict[str, np.ndarray] = {}
         for name in (self.column_names if names is None else names):
-            if name == "time":
-                out[name] = time
+            vector = self.vector_of(name)
+            if vector is not None:
+                out[name] = vec(vector)
             elif name == "load_current":
                 out[name] = vec(self.load_current) if self.load_current else np.full_like(time, np.nan)
             elif name.startswith("coil_"):
@@ -98,6 +99,28 @@ class Probes:
                 c, base = self.contact(name)
                 out[name] = self._contact_column(c, base, vec, time)
         return out
+
+    def vector_of(self, column: str) -> str | None:
+        """The ngspice vector that is the result column ``column`` as it stands (time, a
+        current, a conductance, a flux linkage); None for a column computed from vectors or
+        constant (a voltage, a resistance, a missing load probe or arc)."""
+        if column == "time":
+            return "time"
+        if column == "load_current":
+            return self.load_current or None
+        for c in self.contacts:
+            if column == "contact_current" + c.suffix:
+                return c.current_vector or None
+            if column == "contact_conductance" + c.suffix:
+                return c.conductance_node or None
+            if column == "arc_current" + c.suffix:
+                return c.arc_current_vector or None
+        for c in self.coils:
+            if column == "coil_current" + c.suffix:
+                return c.current_vector or None
+            if column == "coil_flux_linkage" + c.suffix:
+                return c.flux_node or None
+        return None
 
     def _contact_column(self, c: ContactBlock, base: str, vec, time: np.ndarray) -> np.ndarray:
         if base == "contact_voltage":

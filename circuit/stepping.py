@@ -41,6 +41,8 @@ from .ngspice import NgspiceSession, get_session
 from .options import SimulationOptions
 from .probes import COLUMNS, probe_columns
 
+_FIXED = -2  # (a scalar of _plan_scalars read from no vector)
+
 #: The gap distance d(t) >= 0 (m) as a function of time (s).
 Gap = Callable[[float], float]
 
@@ -129,6 +131,11 @@ class Stepper:
         for c in self.probes.coils:
             names += [c.current_vector, c.node_p, c.node_n, c.flux_node]
         self._last_names = tuple(dict.fromkeys(n.lower() for n in names if n and n.lower() not in ("0", "gnd")))
+        self._scalar_plan = self._plan_scalars()
+        self._columns = self.probes.column_names  # (a property that builds its tuple: once, not per step)
+        # the columns that are one ngspice vector as it stands, by its (lower-case) name
+        self._direct = {column: name.lower() for column in self._columns
+                        if (name := self.probes.vector_of(column)) is not None}
         session = get_session()
         with session.exclusive():
             session.claim(self)
@@ -228,12 +235,16 @@ class Stepper:
             points=last_index - first_index - 1,
             reader=self._reader(first_index, last_index),
             values=scalars,
-            columns=self.probes.column_names,
+            columns=self._columns,
         )
 
     def _input_functions(self, conductance, gap, inputs) -> dict[str, Conductance]:
         """Every input channel's source -> its function of time, checked (ValueError/TypeError
         naming the channel before anything runs)."""
+        channels = self.inputs
+        if (conductance is None and gap is None and inputs is not None and len(inputs) == len(channels)
+                and all(name in channels for name in inputs)):  # every channel given by name: nothing to add
+            return {channels[name]: _as_function(value, *_what(name)) for name, value in inputs.items()}
         given = dict(inputs or {})
         if conductance is not None or gap is not None:
             if len(self.probes.contacts) != 1:
@@ -263,30 +274,59 @@ class Stepper:
 
     def _read_last(self, session: NgspiceSession) -> tuple[int, float, dict[str, float]]:
         """Points so far, the last time (s) and the last contact/load values (V, A)."""
-        length, values = session.last_values(self._last_names)
-        last = dict(zip(self._last_names, values))
+        length, last = session.last_values(self._last_names)
+        # (the plan of _plan_scalars: the dict's keys built once, not per macro step)
+        scalars = {key: fixed if a == _FIXED else (last[a] if a >= 0 else 0.0) - (last[b] if b >= 0 else 0.0)
+                   for key, a, b, fixed in self._scalar_plan}
+        return length, last[0], scalars
 
-        def node(name: str) -> float:
-            return 0.0 if name.lower() in ("0", "gnd") else last[name.lower()]
+    def _plan_scalars(self) -> tuple[tuple[str, int, int, float], ...]:
+        """Each scalar of a step (``StepResult.values``) as (key, a, b, fixed): the value
+        ``fixed`` where a is _FIXED, else the last value of ``_last_names[a]`` minus that of
+        ``_last_names[b]``, an index -1 standing for ground (0 V)."""
+        index = {name: k for k, name in enumerate(self._last_names)}
+
+        def node(name: str) -> int:
+            return -1 if name.lower() in ("0", "gnd") else index[name.lower()]
+
+        def vector(key: str, name: str | None, otherwise: float) -> tuple[str, int, int, float]:
+            return (key, index[name.lower()], -1, 0.0) if name else (key, _FIXED, -1, otherwise)
 
         p = self.probes
-        scalars = {"load_current": last[p.load_current.lower()] if p.load_current else math.nan}
+        plan = [vector("load_current", p.load_current, math.nan)]
         for c in p.contacts:
-            scalars["contact_voltage" + c.suffix] = node(c.node_a) - node(c.node_b)
-            scalars["contact_current" + c.suffix] = last[c.current_vector.lower()]
-            scalars["arc_current" + c.suffix] = last[c.arc_current_vector.lower()] if c.arc_current_vector else 0.0
+            plan.append(("contact_voltage" + c.suffix, node(c.node_a), node(c.node_b), 0.0))
+            plan.append(vector("contact_current" + c.suffix, c.current_vector, math.nan))
+            plan.append(vector("arc_current" + c.suffix, c.arc_current_vector, 0.0))
         for c in p.coils:
-            scalars["coil_current" + c.suffix] = last[c.current_vector.lower()]
-            scalars["coil_voltage" + c.suffix] = node(c.node_p) - node(c.node_n)
-            scalars["coil_flux_linkage" + c.suffix] = last[c.flux_node.lower()]
-        return length, last["time"], scalars
+            plan.append(vector("coil_current" + c.suffix, c.current_vector, math.nan))
+            plan.append(("coil_voltage" + c.suffix, node(c.node_p), node(c.node_n), 0.0))
+            plan.append(vector("coil_flux_linkage" + c.suffix, c.flux_node, math.nan))
+        return tuple(plan)
 
     def _reader(self, start: int, stop: int) -> Callable[[str], np.ndarray]:
+        # the step's vectors, each read from ngspice once however many columns and callers
+        # ask (a coupled step's callers read time three times); each call returns its own copy
+        vectors: dict[str, np.ndarray] = {}
+        columns: dict[str, np.ndarray] = {}
+        probes, direct = self.probes, self._direct
+
+        def vector(name: str) -> np.ndarray:
+            values = vectors.get(name)
+            if values is None:
+                values = vectors[name] = self._active().vector(name, start, stop)
+            return values
+
         def read(column: str) -> np.ndarray:
             if self._final is not None:
                 return self._final[column][start:stop].copy()
-            session = self._active()
-            return self.probes.columns(lambda name: session.vector(name, start, stop), (column,))[column]
+            self._active()
+            values = columns.get(column)
+            if values is None:
+                name = direct.get(column)
+                values = columns[column] = (vector(name) if name is not None
+                                            else probes.columns(vector, (column,))[column])
+            return values.copy()
 
         return read
 

@@ -20,6 +20,7 @@ contact pair of its fixed contact (coupling.core.arrangement).
 from __future__ import annotations
 
 import math
+from bisect import bisect_right
 
 import numpy as np
 
@@ -30,6 +31,9 @@ CONTACT_EVENTS = ("contact_start", "contact_end")
 # coil's rated current: changes far below the rated force do not shorten the steps (the
 # coil's ringing after an unsuppressed release, at a thousandth of its rated flux)
 FLUX_FLOOR = 1.0
+# the coil's time scale is at most the time the working gap takes to change by this fraction
+# of itself while the armature moves (CoilLink.observe)
+GAP_CHANGE_FRACTION = 1.0
 
 
 def conduction_onset(penetration: float, onset: float) -> float:
@@ -72,19 +76,27 @@ def contact_intervals(seg, touching_at_start) -> list[list[tuple[float, float]]]
 
 class Tail:
     """The last points of a circuit signal, kept across macro steps for its rate and time
-    scale (``end_rate``); points before a jump say nothing of the signal after it."""
+    scale (``end_rate``); points before a jump say nothing of the signal after it.
+
+    Kept as lists of floats: a macro step adds one to three points, and numpy's per-call
+    overhead on arrays of eight cost more than the arithmetic (the same double arithmetic)."""
 
     def __init__(self):
-        self.t = np.zeros(0)
-        self.v = np.zeros(0)
+        self.t: list[float] = []
+        self.v: list[float] = []
 
     def observe(self, t: np.ndarray, v: np.ndarray, jumped: bool) -> None:
-        self.t = np.concatenate([self.t, t])[-TAIL_POINTS:]
-        self.v = np.concatenate([self.v, v])[-TAIL_POINTS:]
-        keep = np.concatenate([[True], np.diff(self.t) > 0])
-        self.t, self.v = self.t[keep], self.v[keep]
+        times = (self.t + t.tolist())[-TAIL_POINTS:]
+        values = (self.v + v.tolist())[-TAIL_POINTS:]
+        # a point no later than the one before it is dropped (a step's first point is the
+        # previous step's last)
+        keep = [k for k in range(1, len(times)) if times[k] - times[k - 1] > 0.0]
+        if len(keep) < len(times) - 1:
+            times = [times[0]] + [times[k] for k in keep]
+            values = [values[0]] + [values[k] for k in keep]
         if jumped:
-            self.t, self.v = self.t[-1:], self.v[-1:]
+            times, values = times[-1:], values[-1:]
+        self.t, self.v = times, values
 
     def rate(self, span: float) -> tuple[float, float]:
         """(d/dt in units per s, time scale in s) at the last point (``end_rate``)."""
@@ -284,16 +296,17 @@ class CoilLink:
         # the watched signal (``signal``: psi^2 or psi) at the last step's end, its rate (per s),
         # time scale (s) and the slope the step rules chose to extrapolate it with
         self.value, self.rate, self.scale, self.slope = 0.0, 0.0, math.inf, 0.0
-        self.q_times: list[np.ndarray] = []  # the circuit's points ...
-        self.q: list[np.ndarray] = []  # ... and the armature's travel there (m or rad)
+        self._flux_column = "coil_flux_linkage" + label[len("coil"):]
+        self.q_times: list[float] = []  # the circuit's points (s) ...
+        self.q: list[float] = []  # ... and the armature's travel there (m or rad)
         self._sampled = False
 
     def next_switch(self, t: float) -> float:
         """s: the coil drive's next switching instant after t (its driver's PWL vertices: on,
         off and their edges), inf without one. The coil's voltage jumps there, which the
         flux linkage's extrapolation cannot see: a macro step ends at each."""
-        later = [s for s in self.switch_times if s > t * (1.0 + 1e-12) + 1e-15]
-        return min(later) if later else math.inf
+        k = bisect_right(self.switch_times, t * (1.0 + 1e-12) + 1e-15)  # (the first later one: they are sorted)
+        return self.switch_times[k] if k < len(self.switch_times) else math.inf
 
     def gap(self, q: float) -> float:
         """m: the working air gap at the armature's position q."""
@@ -341,14 +354,14 @@ class CoilLink:
 
     def flux(self, step) -> float:
         """Wb: the coil's flux linkage at the step's end."""
-        return float(step.values["coil_flux_linkage" + self.label[len("coil"):]])
+        return float(step.values[self._flux_column])
 
     def observe(self, step, seg, span: float) -> None:
         """After a step: the flux linkage at its end, its rate and time scale from the circuit's
         last points (differences over at least 1e-3 of ``span``, s), and the armature's travel
         at the step's circuit points (for the result's columns)."""
         times = step.reader("time")
-        self.tail.observe(times, self.signal(step.reader("coil_flux_linkage" + self.label[len("coil"):])), False)
+        self.tail.observe(times, self.signal(step.reader(self._flux_column)), False)
         self.value = self.signal(self.flux(step))
         self.rate, self.scale = self.tail.rate(span)
         if self.rate != 0.0:
@@ -362,12 +375,14 @@ class CoilLink:
             # equation holds the gap, and its force 1/g^2, while the armature flies (the flux
             # itself changes little then: at 240 us steps the default relay's coil audit left
             # 3e-3 of its energy to ngspice's coarse points)
-            self.scale = min(self.scale, max(self.gap(float(q)), 0.0) / closing)
+            self.scale = min(self.scale, GAP_CHANGE_FRACTION * max(self.gap(float(q)), 0.0) / closing)
         new = times[1:] if self._sampled else times
         self._sampled = True
         lo, hi = seg.t_start, seg.t_end
-        self.q_times.append(new)
-        self.q.append(np.array([seg.armature(min(max(s, lo), hi))[0] for s in new]))
+        armature = seg.armature
+        for s in new.tolist():  # (a point or two a step: kept as floats, joined into arrays at the end)
+            self.q_times.append(s)
+            self.q.append(armature(lo if s < lo else (hi if s > hi else s))[0])
 
     def columns(self, waves: dict) -> dict:
         """The result's coil columns beside the circuit's (coil_current, coil_voltage,
@@ -383,4 +398,4 @@ class CoilLink:
         """m or rad: the armature's travel at ``times`` (s), from its samples at the circuit's points."""
         if not self.q_times:
             return np.zeros(len(times))
-        return np.interp(times, np.concatenate(self.q_times), np.concatenate(self.q))
+        return np.interp(times, np.array(self.q_times), np.array(self.q))

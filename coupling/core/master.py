@@ -182,6 +182,10 @@ class CoSimulation:
         worker process) can run many times with the same results."""
         self.progress = Progress(self.scene.t_end, self.progress_enabled)
         self.links = self._links()
+        # the links' roles, read at every macro step
+        self._contact_links = [link for link in self.links if isinstance(link, ContactLink)]
+        self._coil_link = next((link for link in self.links if isinstance(link, CoilLink)), None)
+        self._makes = self.scene.mech.bar is not None  # (contact points that can make and break)
         self.stats = dict(macro_steps=0, aligned_steps=0, contact_steps=0, mech_seconds=0.0,
                           circuit_seconds=0.0)
         self._contact_times: list[np.ndarray] = []  # the circuit's points sampled so far ...
@@ -221,7 +225,7 @@ class CoSimulation:
                 pass
             raise CoupledRunError(f"coupled run failed at t = 0.0 s: {type(err).__name__}: {err}", partial) from err
         self.mech, self.stepper = mech, stepper
-        contact, coil = self.contact, self.coil
+        contact, coil = self.contact, self._coil_link
         t = 0.0
         i_now = 0.0
         # a contact closed at t = 0 (a resting start): the circuit's operating point carries
@@ -258,8 +262,9 @@ class CoSimulation:
                             t_coil, coil.slope = self.coil_policy.plan(t, t_next, t_end, touching=True,
                                                                        jumped=switched, current=coil.value,
                                                                        rate=coil.rate, scale=coil.scale)
-                            t_next = min(t_next, t_coil, coil.next_switch(t))
-                            coil_switched = t_next == coil.next_switch(t)
+                            switch = coil.next_switch(t)
+                            t_next = min(t_next, t_coil, switch)
+                            coil_switched = t_next == switch
                         t_new, current, jumped, (rate, scale) = self._mechanics_first_step(
                             mech, stepper, t, t_next, i_now, slope, scale)
                         quiet = t_new - t if (touching and not jumped and not jump_since_prev and policy.steady(
@@ -294,12 +299,12 @@ class CoSimulation:
 
     def _mechanics_first_step(self, mech, stepper, t, t_next, i_now, slope, horizon=math.inf):
         policy = self.policy
-        contact, coil = self.contact, self.coil
+        links, coil = self._contact_links, self._coil_link
+        contact = links[0] if links else None
 
         def current_at(s):
             return policy.extrapolate(i_now, slope, s - t, horizon)
 
-        links = self.contacts
         mu0 = [link.mu(current_at(t)) for link in links]
         arm = mech.armature_now() if coil is not None else None
 
@@ -314,12 +319,14 @@ class CoSimulation:
             return out
 
         touching = mech.friction_engaged()
-        cp = mech.checkpoint() if self.scene.coupling.align_events else None
+        align = self.scene.coupling.align_events
+        # (mechanics without a bar make and break nothing: no step is redone, none returned to)
+        cp = mech.checkpoint() if align and self._makes else None
         tick = time.perf_counter()
         # In free flight no friction acts, so a step may end where it meets a make without
         # being redone there with the current extrapolated to that end: the mechanics stop
         # at it (instead of integrating the bounces beyond and returning to it).
-        in_flight = cp is not None and not np.any(touching)
+        in_flight = align and not touching.any()
         seg = mech.advance(t_next, drives(t_next), stop_at_switch=in_flight)
         switching = [e["time"] for e in seg.events if e["kind"] in CONTACT_EVENTS]
         aligned = False
@@ -391,7 +398,7 @@ class CoSimulation:
         times = step.reader("time")
         self._pending.append(times[1:] if self._started else times)
         self._started = True
-        if mech.dense_rows >= DENSE_FLUSH_ROWS and self.contact is None:
+        if mech.dense_rows >= DENSE_FLUSH_ROWS and not self._contact_links:
             self._pending = []
             mech.release_dense()  # (an armature alone: the coil link samples the armature step by step)
         elif mech.dense_rows >= DENSE_FLUSH_ROWS:

@@ -8,9 +8,8 @@ circuit's last points; ``StepPolicy`` turns them into the next step.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-
-import numpy as np
 
 PROBE_TIME = 1e-4  # s: the step right after a current jump is H^2 / PROBE_TIME (O(H^2): second order)
 # A step extrapolates the current over at most this fraction of its local time scale
@@ -123,13 +122,13 @@ class StepPolicy:
         return None
 
 
-def end_rate(t: np.ndarray, i: np.ndarray, span: float) -> tuple[float, float]:
+def end_rate(t: Sequence[float], i: Sequence[float], span: float) -> tuple[float, float]:
     """(dI/dt in A/s, its time scale |dI/dt| / |d2I/dt2| in s) of the loop current at the last
     of the circuit points (t, i) (several steps' worth: a short step may hold only one or
     two), with differences over at least 1e-3 of ``span`` (s) so a sliver landing step does
     not dominate; (0, inf) without enough points. For an exponential approach the time
     scale is its time constant wherever the current is on it; for a ramp it is infinite."""
-    if len(t) < 2 or not np.all(np.isfinite(i[-3:])):
+    if len(t) < 2 or not all(math.isfinite(v) for v in i[-3:]):
         return 0.0, math.inf
     k = len(t) - 2
     while k > 0 and t[-1] - t[k] < 1e-3 * span:

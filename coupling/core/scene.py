@@ -602,7 +602,9 @@ def _build(doc: dict, base_dir: Path, name: str) -> Scene:
             mech = _armature_of(mech, device)
 
     circuit = None
-    if circuit_table is not None:
+    if circuit_table is not None and device is not None and mech is not None and mech.bar is None:
+        circuit = _actuator_circuit(circuit_table, device)
+    elif circuit_table is not None:
         # R_c(F, I) = g(|I|)/G_F(F): the current factor goes into ngspice (solved without lag)
         factor = tribology.laws.resistance_law.current_factor_expression("I") if tribology is not None else None
         circuit = _circuit(circuit_table, base_dir, factor, device, mech)
@@ -624,6 +626,25 @@ def _build(doc: dict, base_dir: Path, name: str) -> Scene:
                   schedule_t_end=schedule_t_end)
     check_work(scene)
     return scene
+
+
+def _actuator_circuit(table: dict, device) -> CircuitSpec:
+    """An armature alone (no [bar]): its circuit is the coil's drive; [circuit] may set only
+    ngspice's options (a contact template's contact would never be driven)."""
+    import circuit as ck
+
+    table = _table("[circuit]", table)
+    allowed = set(key_fields(ck.SimulationOptions))
+    stray = sorted(set(table) - allowed)
+    if stray:
+        raise ValueError(f"circuit.{', circuit.'.join(stray)}: an armature alone (no [bar]) has no contact, its "
+                         f"circuit is the coil's drive ([coil]); [circuit] may set only ngspice's options: "
+                         f"{', '.join(sorted(allowed))}")
+    try:
+        options = ck.SimulationOptions(**_kwargs(table, ck.SimulationOptions))
+    except TypeError as err:  # a value of a type no check foresaw
+        raise ValueError(str(err)) from None
+    return CircuitSpec(device.drive(), options, template="coil")
 
 
 def _field_default(cls, name: str):

@@ -204,3 +204,24 @@ def test_run_check_compares_operate_and_release_time():
     late = dict(base, release_time=base["release_time"] + 2 * time_tolerance(base))
     assert compare(base, late, tips, tips)["moved"] == ["release_time"]
     assert compare(base, dict(base), tips, tips)["moved"] == []
+
+
+def test_an_actuators_circuit_table_sets_ngspices_options_and_nothing_else():
+    """An armature alone has no contact: its circuit is the coil's drive, and [circuit] may set
+    ngspice's options for it (before, any [circuit] table built a switch template whose
+    contact nothing drove, and the run failed at t = 0). The coil's energy residual is the
+    circuit's integration error on its points: a tenth of ngspice's step makes it far smaller
+    (second order in the points' spacing: a hundredth, less where the macro steps already set
+    the spacing)."""
+    doc = copy.deepcopy(armature_alone(12.0).raw)
+    doc["circuit"] = {"max_step": 5e-6}
+    fine = scene_from_dict(doc, name="actuator.toml")
+    assert fine.circuit.options.max_step == 5e-6
+    residual = [abs(run(scene).relay["energy"]["relative_residual"]) for scene in (armature_alone(12.0), fine)]
+    assert residual[1] < 0.02 * residual[0], residual  # (measured 3.4e-3 of it)
+    doc["circuit"] = {"template": "resistive", "voltage": 24.0}
+    with pytest.raises(ValueError) as err:
+        scene_from_dict(doc, name="actuator.toml")
+    text = str(err.value)
+    assert "circuit.template, circuit.voltage: an armature alone (no [bar]) has no contact" in text, text
+    assert "\n" not in text

@@ -224,3 +224,25 @@ def test_growing_steps_in_a_closed_contact_change_no_checked_metric():
     ha, hb = held.mechanics.history, grown.mechanics.history
     a, b = np.interp(t, ha.time, ha.normal_force_0), np.interp(t, hb.time, hb.normal_force_0)
     assert np.sqrt(np.mean((a - b) ** 2)) < 1e-3 * 1.5
+
+
+def test_the_tail_carries_the_last_points_across_steps_and_forgets_them_at_a_jump():
+    """A circuit signal observed a step at a time, each step's first point the previous
+    step's last (as a step's reader gives them), one new point a step: the tail's rate and
+    time scale are those of the exponential approach, which needs points of several steps
+    (two points alone give the cautious scale |I| / |dI/dt|, tau (e^x - 1) here); after a
+    jump only the last point is left, and no rate."""
+    from coupling.core.exchange import Tail
+
+    tau, dt = 1e-4, 1e-6
+    t = np.arange(0.0, 0.5 * tau, dt)
+    tail = Tail()
+    for k in range(1, len(t)):
+        tail.observe(t[k - 1:k + 1], exponential(t[k - 1:k + 1], tau=tau), jumped=False)
+    rate, scale = tail.rate(H)
+    slope = 2.0 / tau * math.exp(-t[-1] / tau)
+    # one-sided differences over dt: both off by dt / (2 tau) (the derivative half a point back)
+    assert rate == pytest.approx(slope, rel=dt / tau)
+    assert scale == pytest.approx(tau, rel=dt / tau)
+    tail.observe(t[-1:] + dt, exponential(t[-1:] + dt, tau=tau), jumped=True)
+    assert tail.rate(H) == (0.0, math.inf)
