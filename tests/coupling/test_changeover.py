@@ -283,6 +283,29 @@ def test_an_arc_still_burning_at_the_other_throws_make_is_a_warning():
         assert (len(lines) == 1 and "NC's arc still burns when NO makes at 2 ms" in lines[0]) is burning
 
 
+def test_a_make_before_break_changeover_opening_both_throws_burns_both_arcs():
+    """The bridge contactor's motion (examples/bridge_contactor.toml: both rivets closed at
+    once, then pulled off together) wired as a changeover: both throws open on the wiring's
+    current and both arcs burn at once. The run goes to its end (it had aborted, "timestep
+    too small" at the common: not the two arcs, but a 1e-19 s step where an arc's landing
+    fell an ulp before a macro step's end), and wherever both burn each holds at least its
+    burning voltage U_min (the arc model's dead zone: |v| = U_min + E_col d + R_arc |i|)."""
+    bridge = tomllib.loads((EXAMPLE.parent / "bridge_contactor.toml").read_text())
+    names = iter(("NO", "NC"))
+    for fixed in bridge["fixed"]:
+        fixed["name"] = next(names)
+    bridge["circuit"]["template"] = "changeover"
+    result = run(scene_from_dict(bridge, base_dir=EXAMPLE.parent))
+    assert result.status == "ok", result.message
+    assert result.summary["changeover"]["break_before_make"] is False
+    w = result.waveform_columns
+    u_min, i_min = bridge["circuit"]["arc"]["min_voltage"], bridge["circuit"]["arc"]["min_current"]
+    both = (np.abs(w["arc_current_NO"]) >= i_min) & (np.abs(w["arc_current_NC"]) >= i_min)
+    assert np.count_nonzero(both) > 10
+    for name in ("NO", "NC"):
+        assert np.all(np.abs(w[f"contact_voltage_{name}"][both]) >= u_min)
+
+
 # --- bad input ------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("change, words", [
