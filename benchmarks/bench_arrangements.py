@@ -12,9 +12,8 @@ the same run (no timed tests):
   "resistive" (one circuit contact fed by NO's and NC's pairs in parallel, NO's load).
 
 The one motion cannot serve all three: a changeover's throws wired to a bridge's motion are
-both closed at once and, opening together, put two arcs in parallel on the wiring
-inductance's current (ngspice aborts there, "timestep too small"), and a bridge wired to a
-changeover's motion never conducts. Per run: the wall time (``result.stats`` wall_time),
+both closed at once and open together (a make-before-break changeover, not the example's
+form C), and a bridge wired to a changeover's motion never conducts. Per run: the wall time (``result.stats`` wall_time),
 the mechanics and circuit seconds, macro steps and the circuit's points, median of
 --repeat runs. The issue's target: the co-simulation's cost grows at most linearly with
 the contacts, so a two-contact run costs at most twice its one-contact run (ratio <= 2). Baseline for the machine's speed:

@@ -153,6 +153,12 @@ _CHATTER = re.compile(
 _ERROR_LINE = re.compile(r"error|abort|fail|too small|trouble with|singular|iteration limit|can't find", re.I)
 
 
+def stop_margin(target: float) -> float:
+    """s: how far before a pause's target (s) a point counts as reaching it (ngspice parses
+    the stop time itself; the margin keeps its rounding harmless)."""
+    return max(1e-12 * abs(target), 1e-300)
+
+
 class NgspiceSession(NgSpiceShared):
     """PySpice's NgSpiceShared with the quirks of PySpice 1.5 + ngspice 39 fixed.
 
@@ -340,7 +346,11 @@ class NgspiceSession(NgSpiceShared):
                 if self._arc_land < target:
                     target = self._arc_land
         remaining = target - ckttime
-        if remaining > 0.0:
+        # Within transient()'s stop margin of the target the pause is reached: a step aimed
+        # at the target from there would be a sliver (an arc's landing an ulp before a
+        # macro step's end took a 1e-19 s step, and the next rejection, below ngspice's
+        # smallest step, aborted the run with "timestep too small").
+        if remaining > stop_margin(target):
             delta = pdelta[0]
             if delta >= remaining * (1.0 - LANDING_TOLERANCE):  # equal up to rounding: land, no extra point
                 pdelta[0] = remaining
@@ -492,7 +502,7 @@ class NgspiceSession(NgSpiceShared):
                 self._raise_if_failed(printed)
                 self._check_reached(printed, -math.inf)
             # ngspice parses the number itself; the margin keeps its rounding harmless.
-            threshold = target - max(1e-12 * abs(target), 1e-300)
+            threshold = target - stop_margin(target)
             if first and self.last_time() >= threshold:
                 return
             for _ in range(8):

@@ -166,7 +166,8 @@ class InductiveLoad:
 
     SECTION: ClassVar[str] = "circuit"
     load_resistance: float = scene_key(24.0, unit="ohm")
-    load_inductance: float = scene_key(10e-3, unit="H", doc="inductive")
+    load_inductance: float = scene_key(
+        10e-3, unit="H", doc="inductive; changeover: NO's load inductance, in series with `load_resistance` (0: resistive)")
 
     def __post_init__(self) -> None:
         check_range(self.SECTION, "load_resistance", self.load_resistance, "ohm", 1e-6, 1e9)
@@ -256,7 +257,7 @@ class SwitchCircuit:
         "both): [circuit.snubber]; omitted or false: none")
     flyback: FlybackDiode | None = scene_key(
         None, unit="-", doc="a diode across an inductive load: true (its defaults) or a table: [circuit.flyback]; "
-        "omitted or false: none (not with changeover: its loads are resistive)")
+        "omitted or false: none (changeover: one across each inductive throw's load)")
     arc: ArcModel | None = scene_key(
         None, unit="-", doc="the arc model: true (its defaults) or a table: [circuit.arc]; omitted or false: none")
     leakage_conductance: float = scene_key(DEFAULT_LEAKAGE, unit="S", doc="open-contact insulation")
@@ -278,11 +279,9 @@ class SwitchCircuit:
             value = getattr(self, attr)
             if value is not None and not isinstance(value, kind):
                 raise ValueError(f"SwitchCircuit.{attr} = {value!r}: must be a {kind.__name__} or None")
-        if self.flyback is not None and not isinstance(self.load, InductiveLoad):
-            raise ValueError(
-                f"{name}.flyback is set but load is {type(self.load).__name__}: "
-                "a flyback diode belongs across an InductiveLoad"
-            )
+        self._check_own_keys()
+        if self.flyback is not None and not self._inductive_load:
+            raise ValueError(self._flyback_refusal)
         if isinstance(self.source, CurrentSource):
             if not isinstance(self.load, ResistiveLoad):
                 raise ValueError(f"SwitchCircuit.load is {type(self.load).__name__}: a CurrentSource drives a "
@@ -296,8 +295,7 @@ class SwitchCircuit:
                     "supply could not drive the set current even through the closed contact"
                 )
         check_range(name, "contact_capacitance", self.contact_capacitance, "F", 0.0, 1e-6)
-        series_l = self.wiring.wiring_inductance + (self.load.load_inductance if isinstance(self.load, InductiveLoad)
-                                             and self.flyback is None else 0.0)
+        series_l = self.wiring.wiring_inductance + (self._load_inductance if self.flyback is None else 0.0)
         if self.contact_capacitance == 0.0 and series_l > 0.0 and self.snubber is None:
             raise ValueError(
                 f"{name}.contact_capacitance = 0 F with {series_l!r} H in series with the contact and no snubber: "
@@ -308,6 +306,32 @@ class SwitchCircuit:
         check_current_factor(type(self).__name__, self.contact_current_factor)
         if not isinstance(self.title, str) or "\n" in self.title:
             raise ValueError(f"SwitchCircuit.title = {self.title!r}: must be a one-line string")
+
+    def _check_own_keys(self) -> None:
+        """A subclass's own keys, checked before the checks here read them."""
+
+    @property
+    def _inductive_load(self) -> bool:
+        """Whether a flyback diode has an inductive load to go across."""
+        return isinstance(self.load, InductiveLoad)
+
+    @property
+    def _flyback_refusal(self) -> str:
+        return (f"{self.SECTION}.flyback is set but load is {type(self.load).__name__}: "
+                "a flyback diode belongs across an InductiveLoad")
+
+    @property
+    def _load_inductance(self) -> float:
+        """H: the largest load inductance in series with a contact."""
+        return float(self.load.load_inductance) if isinstance(self.load, InductiveLoad) else 0.0
+
+    def _place_flyback(self, c: Circuit, node: str, name: str = "flyback") -> None:
+        """The flyback diode from ground to ``node`` (the load's top), its model once."""
+        d = self.flyback
+        c.D(name, c.gnd, node, model="switchsim_flyback")
+        if "switchsim_flyback" not in c.model_names:
+            c.model("switchsim_flyback", "D", IS=float(d.saturation_current), N=float(d.emission_coefficient),
+                    RS=float(d.series_resistance))
 
     @property
     def contacts(self) -> tuple[ContactBlock, ...]:
@@ -341,15 +365,7 @@ class SwitchCircuit:
             c.C("load", "load_c", gnd, float(load.load_capacitance))
             c.R("bleed", "load_c", gnd, float(load.bleed_resistance))
         if self.flyback is not None:
-            d = self.flyback
-            c.D("flyback", gnd, NODE_B, model="switchsim_flyback")
-            c.model(
-                "switchsim_flyback",
-                "D",
-                IS=float(d.saturation_current),
-                N=float(d.emission_coefficient),
-                RS=float(d.series_resistance),
-            )
+            self._place_flyback(c, NODE_B)
         if self.coil is not None:
             self.coil.add_to(c)
         return c
@@ -475,8 +491,9 @@ class ChangeoverCircuit(SwitchCircuit):
     (NC) fixed contact, each throw with its own resistive load to ground, as a relay's form C
     contact is wired and tested (SI units)::
 
-        ... Lwire -- common --Vload-- contact_a =CONTACT_<no>= throw_<no> --Vload_<no>-- load_<no> --Rload_<no>-- 0
-                                                |          =CONTACT_<nc>= throw_<nc> --Vload_<nc>-- load_<nc> --Rload_<nc>-- 0
+        ... Lwire -- common --Vload-- contact_a =CONTACT_<no>= throw_<no> --Vload_<no>-- load_<no> --Rload_<no>-- [load_<no>_l --Lload_<no>--] 0
+                                                |          =CONTACT_<nc>= throw_<nc> --Vload_<nc>-- load_<nc> --Rload_<nc>-- [load_<nc>_l --Lload_<nc>--] 0
+        (an inductive throw: Lload_<n> below its resistor, the flyback Dflyback_<n> from 0 to throw_<n>)
         across each contact: Ccontact_<n>, its arc path, the snubber (Rsnubber_<n>, Csnubber_<n>) when given
 
     contact_names: (NO's name, NC's name): each contact a block name (circuit.names; the
@@ -485,6 +502,11 @@ class ChangeoverCircuit(SwitchCircuit):
         and result columns (``contact_voltage_<name>``, ...). NO is the first contact.
     load: NO's load, a ResistiveLoad (ohm).
     nc_load_resistance: ohm, NC's load; None: the same as NO's.
+    load_inductance: H, NO's load inductance in series with its resistance (0: resistive;
+        a valve or motor winding, a contactor's coil).
+    nc_load_inductance: H, NC's; None: the same as NO's.
+    flyback: a diode across each inductive throw's load (``FlybackDiode``), or None; only
+        with an inductive throw.
     contact_capacitance: F, across each contact; the snubber, when given, across each too.
     The load probe ``Vload`` sits in the common's lead: ``load_current`` is the supply's
     current through the moving contact, NO's and NC's together; each throw's own load current
@@ -496,6 +518,10 @@ class ChangeoverCircuit(SwitchCircuit):
     contact_names: tuple = internal(("NO", "NC"))  # the scene's electrical [[fixed]] contacts NO and NC
     nc_load_resistance: float | None = scene_key(
         None, unit="ohm", doc="changeover: NC's load (> 0); omitted: the same as `load_resistance`")
+    load_inductance: float = scene_key(
+        0.0, unit="H", doc="changeover: NO's load inductance, in series with `load_resistance` (0: resistive)")
+    nc_load_inductance: float | None = scene_key(
+        None, unit="H", doc="changeover: NC's load inductance (0: resistive); omitted: the same as `load_inductance`")
 
     #: how the contacts are arranged: each in its own branch, each closed while it touches
     arrangement = "changeover"
@@ -521,6 +547,32 @@ class ChangeoverCircuit(SwitchCircuit):
         if self.nc_load_resistance is not None:
             check_range(self.SECTION, "nc_load_resistance", self.nc_load_resistance, "ohm", 0.0, 1e9, low_open=True)
 
+    def _check_own_keys(self) -> None:
+        # (the load inductances are checked before SwitchCircuit's checks read them)
+        check_range(self.SECTION, "load_inductance", self.load_inductance, "H", 0.0, 100.0)
+        if self.nc_load_inductance is not None:
+            check_range(self.SECTION, "nc_load_inductance", self.nc_load_inductance, "H", 0.0, 100.0)
+
+    @property
+    def load_inductances(self) -> tuple[float, float]:
+        """H: (NO's load inductance, NC's)."""
+        nc = self.load_inductance if self.nc_load_inductance is None else self.nc_load_inductance
+        return float(self.load_inductance), float(nc)
+
+    @property
+    def _inductive_load(self) -> bool:
+        return any(x > 0.0 for x in self.load_inductances)
+
+    @property
+    def _flyback_refusal(self) -> str:
+        return (f"{self.SECTION}.flyback is set but both throws are resistive (load_inductance = "
+                f"{self.load_inductance!r}, nc_load_inductance = {self.nc_load_inductance!r}): a flyback diode belongs "
+                "across an inductive load")
+
+    @property
+    def _load_inductance(self) -> float:
+        return max(self.load_inductances)
+
     @property
     def load_resistances(self) -> tuple[float, float]:
         """ohm: (NO's load, NC's load)."""
@@ -538,7 +590,7 @@ class ChangeoverCircuit(SwitchCircuit):
         gnd = c.gnd
         self._place_supply(c, COMMON_NODE)
         c.V(LOAD_PROBE[1:], COMMON_NODE, NODE_A, 0)
-        for block, resistance in zip(self.contacts, self.load_resistances):
+        for block, resistance, inductance in zip(self.contacts, self.load_resistances, self.load_inductances):
             add_contact(c, block.node_a, block.node_b, self.leakage_conductance, self.contact_current_factor,
                         block.name)
             n = block.name.lower()
@@ -550,7 +602,17 @@ class ChangeoverCircuit(SwitchCircuit):
             if self.arc is not None:
                 add_arc(c, self.arc, block.node_a, block.node_b, block.name)
             c.V(f"load_{n}", block.node_b, f"load_{n}", 0)
-            c.R(f"load_{n}", f"load_{n}", gnd, resistance)
+            if inductance > 0.0:
+                c.R(f"load_{n}", f"load_{n}", f"load_{n}_l", resistance)
+                c.L(f"load_{n}", f"load_{n}_l", gnd, inductance)
+                if self.flyback is not None:
+                    # across the load and its probe (as the one-contact template's): below the
+                    # probe, the probe's branch current, a few nA, came out of the KCL of a node
+                    # where the diode carries amperes, and its Newton noise (~1e-7 A) never met
+                    # ABSTOL: "timestep too small" at the freewheeling throw's break
+                    self._place_flyback(c, block.node_b, f"flyback_{n}")
+            else:
+                c.R(f"load_{n}", f"load_{n}", gnd, resistance)
         if self.coil is not None:
             self.coil.add_to(c)
         return c

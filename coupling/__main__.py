@@ -12,7 +12,11 @@ import sys
 
 
 def drop_working_folder() -> None:
-    """Remove the entry ``-m`` put first on sys.path: '' or the working folder."""
+    """Remove the entry ``-m`` put first on sys.path: '' or the working folder. With
+    PYTHONSAFEPATH (``-P``) Python put none there: the first entry is then the user's own
+    (PYTHONPATH's first, which may well be the working folder) and stays."""
+    if sys.flags.safe_path:
+        return
     if sys.path and (sys.path[0] == "" or os.path.realpath(sys.path[0]) == os.path.realpath(os.getcwd())):
         del sys.path[0]
 

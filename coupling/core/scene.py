@@ -177,7 +177,8 @@ class CircuitSpec:
             '`fault_time`: a fault current through the closed contact), "bridge" (resistive, its switch a '
             "double-break bridge: two contacts in series, each its own circuit contact named as the scene's two "
             "electrical `[[fixed]]` contacts, which it needs; docs/circuit.md section 6), \"changeover\" (form C: "
-            "the supply on the moving contact, its NO and NC throws each with its own resistive load; each its own "
+            "the supply on the moving contact, its NO and NC throws each with its own load, resistive or R-L "
+            "(`load_inductance`, `nc_load_inductance`); each its own "
             "circuit contact fed by the electrical `[[fixed]]` contact named \"NO\" or \"NC\", which it needs; "
             'docs/coupling.md, "A changeover")')
     probes: tuple = scene_key(  # circuit.probes.UserProbe
@@ -380,8 +381,6 @@ TRIBOLOGY_KEYS = tuple(section_keys(TribologySpec))
 def template_keys(template: str) -> set:
     """The [circuit] keys a template uses (besides template, schedule, probes and the ngspice options)."""
     keys = set().union(*(key_fields(cls) for cls in template_classes(template)))
-    if template == "changeover":  # its throws are resistive: no flyback diode across a load
-        keys -= {"flyback"}
     return keys | {"netlist"} if template == "netlist" else keys
 
 

@@ -278,3 +278,18 @@ def test_python_m_coupling_runs_no_module_from_the_working_folder(tmp_path, modu
     assert not marker.exists(), marker.read_text()
     assert done.returncode == 2 and done.stderr.startswith("switchsim: error: bad.toml: bar.length = -1"), \
         done.stderr
+
+
+def test_safe_path_keeps_the_users_first_entry(tmp_path):
+    """With PYTHONSAFEPATH (-P) `python -m` puts nothing on sys.path: its first entry is then
+    the user's own (PYTHONPATH's first), which may be the working folder itself (a checkout
+    run from inside it), and must stay: dropping it ran the installed copy instead."""
+    env = {**ENV, "PYTHONSAFEPATH": "1",
+           "PYTHONPATH": os.pathsep.join((str(tmp_path), ENV["PYTHONPATH"]))}
+    code = ("import sys; before = list(sys.path); from coupling.__main__ import drop_working_folder; "
+            "drop_working_folder(); print(sys.path == before, sys.path[0])")
+    done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 0, done.stderr
+    kept, first = done.stdout.split()
+    assert kept == "True" and os.path.realpath(first) == os.path.realpath(tmp_path)

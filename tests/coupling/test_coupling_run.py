@@ -140,3 +140,17 @@ def test_bad_scene_file_gives_one_line_error_and_exit_2(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "bar.length" in err[0] and "must be > 0" in err[0]
     assert not (tmp_path / "out").exists()
+
+
+def test_no_circuit_step_is_a_pauses_round_off():
+    """The circuit's accepted points of the coupled free drop (arcs, make/break landings,
+    a pause at every macro step's end): none closer to the one before than the margin a
+    pause's target is reached within (1e-12 of the time). Steering the step at a target
+    already within it took ulp-sized steps (55 of them below 1e-15 s in the default relay),
+    from which ngspice grows its step by at most 2x a point; one rejection there, below
+    ngspice's smallest step, aborted a run."""
+    result = run(builtin_scene("free_drop"))
+    assert result.status == "ok", result.message
+    t = np.asarray(result.waveform_columns["time"])
+    steps = np.diff(t)
+    assert np.all(steps > 1e-12 * t[1:]), (steps.min(), t[1:][np.argmin(steps)])

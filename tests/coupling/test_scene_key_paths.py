@@ -285,7 +285,7 @@ EXAMPLES = {
     "force.travel": [0.0, 2e-3], "force.share": [1.0, 0.5],
     "spring.between": "armature", "spring.lever": 2.0,
     "rivet.name": "mid", "fixed.name": "NO", "fixed.radius": 2e-3, "fixed.facing": "down", "fixed.gap": 2e-3,
-    "circuit.nc_load_resistance": 20.0,
+    "circuit.nc_load_resistance": 20.0, "circuit.nc_load_inductance": 5e-3,
 }
 RC_PLAIN = "net\n.param RS=1\nV1 a 0 24\nXCONTACT a b\nVLOAD b c 0\nR1 c 0 {RS}\n"
 COUPLED = {"tribology": {"source": "illustrative"}, "circuit": {}, "solver": {"t_end": 1e-3}}
