@@ -127,6 +127,11 @@ def scaled_rebound(c_hat: float, beta: float) -> float:
         v_end = v2
         while hi - lo > 1e-16 * (1.0 + hi):
             mid = 0.5 * (lo + hi)
+            if mid <= lo or mid >= hi:
+                # no double between them: above h ~ 1.1 their spacing (2.2e-16) never gets
+                # below the bound, and the bisection went on for ever (a heavily damped
+                # impact coasts to its end in steps of order 1: restitution 0.05 hung)
+                break
             yn, vn = step(y, v, mid)
             if over(yn, vn):
                 hi = mid

@@ -99,3 +99,25 @@ def test_paper_law_small_damping_asymptote():
     assert errors[-1] < 1e-3
     assert errors[0] / errors[1] == pytest.approx(10.0, rel=0.2)
     assert errors[1] / errors[2] == pytest.approx(10.0, rel=0.2)
+
+
+def test_heavy_damping_rebounds_at_the_speed_where_the_force_clips():
+    """Hunt-Crossley's dimensionless force y^1.5 (1 + c v) falls to zero, and clips, where the
+    rebound speed reaches 1/c: a heavily damped impact ends there (closed form, to the
+    solve's 1e-14 local error). These impacts coast to their end in steps of order 1, where
+    the final bisection had no double between its ends and never stopped (restitution 0.05
+    on the relay hung); calibrating e = 0.05 must return the c that gives it back. Run in
+    a child process: before the fix these calls did not return."""
+    import subprocess
+    import sys
+
+    code = ("from mech.compiled import scaled_rebound as s; from mech.contact_laws import scaled_rebound as p; "
+            "from mech.damping_calibration import calibrate_damping as cal, single_impact_restitution as e; "
+            "print(*[f(c, 1.5) for c in (24.24, 30.0, 100.0) for f in (s, p)], "
+            "e('hunt_crossley', cal('hunt_crossley', 0.05, 1.0, 1.6e9, 2e-5), 1.0, 1.6e9, 2e-5))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    values = [float(x) for x in done.stdout.split()]
+    for (compiled, plain), c in zip(zip(values[0:6:2], values[1:6:2]), (24.24, 30.0, 100.0)):
+        assert compiled == pytest.approx(1.0 / c, rel=1e-9) and plain == pytest.approx(1.0 / c, rel=1e-9)
+    assert values[6] == pytest.approx(0.05, rel=1e-9)
