@@ -182,7 +182,7 @@ SCENE = {
     "circuit": {"template": "-", "voltage": "V", "source_resistance": "ohm", "current": "A",
                 "compliance_voltage": "V", "output_capacitance": "F", "output_resistance": "ohm",
                 "wiring_resistance": "ohm", "wiring_inductance": "H", "load_resistance": "ohm",
-                "nc_load_resistance": "ohm",
+                "nc_load_resistance": "ohm", "nc_load_inductance": "H",
                 "load_inductance": "H", "load_capacitance": "F", "bleed_resistance": "ohm",
                 "contact_capacitance": "F", "leakage_conductance": "S", "snubber": "-", "flyback": "-", "arc": "-",
                 "netlist": "path", "load_probe": "-", "probes": "-", "max_step": "s", "reltol": "-", "abstol": "A",
