@@ -28,6 +28,8 @@ are zero), the norms d_j, and G's non-zero entries
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .jit import njit, njit_borrowing
@@ -43,7 +45,9 @@ def inverse3(A, out):
     c01 = A[1, 2] * A[2, 0] - A[1, 0] * A[2, 2]
     c02 = A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]
     det = A[0, 0] * c00 + A[0, 1] * c01 + A[0, 2] * c02
-    inv = 1.0 / det
+    # singular only at a trial state far off the motion (a step through a contact): NaN
+    # then, which the step control rejects, where the compiled division would raise
+    inv = 1.0 / det if det != 0.0 else math.nan
     out[0, 0] = c00 * inv
     out[1, 0] = c01 * inv
     out[2, 0] = c02 * inv

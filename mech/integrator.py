@@ -291,14 +291,17 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
             err += (e / sc) ** 2
             if not math.isfinite(ynew[i]):
                 finite = False
-        if not finite:
+        err = math.sqrt(err / N)
+        if not finite or not err < math.inf:
+            # (a NaN estimate, from a stage that left the motion, compares false with 1:
+            # it had accepted a 1.7 ms step through a contact, and every step after it
+            # failed on the garbage state)
             if h < 1e-14:
                 return NOT_FINITE, t, h, n_rec, -1
             h *= 0.1
             reject = True
             stats[1] += 1
             continue
-        err = math.sqrt(err / N)
         # PI step-size control (Hairer's DOPRI5 constants)
         fac11 = err ** 0.17 if err > 0.0 else 0.0
         fac = fac11 / facold ** 0.04 if facold > 0.0 else fac11

@@ -458,7 +458,9 @@ class ImpactSolver:
             try:
                 n0 = rec.n
                 status, t_new, h, n_rec, ev = self.stepper.segment(self, goal)
-            except np.linalg.LinAlgError as err:
+            except (np.linalg.LinAlgError, ArithmeticError) as err:
+                # (ArithmeticError: a division by zero the compiled code raises; a failed run
+                # with what it computed, not a crash)
                 self.wall_time += time.perf_counter() - tick
                 raise MechSolverError(f"mechanics integration failed at t = {self.t!r} s: {err}",
                                       self.t, self.named_state(), partial=self.result()) from err
