@@ -23,6 +23,12 @@ Metrics (pure functions of the per-tip contact intervals and the waveforms, SI):
     arc_energy           J (coupled)
     operate_time, release_time   s (a relay: coil switched on to the first make, off to
                          the break after it; summary.json relay)
+    pole_arrival, last_pole_arrival, pole_bounces   s, s, count (an armature: its first
+                         and last arrival on the pole stop and how often it bounced off
+                         it; summary.json armature; for an actuator alone, with no
+                         contact, the only switching the run has). With no contact, the
+                         sensitivity reruns change the armature's travel and its stops'
+                         damping instead of the gap and the contact's dissipation.
 
 The switching window of a run: from its first make to its last switching instant (the
 last make when the run ends closed, the last break when it ends open), without the held
@@ -75,8 +81,9 @@ TOLERANCES = dict(mismatch_fraction=0.02, time_floor=1e-6, time_fraction=0.01, p
                   voltage_rel=0.02, voltage_abs=0.01, arc_rel=0.05, arc_abs=1e-6)
 SENSITIVITY = 0.01  # the relative change of an input in the sensitivity reruns
 SENSITIVITY_RERUNS = 4
-COUNT_KEYS = ("contacts", "bounces")
-TIME_KEYS = ("first_make", "last_make", "total_bounce_time", "operate_time", "release_time")
+COUNT_KEYS = ("contacts", "bounces", "pole_bounces")
+TIME_KEYS = ("first_make", "last_make", "total_bounce_time", "operate_time", "release_time", "pole_arrival",
+             "last_pole_arrival")
 MAX_MODES = 40  # the largest count a family may have (mech.parameters)
 MIN_RTOL = 1e-13
 MIN_RELTOL = 1e-9
@@ -190,8 +197,10 @@ def compare(base: dict, refined: dict, base_tips: dict, refined_tips: dict, tol:
     out["mismatch_time"] = dict(base=0.0, refined=mism, change=mism, within=mism <= allowed + 1e-15,
                                 allowed=allowed)
     for key in COUNT_KEYS:
-        out[key] = dict(base=base[key], refined=refined[key], change=refined[key] - base[key],
-                        within=refined[key] == base[key])
+        if key not in base and key not in refined:
+            continue
+        a, b = base.get(key, 0), refined.get(key, 0)
+        out[key] = dict(base=a, refined=b, change=b - a, within=b == a)
     time_tol = time_tolerance(base, tol)
     for key in TIME_KEYS:
         a, b = base.get(key), refined.get(key)
@@ -265,6 +274,13 @@ def metrics_of(result) -> dict:
         c = result.mechanics.contacts
         out["peak_force"] = float(c.peak_force.max()) if len(c) else 0.0
         out["energy_residual"] = float(result.mechanics.energy["relative_residual"])
+        armature = result.mechanics.armature
+        if armature is not None:
+            # the armature's own impacts on its pole stop: for an actuator alone (no
+            # contact) the only switching the run has
+            out["pole_arrival"] = armature["first_arrival"]
+            out["last_pole_arrival"] = armature["last_arrival"]
+            out["pole_bounces"] = armature["pole_bounces"]
     if result.waveform_columns is not None and result.scene.circuit is not None:
         b = result.bounce
         out["peak_contact_voltage"] = b.get("peak_contact_voltage")
@@ -352,14 +368,24 @@ def perturbations(scene) -> list[tuple[str, str, object]]:
     SENSITIVITY each way, the gap by half as much in place of what cannot be changed."""
     if scene.mech is None:
         return [("inputs", "not applicable: no mechanics (prescribed contact schedule)", None)]
-    ini, con = scene.mech.initial, scene.mech.contact
-    gap = None if (ini.resting or not ini.height > 0.0) else ini.height
-    if con.restitution is not None:
-        dissipation = ("restitution", "contact.restitution", con.restitution, 1.0)
-    elif con.damping:
-        dissipation = ("damping", "contact.damping", con.damping, math.inf)
+    gap_label, gap_key, gap_scale, gap_unit = "gap", "initial.height", 1e6, " um"
+    if scene.mech.bar is None:
+        # an armature alone (an actuator): its travel is the gap it closes, its stops'
+        # damping the dissipation of the impacts it bounces with
+        arm = scene.mech.armature
+        gap_label, gap_key, gap_scale, gap_unit = "travel", "armature.travel", 1.0, ""
+        gap = arm.travel if arm.travel and arm.travel > 0.0 else None
+        dissipation = ("stop damping", "armature.stop_damping", arm.stop_damping, math.inf) if arm.stop_damping \
+            else None
     else:
-        dissipation = None
+        ini, con = scene.mech.initial, scene.mech.contact
+        gap = None if (ini.resting or not ini.height > 0.0) else ini.height
+        if con.restitution is not None:
+            dissipation = ("restitution", "contact.restitution", con.restitution, 1.0)
+        elif con.damping:
+            dissipation = ("damping", "contact.damping", con.damping, math.inf)
+        else:
+            dissipation = None
     out = []
 
     def add(label, key, value, rel, top, unit_scale=1.0, unit=""):
@@ -370,12 +396,12 @@ def perturbations(scene) -> list[tuple[str, str, object]]:
 
     for rel in (-SENSITIVITY, SENSITIVITY):
         if gap is not None:
-            add("gap", "initial.height", gap, rel, math.inf, 1e6, " um")
+            add(gap_label, gap_key, gap, rel, math.inf, gap_scale, gap_unit)
         if dissipation is not None:
             add(dissipation[0], dissipation[1], dissipation[2], rel, dissipation[3])
     for rel in (-0.5 * SENSITIVITY, 0.5 * SENSITIVITY):
         if gap is not None and len(out) < SENSITIVITY_RERUNS:
-            add("gap", "initial.height", gap, rel, math.inf, 1e6, " um")
+            add(gap_label, gap_key, gap, rel, math.inf, gap_scale, gap_unit)
     if not out:
         return [("inputs", "not applicable: no contact gap and no contact dissipation to change", None)]
     return out
@@ -422,7 +448,7 @@ def verdict(entries: list[dict], sensitivity: list[dict] | None = None) -> tuple
              for e in moved]
     parts += [f"{e['name']} refinement {e['status']}" for e in failed]
     ranges = sensitivity_ranges(sensitivity)
-    inputs = sorted({e["name"].split()[0] for e in sensitivity if e.get("status") == "ok"})
+    inputs = sorted({e["name"].rsplit(" ", 1)[0] for e in sensitivity if e.get("status") == "ok"})
     band = f"{SENSITIVITY:.0%} change of the {' or the '.join(inputs) or 'inputs'}"
     spans = "; ".join(_describe_range(k, lo, hi) for k, (lo, hi) in ranges.items())
     if status == "converged":
@@ -438,14 +464,15 @@ def verdict(entries: list[dict], sensitivity: list[dict] | None = None) -> tuple
         if spans:
             line += f"; for scale, over a {band}: {spans}"
     runs = [e for e in entries + sensitivity if e.get("status") == "ok" and "agreeing_contacts" in e]
-    if runs and any(e["moved"] for e in runs):
+    if runs and any(e["moved"] for e in runs) and runs[0]["contacts_total"]:
         k = min(e["agreeing_contacts"] for e in runs)
         line += f"; the first {k} of {runs[0]['contacts_total']} closures agree in every rerun"
     return status, line
 
 
 _UNITS = {"first_make": ("ms", 1e3), "last_make": ("ms", 1e3), "total_bounce_time": ("ms", 1e3),
-          "operate_time": ("ms", 1e3), "release_time": ("ms", 1e3),
+          "operate_time": ("ms", 1e3), "release_time": ("ms", 1e3), "pole_arrival": ("ms", 1e3),
+          "last_pole_arrival": ("ms", 1e3),
           "peak_force": ("N", 1.0), "peak_contact_voltage": ("V", 1.0), "arc_energy": ("mJ", 1e3)}
 
 

@@ -373,3 +373,34 @@ def test_a_changeover_is_judged_contact_by_contact(tmp_path, capsys):
         assert split == pytest.approx(entry["metrics"]["mismatch_time"]["refined"], rel=1e-12, abs=1e-15)
         assert sum(parts[name]["metrics"]["contacts"]["refined"] for name in ("NO", "NC")) == \
             entry["metrics"]["contacts"]["refined"]
+
+
+def test_an_actuator_alone_is_judged_on_its_armatures_pole_impacts():
+    """The plunger solenoid (an armature alone: no contact) up to just after it reaches its
+    pole stop. The check once compared only contact metrics, all zero here, and reported
+    "converged" whatever the run did; and its sensitivity reruns changed the contact gap,
+    which such a scene refuses (a crash). Now it compares the armature's arrival on the pole
+    and perturbs what an actuator has: its travel and its stops' damping. Physics of the
+    reruns: a longer travel arrives later and a shorter one earlier; the stops' damping,
+    which acts only once the armature touches, leaves the first arrival where it was."""
+    from pathlib import Path
+
+    from coupling import load_scene
+    from coupling.app.accuracy import check
+
+    scene = load_scene(Path(__file__).resolve().parents[2] / "examples" / "plunger_solenoid.toml")
+    scene = scene.set("solver.t_end", 0.0125)
+    base = run(scene)
+    arrival = base.mechanics.armature["first_arrival"]
+    assert arrival is not None and arrival < 0.0125
+    acc = check(scene, base)
+    assert acc["status"] in ("converged", "within sensitivity"), acc["verdict"]
+    rerun = {e["name"]: e for e in acc["sensitivity"] if e.get("status") == "ok"}
+    assert set(rerun) == {"travel -1.0%", "travel +1.0%", "stop damping -1.0%", "stop damping +1.0%"}
+    moved = {name: e["metrics"]["pole_arrival"]["refined"] for name, e in rerun.items()}
+    assert moved["travel -1.0%"] < arrival < moved["travel +1.0%"]
+    for name in ("stop damping -1.0%", "stop damping +1.0%"):
+        assert moved[name] == pytest.approx(arrival, rel=1e-12, abs=0.0)
+    for entry in acc["refinements"]:
+        if entry["status"] == "ok":
+            assert "pole_arrival" in entry["metrics"]
