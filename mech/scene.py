@@ -110,6 +110,13 @@ def _section(name: str, cls, table: dict, where: str):
     kwargs = dict(table)
     renamed = {}
     if name == "bar" and "modes" in kwargs:
+        for field_name in ("axial_modes", "bending_modes"):
+            if field_name in kwargs:
+                # (modes would have overridden it without a word: Scene.set("bar.axial_modes",
+                # 3) on a scene with modes = "auto" ran at the auto count)
+                raise ValueError(f"{where}: bar.{field_name} = {kwargs[field_name]!r} beside bar.modes = "
+                                 f"{kwargs['modes']!r}: give the counts in one key, bar.modes = "
+                                 "{axial = ..., bending = ...}")
         kwargs, renamed = _modes(kwargs, where)
     if name == "bar" and ("width" in kwargs or "thickness" in kwargs) and "diameter" not in kwargs:
         kwargs["diameter"] = None  # a rectangular section replaces the default round one

@@ -65,6 +65,19 @@ def test_bar_modes_errors_name_the_key_the_user_wrote(tmp_path, value, words):
     assert "axial_modes" not in line
 
 
+def test_a_family_count_beside_bar_modes_is_refused_not_overridden():
+    """bar.modes stands for both families' counts; a field of it set beside it
+    (Scene.set("bar.axial_modes", 3) on a scene with modes = "auto") was silently
+    overridden by modes: the run went on at the auto count. One line naming both keys."""
+    from coupling.core.scene import builtin_scene
+
+    with pytest.raises(ValueError) as err:
+        builtin_scene("default").set("bar.axial_modes", 3)
+    line = str(err.value)
+    assert "bar.axial_modes = 3 beside bar.modes = 'auto'" in line and "\n" not in line
+    assert builtin_scene("default").set("bar.modes", {"axial": 3, "bending": 17}).mech.bar.axial_modes == 3
+
+
 def test_a_byte_order_mark_is_accepted(tmp_path):
     """Some Windows editors start UTF-8 files with a BOM: the scene is read as written."""
     from coupling.core.scene import load_scene
