@@ -27,7 +27,8 @@ the rows it thinned away (``mech.ImpactResult.thinning``)):
   about that fraction;
 - circuit (template circuits): the loop current through the load is at most
   2 V / (R_source + R_wiring + R_load) (A): the supply across the series loop, plus one
-  full overshoot of the loop's ringing (a short_circuit template: R_load || R_fault). A
+  full overshoot of the loop's ringing (a short_circuit template: R_load || R_fault; a
+  changeover: R_load || R_nc_load, its two throws closed together before one breaks). A
   netlist circuit's topology is not known: no current bound.
 
 Bounds are compared with a relative margin (BOUND_MARGIN) for round-off and the
@@ -226,4 +227,9 @@ def _circuit_current_bound(scene) -> float | None:
     fault = getattr(circ, "fault_resistance", None)  # circuit.ShortCircuit: the load shorted by it
     if fault is not None:
         series += load * fault / (load + fault) - load
+    if getattr(circ, "arrangement", None) == "changeover":
+        # load_current is the common's lead: NC's throw alone, or (make before break) both
+        # throws in parallel; NO's load alone bounded a run on a smaller NC load as unsound
+        nc = circ.nc_load_resistance if circ.nc_load_resistance is not None else load
+        series += load * nc / (load + nc) - load
     return loop_current_bound(voltage, series) if series > 0 else None

@@ -157,3 +157,29 @@ def test_the_api_and_a_sweep_row_judge_the_same_run_the_same_way(tmp_path):
            "waveforms": False}
     row = execute(doc, {"run_id": "r0", "name": "strict", "params": {}}, None)
     assert row["status"] == "unsound" and row["error"] == result.problems[0]
+
+
+def test_a_changeover_on_a_small_nc_load_is_bounded_by_both_throws_not_no_alone():
+    """The changeover's load_current is the common's lead: resting on NC it carries
+    V / (R_source + R_wiring + R_nc) (+ the closed contact's milliohms). With NO's 1 kohm
+    alone the bound was 2 x 24 V / 1 kohm = 48 mA and the 44 A run was judged unsound."""
+    from pathlib import Path
+
+    import numpy as np
+
+    from coupling import load_scene, run
+
+    example = Path(__file__).resolve().parents[2] / "examples" / "changeover_relay.toml"
+    scene = load_scene(example).update({
+        "solver.t_end": 2e-3,  # the blade rests on NC under its preload; the coil is off until 6 ms
+        "circuit.load_resistance": 1e3, "circuit.nc_load_resistance": 0.5,
+        "output.csv": False, "output.plots": False})
+    res = run(scene)
+    assert res.status.value == "ok", res.message
+    circ = scene.circuit.circuit
+    expected = circ.source.voltage / (circ.source.source_resistance + circ.wiring.wiring_resistance + 0.5)
+    # the closed silver contact adds milliohms (Holm) to the 0.55 ohm loop: < 1 %
+    assert float(np.asarray(res.waveform_columns["load_current"])[-1]) == pytest.approx(expected, rel=1e-2)
+    verdict = soundness.assess(res)
+    assert verdict["problems"] == []
+    assert verdict["load_current_bound"] >= expected
