@@ -143,13 +143,36 @@ class Recorder:
                 while cap < size:
                     cap *= 2
                 cap = min(cap, span)
+                self._within_limit(0, cap)
                 self.dense_t0 = _grown(self.dense_t0, cap, used)
                 self.dense_h = _grown(self.dense_h, cap, used)
                 self.dense_coef = _grown(self.dense_coef, cap, used)
 
+    def _within_limit(self, rows: int, dense_rows: int) -> None:
+        """Raise MemoryError before the buffers would hold more than a run may take
+        (MEMORY_LIMIT): ``rows`` more history rows and ``dense_rows`` more rows of dense
+        output beside the buffers there are and their copies (as history_memory counts the
+        peak). The solver then ends the run with its partial result.
+        A scene's history_rows bound the rows a run keeps, but not those of one stretch
+        whose dense output is all kept (a coupled macro step): a bar whose highest mode
+        needs nanosecond steps filled the machine's memory there (observed: 18 GB in a
+        minute) until the system killed the process, and nothing was kept."""
+        per_row = 8 * (1 + self.y.shape[1] + self.aux.shape[1] * self.aux.shape[2] + self.fmax.shape[1]
+                       + self.ext.shape[1]) + self.regime.shape[1] * self.regime.itemsize
+        dense = 8 * (2 + 5 * self.y.shape[1])
+        # (the buffers now, the grown ones, and the copies a segment and the result take)
+        need = (2 * self.capacity + rows) * per_row + (2 * len(self.dense_t0) + dense_rows) * dense
+        if need > MEMORY_LIMIT:
+            raise MemoryError(
+                f"the mechanics' history would take {need / 2**30:.3g} GiB, more than the "
+                f"{MEMORY_LIMIT / 2**30:g} GiB a run may take ({self.recorded} steps recorded, {self.n} held): "
+                "its steps are far below the scene's time scales (the highest mode's stability limit: fewer "
+                "modes, bar.modes) or its run is too long (solver.t_end)")
+
     def grow(self, cap: int) -> None:
         """Make room for ``cap`` history rows (the rows held kept; numpy's MemoryError, when
         it cannot allocate them, propagates: the solver ends the run with its partial result)."""
+        self._within_limit(cap, 0)
         n = self.n
         self.t, self.y, self.aux = _grown(self.t, cap, n), _grown(self.y, cap, n), _grown(self.aux, cap, n)
         self.fmax, self.regime, self.ext = _grown(self.fmax, cap, n), _grown(self.regime, cap, n), _grown(self.ext, cap, n)

@@ -207,3 +207,25 @@ def test_the_state_estimate_counts_a_hysteretic_spring_s_state():
            "initial": dict(height=1e-3), "environment": dict(gravity=0.0), "solver": dict(t_end=1e-3)}
     scene = scene_from_dict(doc, name="loop")
     assert _largest_state(scene.mech) == len(ImpactSolver(scene.mech).y)
+
+
+def test_a_run_whose_steps_collapse_stops_at_the_memory_a_run_may_take(monkeypatch):
+    """The tactile switch's stiff lever at 30 modes per family: its highest mode (56 MHz)
+    holds the explicit step near 6 ns, and a coupled macro step keeps all its rows' dense
+    output, so the run took the machine's memory (18 GB in a minute) until the system
+    killed it, with nothing kept. The recorder now stops at MEMORY_LIMIT (here lowered to
+    256 MiB, the same rule at a size a test can reach): a failed run whose message names
+    bar.modes, with its partial result: the mechanics up to where it stopped (inside the
+    first macro step, which ngspice never reached: the circuit's part is empty)."""
+    import mech.recorder
+
+    monkeypatch.setattr(mech.recorder, "MEMORY_LIMIT", 256 * 2**20)
+    doc = tomllib.loads((ROOT / "examples" / "tactile_switch.toml").read_text())
+    doc["bar"]["modes"] = 30
+    scene = scene_from_dict(doc, base_dir=ROOT / "examples")
+    with pytest.raises(CoupledRunError) as err:
+        run(scene)
+    assert "bar.modes" in str(err.value) and "0.25 GiB" in str(err.value)
+    partial = err.value.partial
+    assert partial is not None and partial.status == "failed"
+    assert 0.0 < float(partial.mechanics.t[-1]) < scene.t_end
