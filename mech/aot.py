@@ -208,17 +208,20 @@ def argument_checks(folder: Path) -> dict:
             return lambda a: isinstance(a, ndarray) and a.dtype == dtype and a.ndim == ndim
         if kind[0] == "tuple":
             parts = [checker(k) for k in kind[1]]
-            seen = {}  # id -> tuple already checked (held, so its id is not reused)
+            # The last tuple checked, held (so the same object again is not checked again):
+            # one only. A cache of 256 held every tuple of fresh views a solver passed (its
+            # history's rows) and with them the buffers those views were cut from, long
+            # after the history had grown into new ones (a coupled run whose steps
+            # collapsed kept ~2x its history's memory).
+            last_tuple = [None]
 
             def ok(a):
-                if seen.get(id(a)) is a:
+                if a is last_tuple[0]:
                     return True
                 if not (isinstance(a, tuple) and len(a) == len(parts)
                         and all(part is None or part(item) for part, item in zip(parts, a))):
                     return False
-                if len(seen) > 256:
-                    seen.clear()
-                seen[id(a)] = a
+                last_tuple[0] = a
                 return True
             return ok
         return None

@@ -187,3 +187,23 @@ def test_a_tip_cap_smaller_than_the_section_names_half_its_diagonal():
         scene_from_dict({"bar": {"width": w, "thickness": t, "tip_radius": 0.001, "length": 0.02}})
     message = str(info.value)
     assert "half the section's diagonal" in message and repr(0.5 * math.hypot(w, t)) in message
+
+
+def test_the_buffers_a_history_outgrew_are_freed():
+    """A coupled run keeps its dense output: the recorder's buffers grow as the steps come,
+    and each grown buffer replaces the last. The compiled route's argument checks had
+    held the last 256 tuples of the views the solver passed (fresh ones each call), and
+    with them every buffer those views were cut from: a run kept about twice the memory
+    its history needs (a run whose steps collapsed reached 11 GB against its 4 GiB
+    bound). Once grown past them, the first buffers are garbage."""
+    import gc
+    import weakref
+
+    solver = ImpactSolver(drop(100_000, t_end=0.004), keep_dense=True, capacity=64)
+    rec = solver.recorder
+    first = [weakref.ref(a) for a in (rec.t, rec.y, rec.dense_coef)]
+    for k in range(1, 21):
+        solver.advance(2e-4 * k, {})
+    assert rec.capacity > 64 and rec.n > 64
+    gc.collect()
+    assert [ref() is None for ref in first] == [True, True, True]
