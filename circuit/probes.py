@@ -27,6 +27,11 @@ COIL_COLUMNS = ("coil_current", "coil_voltage", "coil_flux_linkage")
 
 _GROUND = ("0", "gnd")
 CLOSED_CONDUCTANCE = 1e-6  # S: above it the contact voltage is I/G (see Probes._contact_voltage)
+# the per-block result columns that are one ngspice vector as it stands: base name -> the
+# block's attribute naming it (Probes.vector_of; an arc's is None without an arc model)
+RAW_CONTACT_COLUMNS = {"contact_current": "current_vector", "contact_conductance": "conductance_node",
+                       "arc_current": "arc_current_vector"}
+RAW_COIL_COLUMNS = {"coil_current": "current_vector", "coil_flux_linkage": "flux_node"}
 
 
 @dataclass(frozen=True)
@@ -108,41 +113,28 @@ class Probes:
             return "time"
         if column == "load_current":
             return self.load_current or None
-        for c in self.contacts:
-            if column == "contact_current" + c.suffix:
-                return c.current_vector or None
-            if column == "contact_conductance" + c.suffix:
-                return c.conductance_node or None
-            if column == "arc_current" + c.suffix:
-                return c.arc_current_vector or None
-        for c in self.coils:
-            if column == "coil_current" + c.suffix:
-                return c.current_vector or None
-            if column == "coil_flux_linkage" + c.suffix:
-                return c.flux_node or None
+        for blocks, raw in ((self.contacts, RAW_CONTACT_COLUMNS), (self.coils, RAW_COIL_COLUMNS)):
+            for c in blocks:
+                for base, attribute in raw.items():
+                    if column == base + c.suffix:
+                        return getattr(c, attribute) or None
         return None
 
     def _contact_column(self, c: ContactBlock, base: str, vec, time: np.ndarray) -> np.ndarray:
+        """A per-contact column that is not one vector as it stands (``vector_of``)."""
         if base == "contact_voltage":
             return self._contact_voltage(c, vec, time)
-        if base == "contact_current":
-            return vec(c.current_vector)
-        if base == "contact_conductance":
-            return vec(c.conductance_node)
         if base == "contact_resistance":
             g = vec(c.conductance_node)
             with np.errstate(divide="ignore"):
                 return np.where(g > 0.0, 1.0 / np.where(g > 0.0, g, 1.0), np.inf)
-        return vec(c.arc_current_vector) if c.arc_current_vector else np.zeros_like(time)
+        return np.zeros_like(time)  # arc_current without an arc model
 
     def _coil_column(self, name: str, vec, time: np.ndarray) -> np.ndarray:
+        """A coil column that is not one vector as it stands: its terminal voltage."""
         for c in self.coils:
-            if name == "coil_current" + c.suffix:
-                return vec(c.current_vector)
             if name == "coil_voltage" + c.suffix:
                 return self._node(vec, c.node_p, time) - self._node(vec, c.node_n, time)
-            if name == "coil_flux_linkage" + c.suffix:
-                return vec(c.flux_node)
         raise KeyError(f"unknown result column {name!r}; known: {', '.join(self.column_names)}")
 
     def frame(self, read: Callable[[str], np.ndarray], extra: tuple[str, ...] = ()):
