@@ -157,9 +157,9 @@ class Recorder:
         whose dense output is all kept (a coupled macro step): a bar whose highest mode
         needs nanosecond steps filled the machine's memory there (observed: 18 GB in a
         minute) until the system killed the process, and nothing was kept."""
-        per_row = 8 * (1 + self.y.shape[1] + self.aux.shape[1] * self.aux.shape[2] + self.fmax.shape[1]
-                       + self.ext.shape[1]) + self.regime.shape[1] * self.regime.itemsize
-        dense = 8 * (2 + 5 * self.y.shape[1])
+        state, extra, contacts = self.y.shape[1], self.ext.shape[1], self.aux.shape[1]
+        per_row = row_bytes(state, extra, contact_rows=contacts)
+        dense = row_bytes(state, extra, dense=True, contact_rows=contacts) - per_row
         # (the buffers now, the grown ones, and the copies a segment and the result take)
         need = (2 * self.capacity + rows) * per_row + (2 * len(self.dense_t0) + dense_rows) * dense
         if need > MEMORY_LIMIT:
