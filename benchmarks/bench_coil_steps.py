@@ -4,11 +4,11 @@ reference, beside the results' sensitivity to 1 % changes of the scene's inputs.
 
     .venv/bin/python benchmarks/bench_coil_steps.py [--repeat 5] [--no-write]
 
-The coil's macro steps (coupling/core/master.py, coupling/core/exchange.py CoilLink.observe)
-are at most COIL_TIME_SCALE_FRACTION of the time scale of psi^2 (from its curvature, at most
-the time it takes to change by its own size) and of the time the working gap takes to change
-by GAP_CHANGE_FRACTION of itself while the armature moves, and at most max_macro_step. Each
-row runs the scene with those two constants changed (module constants, read at each run) and
+The coil's macro steps (coupling/core/policy.py, coupling/core/exchange.py CoilLink.observe)
+are at most `coupling.coil_time_scale_fraction` of the time scale of psi^2 (from its
+curvature, at most the time it takes to change by its own size) and of the time the working
+gap takes to change by `coupling.gap_change_fraction` of itself while the armature moves,
+and at most max_macro_step. Each row runs the scene with those two keys changed and
 compares with the reference: every step rule at a quarter (fraction, gap rule, macro_step,
 max_macro_step) and ngspice RELTOL / 10. Results (SI): the armature's first arrival at the
 pole (s), the coil current at the end (A, relative), the times of the armature's later
@@ -34,7 +34,7 @@ BEGIN, END = "<!-- bench-coil-steps:begin -->", "<!-- bench-coil-steps:end -->"
 PLUNGER = ROOT / "examples" / "plunger_solenoid.toml"
 REFINE = 4.0  # the reference: every step rule at 1 / REFINE ...
 RELTOL_REFINE = 10.0  # ... and ngspice RELTOL / RELTOL_REFINE
-# (label, COIL_TIME_SCALE_FRACTION, GAP_CHANGE_FRACTION, max_macro_step factor, ngspice's
+# (label, coupling.coil_time_scale_fraction, coupling.gap_change_fraction, max_macro_step factor, ngspice's
 # largest step in s, None: its own choice, or "reltol": RELTOL / RELTOL_REFINE)
 VARIANTS = (
     ("current rules", 0.1, 1.0, 1.0, None),
@@ -63,18 +63,17 @@ def with_options(scene, **options):
 
 
 def run(scene, fraction: float, gap: float, repeat: int = 1) -> dict:
-    """The results of ``scene`` at the coil rules' constants, and its median wall time (s)."""
-    from coupling.core import exchange, master
+    """The results of ``scene`` at the coil's step rules ``fraction`` and ``gap``, and its
+    median wall time (s)."""
+    from coupling.core import master
 
-    saved = master.COIL_TIME_SCALE_FRACTION, exchange.GAP_CHANGE_FRACTION
-    master.COIL_TIME_SCALE_FRACTION, exchange.GAP_CHANGE_FRACTION = fraction, gap
-    try:
-        walls = []
-        for _ in range(repeat):
-            result = master.run(scene)
-            walls.append(result.stats["wall_time"])
-    finally:
-        master.COIL_TIME_SCALE_FRACTION, exchange.GAP_CHANGE_FRACTION = saved
+    # (replaced, not set by key: a scene from with_options keeps its ngspice options)
+    scene = dataclasses.replace(scene, coupling=dataclasses.replace(
+        scene.coupling, coil_time_scale_fraction=fraction, gap_change_fraction=gap))
+    walls = []
+    for _ in range(repeat):
+        result = master.run(scene)
+        walls.append(result.stats["wall_time"])
     relay = result.relay
     arrivals = [e["time"] for e in result.mechanics.events
                 if e["kind"] == "armature_stop_start" and relay["armature_arrival"] is not None
@@ -98,13 +97,13 @@ def binding_rules(scene) -> list[tuple[float, float, str]]:
     log = []
     observe = exchange.CoilLink.observe
 
-    def watched(self, step, seg, span):
-        observe(self, step, seg, span)
-        curvature = end_rate(self.tail.t, self.tail.v, span)[1]
+    def watched(self, step, seg, policy):
+        observe(self, step, seg, policy)
+        curvature = end_rate(self.tail.t, self.tail.v, policy.macro_step)[1]
         size = (abs(self.value) + self.floor) / abs(self.rate) if self.rate else math.inf
         q, q_dot = seg.armature(seg.t_end)[:2]
         closing = self.lever * abs(float(q_dot))
-        gap = exchange.GAP_CHANGE_FRACTION * max(self.gap(float(q)), 0.0) / closing if closing > 0 else math.inf
+        gap = policy.gap_change_fraction * max(self.gap(float(q)), 0.0) / closing if closing > 0 else math.inf
         log.append((seg.t_start, seg.t_end - seg.t_start, min((curvature, "curvature"), (size, "size"),
                                                                (gap, "gap"))[1]))
 

@@ -6,7 +6,9 @@ the result:
 
     modes       every mode family 1.5x its count (rounded up, at least +1, at most 40)
     rtol        solver.rtol / 10 (at least 1e-13)
-    macro_step  coupling.macro_step / 2                       (coupled scenes)
+    macro_step  coupling.macro_step / 2 and every other step rule of the coupling
+                (STEP_RULES: the free step, the time-scale fractions of the current
+                and of the coil's flux, the gap rule) / 2      (coupled scenes)
     reltol      ngspice RELTOL / 10 (at least 1e-9)            (coupled scenes)
 
 and writes ``summary.accuracy``: per refinement the base and refined value of each
@@ -87,6 +89,11 @@ TIME_KEYS = ("first_make", "last_make", "total_bounce_time", "operate_time", "re
 MAX_MODES = 40  # the largest count a family may have (mech.parameters)
 MIN_RTOL = 1e-13
 MIN_RELTOL = 1e-9
+# the coupling's step rules (coupling.core.scene.CouplingOptions), all halved by the macro_step
+# refinement: the contact's macro step and free step, the time-scale rules of the loop current
+# and the coil's flux, the gap rule (a coil-driven run's steps are mostly set by the last two)
+STEP_RULES = ("macro_step", "max_macro_step", "time_scale_fraction", "coil_time_scale_fraction",
+              "gap_change_fraction")
 
 # ---------------------------------------------------------------------------------------
 # metrics: pure functions
@@ -352,8 +359,7 @@ def refinements(scene, base_result) -> list[tuple[str, str, object]]:
             new_rtol = max(rtol / 10.0, MIN_RTOL)
             out.append(("rtol", f"rtol {rtol:g} -> {new_rtol:g}", scene.set("solver.rtol", new_rtol)))
     if scene.kind == "coupled":
-        h = scene.coupling.macro_step
-        out.append(("macro_step", f"macro step {h * 1e6:g} -> {h * 5e5:g} us", scene.set("coupling.macro_step", h / 2.0)))
+        out.append(("macro_step", *refined_steps(scene)))
     if scene.circuit is not None:
         reltol = scene.circuit.options.reltol
         if reltol <= MIN_RELTOL * (1 + 1e-9):
@@ -362,6 +368,15 @@ def refinements(scene, base_result) -> list[tuple[str, str, object]]:
             new = max(reltol / 10.0, MIN_RELTOL)
             out.append(("reltol", f"ngspice RELTOL {reltol:g} -> {new:g}", scene.set("circuit.reltol", new)))
     return out
+
+
+def refined_steps(scene) -> tuple[str, object]:
+    """The macro_step refinement: every step rule of the coupling halved (STEP_RULES), so that
+    whichever rule sets a run's macro steps, they halve; (description, refined scene)."""
+    c = scene.coupling
+    changes = {f"coupling.{key}": getattr(c, key) / 2.0 for key in STEP_RULES if getattr(c, key) is not None}
+    return (f"macro step {c.macro_step * 1e6:g} -> {c.macro_step * 5e5:g} us, every other step rule halved too "
+            f"({', '.join(key for key in STEP_RULES[1:] if getattr(c, key) is not None)})"), scene.update(changes)
 
 
 def perturbations(scene) -> list[tuple[str, str, object]]:

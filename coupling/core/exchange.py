@@ -31,9 +31,6 @@ CONTACT_EVENTS = ("contact_start", "contact_end")
 # coil's rated current: changes far below the rated force do not shorten the steps (the
 # coil's ringing after an unsuppressed release, at a thousandth of its rated flux)
 FLUX_FLOOR = 1.0
-# the coil's time scale is at most the time the working gap takes to change by this fraction
-# of itself while the armature moves (CoilLink.observe)
-GAP_CHANGE_FRACTION = 1.0
 
 
 def conduction_onset(penetration: float, onset: float) -> float:
@@ -356,14 +353,15 @@ class CoilLink:
         """Wb: the coil's flux linkage at the step's end."""
         return float(step.values[self._flux_column])
 
-    def observe(self, step, seg, span: float) -> None:
+    def observe(self, step, seg, policy) -> None:
         """After a step: the flux linkage at its end, its rate and time scale from the circuit's
-        last points (differences over at least 1e-3 of ``span``, s), and the armature's travel
-        at the step's circuit points (for the result's columns)."""
+        last points (differences over at least 1e-3 of the policy's macro step), bounded by the
+        gap rule (``policy.gap_change_fraction``), and the armature's travel at the step's
+        circuit points (for the result's columns)."""
         times = step.reader("time")
         self.tail.observe(times, self.signal(step.reader(self._flux_column)), False)
         self.value = self.signal(self.flux(step))
-        self.rate, self.scale = self.tail.rate(span)
+        self.rate, self.scale = self.tail.rate(policy.macro_step)
         if self.rate != 0.0:
             # not beyond the time it takes to change by its own size (plus the floor): a signal
             # falling linearly to zero (a clamped coil's release) has no curvature
@@ -375,7 +373,7 @@ class CoilLink:
             # equation holds the gap, and its force 1/g^2, while the armature flies (the flux
             # itself changes little then: at 240 us steps the default relay's coil audit left
             # 3e-3 of its energy to ngspice's coarse points)
-            self.scale = min(self.scale, GAP_CHANGE_FRACTION * max(self.gap(float(q)), 0.0) / closing)
+            self.scale = min(self.scale, policy.gap_change_fraction * max(self.gap(float(q)), 0.0) / closing)
         new = times[1:] if self._sampled else times
         self._sampled = True
         lo, hi = seg.t_start, seg.t_end

@@ -26,7 +26,6 @@ t_n, held: mu(I_n) and the conductance G(F_n(t_n)).
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 import math
 import signal
 import sys
@@ -131,8 +130,7 @@ class CoSimulation:
         self._reset()
         # the coil's flux linkage is watched by the same rules, with a floor in Wb
         coil = self.coil
-        self.coil_policy = dataclasses.replace(self.policy, current_floor=coil.floor,
-                                               time_scale_fraction=COIL_TIME_SCALE_FRACTION) if coil is not None else None
+        self.coil_policy = self.policy.for_coil(scene.coupling, coil.floor) if coil is not None else None
 
     def _links(self) -> list:
         """The links between the scene's mechanics and circuit blocks: each circuit contact fed
@@ -360,7 +358,7 @@ class CoSimulation:
         self._sample_contact(mech, step)
         jumped = bool(switching) or aligned
         if coil is not None:
-            coil.observe(step, seg, self.coil_policy.macro_step)
+            coil.observe(step, seg, self.coil_policy)
         if contact is None:
             return t_next, 0.0, jumped, (0.0, math.inf)
         for link in links:

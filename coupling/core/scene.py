@@ -38,9 +38,11 @@ from mech.scene import SCENE_SECTIONS as MECH_SECTIONS
 from mech.scene import read_toml
 from mech.scene import scene_from_dict as mech_scene_from_dict
 from mech.validation import (
-    check_bool, check_choice, check_file, check_keys, check_nonnegative, check_positive, check_whole, internal,
+    check_bool, check_choice, check_file, check_keys, check_nonnegative, check_positive, check_range, check_whole,
+    internal,
     scene_key,
 )
+from coupling.core.policy import COIL_TIME_SCALE_FRACTION, GAP_CHANGE_FRACTION, TIME_SCALE_FRACTION
 
 COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output", "metrics", "duty", "coil", "magnet")
 # macro steps a coupled run may take at most (t_end / macro_step, every step in contact):
@@ -57,6 +59,9 @@ MACRO_STEP_LOG_BYTES = 152  # the friction coefficient's log, one entry per macr
 TEMPLATES = ("resistive", "inductive", "capacitive", "current_source", "netlist", "mcu_input", "short_circuit",
              "bridge", "changeover")
 SCHEMES = ("mechanics_first", "jacobi")
+# coupling.gap_change_fraction at most: a step may carry the armature past its landing (the
+# mechanics find the stop exactly), not over many times the gap
+GAP_CHANGE_MAX = 10.0
 
 
 def _table(where: str, value) -> dict:
@@ -81,6 +86,10 @@ class CouplingOptions:
     (coupling.core.exchange.conduction_onset): the continuum Hertz/Holm laws do not hold below
     the surface-roughness scale, and G ~ y^0.4 has an unbounded derivative at touchdown
     that ngspice's truncation-error control cannot follow at tight RELTOL.
+    time_scale_fraction, coil_time_scale_fraction, gap_change_fraction: the step rules
+    (coupling.core.policy, docs/coupling.md "Step lengths" and "The coil's steps"): a macro
+    step extrapolates the loop current, the coil's flux, over at most that fraction of its
+    time scale, and lets the working gap change by at most that fraction of itself.
     """
 
     scheme: str = scene_key("mechanics_first", unit="-", doc='or "jacobi"')
@@ -88,6 +97,16 @@ class CouplingOptions:
     max_macro_step: float | None = scene_key(1e-4, unit="s", doc="while both tips are free")
     align_events: bool = scene_key(True, unit="-", doc="end a macro step at each make/break")
     onset_penetration: float = scene_key(10e-9, unit="m", doc="conduction ramps in over this penetration")
+    time_scale_fraction: float = scene_key(
+        TIME_SCALE_FRACTION, unit="-",
+        doc="a macro step extrapolates the loop current over at most this fraction of its time scale; (0, 1]")
+    coil_time_scale_fraction: float = scene_key(
+        COIL_TIME_SCALE_FRACTION, unit="-",
+        doc="the same for the coil's flux (psi^2 for a flux-tube magnet); (0, 1]")
+    gap_change_fraction: float = scene_key(
+        GAP_CHANGE_FRACTION, unit="-",
+        doc="while the armature moves, a macro step lets the working gap change by at most this fraction of itself; "
+            "(0, 10]")
 
     def __post_init__(self):
         check_choice("coupling.scheme", self.scheme, SCHEMES)
@@ -99,6 +118,9 @@ class CouplingOptions:
                                  f"coupling.macro_step = {self.macro_step!r}")
         check_bool("coupling.align_events", self.align_events)
         check_nonnegative("coupling.onset_penetration", self.onset_penetration, high=LENGTH_MAX)
+        for name in ("time_scale_fraction", "coil_time_scale_fraction"):
+            check_range(f"coupling.{name}", getattr(self, name), 0.0, 1.0, closed_high=True)
+        check_range("coupling.gap_change_fraction", self.gap_change_fraction, 0.0, GAP_CHANGE_MAX, closed_high=True)
 
     @property
     def free_step(self) -> float:

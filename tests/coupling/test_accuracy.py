@@ -348,7 +348,14 @@ def test_a_changeover_is_judged_contact_by_contact(tmp_path, capsys):
     mismatch splits exactly into NO's and NC's (it is a sum over contact pairs, and each
     pair feeds one contact), and so do the closures; NC's one closure, from rest to the card
     lifting it, is well-conditioned and converged in every refinement, whatever NO's bounces
-    do. The command line prints one accuracy line per contact."""
+    do. The command line prints one accuracy line per contact.
+
+    The coil's time-scale rule is at half the default here: at 0.1 NC's break (9.0730 ms)
+    carries a coupling error of 1.5 us (the runs with every step rule halved once, twice and
+    three times break at 9.0716, 9.0714, 9.0715 ms), which the check's step refinement moves
+    by 1.44 us, above NC's 1 us tolerance, and nothing else changes NC (its sensitivity
+    scale is zero): "not converged" is then the right verdict for NC. At 0.05 the refinement
+    moves it by 0.46 us."""
     from pathlib import Path
 
     from coupling.app.cli import main
@@ -357,7 +364,9 @@ def test_a_changeover_is_judged_contact_by_contact(tmp_path, capsys):
     text = (root / "examples" / "changeover_relay.toml").read_text()
     assert "t_end = 0.019" in text
     path = tmp_path / "changeover.toml"
-    path.write_text(text.replace("t_end = 0.019", "t_end = 0.013"))
+    assert "\nmax_macro_step = 1e-3\n" in text
+    path.write_text(text.replace("t_end = 0.019", "t_end = 0.013")
+                    .replace("\nmax_macro_step = 1e-3\n", "\nmax_macro_step = 1e-3\ncoil_time_scale_fraction = 0.05\n"))
     assert main(["run", str(path), "--out", str(tmp_path / "out"), "--check", "--quiet"]) == 0
     lines = [line for line in capsys.readouterr().out.splitlines() if line.startswith("switchsim: accuracy of")]
     assert [line.split(":")[1].strip() for line in lines] == ["accuracy of contact NO", "accuracy of contact NC"]
@@ -404,3 +413,30 @@ def test_an_actuator_alone_is_judged_on_its_armatures_pole_impacts():
     for entry in acc["refinements"]:
         if entry["status"] == "ok":
             assert "pole_arrival" in entry["metrics"]
+
+
+def test_the_macro_step_refinement_halves_every_step_rule_and_the_coil_error_falls():
+    """A coil-driven run's macro steps are set by the free step and the coil's own rules (its
+    flux's time scale, the gap rule), not by coupling.macro_step: halving that alone, as the
+    refinement once did, left the plunger's steps as they were, and `run --check` could say
+    "did not move" about a coupling it had never refined. Halving every rule halves the steps
+    whichever binds (at least 1.8x the macro steps per halving), and the armature's arrival
+    on the pole then converges: against the run refined twice, the once-refined run's error is
+    at most 0.6 of the base run's (Richardson: 1/3 at first order, 1/5 at second; a rule
+    that did not refine the coupling leaves ~1)."""
+    from pathlib import Path
+
+    from coupling import load_scene
+    from coupling.app.accuracy import refined_steps
+
+    scene = load_scene(Path(__file__).resolve().parents[2] / "examples" / "plunger_solenoid.toml")
+    scene = scene.set("solver.t_end", 0.0125)
+    fine = refined_steps(scene)[1]
+    finer = refined_steps(fine)[1]
+    runs = [run(s) for s in (scene, fine, finer)]
+    steps = [r.stats["macro_steps"] for r in runs]
+    assert steps[1] >= 1.8 * steps[0] and steps[2] >= 1.8 * steps[1], steps
+    arrival = [r.mechanics.armature["first_arrival"] for r in runs]
+    assert all(a is not None and a < 0.0125 for a in arrival), arrival
+    base_error, fine_error = abs(arrival[0] - arrival[2]), abs(arrival[1] - arrival[2])
+    assert fine_error <= 0.6 * base_error, (arrival, steps)

@@ -56,6 +56,13 @@ def test_set_revalidates_and_keeps_the_original():
     ({**MECH, "circuitry": {}}, "unknown section \\[circuitry\\]"),
     ({**MECH, **TRIB, **CIRCUIT, "coupling": {"scheme": "gauss_seidel"}}, "coupling.scheme"),
     ({**MECH, **TRIB, **CIRCUIT, "coupling": {"macro_step": 1e-5, "max_macro_step": 1e-6}}, "max_macro_step"),
+    # the step rules: fractions of a time scale (a step past the scale extrapolates beyond what the
+    # last points say), the gap rule at most a few gaps
+    ({**MECH, **TRIB, **CIRCUIT, "coupling": {"time_scale_fraction": 0.0}},
+     "coupling.time_scale_fraction = 0.0: allowed range is \\(0.0, 1.0\\]"),
+    ({**MECH, **TRIB, **CIRCUIT, "coupling": {"coil_time_scale_fraction": 2}}, "coupling.coil_time_scale_fraction = 2"),
+    ({**MECH, **TRIB, **CIRCUIT, "coupling": {"gap_change_fraction": "1"}}, "coupling.gap_change_fraction = '1'"),
+    ({**MECH, **TRIB, **CIRCUIT, "coupling": {"gap_change_fraction": 50.0}}, "allowed range is \\(0.0, 10.0\\]"),
     ({**MECH, "tribology": {"source": "illustrative", "fit": "x.json"}}, "exactly one of"),
     ({**MECH, "tribology": {"source": "paper"}}, "only built-in source"),
     ({**MECH, **TRIB, "circuit": {"voltage": -5.0}}, "voltage"),
