@@ -102,8 +102,11 @@ def binding_rules(scene) -> list[tuple[float, float, str]]:
         curvature = end_rate(self.tail.t, self.tail.v, policy.macro_step)[1]
         size = (abs(self.value) + self.floor) / abs(self.rate) if self.rate else math.inf
         q, q_dot = seg.armature(seg.t_end)[:2]
-        closing = self.lever * abs(float(q_dot))
-        gap = policy.gap_change_fraction * max(self.gap(float(q)), 0.0) / closing if closing > 0 else math.inf
+        span = seg.t_end - seg.t_start
+        speed = self.lever * abs(float(q_dot))
+        accel = self.lever * abs(float(q_dot) - float(seg.armature(seg.t_start)[1])) / span if span > 0 else 0.0
+        gap = (exchange.gap_time(policy.gap_change_fraction * max(self.gap(float(q)), 0.0), speed, accel)
+               if speed > 0 or accel > 0 else math.inf)
         log.append((seg.t_start, seg.t_end - seg.t_start, min((curvature, "curvature"), (size, "size"),
                                                                (gap, "gap"))[1]))
 

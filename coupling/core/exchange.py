@@ -33,6 +33,16 @@ CONTACT_EVENTS = ("contact_start", "contact_end")
 FLUX_FLOOR = 1.0
 
 
+def gap_time(room: float, speed: float, accel: float) -> float:
+    """s: the time a gap takes to close by ``room`` (m) from ``speed`` (m/s) at ``accel``
+    (m/s^2), both magnitudes: the root of speed t + accel t^2 / 2 = room, in the form without
+    cancellation. At rest and unaccelerated: inf."""
+    if room <= 0.0:
+        return 0.0
+    root = speed + math.sqrt(speed * speed + 2.0 * accel * room)
+    return 2.0 * room / root if root > 0.0 else math.inf
+
+
 def conduction_onset(penetration: float, onset: float) -> float:
     """Fraction (0..1) of the law's conductance a contact point carries at penetration y (m).
 
@@ -367,13 +377,18 @@ class CoilLink:
             # falling linearly to zero (a clamped coil's release) has no curvature
             self.scale = min(self.scale, (abs(self.value) + self.floor) / abs(self.rate))
         q, q_dot = seg.armature(seg.t_end)[:2]
-        closing = self.lever * abs(float(q_dot))  # m/s of the working gap
-        if closing > 0.0:
+        span = seg.t_end - seg.t_start
+        speed = self.lever * abs(float(q_dot))  # m/s of the working gap
+        # m/s^2: the armature's acceleration over the step (its velocity change)
+        accel = self.lever * abs(float(q_dot) - float(seg.armature(seg.t_start)[1])) / span if span > 0.0 else 0.0
+        if speed > 0.0 or accel > 0.0:
             # nor beyond the time the gap takes to change by its own size: the coil's flux
             # equation holds the gap, and its force 1/g^2, while the armature flies (the flux
             # itself changes little then: at 240 us steps the default relay's coil audit left
-            # 3e-3 of its energy to ngspice's coarse points)
-            self.scale = min(self.scale, policy.gap_change_fraction * max(self.gap(float(q)), 0.0) / closing)
+            # 3e-3 of its energy to ngspice's coarse points); at its speed and acceleration,
+            # for an armature leaving its stop has no speed yet
+            self.scale = min(self.scale, gap_time(policy.gap_change_fraction * max(self.gap(float(q)), 0.0),
+                                                  speed, accel))
         new = times[1:] if self._sampled else times
         self._sampled = True
         lo, hi = seg.t_start, seg.t_end

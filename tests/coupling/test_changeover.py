@@ -129,10 +129,19 @@ def test_the_preloaded_blade_rests_on_nc_with_the_spring_preload():
     assert res.changeover["operate"] == [] and res.contact_closed["NC"][1]
 
 
+# s: how far apart two integrations of one macro step may locate the same make or break
+RELOCATION = 1e-9
+# S: a contact's conductance channel below this is open. At a break the channel gives its left
+# limit (circuit.contact.left_limited), the Hertz-Holm conductance a femtosecond before the
+# break, which is 0 or, where the penetration there is a round-off above 0, ~1e-19 S
+# (measured); the circuit holds 1 nS across an open contact anyway
+OPEN_BELOW = 1e-12
+
+
 def _switching(t, g):
     """(s, s, closed after) of each change of a conductance column: the last point of one
     state, the first of the other, and whether the other is conducting."""
-    on = g > 0.0
+    on = g > OPEN_BELOW
     k = np.flatnonzero(on[1:] != on[:-1])
     return [(t[i], t[i + 1], bool(on[i + 1])) for i in k]
 
@@ -144,7 +153,13 @@ def test_the_transfer_time_is_where_the_circuits_conduction_changes(relay):
     event and ngspice lands on it: at a break the first open point of the circuit is the
     mechanics' break, at a make the last open point is the make (G = 0 at zero
     penetration), each within the metrics' make guard (1e-9 of the run, 19 ps); so the
-    transfer times agree to twice that."""
+    transfer times agree to twice that, up to where the mechanics locate a switch: a step
+    redone to end at a switch ends where the first run located it, and the redone run, on
+    other steps, can locate it a little earlier (77 ps on the release, once the coil's gap
+    rule changed the steps), so ngspice switches the contact at the step's end, that much
+    after the reported break. The bound below allows 1 ns for that (the switch's location
+    between two integrations of the same step; ending the redone step where it locates the
+    switch instead moves every aligned scene's results at the integration tolerance)."""
     w = relay.waveform_columns
     t = w["time"]
     guard = 1e-9 * RAW["solver"]["t_end"]
@@ -154,12 +169,12 @@ def test_the_transfer_time_is_where_the_circuits_conduction_changes(relay):
     no_changes = _switching(t, w["contact_conductance_NO"])
     nc_break = next(c for c in nc_changes if not c[2])
     no_make = next(c for c in no_changes if c[2])
-    assert nc_break[1] == pytest.approx(op["nc_break"], abs=guard)
-    assert no_make[0] == pytest.approx(op["no_make"], abs=guard)
-    assert co["transfer_time"] == pytest.approx(no_make[0] - nc_break[1], abs=2 * guard)
+    assert nc_break[1] == pytest.approx(op["nc_break"], abs=guard + RELOCATION)
+    assert no_make[0] == pytest.approx(op["no_make"], abs=guard + RELOCATION)
+    assert co["transfer_time"] == pytest.approx(no_make[0] - nc_break[1], abs=2 * guard + RELOCATION)
     no_break = next(c for c in no_changes if not c[2] and c[1] > rel["no_break"] - guard)
     nc_make = next(c for c in nc_changes if c[2] and c[0] > no_break[0])
-    assert rel["transfer_time"] == pytest.approx(nc_make[0] - no_break[1], abs=2 * guard)
+    assert rel["transfer_time"] == pytest.approx(nc_make[0] - no_break[1], abs=2 * guard + RELOCATION)
     # the NC make's bounces: NC's own closures in its make episode, as the circuit sees them
     closures = [c for c in nc_changes if c[2] and c[0] >= nc_make[0]]
     assert rel["nc_bounces"] == len(closures) - 1
