@@ -25,7 +25,10 @@ Commit {commit}, {date} UTC, Python {python}; {load} when assembled. The machine
 `switchsim run SCENE --check --out DIR` (or `run(scene, check=True)`) runs the scene, then
 reruns it once per refinement, each alone so the verdict can name the one that moved the result:
 more modes (every family 1.5x, rounded up, at least +1, at most 40), rtol / 10, and for
-coupled scenes half the macro step and ngspice RELTOL / 10. summary.json gets `accuracy`:
+coupled scenes every step rule of the coupling halved (`coupling.macro_step`,
+`max_macro_step`, `time_scale_fraction`, `coil_time_scale_fraction`,
+`gap_change_fraction`: whichever sets a run's macro steps, they halve) and ngspice
+RELTOL / 10. summary.json gets `accuracy`:
 for each refinement the base and refined value of every metric, the change, the tolerance
 and whether it held, and one `verdict` line, which the command line prints:
 
@@ -37,6 +40,8 @@ and whether it held, and one `verdict` line, which the command line prints:
 | peak normal force | within 2 % |
 | peak contact voltage | within 2 % + 10 mV |
 | arc energy | within 5 % + 1 uJ |
+| a relay's operate and release time | within max(1 us, 1 % of the switching window) |
+| an actuator's (an armature without a contact) first and last arrival on its pole stop, its bounces off it | within max(1 us, 1 % of the switching window); equal |
 
 The switching window runs from the first make to the last switching instant (the last
 make when the run ends closed, the last break when it ends open), without held closures
@@ -47,12 +52,27 @@ not loosen the tolerances.
 designer knows to 1 % changed by 1 % each way: the contact gap (`initial.height`) and the
 contact's dissipation (`contact.restitution`, or `contact.damping`); where one cannot be
 changed (a contact that starts closed, an elastic contact) the gap changed by 0.5 % each
-way takes its place. Each perturbed contact sequence is shifted onto the base run's first
+way takes its place. An actuator alone (an `[armature]` without a `[bar]`: no contact) has
+its travel (`armature.travel`) and its stops' damping (`armature.stop_damping`) changed
+instead, and is judged on its pole arrivals. `switchsim run examples/plunger_solenoid.toml
+--check` (this session): within sensitivity. rtol / 10 and RELTOL / 10 move the
+armature's last arrival on the pole, after eleven bounces on it, by 5 and 2 us; the halved
+step rules by 41 us, a little more than a 1 % change of the stops' damping does (32 us);
+a 1 % change of the travel moves it by 0.9-1.2 ms. The first arrival (12.337 ms) moves by
+at most 0.5 us. (The macro-step refinement once halved `coupling.macro_step` alone, which
+sets none of the plunger's steps: its reruns took the same 923 steps and the check could
+not see the coupling's error. tests/coupling/test_accuracy.py now asserts that the
+refinement halves the steps and that the first arrival converges under it.) Each perturbed contact sequence is shifted onto the base run's first
 make, and the check reports the range each metric spans over these five runs
 (`sensitivity_ranges`). A switch closure's late micro-bounces are often
-ill-conditioned: on the default relay a 0.1 % change of the gap adds or removes a
-bounce (docs/accuracy-modes.md); no numerical setting makes such a metric more certain
-than its inputs. `status` is then one of
+ill-conditioned: on the force-driven relay (relay_force) a 0.1 % change of the gap adds
+or removes a bounce (docs/accuracy-modes.md); no numerical setting makes such a metric more
+certain than its inputs. On the coil-driven default relay (measured this session,
+`switchsim run --check`): every refinement moves the operate time by at most 2.3 us (the
+halved step rules; 0.5 us when the macro step alone was halved, which left the coil's rules
+as they were) and the release time by at most 0.5 us, the 1 % changes move the operate time
+over 4.446-4.475 ms and the release time over 0.324-0.344 ms, and the bounce count over 2-8
+("within sensitivity"). `status` is then one of
 
 - `converged`: no refinement moved a metric beyond its tolerance (the verdict still names
   the metrics the perturbed inputs move, as ill-conditioned);
@@ -63,7 +83,23 @@ than its inputs. `status` is then one of
   make, or a rerun failed): a numerical error to remove.
 
 The verdict also says how many first closures agree (make and break within the time
-tolerance) in every rerun: up to there the sequence is a prediction. `accuracy.png`
+tolerance) in every rerun: up to there the sequence is a prediction.
+
+A circuit of several contacts (a changeover's NO and NC, a netlist's contacts) is also
+judged contact by contact: `accuracy.per_contact.<name>` holds each contact's `status`,
+`verdict` and `sensitivity_ranges`, from the same reruns, with the contact metrics of the
+contact pairs that feed that contact alone (a perturbed run's sequence aligned on that
+contact's own first make), and the command line prints one `accuracy of contact <name>`
+line each. The overall status still judges all pairs together, where one contact's
+ill-conditioned tail sets the scale for both: on the changeover example (measured this
+session, `switchsim run examples/changeover_relay.toml --check`) the whole is "NOT
+converged", by NC's release bounces: an ill-conditioned tail, which every refinement moves
+(contact state by 262-344 us, NC's contact count to 12-14) somewhat more than the 1 %
+changes of the gap or restitution do (285 us; its contact count over 10-13). NO is "within
+sensitivity": 1.5 times the modes (2 + 11 -> 3 + 17) removes a grazing opening (3 us at
+12.442 ms), and the refinements move NO's contact state by 7-13 us while the 1 % input
+changes move it by up to 18 us (its contact count over 5-6). NO's first make agrees within
+0.5 us and its last make within 3 us at bending counts 11, 17 and 22 (13 ms runs, axial 2). `accuracy.png`
 (written with the plots) draws the closed intervals of the run and of every rerun, one
 row each.
 
