@@ -24,7 +24,7 @@ and capacitance and a compliance clamp; see its docstring for the netlist)::
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import ClassVar, Union
 
 from PySpice.Spice.Netlist import Circuit
@@ -438,11 +438,19 @@ class BridgeCircuit(SwitchCircuit):
         inputs, arc and result columns (``contact_voltage_<name>``, ...).
     contact_capacitance: F, across each contact (not across the bridge: in series two
         such give half of it across the whole).
+    load_inductance: H, the load's inductance in series with its resistance (0: resistive; a
+        contactor's motor or coil, AC-3/DC-3 duty): Lload below Rload (node ``load_l``), as
+        an ``InductiveLoad``'s; ``flyback`` is then a diode from ground to ``contact_b``,
+        across the load and its probe (as the one-contact template's: below the probe, the
+        probe's nA open current would come out of a node where the diode carries amperes).
     Every other field is SwitchCircuit's; the arc model (``arc``) is each contact's, so at
-    a break the two arcs in series hold twice its burning voltage.
+    a break the two arcs in series hold twice its burning voltage and share the inductor's
+    energy.
     """
 
     contact_names: tuple = internal(("a", "b"))  # the scene's two electrical [[fixed]] contacts
+    load_inductance: float = scene_key(
+        0.0, unit="H", doc="bridge: the load's inductance, in series with `load_resistance` (0: resistive)")
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -456,6 +464,33 @@ class BridgeCircuit(SwitchCircuit):
         if names[0].lower() == names[1].lower():
             raise ValueError(f"BridgeCircuit.contact_names = {tuple(names)!r}: two distinct names (SPICE ignores case)")
         object.__setattr__(self, "contact_names", tuple(names))
+
+    def _check_own_keys(self) -> None:
+        # (before SwitchCircuit's checks read the load's inductance)
+        check_range(self.SECTION, "load_inductance", self.load_inductance, "H", 0.0, 100.0)
+        if self.load_inductance > 0.0 and not isinstance(self.load, ResistiveLoad):
+            raise ValueError(f"{self.SECTION}.load_inductance = {self.load_inductance!r} with a "
+                             f"{type(self.load).__name__}: the bridge's load_inductance goes in series with a "
+                             "ResistiveLoad (or give the InductiveLoad alone)")
+
+    @property
+    def _inductive_load(self) -> bool:
+        return self.load_inductance > 0.0 or isinstance(self.load, InductiveLoad)
+
+    @property
+    def _flyback_refusal(self) -> str:
+        return (f"{self.SECTION}.flyback is set but the bridge's load is resistive (load_inductance = "
+                f"{self.load_inductance!r}): a flyback diode belongs across an inductive load")
+
+    @property
+    def _load_inductance(self) -> float:
+        return float(self.load_inductance) if self.load_inductance > 0.0 else super()._load_inductance
+
+    def build(self) -> Circuit:
+        if self.load_inductance > 0.0:  # the one-contact template's R-L load, the same netlist
+            load = InductiveLoad(self.load.load_resistance, self.load_inductance)
+            return replace(self, load=load, load_inductance=0.0).build()
+        return super().build()
 
     #: how the contacts are arranged in the loop: the current flows only while both are closed
     arrangement = "series"
