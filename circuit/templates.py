@@ -167,7 +167,8 @@ class InductiveLoad:
     SECTION: ClassVar[str] = "circuit"
     load_resistance: float = scene_key(24.0, unit="ohm")
     load_inductance: float = scene_key(
-        10e-3, unit="H", doc="inductive; changeover: NO's load inductance, in series with `load_resistance` (0: resistive)")
+        10e-3, unit="H", doc="inductive; bridge: the load's inductance, changeover: NO's, in series with "
+        "`load_resistance` (0: resistive)")
 
     def __post_init__(self) -> None:
         check_range(self.SECTION, "load_resistance", self.load_resistance, "ohm", 1e-6, 1e9)
@@ -257,7 +258,7 @@ class SwitchCircuit:
         "both): [circuit.snubber]; omitted or false: none")
     flyback: FlybackDiode | None = scene_key(
         None, unit="-", doc="a diode across an inductive load: true (its defaults) or a table: [circuit.flyback]; "
-        "omitted or false: none (changeover: one across each inductive throw's load)")
+        "omitted or false: none (bridge: across its inductive load; changeover: one across each inductive throw's load)")
     arc: ArcModel | None = scene_key(
         None, unit="-", doc="the arc model: true (its defaults) or a table: [circuit.arc]; omitted or false: none")
     leakage_conductance: float = scene_key(DEFAULT_LEAKAGE, unit="S", doc="open-contact insulation")

@@ -196,8 +196,8 @@ class CircuitSpec:
         "resistive", unit="-",
         doc='"inductive", "capacitive", "current_source", "netlist", "mcu_input" (a switch read by a '
             'microcontroller pin: docs/circuit.md section 6), "short_circuit" (resistive, the load shorted at '
-            '`fault_time`: a fault current through the closed contact), "bridge" (resistive, its switch a '
-            "double-break bridge: two contacts in series, each its own circuit contact named as the scene's two "
+            '`fault_time`: a fault current through the closed contact), "bridge" (resistive or R-L with '
+            "`load_inductance`, a contactor's motor or coil, its switch a double-break bridge: two contacts in series, each its own circuit contact named as the scene's two "
             "electrical `[[fixed]]` contacts, which it needs; docs/circuit.md section 6), \"changeover\" (form C: "
             "the supply on the moving contact, its NO and NC throws each with its own load, resistive or R-L "
             "(`load_inductance`, `nc_load_inductance`); each its own "
