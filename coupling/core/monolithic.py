@@ -57,6 +57,10 @@ def series_loop(circuit) -> SeriesLoop:
 
     if not isinstance(circuit, ck.SwitchCircuit):
         raise ValueError("monolithic reference: only template circuits (SwitchCircuit) can be written as an ODE")
+    if len(circuit.contacts) != 1:
+        # (a bridge's or a changeover's contacts would be read as one, and their load_inductance missed)
+        raise ValueError(f"monolithic reference: the circuit holds {len(circuit.contacts)} contacts "
+                         f"({type(circuit).__name__}); the reference covers a loop with one contact")
     for part in ("arc", "snubber", "flyback"):
         if getattr(circuit, part) is not None:
             raise ValueError(f"monolithic reference: circuit.{part} is set; the reference covers series "

@@ -54,6 +54,19 @@ def test_the_reference_is_a_series_loop_of_the_scene():
     assert not loop.has_inductance
 
 
+@pytest.mark.parametrize("template", ["bridge", "changeover"])
+def test_the_reference_refuses_a_loop_of_several_contacts(template):
+    """A bridge's two contacts in series (or a changeover's two throws) read as the one
+    contact of a series loop would be a wrong reference, their load_inductance missed: refused
+    with a one-line error before anything runs."""
+    import circuit as ck
+
+    cls = ck.BridgeCircuit if template == "bridge" else ck.ChangeoverCircuit
+    with pytest.raises(ValueError, match="holds 2 contacts") as err:
+        series_loop(cls(ck.DCSource(24.0), ck.ResistiveLoad(10.0)))
+    assert "\n" not in str(err.value)
+
+
 def test_current_and_friction_really_couple(reference):
     """Precondition: the inrush reaches amperes during the contact and mu moves with it."""
     w = reference.waveforms
