@@ -25,6 +25,8 @@ the rows it thinned away (``mech.ImpactResult.thinning``)):
   a > 0.45 R) the result is unsound; between 1 % and 5 % (y > 0.04 R) it carries a
   warning (coupling.core.diagnostics), its forces and contact times being approximate to
   about that fraction;
+- coil (a relay's or solenoid's coil, coupling.core.relay): its energy audit's |residual|
+  <= energy_tolerance * the energy into the coil;
 - circuit (template circuits): the loop current through the load is at most
   2 V / (R_source + R_wiring + R_load) (A): the supply across the series loop, plus one
   full overshoot of the loop's ringing (a short_circuit template: R_load || R_fault; a
@@ -79,6 +81,20 @@ def energy_problem(max_residual: float, energy_scale: float, tolerance: float) -
         return None
     return (f"energy audit: residual {max_residual:.3g} J is {rel:.3g} of the scene's energy {energy_scale:.3g} J "
             f"(allowed: solver.energy_tolerance = {tolerance:g}); {FIX}")
+
+
+COIL_FIX = ("the coil's flux is not integrated accurately enough: cap [coupling] max_macro_step "
+            "(e.g. 2e-5 s) or [circuit] max_step")
+
+
+def coil_energy_problem(relative_residual: float | None, tolerance: float) -> str | None:
+    """The coil's energy audit's verdict (coupling.core.relay): None if its |residual| is
+    at most tolerance x the energy into the coil (both J); a coil into which no energy went
+    (None) has nothing to judge."""
+    if relative_residual is None or relative_residual <= tolerance:
+        return None
+    return (f"coil energy audit: residual {relative_residual:.3g} of the energy into the coil "
+            f"(allowed: solver.energy_tolerance = {tolerance:g}); {COIL_FIX}")
 
 
 def speed_problem(max_speed: float, bound: float) -> str | None:
@@ -167,6 +183,13 @@ def assess(result) -> dict:
             problems += [p for p in (speed_problem(speed, v_max),
                                      penetration_problem(pen, y_max, scene.bar.tip_radius)) if p]
             problems += [p for p in (hertz_problem(y, r, name) for name, y, r in mres.contact_depths) if p]
+        relay = result.relay
+        coil = relay.get("energy") if relay else None
+        if coil is not None:
+            out["coil_relative_residual"] = coil["relative_residual"]
+            problem = coil_energy_problem(coil["relative_residual"], scene.solver.energy_tolerance)
+            if problem:
+                problems.append(problem)
     bound = _circuit_current_bound(result.scene)
     waves = result.waveform_columns
     if bound is not None and waves is not None and len(waves["time"]) and "load_current" in waves:
