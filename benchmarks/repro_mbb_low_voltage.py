@@ -20,7 +20,9 @@ alike, 1e-6 S passes. The arc never burns here (|V| < U_min at 5 V, so the uramp
 and their Jacobian are zero), and arc = false passes with the same 1e-9 S leakage, so
 the arc's part that matters is what it adds besides its off path: the 0-V sense source
 Varc (a branch-current unknown carrying nA) and the node arc_p between it and Barc, or
-the EXTERNAL Iarc_on into its 1-ohm node. Next to test: drop Varc (sense the current
+the EXTERNAL Iarc_on into its 1-ohm node. Nor is it Barc's nonlinearity: with its
+expression replaced by the linear 1e-9*V(arc_p,b) alone (PySpice's Circuit.B wrapped
+in a probe script) the run still fails, at 0.40334 ms. Next to test: drop Varc (sense the current
 another way) and see whether the failure goes; then ngspice's NIconvTest on branch
 currents at RELTOL 1e-6.
 
