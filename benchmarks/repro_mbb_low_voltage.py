@@ -14,6 +14,18 @@ leakage_conductance from 1e-9 to 1e-6 S makes it pass. With both throws open the
 node hangs on the two contact capacitances and ~4e-9 S of leakage and arc off-conductance,
 its lead current (the 0-V probe Vload) ~1e-8 A.
 
+Not the arc's off-conductance either (measured by setting circuit.arc.OFF_CONDUCTANCE
+before the run, the failing variant otherwise): 0, 1e-12 and 1e-9 S fail at 0.40379 ms
+alike, 1e-6 S passes. The arc never burns here (|V| < U_min at 5 V, so the uramp terms
+and their Jacobian are zero), and arc = false passes with the same 1e-9 S leakage, so
+the arc's part that matters is what it adds besides its off path: the 0-V sense source
+Varc (a branch-current unknown carrying nA) and the node arc_p between it and Barc, or
+the EXTERNAL Iarc_on into its 1-ohm node. Nor is it Barc's nonlinearity: with its
+expression replaced by the linear 1e-9*V(arc_p,b) alone (PySpice's Circuit.B wrapped
+in a probe script) the run still fails, at 0.40334 ms. Next to test: drop Varc (sense the current
+another way) and see whether the failure goes; then ngspice's NIconvTest on branch
+currents at RELTOL 1e-6.
+
     .venv/bin/python benchmarks/repro_mbb_low_voltage.py    (prints one line per variant)
 """
 
