@@ -43,7 +43,9 @@ import math
 import numpy as np
 
 from coupling.core.metrics import ARC_BURNING_CURRENT, arc_toggles
-from coupling.core.soundness import HERTZ_UNSOUND_ERROR, HERTZ_WARN_ERROR, hertz_gap_error, hertz_validity_line
+from coupling.core.soundness import (
+    COIL_UNSOUND_FACTOR, HERTZ_UNSOUND_ERROR, HERTZ_WARN_ERROR, coil_energy_line, hertz_gap_error, hertz_validity_line,
+)
 
 PASCHEN_A = 15.0  # 1/(cm Torr), air
 PASCHEN_B = 365.0  # V/(cm Torr), air
@@ -95,6 +97,21 @@ def hertz_warnings(mres) -> list[str]:
     HERTZ_WARN_ERROR (and not past HERTZ_UNSOUND_ERROR, which makes the run unsound)."""
     return [hertz_validity_line(y, r, name) for name, y, r in mres.contact_depths
             if HERTZ_WARN_ERROR < hertz_gap_error(y, r) <= HERTZ_UNSOUND_ERROR]
+
+
+def coil_audit_warning(result) -> str | None:
+    """One line where the coil's energy audit is above solver.energy_tolerance (and not past
+    COIL_UNSOUND_FACTOR times it, which makes the run unsound): the coil's side is then
+    approximate to about that fraction."""
+    relay = result.relay if result.mechanics is not None else None
+    energy = relay.get("energy") if relay else None
+    rel = energy.get("relative_residual") if energy else None
+    if rel is None:
+        return None
+    tolerance = result.mechanics.model.scene.solver.energy_tolerance
+    if tolerance < rel <= COIL_UNSOUND_FACTOR * tolerance:
+        return coil_energy_line(rel, tolerance, tolerance)
+    return None
 
 
 def overcurrent_warning(t, currents: dict, limit: float, source: str) -> str | None:
@@ -241,6 +258,9 @@ def run_warnings(result) -> list[str]:
     if result.mechanics is not None:
         out += hertz_warnings(result.mechanics)
         line = table_ringing_warning(result.mechanics)
+        if line:
+            out.append(line)
+        line = coil_audit_warning(result)
         if line:
             out.append(line)
     w = result.waveform_columns

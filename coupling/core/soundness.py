@@ -26,7 +26,10 @@ the rows it thinned away (``mech.ImpactResult.thinning``)):
   warning (coupling.core.diagnostics), its forces and contact times being approximate to
   about that fraction;
 - coil (a relay's or solenoid's coil, coupling.core.relay): its energy audit's |residual|
-  <= energy_tolerance * the energy into the coil;
+  <= COIL_UNSOUND_FACTOR x energy_tolerance x the energy into the coil; above
+  energy_tolerance x that energy it carries a warning (coupling.core.diagnostics), its coil
+  side approximate to about that fraction (the default relay with an RC suppression:
+  3.4e-3 at ngspice's own steps; a coil drawing 5 % too much current: 1.5e-2);
 - circuit (template circuits): the loop current through the load is at most
   2 V / (R_source + R_wiring + R_load) (A): the supply across the series loop, plus one
   full overshoot of the loop's ringing (a short_circuit template: R_load || R_fault; a
@@ -85,16 +88,26 @@ def energy_problem(max_residual: float, energy_scale: float, tolerance: float) -
 
 COIL_FIX = ("the coil's flux is not integrated accurately enough: cap [coupling] max_macro_step "
             "(e.g. 2e-5 s) or [circuit] max_step")
+# the coil's audit: above energy_tolerance a warning, above this many times it unsound (as
+# Hertz's validity: warned from 1 %, unsound from 5 %)
+COIL_UNSOUND_FACTOR = 5.0
+
+
+def coil_energy_line(relative_residual: float, tolerance: float, bound: float) -> str:
+    """The one line of a coil audit above ``bound`` (a fraction of the energy into the coil)."""
+    return (f"coil energy audit: residual {relative_residual:.3g} of the energy into the coil, above "
+            f"{bound:g} (solver.energy_tolerance = {tolerance:g}); {COIL_FIX}")
 
 
 def coil_energy_problem(relative_residual: float | None, tolerance: float) -> str | None:
     """The coil's energy audit's verdict (coupling.core.relay): None if its |residual| is
-    at most tolerance x the energy into the coil (both J); a coil into which no energy went
-    (None) has nothing to judge."""
-    if relative_residual is None or relative_residual <= tolerance:
+    at most COIL_UNSOUND_FACTOR x tolerance x the energy into the coil (both J); a coil into
+    which no energy went (None) has nothing to judge. Between tolerance and that, a warning
+    (coupling.core.diagnostics.coil_audit_warning)."""
+    bound = COIL_UNSOUND_FACTOR * tolerance
+    if relative_residual is None or relative_residual <= bound:
         return None
-    return (f"coil energy audit: residual {relative_residual:.3g} of the energy into the coil "
-            f"(allowed: solver.energy_tolerance = {tolerance:g}); {COIL_FIX}")
+    return coil_energy_line(relative_residual, tolerance, bound)
 
 
 def speed_problem(max_speed: float, bound: float) -> str | None:
