@@ -44,6 +44,17 @@ def _frame(columns: dict, categorical: tuple = ()):
     return pd.DataFrame(data)
 
 
+def seat_credit(t: np.ndarray, events: list[dict]) -> np.ndarray:
+    """J at each time of ``t`` (s): the energy of the armature's ringing removed where it was
+    seated on a stop (its "armature_seat" events), credited from then on (the record at that
+    time holds the state before: its step ended at the turn where the armature was seated)."""
+    out = np.zeros(len(t))
+    for ev in events:
+        if ev["kind"] == "armature_seat" and ev["energy"] != 0.0:
+            out[t > ev["time"]] += ev["energy"]
+    return out
+
+
 @dataclass
 class ImpactResult:
     """Outcome of ``ImpactSolver.run``. Build tables with the properties; ``save`` writes them."""
@@ -138,14 +149,8 @@ class ImpactResult:
         return out + self._seat_series()
 
     def _seat_series(self) -> np.ndarray:
-        """J per record: the energy of the armature's ringing removed where it was seated on a
-        stop (its "armature_seat" events), credited from then on (the record at that time
-        holds the state before: its step ended at the turn where the armature was seated)."""
-        out = np.zeros(len(self.t))
-        for ev in self.events:
-            if ev["kind"] == "armature_seat" and ev["energy"] != 0.0:
-                out[self.t > ev["time"]] += ev["energy"]
-        return out
+        """J per record: seat_credit at the records' times."""
+        return seat_credit(self.t, self.events)
 
     @property
     def history_columns(self) -> dict:

@@ -45,7 +45,7 @@ from .mechanism import base_velocity_jumps
 from .model import BarModel, armature_scales, build_model
 from .parameters import MechScene
 from .recorder import MEMORY_LIMIT, Recorder, history_memory
-from .results import ImpactResult
+from .results import ImpactResult, seat_credit
 from .scipy_backend import METHODS as SCIPY_METHODS, ScipyStepper
 from .stepping import CompiledStepper, Stepper
 
@@ -626,16 +626,12 @@ class ImpactSolver:
         m = self.model
         Y = rec.y[:len(drop)][drop]
         # as the result computes its own rows' energies: the armature's included, and the
-        # ringing its seats removed credited (mech.results.ImpactResult._seat_series)
+        # ringing its seats removed credited (seat_credit, as ImpactResult's residual)
         E = energy_table(Y, m.arrays, m.armature_arrays)
         first = energy_table(rec.y[:1], m.arrays, m.armature_arrays)[0]
         qd = Y[:, m.slices()["quad"]]
         terms = audit_terms(E, qd, first)
-        residual = audit_residual(E, qd, first)
-        t = rec.t[:len(drop)][drop]
-        for ev in self.events:
-            if ev["kind"] == "armature_seat" and ev["energy"] != 0.0:
-                residual = residual + np.where(t > ev["time"], ev["energy"], 0.0)
+        residual = audit_residual(E, qd, first) + seat_credit(rec.t[:len(drop)][drop], self.events)
         th["max_abs_residual"] = max(th["max_abs_residual"], float(np.max(np.abs(residual))))
         th["max_kinetic"] = max(th["max_kinetic"], float(E[:, 0].max()))
         drive = terms["work_in"] - terms["potential"] - (terms["spring_stored"] - first[4])
