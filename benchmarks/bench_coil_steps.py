@@ -87,28 +87,15 @@ def run(scene, fraction: float, gap: float, repeat: int = 1) -> dict:
 
 def binding_rules(scene) -> list[tuple[float, float, str]]:
     """(step start s, step length s, the rule that set the coil's time scale after it:
-    "curvature", "size" or "gap") of each macro step of a run of ``scene``, by watching
-    CoilLink.observe (the three candidate scales recomputed as it computes them)."""
-    import math
-
+    "curvature", "size" or "gap", CoilLink.bound_by) of each macro step of a run of ``scene``."""
     from coupling.core import exchange, master
-    from coupling.core.policy import end_rate
 
     log = []
     observe = exchange.CoilLink.observe
 
     def watched(self, step, seg, policy):
         observe(self, step, seg, policy)
-        curvature = end_rate(self.tail.t, self.tail.v, policy.macro_step)[1]
-        size = (abs(self.value) + self.floor) / abs(self.rate) if self.rate else math.inf
-        q, q_dot = seg.armature(seg.t_end)[:2]
-        span = seg.t_end - seg.t_start
-        speed = self.lever * abs(float(q_dot))
-        accel = self.lever * abs(float(q_dot) - float(seg.armature(seg.t_start)[1])) / span if span > 0 else 0.0
-        gap = (exchange.gap_time(policy.gap_change_fraction * max(self.gap(float(q)), 0.0), speed, accel)
-               if speed > 0 or accel > 0 else math.inf)
-        log.append((seg.t_start, seg.t_end - seg.t_start, min((curvature, "curvature"), (size, "size"),
-                                                               (gap, "gap"))[1]))
+        log.append((seg.t_start, seg.t_end - seg.t_start, self.bound_by))
 
     exchange.CoilLink.observe = watched
     try:

@@ -303,6 +303,7 @@ class CoilLink:
         # the watched signal (``signal``: psi^2 or psi) at the last step's end, its rate (per s),
         # time scale (s) and the slope the step rules chose to extrapolate it with
         self.value, self.rate, self.scale, self.slope = 0.0, 0.0, math.inf, 0.0
+        self.bound_by = "curvature"  # the rule that set ``scale``: "curvature", "size" or "gap"
         self._flux_column = "coil_flux_linkage" + label[len("coil"):]
         self.q_times: list[float] = []  # the circuit's points (s) ...
         self.q: list[float] = []  # ... and the armature's travel there (m or rad)
@@ -366,16 +367,18 @@ class CoilLink:
     def observe(self, step, seg, policy) -> None:
         """After a step: the flux linkage at its end, its rate and time scale from the circuit's
         last points (differences over at least 1e-3 of the policy's macro step), bounded by the
-        gap rule (``policy.gap_change_fraction``), and the armature's travel at the step's
-        circuit points (for the result's columns)."""
+        change-by-its-size and gap rules (``policy.gap_change_fraction``; ``bound_by`` names
+        the rule that set it), and the armature's travel at the step's circuit points (for the
+        result's columns)."""
         times = step.reader("time")
         self.tail.observe(times, self.signal(step.reader(self._flux_column)), False)
         self.value = self.signal(self.flux(step))
-        self.rate, self.scale = self.tail.rate(policy.macro_step)
+        self.rate, curvature = self.tail.rate(policy.macro_step)
+        scales = [(curvature, "curvature")]
         if self.rate != 0.0:
             # not beyond the time it takes to change by its own size (plus the floor): a signal
             # falling linearly to zero (a clamped coil's release) has no curvature
-            self.scale = min(self.scale, (abs(self.value) + self.floor) / abs(self.rate))
+            scales.append(((abs(self.value) + self.floor) / abs(self.rate), "size"))
         q, q_dot = seg.armature(seg.t_end)[:2]
         span = seg.t_end - seg.t_start
         speed = self.lever * abs(float(q_dot))  # m/s of the working gap
@@ -387,8 +390,9 @@ class CoilLink:
             # itself changes little then: at 240 us steps the default relay's coil audit left
             # 3e-3 of its energy to ngspice's coarse points); at its speed and acceleration,
             # for an armature leaving its stop has no speed yet
-            self.scale = min(self.scale, gap_time(policy.gap_change_fraction * max(self.gap(float(q)), 0.0),
-                                                  speed, accel))
+            scales.append((gap_time(policy.gap_change_fraction * max(self.gap(float(q)), 0.0), speed, accel),
+                           "gap"))
+        self.scale, self.bound_by = min(scales)
         new = times[1:] if self._sampled else times
         self._sampled = True
         lo, hi = seg.t_start, seg.t_end
