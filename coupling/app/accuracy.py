@@ -374,9 +374,10 @@ def refined_steps(scene) -> tuple[str, object]:
     """The macro_step refinement: every step rule of the coupling halved (STEP_RULES), so that
     whichever rule sets a run's macro steps, they halve; (description, refined scene)."""
     c = scene.coupling
-    changes = {f"coupling.{key}": getattr(c, key) / 2.0 for key in STEP_RULES if getattr(c, key) is not None}
+    keys = [key for key in STEP_RULES if getattr(c, key) is not None]  # (max_macro_step may be None)
+    changes = {f"coupling.{key}": getattr(c, key) / 2.0 for key in keys}
     return (f"macro step {c.macro_step * 1e6:g} -> {c.macro_step * 5e5:g} us, every other step rule halved too "
-            f"({', '.join(key for key in STEP_RULES[1:] if getattr(c, key) is not None)})"), scene.update(changes)
+            f"({', '.join(keys[1:])})"), scene.update(changes)
 
 
 def perturbations(scene) -> list[tuple[str, str, object]]:
