@@ -185,6 +185,7 @@ class NgspiceSession(NgSpiceShared):
         self._channels: dict[str, Channel] = {}
         self._by_pointer: dict[object, Channel] = {}
         self._target = math.inf
+        self._max_step = math.inf  # s: the step bound of the current pause (transient's max_step)
         self._deadline = math.inf
         self._failure: BaseException | None = None
         # a stop condition met at the analysis' last point leaves ngspice's pause request set
@@ -328,6 +329,8 @@ class NgspiceSession(NgSpiceShared):
             pdelta[0] = 0.0
             return 1
         target = self._target
+        if pdelta[0] > self._max_step:
+            pdelta[0] = self._max_step
         if self._arcs:
             if loc == 0:
                 # loc 0: after a point was accepted (and stored), before the next step.
@@ -465,7 +468,7 @@ class NgspiceSession(NgSpiceShared):
             raise NgspiceError(f"ngspice refused a breakpoint at t = {t!r} s", _message(printed))
 
     def transient(self, target: float | None, first: bool, wall_timeout: float | None, t_end: float,
-                  end_tolerance: float = 0.0) -> None:
+                  end_tolerance: float = 0.0, max_step: float = math.inf) -> None:
         """Start (``first``) or resume the loaded transient and pause exactly at ``target`` (s).
 
         ``target=None`` runs to ``t_end``, the end time of the ``.tran`` line (a stop
@@ -474,10 +477,12 @@ class NgspiceSession(NgSpiceShared):
         ngspice has stopped; KeyboardInterrupt if Ctrl-C paused ngspice (ngspice installs
         its own SIGINT handler while it runs, which pauses instead of raising).
         ``end_tolerance``: how early (s) ngspice may end a run to ``t_end``
-        (``SimulationOptions.end_tolerance``).
+        (``SimulationOptions.end_tolerance``). ``max_step``: s, no step of this run or pause
+        longer (below the deck's own TMAX; the sync callback shortens longer ones).
         """
         self._deadline = math.inf if wall_timeout is None else time.monotonic() + wall_timeout
         self._target = math.inf if target is None else float(target)
+        self._max_step = float(max_step)
         ended = t_end - max(1e-9 * t_end, end_tolerance)  # ngspice ends a run within this of t_end
         try:
             if target is None:
@@ -517,6 +522,7 @@ class NgspiceSession(NgSpiceShared):
             raise SimulationAborted(f"ngspice did not reach t = {target!r} s after repeated resumes")
         finally:
             self._target = math.inf
+            self._max_step = math.inf
             self._deadline = math.inf
 
     def _unstale(self, printed: list[str]) -> list[str]:

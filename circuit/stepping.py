@@ -152,6 +152,7 @@ class Stepper:
     def advance(
         self, t_next: float, conductance: Conductance | float | None = None, breakpoints: Iterable[float] = (),
         gap: Gap | float | None = None, *, inputs: Mapping[str, Conductance | float] | None = None,
+        max_step: float = math.inf,
     ) -> StepResult:
         """Integrate from the current time to ``t_next`` (s).
 
@@ -160,6 +161,9 @@ class Stepper:
             trial points too), or a constant. A conductance (S) is exactly 0 for an open
             contact; a gap (m) is the distance d(t) >= 0. A circuit with one contact may
             give ``conductance`` and ``gap`` instead.
+        max_step: s, ngspice's steps within this macro step at most this long (besides the
+            options' max_step for the whole run): a caller that knows a state changes fast
+            over the step (a coil's flux) asks for points in it.
         breakpoints: make/break instants (s) in (t_current, t_next]; ngspice lands on
             each, and every input is read as its left limit there (the pre-event state).
         gap: required when the arc model depends on the gap (``uses_gap``; without it
@@ -174,6 +178,8 @@ class Stepper:
         t_next = float(t_next)
         if self._finished:
             raise ValueError(f"the run is finished (t_end = {self.t_end!r} s)")
+        if not max_step > 0.0:  # (also NaN)
+            raise ValueError(f"max_step = {max_step!r} s: must be > 0 (inf: no bound)")
         tol = 1e-12 * self.t_end
         if not (t_next > t0 and t_next <= self.t_end + tol):
             raise ValueError(
@@ -210,7 +216,7 @@ class Stepper:
             clock = _time.perf_counter()
             try:
                 session.transient(None if final else t_next, not self._started, self.options.wall_timeout, self.t_end,
-                                  self.options.end_tolerance(self.t_end))
+                                  self.options.end_tolerance(self.t_end), max_step)
             except BaseException as exc:
                 self._failure = exc
                 raise
