@@ -110,6 +110,9 @@ OFF_CONDUCTANCE = 1e-9  # S: an extinguished gap (and the path's floor when burn
 RESOLUTION = 1e-5  # events located to this fraction of I_min or V_bd
 _APPROACH = 0.75  # fraction of the remaining distance to a threshold one step may cover
 RESTART = 1e-3  # the first step after the arc switches, as a fraction of the step before it
+# steps whose rates an approach remembers: the fastest of them may come back (a blade ringing
+# at ~100 us opens the gap at 40-75 um/ms in turn over 20-40 us steps)
+_RATE_MEMORY = 3
 _LEVEL_TOLERANCE = 1e-9  # of the armed filter's level, when landing on its crossing of 1/2
 _ATTRIBUTE = "_switchsim_arc"  # where add_arc records the model on a PySpice Circuit
 CHARACTERISTICS = ("linear", "ayrton")
@@ -334,6 +337,7 @@ class ArcState:
         # (t, |i| or |v|, the rate over the step before it and that step's midpoint or None) at
         # the last point, same state
         self._previous: tuple[float, float, tuple[float, float] | None] | None = None
+        self._rates: list[float] = []  # the approach's last _RATE_MEMORY rates (per s)
         self.filtered_current = 0.0  # I_f of the Ayrton characteristic, A (0: not yet carrying I_min)
 
     def add_breakpoints(self, times: Sequence[float]) -> None:
@@ -430,21 +434,26 @@ class ArcState:
 
     def _approach(self, t: float, x: float, threshold: float, direction: float, floor: float) -> float:
         """s: the next step's bound while x (|i| or |v|) approaches ``threshold``: it covers at
-        most _APPROACH of the distance left (plus RESOLUTION of the threshold), at the rate of
-        the last step, grown by its change since the step before when the approach speeds up,
-        and at least the step before's rate when it slowed down.
+        most _APPROACH of the distance left (plus RESOLUTION of the threshold), at the fastest
+        rate of the last _RATE_MEMORY steps, grown by the last step's change of rate when the
+        approach speeds up.
 
         A rate from the last step alone lags half a step behind an approach that speeds up,
-        and one step's slowing says nothing of the next: a break's arc whose gap a ringing
-        blade opens unevenly while the armature accelerates went out 0.27 % below I_min (the
+        and a slowing says nothing of the next steps: a break's arc whose gap a ringing blade
+        opens unevenly while the armature accelerates went out 0.27 % below I_min (the
         changeover example: the rate halved over one step, the bound grew to 38 us and the
-        next step's rate doubled), not within RESOLUTION."""
+        next step's rate doubled), not within RESOLUTION; with the step before's rate alone
+        where it slowed, and the last step's where it sped up, it still went out 0.2 % below
+        where two slow steps followed a fast one (40, 39, then 75 um/ms of gap opening, the
+        blade's ~100 us ringing over 22-38 us steps, ngspice's steps bounded by a coil's)."""
         previous, self._previous = self._previous, (t, x, None)
         if previous is None or not t > previous[0]:
+            self._rates = []
             return math.inf
         rate = direction * (x - previous[1]) / (t - previous[0])  # > 0: moving towards the threshold
         middle = 0.5 * (t + previous[0])
         self._previous = (t, x, (rate, middle))
+        self._rates = (self._rates + [rate])[-_RATE_MEMORY:]
         distance = direction * (threshold - x)
         if rate <= 0.0 or distance < 0.0:
             return math.inf
@@ -454,9 +463,8 @@ class ArcState:
             rate_before, middle_before = previous[2]
             if rate > rate_before and middle > middle_before:
                 growth = (rate - rate_before) / (middle - middle_before)
-            else:
-                # a rate that fell may rise again as fast (a gap opened by a ringing blade)
-                rate = rate_before
+        # a rate that fell may rise again as fast (a gap opened by a ringing blade)
+        rate = max(self._rates)
         # the rate at t and its growth: the time to cover ``room``, the root of
         # rate t + growth t^2 / 2 = room (without cancellation)
         rate += growth * (t - middle)
