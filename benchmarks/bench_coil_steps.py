@@ -8,9 +8,11 @@ The coil's macro steps (coupling/core/policy.py, coupling/core/exchange.py CoilL
 are at most `coupling.coil_time_scale_fraction` of the time scale of psi^2 (from its
 curvature, at most the time it takes to change by its own size) and of the time the working
 gap takes to change by `coupling.gap_change_fraction` of itself while the armature moves,
-and at most max_macro_step. Each row runs the scene with those two keys changed and
+and at most max_macro_step; ngspice takes at least `coupling.coil_step_points` points per
+macro step, and while the coil's flux changes its steps are at most
+`coupling.coil_point_fraction` of the coil's time constant L/R. Each row runs the scene with those keys changed and
 compares with the reference: every step rule at a quarter (fraction, gap rule, macro_step,
-max_macro_step) and ngspice RELTOL / 10. Results (SI): the armature's first arrival at the
+max_macro_step, coil_point_fraction) and ngspice RELTOL / 10. Results (SI): the armature's first arrival at the
 pole (s), the coil current at the end (A, relative), the times of the armature's later
 arrivals at the pole (its bounces there; the largest difference, s) and the coil's energy
 residual (relative to the energy into the coil). Run time: the co-simulation's own
@@ -34,21 +36,26 @@ BEGIN, END = "<!-- bench-coil-steps:begin -->", "<!-- bench-coil-steps:end -->"
 PLUNGER = ROOT / "examples" / "plunger_solenoid.toml"
 REFINE = 4.0  # the reference: every step rule at 1 / REFINE ...
 RELTOL_REFINE = 10.0  # ... and ngspice RELTOL / RELTOL_REFINE
+POINTS = 2  # coupling.coil_step_points of the current rules
+POINT_FRACTION = 0.0125  # coupling.coil_point_fraction of the current rules (1: ngspice's own steps, about)
 # (label, coupling.coil_time_scale_fraction, coupling.gap_change_fraction, max_macro_step factor, ngspice's
-# largest step in s, None: its own choice, or "reltol": RELTOL / RELTOL_REFINE)
+# largest step in s, None: its own choice, or "reltol": RELTOL / RELTOL_REFINE; coupling.coil_step_points)
 VARIANTS = (
-    ("current rules", 0.1, 1.0, 1.0, None),
-    ("fraction 0.05", 0.05, 1.0, 1.0, None),
-    ("fraction 0.15", 0.15, 1.0, 1.0, None),
-    ("fraction 0.2", 0.2, 1.0, 1.0, None),
-    ("fraction 0.3", 0.3, 1.0, 1.0, None),
-    ("fraction 0.5", 0.5, 1.0, 1.0, None),
-    ("gap rule x2", 0.1, 2.0, 1.0, None),
-    ("gap rule x4", 0.1, 4.0, 1.0, None),
-    ("max_macro_step x2", 0.1, 1.0, 2.0, None),
-    ("RELTOL / 10", 0.1, 1.0, 1.0, "reltol"),
-    ("ngspice max step 5 us", 0.1, 1.0, 1.0, 5e-6),
-    ("fraction 0.3, ngspice max step 5 us", 0.3, 1.0, 1.0, 5e-6),
+    ("current rules", 0.1, 1.0, 1.0, None, POINTS),
+    ("fraction 0.05", 0.05, 1.0, 1.0, None, POINTS),
+    ("fraction 0.15", 0.15, 1.0, 1.0, None, POINTS),
+    ("fraction 0.2", 0.2, 1.0, 1.0, None, POINTS),
+    ("fraction 0.3", 0.3, 1.0, 1.0, None, POINTS),
+    ("fraction 0.5", 0.5, 1.0, 1.0, None, POINTS),
+    ("gap rule x2", 0.1, 2.0, 1.0, None, POINTS),
+    ("gap rule x4", 0.1, 4.0, 1.0, None, POINTS),
+    ("max_macro_step x2", 0.1, 1.0, 2.0, None, POINTS),
+    ("RELTOL / 10", 0.1, 1.0, 1.0, "reltol", POINTS),
+    ("coil_step_points 1", 0.1, 1.0, 1.0, None, 1),
+    ("coil_step_points 4", 0.1, 1.0, 1.0, None, 4),
+    ("coil_step_points 1, coil_point_fraction 1 (before them)", 0.1, 1.0, 1.0, None, (1, 1.0)),
+    ("ngspice max step 5 us", 0.1, 1.0, 1.0, 5e-6, POINTS),
+    ("fraction 0.3, ngspice max step 5 us", 0.3, 1.0, 1.0, 5e-6, POINTS),
 )
 # the inputs changed by 1 % each way for the sensitivity rows (the plunger's own keys)
 INPUTS = ("coil.voltage", "armature.mass", "armature.travel", "armature.stop_damping")
@@ -62,14 +69,17 @@ def with_options(scene, **options):
         spec, options=dataclasses.replace(spec.options, **options)))
 
 
-def run(scene, fraction: float, gap: float, repeat: int = 1) -> dict:
-    """The results of ``scene`` at the coil's step rules ``fraction`` and ``gap``, and its
-    median wall time (s)."""
+def run(scene, fraction: float, gap: float, points=POINTS, repeat: int = 1) -> dict:
+    """The results of ``scene`` at the coil's step rules ``fraction``, ``gap`` and ``points``
+    (coupling.coil_step_points, or that and coupling.coil_point_fraction as a pair; alone,
+    the current rules' fraction), and its median wall time (s)."""
     from coupling.core import master
 
+    count, point_fraction = points if isinstance(points, tuple) else (points, POINT_FRACTION)
     # (replaced, not set by key: a scene from with_options keeps its ngspice options)
     scene = dataclasses.replace(scene, coupling=dataclasses.replace(
-        scene.coupling, coil_time_scale_fraction=fraction, gap_change_fraction=gap))
+        scene.coupling, coil_time_scale_fraction=fraction, gap_change_fraction=gap, coil_step_points=count,
+        coil_point_fraction=point_fraction))
     walls = []
     for _ in range(repeat):
         result = master.run(scene)
@@ -133,15 +143,17 @@ def main() -> None:
     refined = with_options(base.update({"coupling.macro_step": opts.macro_step / REFINE,
                                        "coupling.max_macro_step": opts.max_macro_step / REFINE}),
                           reltol=base.circuit.options.reltol / RELTOL_REFINE)
-    ref = run(refined, 0.1 / REFINE, 1.0 / REFINE)
-    check = run(refined.set("solver.rtol", base.mech.solver.rtol / 10.0), 0.1 / REFINE, 1.0 / REFINE)
+    fine = (POINTS, POINT_FRACTION / REFINE)
+    ref = run(refined, 0.1 / REFINE, 1.0 / REFINE, fine)
+    check = run(refined.set("solver.rtol", base.mech.solver.rtol / 10.0), 0.1 / REFINE, 1.0 / REFINE, fine)
     d_check = difference(check, ref)
 
     lines = [f"`{command_line()}`: examples/plunger_solenoid.toml (50 ms; the armature arrives at the pole at "
              f"{ref['arrival'] * 1e3:.3f} ms and bounces there {len(ref['bounces'])} more times up to "
              f"{ref['bounces'][-1] * 1e3:.2f} ms). Reference: every step rule at 1/{REFINE:g} (fraction "
              f"{0.1 / REFINE:g}, gap rule {1.0 / REFINE:g}, macro_step {opts.macro_step / REFINE * 1e6:g} us, "
-             f"max_macro_step {opts.max_macro_step / REFINE * 1e6:g} us) and RELTOL "
+             f"max_macro_step {opts.max_macro_step / REFINE * 1e6:g} us, coil_point_fraction "
+             f"{POINT_FRACTION / REFINE:g}) and RELTOL "
              f"{base.circuit.options.reltol / RELTOL_REFINE:g}: {ref['steps']} macro steps, "
              f"{ref['wall']:.2f} s; the reference with the mechanics' rtol / 10 differs from it by "
              f"{d_check['arrival'] * 1e6:.2f} us (arrival), {d_check['current']:.1e} (current), "
@@ -160,13 +172,13 @@ def main() -> None:
                       f"the curvature rule after {share['curvature']:.0%} of them, the gap rule "
                       f"{share['gap']:.0%}, the change-by-its-size rule {share['size']:.0%})."]
     rows, scenes = {}, {}
-    for label, fraction, gap, free, max_step in VARIANTS:
+    for label, fraction, gap, free, max_step, points in VARIANTS:
         scene = base if free == 1.0 else base.set("coupling.max_macro_step", opts.max_macro_step * free)
         if max_step == "reltol":
             scene = with_options(scene, reltol=base.circuit.options.reltol / RELTOL_REFINE)
         elif max_step is not None:
             scene = with_options(scene, max_step=max_step)
-        scenes[label] = (scene, fraction, gap)
+        scenes[label] = (scene, fraction, gap, points)
         rows[label] = run(*scenes[label])
     # the run times: the rows interleaved, repeat times, so that the shared machine's load
     # falls on every row alike
@@ -199,19 +211,21 @@ def main() -> None:
     ropts = relay.coupling
     rref = run(with_options(relay.update({"coupling.macro_step": ropts.macro_step / REFINE,
                                          "coupling.max_macro_step": ropts.max_macro_step / REFINE}),
-                           reltol=relay.circuit.options.reltol / RELTOL_REFINE), 0.1 / REFINE, 1.0 / REFINE)
+                           reltol=relay.circuit.options.reltol / RELTOL_REFINE), 0.1 / REFINE, 1.0 / REFINE, fine)
     parts = []
-    relay_rows = {fraction: run(relay, fraction, 1.0) for fraction in (0.1, 0.2)}
-    relay_walls = {fraction: [] for fraction in relay_rows}
+    relay_configs = {"the current rules": (0.1, POINTS), "fraction 0.2": (0.2, POINTS),
+                     "coil_point_fraction 1 (no bound from L/R)": (0.1, (POINTS, 1.0)),
+                     "coil_step_points 1, coil_point_fraction 1 (before them)": (0.1, (1, 1.0))}
+    relay_rows = {label: run(relay, fraction, 1.0, points) for label, (fraction, points) in relay_configs.items()}
+    relay_walls = {label: [] for label in relay_rows}
     for _ in range(max(1, args.repeat // 2)):
-        for fraction in relay_rows:
-            relay_walls[fraction].append(run(relay, fraction, 1.0)["wall"])
-    for label, fraction in (("0.1 (now)", 0.1), ("0.2", 0.2)):
-        m = relay_rows[fraction]
-        m["wall"] = statistics.median(relay_walls[fraction])
-        parts.append(f"fraction {label}: {m['steps']} macro steps, {m['wall'] * 1e3:.0f} ms, operate time "
-                     f"{abs(m['operate'] - rref['operate']) * 1e6:.1f} us from the reference's "
-                     f"{rref['operate'] * 1e3:.4f} ms")
+        for label, (fraction, points) in relay_configs.items():
+            relay_walls[label].append(run(relay, fraction, 1.0, points)["wall"])
+    for label, m in relay_rows.items():
+        m["wall"] = statistics.median(relay_walls[label])
+        parts.append(f"{label}: {m['steps']} macro steps, {m['points']} ngspice points, {m['wall'] * 1e3:.0f} ms, "
+                     f"operate time {abs(m['operate'] - rref['operate']) * 1e6:.1f} us from the reference's "
+                     f"{rref['operate'] * 1e3:.4f} ms, coil energy residual {m['residual']:.1e}")
     lines += ["", "- The default relay (same reference rule): " + "; ".join(parts) + ".",
               load_line()]
     publish(DOC, BEGIN, END, lines, write=not args.no_write)

@@ -93,7 +93,7 @@ MIN_RELTOL = 1e-9
 # refinement: the contact's macro step and free step, the time-scale rules of the loop current
 # and the coil's flux, the gap rule (a coil-driven run's steps are mostly set by the last two)
 STEP_RULES = ("macro_step", "max_macro_step", "time_scale_fraction", "coil_time_scale_fraction",
-              "gap_change_fraction")
+              "gap_change_fraction", "coil_point_fraction")
 
 # ---------------------------------------------------------------------------------------
 # metrics: pure functions

@@ -300,6 +300,12 @@ class CoilLink:
         # a flux-tube magnet's iron carries the whole coil flux: W = W_iron(psi) + psi^2 R(g) / (2 N^2)
         self.separable = isinstance(magnet, FluxTubeMagnet)
         self.tail = Tail()
+        # the circuit's step rule: the coil's time constant L/R at the rest gap (s), the flux
+        # linkage's floor (Wb: FLUX_FLOOR of the rated), its last points and rate (Wb/s)
+        self.time_constant = math.inf
+        self.flux_floor = 0.0
+        self.flux_tail = Tail()
+        self.flux_rate = 0.0
         # the watched signal (``signal``: psi^2 or psi) at the last step's end, its rate (per s),
         # time scale (s) and the slope the step rules chose to extrapolate it with
         self.value, self.rate, self.scale, self.slope = 0.0, 0.0, math.inf, 0.0
@@ -349,6 +355,14 @@ class CoilLink:
         return {"armature.force": (self.lever * float(self.magnet.force(s0, g0)),
                                    self.lever * float(self.magnet.force(s1, g1)))}
 
+    def flux_changing(self, change_fraction: float) -> bool:
+        """True if the flux linkage, at its rate at the last step's end, moves by more than
+        ``change_fraction`` of (|psi| + its floor) over the coil's time constant (the step rules'
+        change rule on psi itself: psi^2 starts from zero with zero slope when the coil is
+        switched on)."""
+        psi = self.flux_tail.v[-1] if self.flux_tail.v else 0.0
+        return abs(self.flux_rate) * self.time_constant > change_fraction * (abs(psi) + self.flux_floor)
+
     def inputs(self, seg) -> dict:
         """The coil's gap channel over the segment, from the armature's dense output."""
         lo, hi = seg.t_start, seg.t_end
@@ -371,7 +385,10 @@ class CoilLink:
         the rule that set it), and the armature's travel at the step's circuit points (for the
         result's columns)."""
         times = step.reader("time")
-        self.tail.observe(times, self.signal(step.reader(self._flux_column)), False)
+        psi = step.reader(self._flux_column)
+        self.tail.observe(times, self.signal(psi), False)
+        self.flux_tail.observe(times, psi, False)
+        self.flux_rate = self.flux_tail.rate(policy.macro_step)[0]
         self.value = self.signal(self.flux(step))
         self.rate, curvature = self.tail.rate(policy.macro_step)
         scales = [(curvature, "curvature")]

@@ -157,6 +157,10 @@ class CoSimulation:
             link = CoilLink(coils[0].label, spec.magnet, spec.rest_gap, spec.lever, switches)
             rated_psi = float(spec.magnet.flux_linkage(rated, spec.rest_gap)) if rated > 0 else 1e-6
             link.floor = FLUX_FLOOR * float(link.signal(rated_psi))
+            # (a thousandth of the rated current: the unsaturated inductance; 1 mA for a netlist's coil)
+            probe = 1e-3 * rated if rated > 0 else 1e-3
+            link.time_constant = float(spec.magnet.flux_linkage(probe, spec.rest_gap)) / probe / spec.resistance
+            link.flux_floor = FLUX_FLOOR * abs(rated_psi)
             links.append(link)
         return links
 
@@ -352,8 +356,11 @@ class CoSimulation:
             inputs.update(link.inputs(seg, touching, stepper.uses_gap))
         if coil is not None:
             inputs.update(coil.inputs(seg))
+        # (ngspice's points inside a macro step of a coil: the coil's step rules)
+        cap = math.inf if coil is None else self.coil_policy.circuit_step(
+            t, t_next, coil.time_constant if coil.flux_changing(self.coil_policy.change_fraction) else math.inf)
         tick = time.perf_counter()
-        step = stepper.advance(t_next, inputs=inputs, breakpoints=breakpoints)
+        step = stepper.advance(t_next, inputs=inputs, breakpoints=breakpoints, max_step=cap)
         self.stats["circuit_seconds"] += time.perf_counter() - tick
         self._sample_contact(mech, step)
         jumped = bool(switching) or aligned

@@ -23,6 +23,16 @@ COIL_TIME_SCALE_FRACTION = 0.1
 # While the armature moves, a macro step lets the working gap change by at most this fraction
 # of itself: the coil's flux equation holds the gap, and its force 1/g^2, over the step
 GAP_CHANGE_FRACTION = 1.0
+# In a coil-driven run ngspice's steps are bounded twice. Its flux increments are second order
+# in its own step, and its truncation control let them be a macro step long (up to t_end / 50
+# through the coil's rise): the default relay's coil audit was left at 8.9e-4 of the energy
+# into the coil and its operate time ~6 us early (docs/coupling.md, "The coil's steps").
+# At least this many points per macro step: the circuit's error then falls with the macro
+# step, in the coupling's order ...
+COIL_STEP_POINTS = 2
+# ... and, while the coil's flux changes, steps of at most this fraction of the coil's time
+# constant L/R (at the rest gap, unsaturated): 80 points a time constant
+COIL_POINT_FRACTION = 0.0125
 CHANGE_FRACTION = 1e-3  # the time-scale rule applies only where a step would change the current by more
 CURRENT_FLOOR = 1e-3  # A: floor of |I| in the cautious time scale |I|/|dI/dt|
 GROWTH_CAP = 4.0  # macro steps: the longest step in a closed contact with a steady current
@@ -65,6 +75,8 @@ class StepPolicy:
     current_floor: float = CURRENT_FLOOR
     growth_cap: float = GROWTH_CAP
     gap_change_fraction: float = GAP_CHANGE_FRACTION
+    circuit_points: int = 1
+    point_fraction: float = math.inf
 
     def __post_init__(self):
         for name in ("macro_step", "free_step", "probe_time", "time_scale_fraction", "current_floor", "growth_cap",
@@ -74,6 +86,10 @@ class StepPolicy:
                 raise ValueError(f"StepPolicy.{name} = {value!r}: must be a finite number > 0")
         if self.free_step < self.macro_step:
             raise ValueError(f"StepPolicy.free_step = {self.free_step!r}: must be >= macro_step = {self.macro_step!r}")
+        if isinstance(self.circuit_points, bool) or not isinstance(self.circuit_points, int) or self.circuit_points < 1:
+            raise ValueError(f"StepPolicy.circuit_points = {self.circuit_points!r}: must be a whole number >= 1")
+        if not self.point_fraction > 0:  # (inf: no such bound)
+            raise ValueError(f"StepPolicy.point_fraction = {self.point_fraction!r}: must be > 0")
         if not (math.isfinite(self.change_fraction) and self.change_fraction >= 0):
             raise ValueError(f"StepPolicy.change_fraction = {self.change_fraction!r}: must be a finite number >= 0")
 
@@ -88,7 +104,9 @@ class StepPolicy:
         """The coil's rules: the same steps, its own time-scale fraction and gap rule from the
         scene's CouplingOptions, ``floor`` the watched signal's floor (Wb^2 or Wb)."""
         return replace(self, current_floor=floor, time_scale_fraction=float(options.coil_time_scale_fraction),
-                       gap_change_fraction=float(options.gap_change_fraction))
+                       gap_change_fraction=float(options.gap_change_fraction),
+                       circuit_points=int(options.coil_step_points),
+                       point_fraction=float(options.coil_point_fraction))
 
     @property
     def probe(self) -> float:
@@ -118,6 +136,17 @@ class StepPolicy:
         if touching and not self.steady(current, rate, t_next - t):
             t_next = min(t_next, t + max(self.probe, self.time_scale_fraction * scale))
         return t_next, rate
+
+    def circuit_step(self, t: float, t_next: float, time_constant: float = math.inf) -> float:
+        """s: the longest circuit step inside the macro step [t, t_next]: the step over
+        ``circuit_points``, and ``point_fraction`` of ``time_constant`` (s; inf: none, as
+        where the coil's flux is steady); inf: ngspice's own steps (landing on t_next). The
+        first bound is proportional to the macro step, so the circuit's error falls with it in
+        the coupling's order; the second does not come and go with the macro step either (a
+        bound that did, the change rule over the step, made the convergence under halved
+        steps erratic)."""
+        step = math.inf if self.circuit_points == 1 else (t_next - t) / self.circuit_points
+        return min(step, self.point_fraction * time_constant)
 
     def steady(self, current: float, rate: float, span: float) -> bool:
         """True if the current (A) at rate dI/dt (A/s) moves by no more than the change rule

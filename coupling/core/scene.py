@@ -42,7 +42,9 @@ from mech.validation import (
     internal,
     scene_key,
 )
-from coupling.core.policy import COIL_TIME_SCALE_FRACTION, GAP_CHANGE_FRACTION, TIME_SCALE_FRACTION
+from coupling.core.policy import (
+    COIL_POINT_FRACTION, COIL_STEP_POINTS, COIL_TIME_SCALE_FRACTION, GAP_CHANGE_FRACTION, TIME_SCALE_FRACTION,
+)
 
 COUPLING_SECTIONS = ("tribology", "circuit", "coupling", "output", "metrics", "duty", "coil", "magnet")
 # macro steps a coupled run may take at most (t_end / macro_step, every step in contact):
@@ -62,6 +64,7 @@ SCHEMES = ("mechanics_first", "jacobi")
 # coupling.gap_change_fraction at most: a step may carry the armature past its landing (the
 # mechanics find the stop exactly), not over many times the gap
 GAP_CHANGE_MAX = 10.0
+COIL_STEP_POINTS_MAX = 64  # (ngspice's points cost ~10-30 us each; more buys nothing the audit can see)
 
 
 def _table(where: str, value) -> dict:
@@ -90,6 +93,10 @@ class CouplingOptions:
     (coupling.core.policy, docs/coupling.md "Step lengths" and "The coil's steps"): a macro
     step extrapolates the loop current, the coil's flux, over at most that fraction of its
     time scale, and lets the working gap change by at most that fraction of itself.
+    coil_step_points, coil_point_fraction: in a coil-driven run ngspice takes at least that
+    many points per macro step, and while the coil's flux changes its steps are at most that
+    fraction of the coil's time constant L/R (at the rest gap): the coil flux's integration
+    error, second order in ngspice's step, is what the coil's energy audit measures.
     """
 
     scheme: str = scene_key("mechanics_first", unit="-", doc='or "jacobi"')
@@ -107,6 +114,13 @@ class CouplingOptions:
         GAP_CHANGE_FRACTION, unit="-",
         doc="while the armature moves, a macro step lets the working gap change by at most this fraction of itself; "
             "(0, 10]")
+    coil_step_points: int = scene_key(
+        COIL_STEP_POINTS, unit="-",
+        doc="in a coil-driven run ngspice takes at least this many points per macro step; 1 .. 64")
+    coil_point_fraction: float = scene_key(
+        COIL_POINT_FRACTION, unit="-",
+        doc="while the coil's flux changes, ngspice's steps are at most this fraction of the coil's time constant "
+            "L/R; (0, 1]")
 
     def __post_init__(self):
         check_choice("coupling.scheme", self.scheme, SCHEMES)
@@ -118,9 +132,10 @@ class CouplingOptions:
                                  f"coupling.macro_step = {self.macro_step!r}")
         check_bool("coupling.align_events", self.align_events)
         check_nonnegative("coupling.onset_penetration", self.onset_penetration, high=LENGTH_MAX)
-        for name in ("time_scale_fraction", "coil_time_scale_fraction"):
+        for name in ("time_scale_fraction", "coil_time_scale_fraction", "coil_point_fraction"):
             check_range(f"coupling.{name}", getattr(self, name), 0.0, 1.0, closed_high=True)
         check_range("coupling.gap_change_fraction", self.gap_change_fraction, 0.0, GAP_CHANGE_MAX, closed_high=True)
+        check_whole("coupling.coil_step_points", self.coil_step_points, 1, COIL_STEP_POINTS_MAX)
 
     @property
     def free_step(self) -> float:

@@ -86,8 +86,8 @@ def energy_problem(max_residual: float, energy_scale: float, tolerance: float) -
             f"(allowed: solver.energy_tolerance = {tolerance:g}); {FIX}")
 
 
-COIL_FIX = ("the coil's flux is not integrated accurately enough: cap [coupling] max_macro_step "
-            "(e.g. 2e-5 s) or [circuit] max_step")
+COIL_FIX = ("the coil's flux is not integrated accurately enough: raise [coupling] coil_step_points "
+            "(e.g. 8), cap [coupling] max_macro_step (e.g. 2e-5 s) or [circuit] max_step")
 # the coil's audit: above energy_tolerance a warning, above this many times it unsound (as
 # Hertz's validity: warned from 1 %, unsound from 5 %)
 COIL_UNSOUND_FACTOR = 5.0

@@ -100,16 +100,19 @@ def test_jacobi_sees_the_make_a_macro_step_late(reference):
 
 # --- the coil's channels: armature.force (psi^2 extrapolated) and coil.gap ------------------
 
-COIL_STEPS = (8e-5, 4e-5, 2e-5, 1e-5)
+COIL_STEPS = (2e-5, 1e-5, 5e-6, 2.5e-6)
 
 
 def test_the_coil_channels_keep_second_order():
     """The plunger solenoid of examples/ pulled in (psi^2 into the mechanics, extrapolated by
     the step rules; the working gap into ngspice from the armature's dense output), at fixed
     macro steps halved three times: the armature's arrival at the pole (a located event) and
-    its travel at 10 ms (mid-flight) converge at second order (successive differences fall
-    4x per halving; measured orders 2.3-3.9 and 1.9-2.7). The coil current itself is held
-    at ngspice's own tolerance (reltol), not the macro step's."""
+    its travel at 10 ms (mid-flight) converge at second order, neither less nor more
+    (successive differences fall 4x per halving; measured orders 2.00 and 2.00, 2.06 and
+    1.94). ngspice takes coupling.coil_step_points points per macro step, so its own error
+    falls with the macro step too; at one point per step and its truncation control the
+    orders over 80-10 us were erratic (2.3-3.9), and from 80 us down the convergence is not
+    yet asymptotic (1.5-1.9 at the first halving)."""
     scene = load_scene(Path(__file__).parents[2] / "examples" / "plunger_solenoid.toml").set("solver.t_end", 0.014)
     values = []
     for h in COIL_STEPS:
@@ -118,4 +121,4 @@ def test_the_coil_channels_keep_second_order():
         values.append((res.relay["armature_arrival"], float(np.interp(0.010, w.time, w.armature_position))))
     diffs = np.abs(np.diff(np.array(values), axis=0))
     orders = np.log2(diffs[:-1] / diffs[1:])
-    assert np.all(orders > 1.7), (values, orders)
+    assert np.all((orders > 1.8) & (orders < 2.2)), (values, orders)

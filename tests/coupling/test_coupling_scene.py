@@ -63,6 +63,12 @@ def test_set_revalidates_and_keeps_the_original():
     ({**MECH, **TRIB, **CIRCUIT, "coupling": {"coil_time_scale_fraction": 2}}, "coupling.coil_time_scale_fraction = 2"),
     ({**MECH, **TRIB, **CIRCUIT, "coupling": {"gap_change_fraction": "1"}}, "coupling.gap_change_fraction = '1'"),
     ({**MECH, **TRIB, **CIRCUIT, "coupling": {"gap_change_fraction": 50.0}}, "allowed range is \\(0.0, 10.0\\]"),
+    # the coil's circuit step rules: a whole count of points, a fraction of the time constant
+    ({**MECH, **TRIB, **CIRCUIT, "coupling": {"coil_step_points": 0}},
+     "coupling.coil_step_points = 0: expected a whole number in \\[1, 64\\]"),
+    ({**MECH, **TRIB, **CIRCUIT, "coupling": {"coil_step_points": 2.5}}, "coupling.coil_step_points = 2.5"),
+    ({**MECH, **TRIB, **CIRCUIT, "coupling": {"coil_point_fraction": 0.0}},
+     "coupling.coil_point_fraction = 0.0: allowed range is \\(0.0, 1.0\\]"),
     ({**MECH, "tribology": {"source": "illustrative", "fit": "x.json"}}, "exactly one of"),
     ({**MECH, "tribology": {"source": "paper"}}, "only built-in source"),
     ({**MECH, **TRIB, "circuit": {"voltage": -5.0}}, "voltage"),

@@ -1,6 +1,6 @@
 """The coil's energy audit (coupling.core.relay, relay.energy) judged by the run's soundness:
 a coil whose circuit flux disagrees with its magnet is unsound, the default relay is sound,
-and the residual falls at second order when the macro step caps the circuit's points."""
+and the residual falls at second order with the circuit's step through the coil's rise."""
 
 from __future__ import annotations
 
@@ -42,26 +42,32 @@ def test_a_coil_circuit_carrying_5_percent_too_much_current_is_unsound(monkeypat
     assert "solver.energy_tolerance" in line and "max_macro_step" in line and "\n" not in line
 
 
-def test_the_coil_residual_falls_at_second_order_with_the_macro_step_cap():
+def test_the_coil_residual_falls_at_second_order_with_the_circuits_step():
     """The audit's quadrature is the circuit's (the current's trapezoid against the flux's
     increments and the trapezoid of F in the gap, path integrals of the magnet's exact
     co-energy differential), so what is left is the flux's integration error: second order in
-    the spacing of the points where the coil moves fastest. The caps 1e-4 .. 2.5e-5 s set that
-    spacing (below, ngspice's own steps and the gap's dense output take over: measured
-    2.0e-5 at 1e-5 s)."""
-    caps = (1e-4, 5e-5, 2.5e-5)
-    residuals = [abs(run(default_scene().set("coupling.max_macro_step", h)).relay["energy"]["relative_residual"])
-                 for h in caps]
+    the spacing of the points where the coil moves fastest, its rise. With one point per
+    macro step at least (coupling.coil_step_points = 1), coupling.coil_point_fraction of the
+    coil's time constant (3.0 ms) sets that spacing, 120 .. 30 us here (at 0.08, 240 us,
+    ngspice's own t_end / 50 bounds it instead: the residual 8.9e-4 then, as before the rule)."""
+    fractions = (0.04, 0.02, 0.01)
+    residuals = [abs(run(default_scene().update({"coupling.coil_step_points": 1, "coupling.coil_point_fraction": f}))
+                     .relay["energy"]["relative_residual"]) for f in fractions]
     orders = np.log(np.array(residuals[:-1]) / residuals[1:]) / np.log(2.0)
-    # measured orders 2.3 and 1.7 (ngspice's own step control makes the spacing only nearly
-    # uniform); a first-order audit (F at the step's start in the gap) gives 0.4 and 0.6
+    # measured orders 1.9 and 2.4; a first-order audit (F at the step's start in the gap) gave
+    # 0.4 and 0.6 under the macro step cap that set the spacing before
     assert np.all(orders > 1.5), (residuals, orders)
+    # and the defaults (two points per macro step, 1/80 of the time constant) leave the
+    # residual at a twentieth of solver.energy_tolerance and below (measured 4.5e-5 of 1e-3)
+    res = run(default_scene())
+    assert abs(res.relay["energy"]["relative_residual"]) < 0.1 * tolerance(res)
 
 
 def test_a_coil_audit_above_the_tolerance_but_within_five_times_it_is_a_warning():
-    """The default relay released through its RC suppression: the coil rings with the
-    capacitor (~6 ms period) at ngspice's own steps (up to 240 us), and the audit leaves
-    3.4e-3 of the energy into the coil: above solver.energy_tolerance, below five times it.
+    """The default relay released through its RC suppression: the coil current rings through
+    zero with the capacitor after the release, faster than the coil's own L/R that bounds
+    ngspice's steps (37.5 us), and the audit leaves 1.7e-3 of the energy into the coil (3.4e-3
+    at ngspice's own steps, up to 240 us): above solver.energy_tolerance, below five times it.
     The run stays "ok" and carries one warning naming the key and what to cap (as Hertz's
     validity: warned from 1 %, unsound from 5 %); a coil drawing 5 % too much current (the
     test above, 1.5e-2) is unsound."""
