@@ -33,12 +33,15 @@ def stop_times(events: list[dict], stop: str, kind: str) -> list[float]:
     return [float(e["time"]) for e in events if e.get("stop") == stop and e["kind"] == f"armature_stop_{kind}"]
 
 
-def relay_metrics(waves: dict, operations: list[dict], drive, magnet, events: list[dict], resistance: float) -> dict:
+def relay_metrics(waves: dict, operations: list[dict], drive, magnet, events: list[dict], resistance: float,
+                  received: float | None = None) -> dict:
     """The ``relay`` block (module docstring). waves: the run's columns (SI); operations:
     the contact's (coupling.core.metrics.operations; [] without a contact); drive: the
     circuit's CoilDrive (its on_time and off_time), or None for a netlist's coil; magnet:
     the coupling.laws.magnet magnet; events: the mechanics' events (its armature's stop
-    events); resistance: ohm, the coil's winding."""
+    events); resistance: ohm, the coil's winding; received: J, the work the mechanics
+    received from the armature's drive (coupling.core.exchange.CoilLink.receive), or None
+    (no interface keys)."""
     t = np.asarray(waves["time"], float)
     i = np.asarray(waves["coil_current"], float)
     v = np.asarray(waves["coil_voltage"], float)
@@ -83,4 +86,8 @@ def relay_metrics(waves: dict, operations: list[dict], drive, magnet, events: li
         residual = into - copper - stored - work
         out["energy"] = dict(into_coil=into, copper=copper, magnetic_change=stored, armature_work=work,
                              residual=residual, relative_residual=abs(residual) / abs(into) if into else None)
+        if received is not None:
+            interface = work - received
+            out["energy"].update(armature_received=received, interface_residual=interface,
+                                 interface_relative_residual=abs(interface) / abs(into) if into else None)
     return out
