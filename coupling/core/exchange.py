@@ -145,21 +145,24 @@ def received_work(armature, t0: float, t1: float, drive0: float, drive1: float, 
     span = t1 - t0
     if span <= 0.0:
         return 0.0
+    q1 = armature(t1)[0]  # (first: the segment's armature caches its last time, often the end)
     q0 = armature(t0)[0]
     g0 = gain_integral(q0)
-    work = drive1 * (gain_integral(armature(t1)[0]) - g0)
+    work = drive1 * (gain_integral(q1) - g0)
     slope = (drive1 - drive0) / span
     if slope == 0.0:
         return work
-    edges = [t0] + sorted(c for c in cuts if t0 < c < t1) + [t1]
+    inner = sorted(c for c in cuts if t0 < c < t1) if cuts else ()
+    edges = [t0, *inner, t1]
     total = 0.0
-    for a, b in zip(edges[:-1], edges[1:]):
+    for k in range(len(edges) - 1):
+        a, h = edges[k], edges[k + 1] - edges[k]
         piece = 0.0
         for x, w in zip(GAUSS_NODES, GAUSS_WEIGHTS):
-            q = armature(a + x * (b - a))[0]
+            q = armature(a + x * h)[0]
             if q != q0:  # (an armature that has not moved adds nothing)
                 piece += w * (gain_integral(q) - g0)
-        total += (b - a) * piece
+        total += h * piece
     return work - slope * total
 
 
@@ -393,7 +396,8 @@ class CoilLink:
         # J: the work the mechanics received from the drive "armature.force" so far
         # (``receive``), against which the magnet's work as the circuit sees it is audited
         self.received = 0.0
-        self._gain_integral = None  # GainIntegral of the mechanics' gain table, built at the first step
+        self._gain_integral = None  # GainIntegral of the mechanics' gain table, built at the first step,
+        self._drive_row = -1  # ... and the mechanics' drive row of "armature.force"
 
     def next_switch(self, t: float) -> float:
         """s: the coil drive's next switching instant after t (its driver's PWL vertices: on,
@@ -492,16 +496,18 @@ class CoilLink:
         mechanics' own solution (``received_work`` on its dense output), with the drive as the
         mechanics held it (``mech.drive``'s armature row, linear over the step, read at the
         segment's ends) and the antiderivative of its gain table (``GainIntegral``)."""
-        from mech.drives import values_at
+        from mech.kernel_layout import D_SLOPE, D_T0, D_VALUE
 
         t0, t1 = seg.t_start, seg.t_end
         if self._gain_integral is None:
             self._gain_integral = GainIntegral(mech.model.again)
-        row = mech.model.armature_drive_row
-        drive = mech.drive
-        self.received += received_work(seg.armature, t0, t1, float(values_at(drive, t0)[row]),
-                                       float(values_at(drive, t1)[row]), self._gain_integral,
-                                       [e["time"] for e in seg.events])
+            self._drive_row = mech.model.armature_drive_row
+        # the kernel's drive_at, on the row's three floats (mech.drives.values_at does every row)
+        row = mech.drive[self._drive_row].tolist()
+        value, slope, t_ref = row[D_VALUE], row[D_SLOPE], row[D_T0]
+        self.received += received_work(seg.armature, t0, t1, value + slope * (t0 - t_ref),
+                                       value + slope * (t1 - t_ref), self._gain_integral,
+                                       [e["time"] for e in seg.events] if seg.events else ())
 
     def columns(self, waves: dict) -> dict:
         """The result's coil columns beside the circuit's (coil_current, coil_voltage,
