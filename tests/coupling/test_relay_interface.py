@@ -152,3 +152,24 @@ def test_the_interface_residual_falls_at_the_coupling_order():
         scene = refined_steps(scene)[1]
     orders = np.log2(np.array(residuals[:-1]) / np.array(residuals[1:]))
     assert np.all(orders > 1.7), (residuals, orders)
+
+
+def interface_warnings(result) -> list[str]:
+    return [w for w in result.warnings if w.startswith("coil-armature interface")]
+
+
+def test_a_coupling_too_coarse_for_the_coil_is_warned_the_default_is_not():
+    """The default relay at its own steps: the interface residual 1.1e-5 of the energy into
+    the coil, no line. At 10 times its coil's time-scale fraction (1.0: psi^2 extrapolated
+    over a whole time scale, an error ~x^2/2 of its change) the drive the mechanics got is
+    off by ~2e-2 of that energy (its operate time 78 us late, measured against a run at a
+    quarter of every step rule), above solver.energy_tolerance (1e-3): warned, and only
+    warned."""
+    scene = builtin_scene("default")
+    assert not interface_warnings(run(scene))
+    coarse = run(scene.set("coupling.coil_time_scale_fraction", 10 * scene.coupling.coil_time_scale_fraction))
+    rel = coarse.relay["energy"]["interface_relative_residual"]
+    assert rel > 5 * coarse.mechanics.model.scene.solver.energy_tolerance
+    lines = interface_warnings(coarse)
+    assert len(lines) == 1 and f"{rel:.3g}" in lines[0] and "coil_time_scale_fraction" in lines[0]
+    assert not any("interface" in p for p in coarse.problems)
