@@ -21,6 +21,13 @@ armature_position, working_gap and magnetic_force), its operations and the coil'
   magnet's exact differential), so what is left is the flux's integration error, second
   order in the points' spacing (docs/coupling.md, "The relay"); the run's soundness judges
   it against solver.energy_tolerance (the mechanics' own audit holds the armature's side).
+  With the work the mechanics received from the drive (``received``, J: the integral of
+  F_drive dq along the mechanics' own solution, coupling.core.exchange.CoilLink.receive):
+  ``armature_received``, ``interface_residual`` = armature_work - armature_received (J,
+  energy made or lost at the coil-armature interface: the extrapolated psi^2 against the
+  circuit's, the gap the circuit read against the mechanics' path) and
+  ``interface_relative_residual`` = |interface_residual| / into_coil; so into_coil = copper
+  + magnetic_change + armature_received + interface_residual + residual.
 """
 
 from __future__ import annotations

@@ -143,8 +143,8 @@ def test_the_interface_residual_falls_at_the_coupling_order():
     step with the circuit's backward slope, against the circuit's psi^2: an error ~ psi^2''
     h^2 in the force, h^3 in a step's work, h^2 over the run: second order (measured 2.9
     and 3.3 per halving: 7.3e-6, 1.0e-6, 1.0e-7 J). Further halvings meet a floor of ~2e-8 J
-    (the gain table's interpolation of h(g), the mechanics' and ngspice's tolerances), which
-    these three levels stay 5x above; 1.7 allows for it."""
+    (docs/coupling.md, "The relay"), which these three levels stay 5x above; 1.7 allows for
+    it."""
     scene = load_scene(PLUNGER).set("solver.t_end", 0.012)
     residuals = []
     for _ in range(3):
