@@ -81,6 +81,91 @@ def contact_intervals(seg, touching_at_start) -> list[list[tuple[float, float]]]
     return intervals
 
 
+# Gauss-Legendre on [0, 1] (nodes, weights) of RECEIVED_NODES points: the quadrature of the
+# armature's drive work (``received_work``), exact for polynomials of degree 7 in time
+RECEIVED_NODES = 4
+_LEGENDRE = np.polynomial.legendre.leggauss(RECEIVED_NODES)
+GAUSS_NODES = tuple(0.5 * (float(x) + 1.0) for x in _LEGENDRE[0])
+GAUSS_WEIGHTS = tuple(0.5 * float(w) for w in _LEGENDRE[1])
+
+
+class GainIntegral:
+    """G(q) = the integral of the mechanics' gain table from its first knot to q (N/Wb^2 m, or
+    what the drive needs times m or rad): the exact antiderivative of mech.armature.gain_at
+    on the table (3, count) of positions, gains and the slopes the mechanics uses (the
+    model's ``again``): each interval's cubic Hermite piece integrated in closed form, the
+    end's tangent line beyond the ends; no table (count 0, gain 1): G(q) = q."""
+
+    def __init__(self, table: np.ndarray):
+        self.count = int(table.shape[1])
+        self.x = [float(v) for v in table[0]]
+        self.y = [float(v) for v in table[1]]
+        self.m = [float(v) for v in table[2]]
+        self.at_knot = [0.0]  # G at each knot
+        for k in range(self.count - 1):
+            h = self.x[k + 1] - self.x[k]
+            self.at_knot.append(self.at_knot[-1] + h * (0.5 * (self.y[k] + self.y[k + 1])
+                                                         + h * (self.m[k] - self.m[k + 1]) / 12.0))
+
+    def __call__(self, q: float) -> float:
+        if self.count == 0:
+            return q
+        x, y, m = self.x, self.y, self.m
+        if q <= x[0]:
+            d = q - x[0]
+            return d * (y[0] + 0.5 * m[0] * d)
+        last = self.count - 1
+        if q >= x[last]:
+            d = q - x[last]
+            return self.at_knot[last] + d * (y[last] + 0.5 * m[last] * d)
+        lo = bisect_right(x, q) - 1
+        h = x[lo + 1] - x[lo]
+        s = (q - x[lo]) / h
+        s2 = s * s
+        s3 = s2 * s
+        s4 = s3 * s
+        # the integrals from 0 to s of the Hermite basis h00, h10, h01, h11
+        return self.at_knot[lo] + h * (y[lo] * (s - s3 + 0.5 * s4) + h * m[lo] * (0.5 * s2 - 2.0 * s3 / 3.0 + 0.25 * s4)
+                                       + y[lo + 1] * (s3 - 0.5 * s4) + h * m[lo + 1] * (0.25 * s4 - s3 / 3.0))
+
+
+def received_work(armature, t0: float, t1: float, drive0: float, drive1: float, gain_integral, cuts=()) -> float:
+    """J: the work a drive did on the armature over [t0, t1] (s), the integral of
+    F(t) dq/dt dt with F = drive(t) gain(q(t)): the drive linear in time from drive0 at t0 to
+    drive1 at t1 (N, or Wb^2: what mech's "armature.force" channel holds), gain the
+    mechanics' gain table, ``gain_integral`` its antiderivative G (``GainIntegral``);
+    armature(t) -> (q, dq/dt) (m, or rad for a clapper, whose drive is then N m).
+
+    By parts, W = drive1 (G(q1) - G(q0)) - slope x the integral of G(q(t)) - G(q0) dt: exact
+    for a constant drive whatever the path, and what is left to a quadrature has no dq/dt in
+    it, which the bar's vibration carries through the card (a 4-point Gauss-Legendre of
+    F dq/dt per macro step left the default relay's received work 1.4e-4 off the mechanics'
+    own quadrature). Gauss-Legendre of RECEIVED_NODES points on each piece between the
+    ``cuts`` (s: the mechanics' events, where dq/dt has a kink: a stop or the card)."""
+    span = t1 - t0
+    if span <= 0.0:
+        return 0.0
+    q1 = armature(t1)[0]  # (first: the segment's armature caches its last time, often the end)
+    q0 = armature(t0)[0]
+    g0 = gain_integral(q0)
+    work = drive1 * (gain_integral(q1) - g0)
+    slope = (drive1 - drive0) / span
+    if slope == 0.0:
+        return work
+    inner = sorted(c for c in cuts if t0 < c < t1) if cuts else ()
+    edges = [t0, *inner, t1]
+    total = 0.0
+    for k in range(len(edges) - 1):
+        a, h = edges[k], edges[k + 1] - edges[k]
+        piece = 0.0
+        for x, w in zip(GAUSS_NODES, GAUSS_WEIGHTS):
+            q = armature(a + x * h)[0]
+            if q != q0:  # (an armature that has not moved adds nothing)
+                piece += w * (gain_integral(q) - g0)
+        total += h * piece
+    return work - slope * total
+
+
 class Tail:
     """The last points of a circuit signal, kept across macro steps for its rate and time
     scale (``end_rate``); points before a jump say nothing of the signal after it.
@@ -314,6 +399,11 @@ class CoilLink:
         self.q_times: list[float] = []  # the circuit's points (s) ...
         self.q: list[float] = []  # ... and the armature's travel there (m or rad)
         self._sampled = False
+        # J: the work the mechanics received from the drive "armature.force" so far
+        # (``receive``), against which the magnet's work as the circuit sees it is audited
+        self.received = 0.0
+        self._gain_integral = None  # GainIntegral of the mechanics' gain table, built at the first step,
+        self._drive_row = -1  # ... and the mechanics' drive row of "armature.force"
 
     def next_switch(self, t: float) -> float:
         """s: the coil drive's next switching instant after t (its driver's PWL vertices: on,
@@ -417,6 +507,24 @@ class CoilLink:
         for s in new.tolist():  # (a point or two a step: kept as floats, joined into arrays at the end)
             self.q_times.append(s)
             self.q.append(armature(lo if s < lo else (hi if s > hi else s))[0])
+
+    def receive(self, seg, mech) -> None:
+        """After a step: add the work the drive did on the armature over the segment, along the
+        mechanics' own solution (``received_work`` on its dense output), with the drive as the
+        mechanics held it (``mech.drive``'s armature row, linear over the step, read at the
+        segment's ends) and the antiderivative of its gain table (``GainIntegral``)."""
+        from mech.kernel_layout import D_SLOPE, D_T0, D_VALUE
+
+        t0, t1 = seg.t_start, seg.t_end
+        if self._gain_integral is None:
+            self._gain_integral = GainIntegral(mech.model.again)
+            self._drive_row = mech.model.armature_drive_row
+        # the kernel's drive_at, on the row's three floats (mech.drives.values_at does every row)
+        row = mech.drive[self._drive_row].tolist()
+        value, slope, t_ref = row[D_VALUE], row[D_SLOPE], row[D_T0]
+        self.received += received_work(seg.armature, t0, t1, value + slope * (t0 - t_ref),
+                                       value + slope * (t1 - t_ref), self._gain_integral,
+                                       [e["time"] for e in seg.events] if seg.events else ())
 
     def columns(self, waves: dict) -> dict:
         """The result's coil columns beside the circuit's (coil_current, coil_voltage,

@@ -366,6 +366,7 @@ class CoSimulation:
         jumped = bool(switching) or aligned
         if coil is not None:
             coil.observe(step, seg, self.coil_policy)
+            coil.receive(seg, mech)
         if contact is None:
             return t_next, 0.0, jumped, (0.0, math.inf)
         for link in links:
@@ -433,7 +434,8 @@ class CoSimulation:
             waves.update(self.coil.columns(waves))
         return CoupledResult(scene=self.scene, mechanics=mech.result(), waveform_columns=waves,
                              stats=dict(self.stats, circuit=stepper.stats), status=status, message=message,
-                             stopped_at=stopped_at)
+                             stopped_at=stopped_at,
+                             armature_received=self.coil.received if self.coil is not None else None)
 
     def _contact_columns(self, mech, waves: dict) -> None:
         """The contact's mechanics at the circuit's points: normal force and penetration per

@@ -21,6 +21,13 @@ armature_position, working_gap and magnetic_force), its operations and the coil'
   magnet's exact differential), so what is left is the flux's integration error, second
   order in the points' spacing (docs/coupling.md, "The relay"); the run's soundness judges
   it against solver.energy_tolerance (the mechanics' own audit holds the armature's side).
+  With the work the mechanics received from the drive (``received``, J: the integral of
+  F_drive dq along the mechanics' own solution, coupling.core.exchange.CoilLink.receive):
+  ``armature_received``, ``interface_residual`` = armature_work - armature_received (J,
+  energy made or lost at the coil-armature interface: the extrapolated psi^2 against the
+  circuit's, the gap the circuit read against the mechanics' path) and
+  ``interface_relative_residual`` = |interface_residual| / into_coil; so into_coil = copper
+  + magnetic_change + armature_received + interface_residual + residual.
 """
 
 from __future__ import annotations
@@ -33,12 +40,15 @@ def stop_times(events: list[dict], stop: str, kind: str) -> list[float]:
     return [float(e["time"]) for e in events if e.get("stop") == stop and e["kind"] == f"armature_stop_{kind}"]
 
 
-def relay_metrics(waves: dict, operations: list[dict], drive, magnet, events: list[dict], resistance: float) -> dict:
+def relay_metrics(waves: dict, operations: list[dict], drive, magnet, events: list[dict], resistance: float,
+                  received: float | None = None) -> dict:
     """The ``relay`` block (module docstring). waves: the run's columns (SI); operations:
     the contact's (coupling.core.metrics.operations; [] without a contact); drive: the
     circuit's CoilDrive (its on_time and off_time), or None for a netlist's coil; magnet:
     the coupling.laws.magnet magnet; events: the mechanics' events (its armature's stop
-    events); resistance: ohm, the coil's winding."""
+    events); resistance: ohm, the coil's winding; received: J, the work the mechanics
+    received from the armature's drive (coupling.core.exchange.CoilLink.receive), or None
+    (no interface keys)."""
     t = np.asarray(waves["time"], float)
     i = np.asarray(waves["coil_current"], float)
     v = np.asarray(waves["coil_voltage"], float)
@@ -83,4 +93,8 @@ def relay_metrics(waves: dict, operations: list[dict], drive, magnet, events: li
         residual = into - copper - stored - work
         out["energy"] = dict(into_coil=into, copper=copper, magnetic_change=stored, armature_work=work,
                              residual=residual, relative_residual=abs(residual) / abs(into) if into else None)
+        if received is not None:
+            interface = work - received
+            out["energy"].update(armature_received=received, interface_residual=interface,
+                                 interface_relative_residual=abs(interface) / abs(into) if into else None)
     return out

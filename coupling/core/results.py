@@ -93,6 +93,9 @@ class CoupledResult:
     stopped_at: float | None = None  # s: where a failed or interrupted run stopped
     accuracy: dict | None = None  # summary.accuracy of run(scene, check=True) (coupling/app/accuracy.py)
     soundness: dict | None = None  # what judge() measured: extremes, bounds and problems (coupling.core.soundness)
+    # J: the work the mechanics received from the coil's drive (coupling.core.exchange.CoilLink.receive), None
+    # without a coil; the relay's energy audit sets the magnet's work against it (coupling.core.relay)
+    armature_received: float | None = None
     _cache: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self):
@@ -284,7 +287,7 @@ class CoupledResult:
             circ = self.scene.circuit.circuit
             drive = circ if isinstance(circ, CoilDrive) else getattr(circ, "coil", None)  # None: a netlist's
             self._cache["relay"] = relay_metrics(w, self.operations, drive, spec.magnet, self.mechanics.events,
-                                                 spec.resistance)
+                                                 spec.resistance, received=self.armature_received)
         return self._cache["relay"]
 
     @property
