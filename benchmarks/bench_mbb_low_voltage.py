@@ -16,9 +16,10 @@ The cause, measured: the solve at those steps was wrong. ngspice factors the mat
 pivot order it chose at the first time point and keeps it (sparse/spfactor.c reorders only
 on an exactly zero pivot). The template had its load probe Vload between the wiring
 inductor and the common (src -R- wire -Lwire- common -Vload- contact_a): node common carried
-no conductance, only the two branch currents, and was eliminated through Lwire's L/h, 1e9
-ohm at 1e-15 s steps. The factored matrix (ngspice's mdump just before the make) held an
-entry of 3.8e15 (8.3e4 with the probe at the source, same time); the solution broke the probe's own 0 V,
+no conductance, only the two branch currents, while Lwire's L/h reached 1e9 ohm at 1e-15 s
+steps. The factored matrix (ngspice's mdump just before the make) held an entry of 3.8e15
+(8.3e4 with the probe at the source, same time; which pivot grew was not traced); the
+solution broke the probe's own 0 V,
 V(common) - V(contact_a), by 5.3 mV (32 mV with a breakpoint at the make), against 0 in the
 arc-off run; Newton's test (niconv.c) failed at node common at every retry and each cut
 the step 8x, down to delmin. Which decks hit it depended on the pivot order, hence the

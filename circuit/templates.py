@@ -631,11 +631,11 @@ class ChangeoverCircuit(SwitchCircuit):
         gnd = c.gnd
         # The load probe sits at the source, not between the wiring and the common: there the
         # node between it and Lwire carried no conductance, only the two branch currents, and
-        # ngspice's LU (its pivot order fixed at the first time point, reordered only at an
-        # exactly zero pivot) eliminated it through Lwire's L/h, 1e9 ohm at the femtosecond
-        # steps of a make: factor entries of 4e15, the probe's 0 V violated by 32 mV, Newton's
-        # test failed at node "common" and a 5 V make at RELTOL 1e-6 aborted (docs/circuit.md,
-        # "A changeover"). The wiring now ends on the common, as in the one-contact template.
+        # in the pivot order ngspice fixes at the first time point (it reorders only at an
+        # exactly zero pivot) the factors grew at the femtosecond steps of a make (Lwire's L/h
+        # 1e9 ohm): an entry of 3.8e15, the probe's 0 V violated by up to 32 mV, Newton's test
+        # failed at node "common" and a 5 V make at RELTOL 1e-6 aborted (docs/circuit.md,
+        # section 7). The wiring now ends on the common, as in the one-contact template.
         self._place_supply(c, NODE_A, probe=LOAD_PROBE)
         for block, resistance, inductance in zip(self.contacts, self.load_resistances, self.load_inductances):
             add_contact(c, block.node_a, block.node_b, self.leakage_conductance, self.contact_current_factor,
