@@ -54,8 +54,9 @@ def main(fast: bool = False, out=None) -> dict:
     numbers the summary prints."""
     out = Path(out) if out else Path("runs/examples") / NAME
     out.mkdir(parents=True, exist_ok=True)
-    # 20 ms lets ngspice step 400 us (t_end / 50) through the coil's rise, where its flux
-    # misses the coil's energy audit (1.5-2.6e-3 > solver.energy_tolerance: warned, docs/coupling.md)
+    # the released coil rings (with the RC: through zero, ~6 ms period) over the default relay's
+    # macro steps of up to 1 ms, and the coil-armature interface's residual reaches 1.4e-3 of
+    # the energy into the coil (> solver.energy_tolerance: warned, docs/coupling.md)
     base = default_scene().set("solver.t_end", T_END).set("coupling.max_macro_step", 1e-4)
     off = float(base.raw["coil"]["off_time"])
     rows, waves = {}, {}

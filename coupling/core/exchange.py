@@ -395,6 +395,7 @@ class CoilLink:
         # time scale (s) and the slope the step rules chose to extrapolate it with
         self.value, self.rate, self.scale, self.slope = 0.0, 0.0, math.inf, 0.0
         self.bound_by = "curvature"  # the rule that set ``scale``: "curvature", "size" or "gap"
+        self.gap_scale = math.inf  # s: the gap rule's time scale (inf: the armature does not move)
         self._flux_column = "coil_flux_linkage" + label[len("coil"):]
         self.q_times: list[float] = []  # the circuit's points (s) ...
         self.q: list[float] = []  # ... and the armature's travel there (m or rad)
@@ -491,14 +492,15 @@ class CoilLink:
         speed = self.lever * abs(float(q_dot))  # m/s of the working gap
         # m/s^2: the armature's acceleration over the step (its velocity change)
         accel = self.lever * abs(float(q_dot) - float(seg.armature(seg.t_start)[1])) / span if span > 0.0 else 0.0
+        self.gap_scale = math.inf
         if speed > 0.0 or accel > 0.0:
             # nor beyond the time the gap takes to change by its own size: the coil's flux
             # equation holds the gap, and its force 1/g^2, while the armature flies (the flux
             # itself changes little then: at 240 us steps the default relay's coil audit left
             # 3e-3 of its energy to ngspice's coarse points); at its speed and acceleration,
             # for an armature leaving its stop has no speed yet
-            scales.append((gap_time(policy.gap_change_fraction * max(self.gap(float(q)), 0.0), speed, accel),
-                           "gap"))
+            self.gap_scale = gap_time(policy.gap_change_fraction * max(self.gap(float(q)), 0.0), speed, accel)
+            scales.append((self.gap_scale, "gap"))
         self.scale, self.bound_by = min(scales)
         new = times[1:] if self._sampled else times
         self._sampled = True
