@@ -125,9 +125,10 @@ def interface_audit_warning(result) -> str | None:
     work as the circuit sees it less the work the mechanics received from the drive) is above
     solver.energy_tolerance of the energy into the coil: the drive the mechanics got was
     extrapolated too far from the circuit's flux (the default relay at 10 times its coil's
-    time-scale fraction: 2e-2, its operate time 78 us late; 3 times: 1.3e-3, 17 us; the
-    shipped relays at their own steps: at most 2.2e-4, docs/coupling.md "The relay"). A
-    warning only: the mechanics' and the coil's own audits still balance."""
+    time-scale fraction: 1.8e-2, its operate time 79 us late; 3 times: 9.5e-4, 24 us; the
+    shipped relays at their own steps: at most 2.9e-4, docs/coupling.md "The relay"; it is
+    a net energy, a lower bound on the exchange's error). A warning only: the mechanics' and
+    the coil's own audits still balance."""
     relay = result.relay if result.mechanics is not None else None
     energy = relay.get("energy") if relay else None
     rel = energy.get("interface_relative_residual") if energy else None
