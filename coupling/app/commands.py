@@ -160,6 +160,8 @@ def _result_lines(summary: dict) -> None:
         energy = relay.get("energy") or {}
         if energy.get("relative_residual") is not None:
             parts.append(f"coil energy residual {energy['relative_residual']:.2g}")
+        if energy.get("interface_relative_residual") is not None:
+            parts.append(f"coil-armature interface {energy['interface_relative_residual']:.2g}")
         print("switchsim: relay: " + ", ".join(p for p in parts if p))
     co = summary.get("changeover")
     if co:  # coupling.core.arrangement.changeover_metrics

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import json
 
 import numpy as np
 import pytest
@@ -166,7 +167,12 @@ def test_an_actuator_alone_writes_its_folder_and_plots(tmp_path, capsys):
     scene = Path(__file__).resolve().parents[2] / "examples" / "plunger_solenoid.toml"
     out = tmp_path / "out"
     assert main(["run", str(scene), "--out", str(out), "--plots", "--quiet"]) == 0
-    assert "switchsim: relay: armature at the pole" in capsys.readouterr().out
+    (line,) = [x for x in capsys.readouterr().out.splitlines() if x.startswith("switchsim: relay:")]
+    assert line.startswith("switchsim: relay: armature at the pole")
+    # the coil's two audits, as summary.json's relay.energy gives them
+    energy = json.loads((out / "summary.json").read_text())["relay"]["energy"]
+    assert f"coil energy residual {energy['relative_residual']:.2g}" in line
+    assert f"coil-armature interface {energy['interface_relative_residual']:.2g}" in line
     assert (out / "waveforms.png").stat().st_size > 10_000
     assert not (out / "openings.png").exists() and not (out / "normal_force.png").exists()
     html = (out / "waveforms.html").read_text()
