@@ -154,9 +154,12 @@ class StepPolicy:
         return abs(rate) * span <= self.change_fraction * (abs(current) + self.current_floor)
 
     @staticmethod
-    def extrapolate(current: float, slope: float, elapsed: float, horizon: float = math.inf) -> float:
-        """A: the current ``elapsed`` s after a point where it is ``current`` with ``slope``."""
-        return current + slope * min(elapsed, horizon)
+    def extrapolate(current: float, slope: float, elapsed: float, horizon: float = math.inf,
+                    curvature: float = 0.0) -> float:
+        """A: the current ``elapsed`` s after a point where it is ``current`` with ``slope`` (and
+        second derivative ``curvature``, per s^2: along that parabola), not beyond ``horizon``."""
+        e = min(elapsed, horizon)
+        return current + slope * e + 0.5 * curvature * e * e
 
     def aligned_end(self, t: float, t_next: float, event: float) -> float | None:
         """s: where to end a step [t, t_next] in which the first make/break is at ``event``; None: keep it."""
@@ -168,29 +171,39 @@ class StepPolicy:
         return None
 
 
-def end_rate(t: Sequence[float], i: Sequence[float], span: float) -> tuple[float, float]:
-    """(dI/dt in A/s, its time scale |dI/dt| / |d2I/dt2| in s) of the loop current at the last
-    of the circuit points (t, i) (several steps' worth: a short step may hold only one or
-    two), with differences over at least 1e-3 of ``span`` (s) so a sliver landing step does
-    not dominate; (0, inf) without enough points. For an exponential approach the time
-    scale is its time constant wherever the current is on it; for a ramp it is infinite."""
+def end_derivatives(t: Sequence[float], i: Sequence[float], span: float) -> tuple[float, float | None]:
+    """(dI/dt, d2I/dt2) of a circuit signal at the last of its points (t, i), from differences
+    over at least 1e-3 of ``span`` (s) so that a sliver landing step does not dominate: the
+    last chord's slope and the change of slope from the chord before (exact for a parabola);
+    (0, None) without two finite points, (dI/dt, None) without a third."""
     if len(t) < 2 or not all(math.isfinite(v) for v in i[-3:]):
-        return 0.0, math.inf
+        return 0.0, None
     k = len(t) - 2
     while k > 0 and t[-1] - t[k] < 1e-3 * span:
         k -= 1
     dt = t[-1] - t[k]
     if dt <= 0:
-        return 0.0, math.inf
+        return 0.0, None
     rate = float((i[-1] - i[k]) / dt)
     j = k - 1
     while j > 0 and t[k] - t[j] < 1e-3 * span:
         j -= 1
     if j < 0 or t[k] <= t[j]:
+        return rate, None
+    previous = (i[k] - i[j]) / (t[k] - t[j])
+    return rate, 2.0 * (rate - previous) / (t[-1] - t[j])
+
+
+def end_rate(t: Sequence[float], i: Sequence[float], span: float) -> tuple[float, float]:
+    """(dI/dt in A/s, its time scale |dI/dt| / |d2I/dt2| in s) of the loop current at the last
+    of the circuit points (t, i) (several steps' worth: a short step may hold only one or
+    two), from ``end_derivatives``; (0, inf) without enough points. For an exponential
+    approach the time scale is its time constant wherever the current is on it; for a ramp
+    it is infinite."""
+    rate, curvature = end_derivatives(t, i, span)
+    if curvature is None:
         # too few points for a curvature: the cautious scale |I|/|dI/dt|
         return rate, (abs(float(i[-1])) + CURRENT_FLOOR) / abs(rate) if rate != 0.0 else math.inf
-    previous = (i[k] - i[j]) / (t[k] - t[j])
-    curvature = 2.0 * (rate - previous) / (t[-1] - t[j])
     if curvature == 0.0:
         return rate, math.inf
     return rate, float(abs(rate / curvature))
