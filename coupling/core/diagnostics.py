@@ -116,8 +116,9 @@ def coil_audit_warning(result) -> str | None:
     return None
 
 
-INTERFACE_FIX = ("the macro steps are too long for the coil's flux: lower [coupling] coil_time_scale_fraction "
-                 "(e.g. 0.05) or cap [coupling] max_macro_step")
+INTERFACE_FIX = ("the macro steps are too long for the coil's flux: cap [coupling] max_macro_step (e.g. 1e-4 s; "
+                 "where psi^2 is momentarily stationary, a ringing coil's, only this helps) or lower [coupling] "
+                 "coil_time_scale_fraction (e.g. 0.05)")
 
 
 def interface_audit_warning(result) -> str | None:

@@ -108,8 +108,8 @@ def test_the_coil_channels_keep_second_order():
     the step rules; the working gap into ngspice from the armature's dense output), at fixed
     macro steps halved three times: the armature's arrival at the pole (a located event) and
     its travel at 10 ms (mid-flight) converge at second order, neither less nor more
-    (successive differences fall 4x per halving; measured orders 2.00 and 2.00, 2.06 and
-    1.94). ngspice takes coupling.coil_step_points points per macro step, so its own error
+    (successive differences fall 4x per halving; measured orders 1.96 and 1.99, 2.00 and
+    1.91). ngspice takes coupling.coil_step_points points per macro step, so its own error
     falls with the macro step too; at one point per step and its truncation control the
     orders over 80-10 us were erratic (2.3-3.9), and from 80 us down the convergence is not
     yet asymptotic (1.5-1.9 at the first halving)."""

@@ -159,7 +159,7 @@ def interface_warnings(result) -> list[str]:
 
 
 def test_a_coupling_too_coarse_for_the_coil_is_warned_the_default_is_not():
-    """The default relay at its own steps: the interface residual 2.9e-4 of the energy into
+    """The default relay at its own steps: the interface residual 2.1e-4 of the energy into
     the coil, no line. At 10 times its coil's time-scale fraction (1.0: psi^2 extrapolated
     over a whole time scale, an error ~x^2/2 of its change) the drive the mechanics got is
     off by ~2e-2 of that energy (its operate time 78 us late, measured against a run at a
@@ -182,7 +182,7 @@ def test_the_released_armatures_return_flight_keeps_the_gap_rule():
     step with its drive held at the step's start: the interface residual 7.5e-4 of the energy
     into the coil. The gap rule (the working gap changes by at most gap_change_fraction of
     itself in a step) holds while the armature moves whatever the flux does: every step of
-    the flight is short of that, and the residual 2.9e-4 (measured)."""
+    the flight is short of that, and the residual 2.1e-4 (measured)."""
     scene = builtin_scene("default")
     steps = []
     observe = CoilLink.observe
