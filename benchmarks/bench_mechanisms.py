@@ -358,7 +358,7 @@ def render(a: dict, b: dict, c: dict, d: list, base: float, load: tuple, repeat:
               f"{b['pre_steps_per_ms'] * 1e3:.3g} steps per simulated second at rest, against "
               f"{b['wall']:.3f} s for the whole held second ({per_s / b['wall']:.0f}x)."]
     ok = c["solver"] < TARGET_C
-    L += ["", f"**(c) Coupled relay closure** (`builtin_scene(\"default\")`, t_end = final closure "
+    L += ["", f"**(c) Coupled relay closure** (`builtin_scene(\"relay_force\")`, t_end = final closure "
           f"{c['final_start'] * 1e3:.3f} ms + 2 ms = {c['t_end'] * 1e3:.3f} ms; first make "
           f"{c['first_make'] * 1e3:.3f} ms, {c['bounces']} bounces, settle time "
           + (f"{c['settle_time'] * 1e3:.3f} ms" if c["settle_time"] is not None else "none") + "):", "",
