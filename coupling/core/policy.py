@@ -174,8 +174,9 @@ class StepPolicy:
 def end_derivatives(t: Sequence[float], i: Sequence[float], span: float) -> tuple[float, float | None]:
     """(dI/dt, d2I/dt2) of a circuit signal at the last of its points (t, i), from differences
     over at least 1e-3 of ``span`` (s) so that a sliver landing step does not dominate: the
-    last chord's slope and the change of slope from the chord before (exact for a parabola);
-    (0, None) without two finite points, (dI/dt, None) without a third."""
+    last chord's slope (the derivative at the chord's middle) and the change of slope from
+    the chord before (a parabola's curvature, exactly); (0, None) without two finite points,
+    (dI/dt, None) without a third."""
     if len(t) < 2 or not all(math.isfinite(v) for v in i[-3:]):
         return 0.0, None
     k = len(t) - 2
