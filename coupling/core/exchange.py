@@ -24,7 +24,7 @@ from bisect import bisect_right
 
 import numpy as np
 
-from coupling.core.policy import TAIL_POINTS, end_derivatives, end_rate
+from coupling.core.policy import TAIL_POINTS, end_derivatives, end_rate, time_scale
 
 CONTACT_EVENTS = ("contact_start", "contact_end")
 # the step rules' floor of the coil's signal (psi^2 or psi), as a fraction of its value at the
@@ -194,9 +194,9 @@ class Tail:
         """(d/dt in units per s, time scale in s) at the last point (``end_rate``)."""
         return end_rate(self.t, self.v, span)
 
-    def curvature(self, span: float) -> float:
-        """d2/dt2 in units per s^2 at the last point (``end_derivatives``; 0 without three points)."""
-        return end_derivatives(self.t, self.v, span)[1] or 0.0
+    def derivatives(self, span: float) -> tuple[float, float | None]:
+        """(d/dt per s, d2/dt2 per s^2 or None) at the last point (``end_derivatives``)."""
+        return end_derivatives(self.t, self.v, span)
 
 
 class ContactLink:
@@ -493,11 +493,11 @@ class CoilLink:
         psi = step.reader(self._flux_column)
         self.tail.observe(times, self.signal(psi), False)
         self.flux_tail.observe(times, psi, False)
-        self.flux_rate = self.flux_tail.rate(policy.macro_step)[0]
+        self.flux_rate = self.flux_tail.derivatives(policy.macro_step)[0]
         self.value = self.signal(self.flux(step))
-        self.rate, curvature = self.tail.rate(policy.macro_step)
-        self.curvature = self.tail.curvature(policy.macro_step)
-        scales = [(curvature, "curvature")]
+        self.rate, curvature = self.tail.derivatives(policy.macro_step)
+        self.curvature = curvature or 0.0
+        scales = [(time_scale(self.rate, curvature, self.tail.v[-1] if self.rate != 0.0 else 0.0), "curvature")]
         if self.rate != 0.0:
             # not beyond the time it takes to change by its own size (plus the floor): a signal
             # falling linearly to zero (a clamped coil's release) has no curvature

@@ -202,9 +202,16 @@ def end_rate(t: Sequence[float], i: Sequence[float], span: float) -> tuple[float
     approach the time scale is its time constant wherever the current is on it; for a ramp
     it is infinite."""
     rate, curvature = end_derivatives(t, i, span)
+    return rate, time_scale(rate, curvature, i[-1] if rate != 0.0 else 0.0)
+
+
+def time_scale(rate: float, curvature: float | None, last: float) -> float:
+    """s: |rate / curvature| (``end_derivatives``' pair at a signal's last point ``last``);
+    with no curvature known the cautious |last| + CURRENT_FLOOR over |rate|; inf where
+    either vanishes."""
     if curvature is None:
         # too few points for a curvature: the cautious scale |I|/|dI/dt|
-        return rate, (abs(float(i[-1])) + CURRENT_FLOOR) / abs(rate) if rate != 0.0 else math.inf
+        return (abs(float(last)) + CURRENT_FLOOR) / abs(rate) if rate != 0.0 else math.inf
     if curvature == 0.0:
-        return rate, math.inf
-    return rate, float(abs(rate / curvature))
+        return math.inf
+    return float(abs(rate / curvature))
