@@ -778,6 +778,11 @@ class ImpactSolver:
         return bool(self.armature_closed[BAR_HELD])
 
     @property
+    def armature_seated(self) -> bool:
+        """True while the armature is seated on one of its stops (held there, see _seat)."""
+        return bool(self.model.has_armature and self.armature_closed[EA_SEAT])
+
+    @property
     def hold_until(self) -> float:
         """s: when the current hold at rest ends (the next load or base change; inf: none)."""
         return self._hold_until if self.at_rest else self.t

@@ -99,6 +99,7 @@ _SUMMARY = {
               "last_edge": ("last logic edge", "s"), "edge_burst": ("logic edge burst", "s"),
               "stable_margin": ("logic stable margin", "V")},
     "run": {"macro_steps": ("macro steps", "-"), "aligned_steps": ("aligned macro steps", "-"),
+            "approach_steps": ("macro steps redone to approach an armature's unseat", "-"),
             "contact_steps": ("macro steps in contact", "-"), "mech_seconds": ("mechanics time", "s"),
             "circuit_seconds": ("circuit time", "s"), "wall_time": ("run wall time", "s"),
             "circuit.steps": ("circuit steps", "-"), "circuit.points": ("circuit points", "-"),

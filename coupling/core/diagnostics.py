@@ -125,9 +125,8 @@ def coil_audit_warning(result) -> str | None:
     return None
 
 
-INTERFACE_FIX = ("the macro steps are too long for the coil's flux: cap [coupling] max_macro_step (e.g. 1e-4 s; "
-                 "where psi^2 is momentarily stationary, a ringing coil's, only this helps) or lower [coupling] "
-                 "coil_time_scale_fraction (e.g. 0.05)")
+INTERFACE_FIX = ("the macro steps are too long for the coil's flux: lower [coupling] coil_time_scale_fraction "
+                 "(e.g. 0.05) or cap [coupling] max_macro_step (e.g. 1e-4 s)")
 
 
 def interface_audit_warning(result) -> str | None:
@@ -135,9 +134,9 @@ def interface_audit_warning(result) -> str | None:
     work as the circuit sees it less the work the mechanics received from the drive) is above
     solver.energy_tolerance of the energy into the coil: the drive the mechanics got was
     extrapolated too far from the circuit's flux, or held through a ringing (the default relay
-    at 10 times its coil's time-scale fraction: 1.1e-2; released through its RC suppression:
-    6.5e-2; the shipped relays at their own steps: at most 2.1e-4, docs/coupling.md "The
-    relay"; it is a net energy, a lower bound on the exchange's error). A warning only: the
+    at 10 times its coil's time-scale fraction: 5.5e-3; the shipped relays at their own steps,
+    and the default one released through each suppression: at most 1.5e-4, docs/coupling.md
+    "The relay"; it is a net energy, a lower bound on the exchange's error). A warning only: the
     mechanics' and the coil's own audits still balance."""
     share = _relay_energy_share(result, "interface_relative_residual")
     if share is None:

@@ -402,6 +402,7 @@ class CoilLink:
         self.curvature = 0.0  # its second derivative (per s^2) there, from the last three points
         self.bound_by = "curvature"  # the rule that set ``scale``: "curvature", "size" or "gap"
         self.gap_scale = math.inf  # s: the gap rule's time scale (inf: the armature does not move)
+        self.left_seat = -math.inf  # s: when the armature last left its seat
         self._flux_column = "coil_flux_linkage" + label[len("coil"):]
         self.q_times: list[float] = []  # the circuit's points (s) ...
         self.q: list[float] = []  # ... and the armature's travel there (m or rad)

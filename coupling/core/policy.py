@@ -33,6 +33,9 @@ COIL_STEP_POINTS = 2
 # ... and, while the coil's flux changes, steps of at most this fraction of the coil's time
 # constant L/R (at the rest gap, unsaturated): 80 points a time constant
 COIL_POINT_FRACTION = 0.0125
+# a step in which the seated armature leaves its stop ends this fraction of the way there
+# (StepPolicy.approach_end): the extrapolated drive decides the unseat only from close by
+APPROACH_FRACTION = 0.5
 CHANGE_FRACTION = 1e-3  # the time-scale rule applies only where a step would change the current by more
 CURRENT_FLOOR = 1e-3  # A: floor of |I| in the cautious time scale |I|/|dI/dt|
 GROWTH_CAP = 4.0  # macro steps: the longest step in a closed contact with a steady current
@@ -65,6 +68,8 @@ class StepPolicy:
       lands on its asymptote).
     - ``aligned_end``: where a step that saw a make/break at t_e is cut: at t_e inside it,
       at t + probe when t_e is at its start, else not cut (None).
+    - ``approach_end``: where a step in which the seated armature left its stop is cut:
+      halfway there while the unseat is more than H ahead, else H past it.
     """
 
     macro_step: float
@@ -128,13 +133,20 @@ class StepPolicy:
         return t_next
 
     def plan(self, t: float, t_next: float, t_end: float, *, touching: bool, jumped: bool, current: float,
-             rate: float, scale: float) -> tuple[float, float]:
+             rate: float, scale: float, curvature: float = 0.0) -> tuple[float, float]:
         """(end of the step in s, slope in A/s to extrapolate the current with) for a step from t
-        proposed to end at t_next, given the current (A), its rate dI/dt (A/s) and time scale (s)."""
+        proposed to end at t_next, given the current (A), its rate dI/dt (A/s) and time scale (s).
+        ``curvature`` (A/s^2): where the slope alone keeps the change rule but the parabola does
+        not (a stationary point: a ringing coil's psi^2 at an extremum or a zero of psi, or at
+        its switch-on), the step is at most time_scale_fraction of sqrt(2 (|I| + floor) /
+        |curvature|), the time the curvature alone takes to change the signal by its size."""
         if jumped:
             return min(t + self.probe, t_end), 0.0
         if touching and not self.steady(current, rate, t_next - t):
             t_next = min(t_next, t + max(self.probe, self.time_scale_fraction * scale))
+        elif touching and curvature and not self.steady(current, rate, t_next - t, curvature):
+            bend = math.sqrt(2.0 * (abs(current) + self.current_floor) / abs(curvature))
+            t_next = min(t_next, t + max(self.probe, self.time_scale_fraction * bend))
         return t_next, rate
 
     def circuit_step(self, t: float, t_next: float, time_constant: float = math.inf) -> float:
@@ -148,10 +160,11 @@ class StepPolicy:
         step = math.inf if self.circuit_points == 1 else (t_next - t) / self.circuit_points
         return min(step, self.point_fraction * time_constant)
 
-    def steady(self, current: float, rate: float, span: float) -> bool:
-        """True if the current (A) at rate dI/dt (A/s) moves by no more than the change rule
-        of ``plan`` allows over ``span`` (s)."""
-        return abs(rate) * span <= self.change_fraction * (abs(current) + self.current_floor)
+    def steady(self, current: float, rate: float, span: float, curvature: float = 0.0) -> bool:
+        """True if the current (A) at rate dI/dt (A/s), and along the parabola of ``curvature``
+        (A/s^2), moves by no more than the change rule of ``plan`` allows over ``span`` (s)."""
+        return abs(rate) * span + 0.5 * abs(curvature) * span * span <= self.change_fraction * (
+            abs(current) + self.current_floor)
 
     @staticmethod
     def extrapolate(current: float, slope: float, elapsed: float, horizon: float = math.inf,
@@ -160,6 +173,18 @@ class StepPolicy:
         second derivative ``curvature``, per s^2: along that parabola), not beyond ``horizon``."""
         e = min(elapsed, horizon)
         return current + slope * e + 0.5 * curvature * e * e
+
+    def approach_end(self, t: float, t_next: float, event: float) -> float | None:
+        """s: where to end a step [t, t_next] in which the mechanics found the seated armature
+        leaving its stop at ``event`` (with the drive extrapolated over the step): halfway
+        there while it is more than a macro step ahead, else a macro step past it; None: keep
+        the step (it ends before that)."""
+        lead = event - t
+        if lead > self.macro_step:
+            return t + APPROACH_FRACTION * lead
+        if t_next > event + self.macro_step:
+            return event + self.macro_step
+        return None
 
     def aligned_end(self, t: float, t_next: float, event: float) -> float | None:
         """s: where to end a step [t, t_next] in which the first make/break is at ``event``; None: keep it."""

@@ -327,3 +327,45 @@ def test_the_coils_gap_rule_keeps_the_changeovers_operate_time_within_its_tolera
     assert None not in (base, mid, ref)
     assert math.log2(abs(base - mid) / abs(mid - ref)) > 1.5, (base, mid, ref)
     assert abs(base - ref) <= 1e-6, (base, ref)
+
+
+def test_a_stationary_point_of_the_watched_signal_bounds_the_step_by_its_curvature():
+    """Where the signal v(t) = v0 + c (t - t0)^2 / 2 is stationary (a ringing coil's psi^2 at an
+    extremum or a zero of psi) its slope vanishes, and the change rule on the slope alone lets
+    the whole proposed step pass. With the curvature the step is tsf sqrt(2 (|v0| + floor) /
+    |c|), over which the parabola moves by exactly tsf^2 (|v0| + floor): the time the curvature
+    takes to change the signal by its size, scaled as the slope's rule scales its time scale."""
+    floor, tsf = 1e-3, 0.1
+    p = policy(current_floor=floor, time_scale_fraction=tsf)
+    v0, c, t = 2e-3, 4000.0, 1e-3
+    proposed = t + 1e-3
+    blind, _ = p.plan(t, proposed, 1.0, touching=True, jumped=False, current=v0, rate=0.0, scale=math.inf)
+    assert blind == proposed
+    end, slope = p.plan(t, proposed, 1.0, touching=True, jumped=False, current=v0, rate=0.0, scale=math.inf,
+                        curvature=c)
+    h = end - t
+    assert slope == 0.0 and h == pytest.approx(tsf * math.sqrt(2.0 * (v0 + floor) / c), rel=1e-12)
+    assert 0.5 * c * h * h == pytest.approx(tsf ** 2 * (v0 + floor), rel=1e-12)
+    # a curvature whose parabola stays within the change rule over the step changes nothing
+    gentle = 0.5 * p.change_fraction * (v0 + floor) / (proposed - t) ** 2
+    assert p.plan(t, proposed, 1.0, touching=True, jumped=False, current=v0, rate=0.0, scale=math.inf,
+                  curvature=gentle)[0] == proposed
+    # nor below the probe
+    assert p.plan(t, proposed, 1.0, touching=True, jumped=False, current=0.0, rate=0.0, scale=math.inf,
+                  curvature=1e30)[0] == pytest.approx(t + p.probe, rel=1e-12)
+
+
+def test_a_step_approaches_the_armatures_unseat_by_halves_and_ends_a_macro_step_past_it():
+    """The mechanics find the seated armature leaving its stop at t_u inside a step (with the
+    drive extrapolated over it): the step ends halfway there while t_u is more than a macro
+    step H ahead, else H past t_u, and is kept where it ends before that."""
+    p = policy()
+    t = 1e-3
+    assert p.approach_end(t, t + 1e-3, t + 400e-6) == pytest.approx(t + 200e-6, rel=1e-12)
+    assert p.approach_end(t, t + 1e-3, t + 0.5 * H) == pytest.approx(t + 1.5 * H, rel=1e-12)
+    assert p.approach_end(t, t + 1.2 * H, t + 0.5 * H) is None
+    lead, steps = 600e-6, 0  # from a 600 us lead down to one macro step: log2(600 / 5) halvings
+    while (end := p.approach_end(t, t + 1e-3, t + lead)) is not None and end - t < lead:
+        lead -= end - t
+        steps += 1
+    assert steps == math.ceil(math.log2(600e-6 / H)) and 0.5 * H < lead <= H
