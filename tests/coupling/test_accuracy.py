@@ -6,11 +6,12 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from coupling import run, scene_from_dict
+from coupling import load_scene, run, scene_from_dict
 from coupling.app.accuracy import (
     TOLERANCES, agreeing_contacts, compare, contact_metrics, intersection, measure,
     metrics_of, mismatch_allowance, mismatch_time, refined_count, status_of, time_tolerance, tip_intervals, verdict,
@@ -440,3 +441,26 @@ def test_the_macro_step_refinement_halves_every_step_rule_and_the_coil_error_fal
     assert all(a is not None and a < 0.0125 for a in arrival), arrival
     base_error, fine_error = abs(arrival[0] - arrival[2]), abs(arrival[1] - arrival[2])
     assert fine_error <= 0.6 * base_error, (arrival, steps)
+
+
+def test_the_checks_gap_reruns_change_the_fixed_contacts_own_gaps():
+    """On a bar with [[fixed]] contacts each contact sits at its own gap from the bar, and
+    initial.height moves only the world frame (the changeover's NO make moved 0.2 us for 1 %
+    of it): the check's gap reruns change every open contact's gap together, and the closed
+    one's (NC, gap 0) stays. The first make then moves by the gap's change over the blade's
+    speed at the make, 1 % of NO's 0.5 mm at 0.457 m/s: 10.9 us (measured 10.9 and 11.0)."""
+    from coupling.app.accuracy import perturbations
+
+    scene = load_scene(Path(__file__).resolve().parents[2] / "examples" / "changeover_relay.toml")
+    scene = scene.set("solver.t_end", 0.0121)  # (through NO's first make)
+    reruns = {name: s for name, _, s in perturbations(scene) if s is not None and name.startswith("gap")}
+    assert set(reruns) == {"gap -1.0%", "gap +1.0%"}
+    gap = scene.raw["fixed"][0]["gap"]
+    base = run(scene)
+    make = next(e for e in base.mechanics.events if e["kind"] == "contact_start" and e["time"] > 0.011)
+    for name, s in reruns.items():
+        assert s.raw["fixed"][1]["gap"] == 0.0 and s.mech.initial.height == scene.mech.initial.height
+        moved = s.raw["fixed"][0]["gap"] - gap
+        assert abs(moved) == pytest.approx(0.01 * gap, rel=1e-12)
+        delay = run(s).relay["operate_time"] - base.relay["operate_time"]
+        assert delay == pytest.approx(moved / make["penetration_rate"], rel=0.03), name
