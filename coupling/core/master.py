@@ -271,7 +271,7 @@ class CoSimulation:
                             # or not: a released armature's return flight under a flux below
                             # the change rule's floor (6e-4 of the rated psi^2 on the default
                             # relay) took one 1 ms step, the drive held, and the coil-armature
-                            # interface missed 7.5e-4 of the energy into the coil (now 2.1e-4)
+                            # interface missed 7.5e-4 of the energy into the coil (2.1e-4 with the rule)
                             t_coil = min(t_coil, t + max(self.coil_policy.probe, coil.gap_scale))
                             # and since the armature left a seat, steps no longer than that
                             # time (_approach_unseat)
