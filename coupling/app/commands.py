@@ -30,11 +30,11 @@ def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = Fa
     returns (the command line's own process, not a caller's): the cyclic collector is off
     while the modules are imported and the scene is built, and what they made is then
     frozen (``gc.freeze``) before the run, so the run's collections never scan it."""
-    # The collections cost a default run 11-14 ms (114 of them, timed by gc.callbacks),
-    # the plunger example 8 ms: most while numpy, mech, PySpice and the scene are loaded
-    # (~40 000 long-lived objects, a few hundred in garbage cycles), and the middle
-    # generation's, which rescanned those objects. With the start frozen: 2 ms, 21
-    # collections. Frozen objects are still freed when their last reference goes; only
+    # The collections cost a default run or the plunger example 10-14 ms (~110 of them,
+    # bench_startup.py's phase table, gc.callbacks): most while numpy, mech, PySpice and the
+    # scene are loaded (~40 000 long-lived objects, a few hundred in garbage cycles), and
+    # the middle generation's, which rescanned those objects. With the start frozen:
+    # 1.3-1.7 ms. Frozen objects are still freed when their last reference goes; only
     # cycles among them wait for the process's end, which is near.
     if one_shot:
         gc.disable()
