@@ -90,9 +90,18 @@ def whole_process(cmd: list[str], repeat: int, root: Path = ROOT) -> tuple[float
 PHASES = textwrap.dedent("""
     import time
     wall0 = time.time()  # the parent's clock: interpreter start = wall0 - the parent's spawn time
-    import json, os, sys
+    import gc, json, os, sys
+    gc.disable()  # as coupling.app.commands.run_command does in the command line's own process
     marks = [("start", time.perf_counter())]
     def mark(name): marks.append((name, time.perf_counter()))
+    collector = {}  # the cyclic collector's own time, from its callbacks
+    def collecting(phase, info):
+        if phase == "start":
+            collector["since"] = time.perf_counter()
+        else:
+            collector["s"] = collector.get("s", 0.0) + time.perf_counter() - collector["since"]
+            collector["n"] = collector.get("n", 0) + 1
+    gc.callbacks.append(collecting)
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")  # as coupling.app.cli.main sets it
     from coupling.core.master import run
     mark("import coupling.core.master (numpy, mech, the compiled module)")
@@ -119,6 +128,8 @@ PHASES = textwrap.dedent("""
     scene = default_scene() if sys.argv[1] == "default" else load_scene(sys.argv[1])
     mark("scene (read, validate; circuit: PySpice, laws)")
     folder = ResultFolder.check(sys.argv[2], scene_identity(scene, None), overwrite=True)
+    gc.freeze()  # the scene built (run_command): frozen, the collector on for the run
+    gc.enable()
     result = run(scene, progress=False)
     mark("run (model build, ngspice start, co-simulation)")
     soundness = assess(result)
@@ -126,7 +137,7 @@ PHASES = textwrap.dedent("""
     folder.write(result, {"soundness": soundness})
     mark("write the default outputs")
     stats = result.stats
-    import gc
+    parts["Python's cyclic collector (gc.callbacks; imports to files written)"] = collector.get("s", 0.0)
     gc.freeze()  # as coupling.app.cli.main does when the process's own command line returns
     phases = [(b[0], b[1] - a[1]) for a, b in zip(marks, marks[1:])]
     steps = result.mechanics.stats["steps"] if result.mechanics is not None else 0

@@ -77,7 +77,7 @@ def main(argv: list[str] | None = None) -> int:
     os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     args = _build_parser().parse_args(argv)
     try:
-        return _command(args)
+        return _command(args, one_shot=argv is None)
     finally:
         if argv is None:
             # The process's own command line (the `switchsim` script, python -m coupling.app.cli):
@@ -89,13 +89,13 @@ def main(argv: list[str] | None = None) -> int:
             gc.freeze()
 
 
-def _command(args) -> int:
+def _command(args, *, one_shot: bool = False) -> int:
     try:
         if args.command == "run":
             from coupling.app.commands import run_command
 
             return run_command(args.scene, args.out, quiet=args.quiet, overwrite=args.overwrite, check=args.check,
-                               plots=args.plots)
+                               plots=args.plots, one_shot=one_shot)
         if args.command == "plot":
             from coupling.app.commands import plot_command
 
