@@ -397,7 +397,7 @@ class CoSimulation:
         drive (psi^2, extrapolated linearly over the step) reaches the stop's press decides
         the unseat, and after it the armature's net force is a small difference of two large
         ones: a step of hundreds of us over it let the extrapolation, not the circuit's flux,
-        decide both (the default relay's unseat 6.4 us early, the card's touch 3.7 us, against
+        decide both (the default relay's unseat 6.6 us early, the card's touch 3.8 us, against
         a run at a quarter of every step rule). So the steps approach the unseat by halves
         (``StepPolicy.approach_end``), end a macro step past it, and then grow no faster than
         the time since (``CoilLink.left_seat``, the rule in ``run``)."""
