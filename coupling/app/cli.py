@@ -1,5 +1,5 @@
 """The `switchsim` command line: `switchsim run [SCENE.toml] [--out DIR] [--overwrite] [--quiet] [--plots]`,
-`switchsim plot RESULT_DIR`, `switchsim fit DATA.csv --out DIR`, `switchsim sweep`, `switchsim life`. Exit codes:
+`switchsim scene [NAME]` (a built-in scene's TOML on stdout), `switchsim plot RESULT_DIR`, `switchsim fit DATA.csv --out DIR`, `switchsim sweep`, `switchsim life`. Exit codes:
 coupling/app/commands.py."""
 
 from __future__ import annotations
@@ -35,6 +35,11 @@ def _build_parser() -> argparse.ArgumentParser:
     run.add_argument("--check", action="store_true",
                      help="rerun refined (modes, rtol, macro step, RELTOL) and with the contact gap and restitution "
                           "changed by 1 %%; report the error against the sensitivity (summary.accuracy, accuracy.png)")
+
+    scene = sub.add_parser("scene", help="print a built-in scene's TOML, to copy and edit "
+                                         "(switchsim scene default > my_relay.toml)")
+    scene.add_argument("name", nargs="?", default="default",
+                       help="default (the coil-driven relay), relay_force, relay_cycle or free_drop")
 
     plot = sub.add_parser("plot", help="draw the PNG plots of a result folder that a run wrote")
     plot.add_argument("result", help="result folder (holds summary.json)")
@@ -96,6 +101,11 @@ def _command(args, *, one_shot: bool = False) -> int:
 
             return run_command(args.scene, args.out, quiet=args.quiet, overwrite=args.overwrite, check=args.check,
                                plots=args.plots, one_shot=one_shot)
+        if args.command == "scene":
+            from coupling.core.scene import builtin_scene_text
+
+            sys.stdout.write(builtin_scene_text(args.name))
+            return 0
         if args.command == "plot":
             from coupling.app.commands import plot_command
 
