@@ -305,8 +305,10 @@ def test_the_gap_rules_time_is_when_the_gap_has_closed_by_its_room(speed, accel)
 def test_the_coils_gap_rule_keeps_the_changeovers_operate_time_within_its_tolerance():
     """The changeover example (max_macro_step 1 ms) up to its operate transfer, at the default
     step rules and with every rule halved once and twice: the operate time converges at the
-    coupling's second order (measured 1.97: 0.39 then 0.10 us), and the default rules' is
-    within 1 us of the twice-halved run's (measured 0.49 us). The gap rule once took the
+    coupling's second order or faster (measured 4.5: 0.36 then 0.016 us, with the steps'
+    approach to the armature's unseat; 1.97 before it), and the default rules' is within 1 us
+    of the twice-halved run's (measured 0.38 us; 0.49 before the approach, 1.25 with psi^2's
+    curvature rule alone, whose longer step over the unseat the approach removed). The gap rule once took the
     armature's speed alone: from its slow start the steps grew to 200-570 us and the operate
     time came out 9.1 us late (5.9390 against 5.9299 ms). With psi^2 extrapolated along the
     chord of the last points instead of the secant of their parabola the default rules' error
