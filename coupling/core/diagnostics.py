@@ -149,6 +149,23 @@ def interface_audit_warning(result) -> str | None:
             f"{INTERFACE_FIX}")
 
 
+def release_warning(result) -> str | None:
+    """One line where the coil was switched off within the run after the contact had made,
+    and the run ended before the contact broke: ``release_time`` is then missing, not a
+    result (a diode's slow release outlasts the default relay's 3 ms after its switch-off)."""
+    relay, drive = result.relay, result.coil_drive
+    if not relay or drive is None or relay.get("operate_time") is None or relay.get("release_time") is not None:
+        return None
+    off, end = drive.off_time, result.scene.t_end
+    if off is None or not off < end:
+        return None
+    left = relay.get("drop_out_current") is not None
+    where = "the armature had left the pole" if left else "the armature was still at the pole"
+    return (f"relay: the contact was still closed when the run ended, {(end - off) * 1e3:.3g} ms after the coil "
+            f"was switched off (coil.off_time = {off * 1e3:.4g} ms; {where}): release_time is missing, not "
+            f"measured; run longer ([solver] t_end)")
+
+
 def overcurrent_warning(t, currents: dict, limit: float, source: str) -> str | None:
     """The largest |current| among ``currents`` (name -> array, A) if above ``limit`` (A)."""
     worst = None
@@ -299,6 +316,9 @@ def run_warnings(result) -> list[str]:
         if line:
             out.append(line)
         line = interface_audit_warning(result)
+        if line:
+            out.append(line)
+        line = release_warning(result)
         if line:
             out.append(line)
     w = result.waveform_columns

@@ -281,14 +281,20 @@ class CoupledResult:
             from coupling.core.device import device
             from coupling.core.relay import relay_metrics
 
-            from circuit.coil_drive import CoilDrive
-
             spec = device(self.scene.raw)
-            circ = self.scene.circuit.circuit
-            drive = circ if isinstance(circ, CoilDrive) else getattr(circ, "coil", None)  # None: a netlist's
-            self._cache["relay"] = relay_metrics(w, self.operations, drive, spec.magnet, self.mechanics.events,
-                                                 spec.resistance, received=self.armature_received)
+            self._cache["relay"] = relay_metrics(w, self.operations, self.coil_drive, spec.magnet,
+                                                 self.mechanics.events, spec.resistance,
+                                                 received=self.armature_received)
         return self._cache["relay"]
+
+    @property
+    def coil_drive(self):
+        """The circuit's CoilDrive (its on_time and off_time, s), or None: no coil, or a
+        netlist's coil (its drive is the user's own circuit)."""
+        from circuit.coil_drive import CoilDrive
+
+        circ = getattr(self.scene.circuit, "circuit", None)
+        return circ if isinstance(circ, CoilDrive) else getattr(circ, "coil", None)
 
     @property
     def opening_columns(self) -> dict:
