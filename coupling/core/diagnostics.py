@@ -153,8 +153,11 @@ def release_warning(result) -> str | None:
     """One line where the coil was switched off within the run after the contact had made,
     and the run ended before the contact broke: ``release_time`` is then missing, not a
     result (a diode's slow release outlasts the default relay's 3 ms after its switch-off)."""
-    relay, drive = result.relay, result.coil_drive
-    if not relay or drive is None or relay.get("operate_time") is None or relay.get("release_time") is not None:
+    relay = result.relay  # (None without a coil: nothing of the circuit is imported then)
+    if not relay or relay.get("operate_time") is None or relay.get("release_time") is not None:
+        return None
+    drive = result.coil_drive
+    if drive is None:
         return None
     off, end = drive.off_time, result.scene.t_end
     if off is None or not off < end:
