@@ -387,28 +387,28 @@ def perturbations(scene) -> list[tuple[str, str, object]]:
     SENSITIVITY each way, the gap by half as much in place of what cannot be changed."""
     if scene.mech is None:
         return [("inputs", "not applicable: no mechanics (prescribed contact schedule)", None)]
-    gap_label, gap_key, gap_scale, gap_unit = "gap", "initial.height", 1e6, " um"
+    # each input: the keys it sets, each at its ratio to the value shown
+    gap_label, gap_keys, gap_scale, gap_unit, gap_shown = "gap", {"initial.height": 1.0}, 1e6, " um", ""
     if scene.mech.bar is None:
         # an armature alone (an actuator): its travel is the gap it closes, its stops'
         # damping the dissipation of the impacts it bounces with
         arm = scene.mech.armature
-        gap_label, gap_key, gap_scale, gap_unit = "travel", "armature.travel", 1.0, ""
+        gap_label, gap_keys, gap_scale, gap_unit = "travel", {"armature.travel": 1.0}, 1.0, ""
         gap = arm.travel if arm.travel and arm.travel > 0.0 else None
         dissipation = ("stop damping", "armature.stop_damping", arm.stop_damping, math.inf) if arm.stop_damping \
             else None
     else:
         ini, con = scene.mech.initial, scene.mech.contact
         gap = None if (ini.resting or not ini.height > 0.0) else ini.height
-        ratios: list[float] = []
         fixed = [(k, float(entry["gap"])) for k, entry in enumerate(scene.raw.get("fixed") or [])
                  if isinstance(entry.get("gap"), (int, float)) and entry["gap"] > 0.0]
         if fixed:
             # [[fixed]] contacts sit at their own gaps from the bar: initial.height only moves
             # the world frame there (the changeover's NO moved 0.2 us for 1 % of it, 226-232 us
             # for 0.5 % of its own gap); every open contact's gap changes together
-            gap_key = tuple(f"fixed[{k}].gap" for k, _ in fixed)
             gap = fixed[0][1]
-            ratios = [value / gap for _, value in fixed]
+            gap_keys = {f"fixed[{k}].gap": value / gap for k, value in fixed}
+            gap_shown = f" ({', '.join(gap_keys)})"
         if con.restitution is not None:
             dissipation = ("restitution", "contact.restitution", con.restitution, 1.0)
         elif con.damping:
@@ -417,23 +417,21 @@ def perturbations(scene) -> list[tuple[str, str, object]]:
             dissipation = None
     out = []
 
-    def add(label, key, value, rel, top, unit_scale=1.0, unit=""):
+    def add(label, keys, value, rel, top, unit_scale=1.0, unit="", shown=""):
         new = value * (1.0 + rel)
         if new <= top:
-            changed = scene.update({k: new * r for k, r in zip(key, ratios)}) if isinstance(key, tuple) \
-                else scene.set(key, new)
-            shown = f" ({', '.join(key)})" if isinstance(key, tuple) else ""
             out.append((f"{label} {rel:+.1%}",
-                        f"{label}{shown} {value * unit_scale:.4g} -> {new * unit_scale:.4g}{unit}", changed))
+                        f"{label}{shown} {value * unit_scale:.4g} -> {new * unit_scale:.4g}{unit}",
+                        scene.update({key: new * ratio for key, ratio in keys.items()})))
 
     for rel in (-SENSITIVITY, SENSITIVITY):
         if gap is not None:
-            add(gap_label, gap_key, gap, rel, math.inf, gap_scale, gap_unit)
+            add(gap_label, gap_keys, gap, rel, math.inf, gap_scale, gap_unit, gap_shown)
         if dissipation is not None:
-            add(dissipation[0], dissipation[1], dissipation[2], rel, dissipation[3])
+            add(dissipation[0], {dissipation[1]: 1.0}, dissipation[2], rel, dissipation[3])
     for rel in (-0.5 * SENSITIVITY, 0.5 * SENSITIVITY):
         if gap is not None and len(out) < SENSITIVITY_RERUNS:
-            add(gap_label, gap_key, gap, rel, math.inf, gap_scale, gap_unit)
+            add(gap_label, gap_keys, gap, rel, math.inf, gap_scale, gap_unit, gap_shown)
     if not out:
         return [("inputs", "not applicable: no contact gap and no contact dissipation to change", None)]
     return out
