@@ -1,13 +1,30 @@
-"""The command line run in-process for input tests: the simulation replaced by an assertion."""
+"""Shared by the command line's tests: a small scene (DROP), and the command line run
+in-process for input tests with the simulation replaced by an assertion."""
 
 from __future__ import annotations
 
 import contextlib
 import io
+import textwrap
 from unittest import mock
 
 import coupling.core.master
 from coupling.app.cli import main
+
+
+# A rigid bar dropped on one tip: mechanics only, no plots, a few ms of compute.
+DROP = textwrap.dedent("""
+    [bar]
+    modes = 0
+    [initial]
+    height = 0.0002
+    angle_deg = 90.0
+    velocity = [0.0, 0.0, -0.5]
+    [solver]
+    t_end = 0.001
+    [output]
+    plots = false
+    """)
 
 
 def no_run(*_args, **_kwargs):

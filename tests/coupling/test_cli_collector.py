@@ -12,22 +12,12 @@ import sys
 import textwrap
 from pathlib import Path
 
+from cli_checks import DROP
+
 from coupling.app.cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
 
-DROP = textwrap.dedent("""
-    [bar]
-    modes = 0
-    [initial]
-    height = 0.0002
-    angle_deg = 90.0
-    velocity = [0.0, 0.0, -0.5]
-    [solver]
-    t_end = 0.001
-    [output]
-    plots = false
-    """)
 
 # The command line's own process (main() reading sys.argv); the run is wrapped to record the
 # collector's state when it starts, and a garbage cycle made inside it must be collected.

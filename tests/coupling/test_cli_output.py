@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from cli_checks import DROP
 
 import coupling.core.master
 from coupling.app.cli import main
@@ -22,19 +23,6 @@ from coupling.core.scene import load_scene
 
 ROOT = Path(__file__).resolve().parents[2]
 
-# A rigid bar dropped on one tip: mechanics only, no plots, a few ms of compute.
-DROP = textwrap.dedent("""
-    [bar]
-    modes = 0
-    [initial]
-    height = 0.0002
-    angle_deg = 90.0
-    velocity = [0.0, 0.0, -0.5]
-    [solver]
-    t_end = 0.001
-    [output]
-    plots = false
-    """)
 
 # The same bar closing a resistive circuit (coupled, ngspice), no plots.
 COUPLED = DROP.replace("[output]", textwrap.dedent("""
