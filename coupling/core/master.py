@@ -68,6 +68,11 @@ class RunInterrupted(KeyboardInterrupt):
         self.partial = partial
 
 
+def _unseat_time(seg) -> float | None:
+    """s: where the segment's armature first leaves a stop (a seated one: its unseat), or None."""
+    return next((e["time"] for e in seg.events if e["kind"] == "armature_stop_end"), None)
+
+
 @contextlib.contextmanager
 def _deferred_interrupt():
     """While ngspice drives callbacks into Python, a KeyboardInterrupt raised inside one is
@@ -401,17 +406,16 @@ class CoSimulation:
         a run at a quarter of every step rule). So the steps approach the unseat by halves
         (``StepPolicy.approach_end``), end a macro step past it, and then grow no faster than
         the time since (``CoilLink.left_seat``, the rule in ``run``)."""
-        coil = self._coil_link
-        leave = next((e["time"] for e in seg.events if e["kind"] == "armature_stop_end"), None)
+        leave = _unseat_time(seg)
         end = None if leave is None else self.coil_policy.approach_end(t, t_next, leave)
         if end is not None:
             t_next = end
             mech.restore(start)
             seg = mech.advance(t_next, drives(t_next), stop_at_switch=in_flight)
             self.stats["approach_steps"] += 1
-            leave = next((e["time"] for e in seg.events if e["kind"] == "armature_stop_end"), None)
+            leave = _unseat_time(seg)
         if leave is not None:
-            coil.left_seat = leave
+            self._coil_link.left_seat = leave
         return t_next, seg
 
     def _jacobi_step(self, mech, stepper, t, t_next, i_now):
