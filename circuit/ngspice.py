@@ -14,6 +14,7 @@ import os
 import re
 import shutil
 import subprocess
+import sys
 import tempfile
 import threading
 import time
@@ -22,7 +23,6 @@ from pathlib import Path
 from typing import Callable, Mapping
 
 import numpy as np
-import sys
 
 from ._ngspice_ffi import ffi
 from .contact import LANDING_TOLERANCE
