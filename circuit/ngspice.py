@@ -1,4 +1,4 @@
-"""The one ngspice of the process: finding libngspice, a PySpice subclass with fixed callbacks, transient control.
+"""The one ngspice of the process: finding libngspice, its session with fixed callbacks, transient control.
 
 ngspice keeps global state, so a process holds exactly one session (``get_session()``);
 it is cleared between runs, and parallel runs need separate processes. Only this
@@ -8,12 +8,13 @@ module talks to the shared library.
 from __future__ import annotations
 
 import contextlib
-import logging
+import locale
 import math
 import os
 import re
 import shutil
 import subprocess
+import sys
 import tempfile
 import threading
 import time
@@ -22,8 +23,8 @@ from pathlib import Path
 from typing import Callable, Mapping
 
 import numpy as np
-from PySpice.Spice.NgSpice.Shared import NgSpiceShared, ffi
 
+from ._ngspice_ffi import ffi
 from .contact import LANDING_TOLERANCE
 from .netlist_check import check_deck
 from .errors import (
@@ -53,8 +54,8 @@ _FALLBACK_PATHS = (
     "/usr/local/lib/libngspice.dylib",
 )
 
-# PySpice's ngSpice_Command keeps every command in ngspice's history; a stepping run
-# sends three per macro step, so the history is released periodically (as PySpice does).
+# ngSpice_Command keeps every command in ngspice's history; a stepping run
+# sends three per macro step, so the history is released periodically (a NULL command).
 _COMMANDS_BEFORE_HISTORY_RELEASE = 5000
 
 
@@ -143,7 +144,7 @@ def isolated_start():
                     os.environ[name] = value
 
 
-# Lines ngspice prints on success that PySpice 1.5 mistakes for errors, or that are
+# Lines ngspice prints on success (some on stderr), or that are
 # progress chatter; never part of an error message.
 _CHATTER = re.compile(
     r"condition met|pause requested|simulation interrupted|^Note:|Trying gmin|Further gmin increment"
@@ -159,23 +160,28 @@ def stop_margin(target: float) -> float:
     return max(1e-12 * abs(target), 1e-300)
 
 
-class NgspiceSession(NgSpiceShared):
-    """PySpice's NgSpiceShared with the quirks of PySpice 1.5 + ngspice 39 fixed.
+class NgspiceSession:
+    """libngspice's shared-library session (circuit/ngspice_api.py declares the calls).
 
-    - stdout/stderr lines are captured per command instead of being logged as errors
-      (PySpice treats "condition met", "Note: ..." and warnings as errors);
+    - stdout/stderr lines are captured per command instead of being printed or logged
+      (ngspice prints "condition met", "Note: ..." and warnings on success);
     - the background-thread and status callbacks return an int, as ngspice expects;
     - the EXTERNAL voltage source gets its value from a Python function of time set
       with ``set_channels`` (by source name); the GetSyncData callback (installed once: ngspice cannot
       uninstall it) shortens steps to land exactly on the next macro time, and aborts
       the run on a callback failure or a wall-clock timeout.
 
+    The library is reached through cffi's out-of-line ABI module (no C parser at a
+    start), not through PySpice's NgSpiceShared, which parses its header at each start;
+    PySpice builds the netlists. One ngspice per process: a PySpice simulator
+    (``circuit.simulator()``) would load the same library a second time and replace these
+    callbacks, so a process that runs switchsim's circuits does not use PySpice's own.
+
     Use ``get_session()``; do not instantiate directly.
     """
 
     def __init__(self, library_path: str):
         self._lines: list[str] = []
-        self._feed_pyspice = True
         self._exit_status: tuple[int, bool, bool] | None = None
         # The input channels: each EXTERNAL voltage source of the loaded circuit gets its
         # value from a Python function of time; ngspice passes the instance's own name
@@ -200,25 +206,18 @@ class NgspiceSession(NgSpiceShared):
         self._encoded: dict[str, bytes] = {}
         self.owner: weakref.ref | None = None
         self.lock = threading.Lock()
-        # PySpice formats the path with the instance id; braces in a path must survive.
-        self.LIBRARY_PATH = library_path.replace("{", "{{").replace("}", "}}")
-        pyspice_logger = logging.getLogger("PySpice.Spice.NgSpice.Shared.NgSpiceShared")
-        previous = pyspice_logger.level
-        # PySpice warns "Unsupported Ngspice version" for every version after 34; the
-        # vector-type enumeration it falls back to is ngspice 39's (time, voltage and
-        # current types checked).
-        pyspice_logger.setLevel(logging.ERROR)
-        try:
-            with isolated_start():
-                super().__init__(ngspice_id=0, send_data=False, verbose=False)
-        finally:
-            pyspice_logger.setLevel(previous)
-        self._feed_pyspice = False
-        # PySpice's own simulator (circuit.simulator()) asks new_instance() for an
-        # instance; handing it this one avoids a second cffi declaration (an error).
-        NgSpiceShared._instances[0] = self
+        # ngspice reads and prints numbers with the C library's locale: a decimal comma
+        # (LC_NUMERIC of de_DE, say) would misread every netlist value
+        locale.setlocale(locale.LC_NUMERIC, "C")
+        self._ngspice_shared = ffi.dlopen(library_path)
+        self._self_c = ffi.new_handle(self)
+        # the callbacks live as long as the session (ngspice keeps their addresses);
         # onerror: an exception escaping a callback (e.g. KeyboardInterrupt) is kept and
         # re-raised after ngspice stops, instead of being printed and lost by cffi.
+        self._send_char_c = ffi.callback("int(char *, int, void *)", self._send_char)
+        self._send_stat_c = ffi.callback("int(char *, int, void *)", self._send_stat)
+        self._exit_c = ffi.callback("int(int, bool, bool, int, void *)", self._exit)
+        self._background_c = ffi.callback("int(bool, int, void *)", self._background_thread_running)
         self._vsrc_c = ffi.callback(
             "int(double *, double, char *, int, void *)", self._on_vsrc, onerror=self._on_callback_error
         )
@@ -229,25 +228,28 @@ class NgspiceSession(NgSpiceShared):
             "int(double, double *, double, int, int, int, void *)", self._on_sync, onerror=self._on_callback_error
         )
         self._ident_c = ffi.new("int *", 0)
+        with isolated_start():
+            rc = self._ngspice_shared.ngSpice_Init(
+                self._send_char_c, self._send_stat_c, self._exit_c, ffi.NULL, ffi.NULL, self._background_c,
+                self._self_c)
+        if rc:
+            raise NgspiceError(f"ngSpice_Init returned {rc}", _message(self._lines))
         rc = self._ngspice_shared.ngSpice_Init_Sync(
             self._vsrc_c, self._isrc_c, self._sync_c, self._ident_c, self._self_c
         )
         if rc:
             raise NgspiceError(f"ngSpice_Init_Sync returned {rc}")
         self.library = library_path
+        # no pager: a long listing would wait for a key press that never comes
+        self.command("set nomoremode")
 
-    # -- PySpice callback overrides (static but _send_char: PySpice registers them through a handle) --
+    # -- ngspice's output and status callbacks --
 
     def _send_char(self, message_c, ngspice_id, user_data):
-        # A method, not static as PySpice's: PySpice makes its callback of self._send_char,
-        # so the instance comes bound instead of through the handle (4 lines a macro step).
-        # Lines arrive as "stdout ..." / "stderr ..."; kept whole, parsed only on failure.
-        message = ffi.string(message_c).decode("utf-8", "replace").rstrip()
-        self._lines.append(message)
-        if self._feed_pyspice:
-            # PySpice's version parsing during __init__ reads these two lists.
-            prefix, _, content = message.partition(" ")
-            (self._stderr if prefix == "stderr" else self._stdout).append(content)
+        # A bound method, so the instance comes with it instead of through the handle (4
+        # lines a macro step). Lines arrive as "stdout ..." / "stderr ..."; kept whole,
+        # parsed only on failure.
+        self._lines.append(ffi.string(message_c).decode("utf-8", "replace").rstrip())
         return 0
 
     @staticmethod
@@ -418,6 +420,10 @@ class NgspiceSession(NgSpiceShared):
         switchsim's own): no line that could run an ngspice command or read a file gets
         through, whoever built the deck (NetlistInputError)."""
         lines = check_deck(list(lines))
+        if _pyspice_holds_ngspice():
+            raise SessionBusyError(
+                "PySpice's own simulator has started ngspice in this process and replaced switchsim's "
+                "callbacks (one ngspice per process): run PySpice's simulations in a separate process")
         self.clear()
         self._check_alive()
         keep = [ffi.new("char[]", line.encode("utf-8")) for line in lines] + [ffi.NULL]
@@ -696,6 +702,13 @@ def _message(printed: list[str]) -> str:
     return "\n".join(kept[-40:])
 
 
+def _pyspice_holds_ngspice() -> bool:
+    """True if PySpice's own NgSpiceShared (never imported by switchsim) has started ngspice
+    in this process: it loads the same library and installs its own callbacks."""
+    pyspice = sys.modules.get("PySpice.Spice.NgSpice.Shared")
+    return pyspice is not None and bool(pyspice.NgSpiceShared._instances)
+
+
 _SESSION: NgspiceSession | None = None
 _SESSION_LOCK = threading.Lock()
 
@@ -705,7 +718,7 @@ def get_session() -> NgspiceSession:
     global _SESSION
     with _SESSION_LOCK:
         if _SESSION is None:
-            if NgSpiceShared._instances:
+            if _pyspice_holds_ngspice():
                 raise SessionBusyError(
                     "PySpice's own NgSpiceShared already holds ngspice in this process "
                     "(only one ngspice can exist per process): create switchsim's session first"

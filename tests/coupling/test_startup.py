@@ -6,8 +6,9 @@ run (the quadrature, the mode roots, the damping calibration and the held bars' 
 element modes are numpy or compiled); pandas never for a run with its default outputs
 (tables written from arrays, the waveforms kept as arrays, the tribology laws read without
 it); pyarrow only to write waveforms.parquet; matplotlib only when plotting; plotly's
-Python side never (waveforms.html is written directly); PySpice only with a circuit; Dask
-never; numpy.ma never (np.unique and np.quantile import it, ~10 ms of a start: the magnet's
+Python side never (waveforms.html is written directly); PySpice only with a circuit, and
+never cffi's C parser (pycparser: ngspice's declarations come pre-parsed,
+circuit/ngspice_api.py); Dask never; numpy.ma never (np.unique and np.quantile import it, ~10 ms of a start: the magnet's
 points and the waveform page's axes use their own, tests/coupling/test_sorted_values.py).
 """
 
@@ -25,8 +26,8 @@ import pytest
 from fit_compare import assert_same_fit
 
 ROOT = Path(__file__).resolve().parents[2]
-HEAVY = ("numba", "scipy", "pandas", "pyarrow", "matplotlib", "plotly", "PySpice", "dask", "distributed",
-         "numpy.ma")
+HEAVY = ("numba", "scipy", "pandas", "pyarrow", "matplotlib", "plotly", "PySpice", "pycparser", "dask",
+         "distributed", "numpy.ma")
 
 MECH = """
 [bar]
