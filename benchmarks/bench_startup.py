@@ -205,6 +205,25 @@ def dopri5_bound(zeta: float) -> float:
     return lo
 
 
+def budget(coupled: dict, plunger: dict, base: float) -> str:
+    """What each target leaves for the co-simulation: the whole process of the phase
+    measurement less the co-simulation itself (the run's wall_time less its model build
+    and ngspice start), against the target times this run's `import numpy` (``base``, s)."""
+    def split(doc: dict) -> tuple[float, float]:
+        setup = sum(doc["parts"].get(k, 0.0) for k in ("model build (modes, FE eigenproblem)",
+                                                        "ngspice start (netlist, operating point)"))
+        cosim = doc["wall_time"] - setup
+        return doc["whole"] - cosim, cosim
+
+    (d_rest, d_sim), (p_rest, p_sim) = split(coupled), split(plunger)
+    return (f"- In the phase measurement above, everything but the co-simulation (interpreter, imports, scene, model build, ngspice start, "
+            f"soundness, writes, exit) takes {d_rest:.3f} s = {d_rest / base:.1f}x `import numpy` for the "
+            f"default scene and {p_rest:.3f} s = {p_rest / base:.1f}x for the plunger: the targets (6x, 3x) "
+            f"leave {6 * base - d_rest:.3f} s for the default relay's 12 ms of co-simulation, which take "
+            f"{d_sim:.3f} s here, and {3 * base - p_rest:.3f} s for the plunger's 50 ms, which take "
+            f"{p_sim:.3f} s.")
+
+
 def step_limit() -> list[str]:
     """What sets the default scene's mechanics step: the steps at three tolerances against the
     explicit integrator's stability bound on the bar's highest mode (a fresh interpreter)."""
@@ -352,6 +371,7 @@ def main() -> None:
     lines.append(f"| (mechanics steps) | {cells(r['steps'] for r in runs)} |")
     lines.append(f"| (macro steps of the co-simulation) | - | {cells(r['macro_steps'] for r in runs[1:])} |")
     lines.append(f"| whole process, this measurement | {cells(r['whole'] for r in runs)} |")
+    lines += ["", budget(coupled_phases, plunger_phases, base)]
     lines += step_limit()
     block = "\n".join(lines)
     print("\n" + block)
