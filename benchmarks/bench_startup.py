@@ -218,8 +218,9 @@ def budget(coupled: dict, plunger: dict, base: float) -> str:
     (d_rest, d_sim), (p_rest, p_sim) = split(coupled), split(plunger)
     return (f"- In the phase measurement above, everything but the co-simulation (interpreter, imports, "
             f"scene, model build, ngspice start, soundness, writes, exit) takes {d_rest:.3f} s = "
-            f"{d_rest / base:.1f}x `import numpy` for the default scene and {p_rest:.3f} s = {p_rest / base:.1f}x for the plunger: the targets (6x, 3x) "
-            f"leave {6 * base - d_rest:.3f} s for the default relay's 12 ms of co-simulation, which take "
+            f"{d_rest / base:.1f}x `import numpy` for the default scene and {p_rest:.3f} s = "
+            f"{p_rest / base:.1f}x for the plunger: the targets (6x, 3x) leave "
+            f"{6 * base - d_rest:.3f} s for the default relay's 12 ms of co-simulation, which take "
             f"{d_sim:.3f} s here, and {3 * base - p_rest:.3f} s for the plunger's 50 ms, which take "
             f"{p_sim:.3f} s.")
 
