@@ -1,0 +1,72 @@
+"""What a relay designer met using switchsim as the README says (session 33's audit): each
+test reproduces a finding through the command line or the sweep API and holds its fix."""
+
+from __future__ import annotations
+
+import textwrap
+
+import pytest
+
+from coupling.app.cli import main
+from coupling.app.sweep import Sweep, run_sweep_inline
+from coupling.core.master import run
+from coupling.core.scene import scene_from_dict
+
+# A rigid bar falling 0.5 m/s from 1 mm above the block for 0.1 ms: it travels 50 um, so
+# the contact never closes and the open contact holds the whole supply (coupled, cheap).
+NEVER_CLOSES = textwrap.dedent("""
+    [bar]
+    modes = 0
+    [initial]
+    height = 1e-3
+    angle_deg = 90.0
+    velocity = [0, 0, -0.5]
+    [solver]
+    t_end = 1e-4
+    [tribology]
+    source = "illustrative"
+    [circuit]
+    template = "resistive"
+    voltage = 24.0
+    [output]
+    plots = false
+    """)
+
+# The same bar released 0.2 mm above the block at 1000 V without an arc model: the open
+# contact's field passes air's breakdown as the gap closes, which summary.json warns about.
+WARNED = {"bar": {"modes": 0},
+          "initial": {"height": 2e-4, "angle_deg": 90.0, "velocity": [0.0, 0.0, -0.5]},
+          "solver": {"t_end": 1e-3},
+          "tribology": {"source": "illustrative"},
+          "circuit": {"template": "resistive", "voltage": 1000.0, "load_resistance": 500.0},
+          "output": {"plots": False}}
+
+
+def test_a_contact_that_never_opened_reports_no_peak_voltage_not_zero_volts(tmp_path, capsys):
+    """Without an opening there is no opening's peak (summary: None); the result line said
+    "peak contact voltage 0 V" while the open contact held the 24 V supply the whole run."""
+    scene = tmp_path / "never.toml"
+    scene.write_text(NEVER_CLOSES)
+    assert main(["run", str(scene), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if "first make" in x)
+    assert "the contact never closed" in line
+    assert "peak contact voltage none (no opening)" in line and "peak contact voltage 0 V" not in line
+
+
+def test_a_sweep_row_carries_the_runs_warnings_one_per_line():
+    """A sweep's row held every summary scalar but not `warnings`: a study could not tell a
+    warned run (a truncated arc, a field beyond breakdown) from a clean one. The row's
+    `warnings` are the run's own, in order, one per line; "" for a run without any."""
+    base = scene_from_dict(WARNED, name="warned")
+    rows = run_sweep_inline(Sweep.grid(base, {"circuit.voltage": [1000.0, 24.0]}))
+    assert [r["status"] for r in rows] == ["ok", "ok"]
+    warned, clean = rows
+    lines = warned["warnings"].split("\n")
+    assert len(lines) >= 1 and any("exceeds air breakdown" in w for w in lines)
+    assert lines == run(base).summary["warnings"]  # the run's own lines, in order
+    # 24 V stays below air's Paschen minimum (~327 V) at every gap: no breakdown warning
+    assert "air breakdown" not in clean["warnings"]
+
+
+if __name__ == "__main__":
+    raise SystemExit(pytest.main([__file__, "-q"]))
