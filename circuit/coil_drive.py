@@ -107,6 +107,13 @@ class CoilDrive:
         if self.switch_breakdown <= self.voltage:
             raise ValueError(f"{name}.switch_breakdown = {self.switch_breakdown:g} V: must exceed the supply "
                              f"{name}.voltage = {self.voltage:g} V (the driver would conduct while off)")
+        if self.suppression == "zener" and self.voltage + self.zener_voltage >= self.switch_breakdown:
+            # the driver's node reaches voltage + V_z + V_d before the zener conducts: the
+            # driver's avalanche clamps first and the zener is never in the circuit
+            raise ValueError(f"{name}.zener_voltage = {self.zener_voltage:g} V: the driver avalanches at "
+                             f"{name}.switch_breakdown = {self.switch_breakdown:g} V before the zener clamps "
+                             f"(supply {name}.voltage = {self.voltage:g} V); allowed zener_voltage < "
+                             f"switch_breakdown - voltage = {self.switch_breakdown - self.voltage:g} V")
         check_range(name, "diode_saturation_current", self.diode_saturation_current, "A", 1e-20, 1e-3,
                     low_open=True)
 

@@ -6,11 +6,13 @@ from __future__ import annotations
 import textwrap
 
 import pytest
+from cli_checks import assert_one_line_error, run_cli
 
+from coupling import default_scene
 from coupling.app.cli import main
 from coupling.app.sweep import Sweep, run_sweep_inline
 from coupling.core.master import run
-from coupling.core.scene import scene_from_dict
+from coupling.core.scene import builtin_scene_text, scene_from_dict
 
 # A rigid bar falling 0.5 m/s from 1 mm above the block for 0.1 ms: it travels 50 um, so
 # the contact never closes and the open contact holds the whole supply (coupled, cheap).
@@ -67,6 +69,29 @@ def test_a_sweep_row_carries_the_runs_warnings_one_per_line():
     # 24 V stays below air's Paschen minimum (~327 V) at every gap: no breakdown warning
     assert "air breakdown" not in clean["warnings"]
 
+
+@pytest.mark.parametrize("voltage, zener, refused", [(12.0, 95.0, True), (12.0, 150.0, True), (24.0, 80.0, True),
+                                                      (12.0, 80.0, False), (12.0, 24.0, False)])
+def test_a_zener_the_drivers_avalanche_would_beat_is_refused_by_its_key(tmp_path, voltage, zener, refused):
+    """Switched off, the driver's node rises to voltage + V_z + V_d before the zener path
+    conducts; the driver avalanches at switch_breakdown (100 V) first when voltage + V_z
+    reaches it. The default relay with a 95 or 150 V zener then released exactly as with no
+    suppression (coil clamped at -88.1 V, release 0.324 ms, both) and nothing said so."""
+    changes = {"coil.suppression": "zener", "coil.zener_voltage": zener, "coil.voltage": voltage}
+    if not refused:
+        assert default_scene().update(changes).raw["coil"]["zener_voltage"] == zener  # built and checked
+        return
+    with pytest.raises(ValueError, match=r"coil\.zener_voltage = .* V: the driver avalanches"):
+        default_scene().update(changes)
+    text = builtin_scene_text("default").replace('suppression = "none"', f'suppression = "zener"\n'
+                                                 f'zener_voltage = {zener!r}')
+    text = text.replace("voltage = 12.0", f"voltage = {voltage!r}", 1)  # [coil] comes before [circuit]
+    path = tmp_path / "zener.toml"
+    path.write_text(text)
+    line = assert_one_line_error(*run_cli(["run", str(path), "--out", str(tmp_path / "out")]))
+    assert line.startswith(f"switchsim: error: {path}: coil.zener_voltage = {zener:g} V")
+    assert "coil.switch_breakdown = 100 V" in line
+    assert f"allowed zener_voltage < switch_breakdown - voltage = {100 - voltage:g} V" in line
 
 if __name__ == "__main__":
     raise SystemExit(pytest.main([__file__, "-q"]))
