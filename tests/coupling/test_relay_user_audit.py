@@ -4,7 +4,10 @@ test reproduces a finding through the command line or the sweep API and holds it
 from __future__ import annotations
 
 import textwrap
+import types
 
+import numpy as np
+import pandas as pd
 import pytest
 from cli_checks import assert_one_line_error, run_cli
 
@@ -12,6 +15,7 @@ from coupling import default_scene
 from coupling.app.cli import main
 from coupling.app.sweep import Sweep, run_sweep_inline
 from coupling.core.master import run
+from coupling.core.metrics import bounce_metrics
 from coupling.core.scene import builtin_scene_text, scene_from_dict
 
 # A rigid bar falling 0.5 m/s from 1 mm above the block for 0.1 ms: it travels 50 um, so
@@ -92,6 +96,43 @@ def test_a_zener_the_drivers_avalanche_would_beat_is_refused_by_its_key(tmp_path
     assert line.startswith(f"switchsim: error: {path}: coil.zener_voltage = {zener:g} V")
     assert "coil.switch_breakdown = 100 V" in line
     assert f"allowed zener_voltage < switch_breakdown - voltage = {100 - voltage:g} V" in line
+
+def test_the_waveform_plots_title_is_inside_the_figure():
+    """The title of waveforms.png (bounces, settling, peaks, arc energy) was centred over the
+    axes, which the legends outside them make narrower than the figure: on the default relay
+    it began left of the figure's edge ("ounce window: ..."). A run built by hand as the
+    default relay's: a bounce, held closed from 1.3 to 4 ms (R_c rising without bound as it
+    parts), then open with a 60 V spike (24 V open, 12 V arcs in the openings)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.text import Text
+
+    from coupling.app.plots import plot_waveforms
+
+    closed_iv, t_end = [(1.0e-3, 1.2e-3), (1.3e-3, 4e-3)], 5e-3
+    t = np.linspace(0.0, t_end, 5001)
+    closed = np.zeros_like(t, bool)
+    for a, b in closed_iv:
+        closed |= (t >= a) & (t <= b)
+    v = np.where(closed, 0.01, np.where((t < 1e-3) | (t > 4.5e-3), 24.0, 12.0))
+    v[np.searchsorted(t, 4.6e-3)] = 60.8
+    arc = np.where(closed | (t < 1e-3) | (t > 4.5e-3), 0.0, 1.0)
+    current = np.where(closed, 2.0, 0.0) + arc
+    resistance = np.where(closed, 0.005, np.inf)
+    resistance[np.searchsorted(t, 4e-3) - 1] = 1.07e21  # the last closed sample, parting
+    w = pd.DataFrame(dict(time=t, contact_voltage=v, contact_current=np.where(closed, 2.0, 0.0),
+                          load_current=current, contact_resistance=resistance, arc_current=arc,
+                          gap=np.where(closed, 0.0, 1e-5)))
+    bounce = bounce_metrics(closed_iv, t_end, False, t, v, current, arc)
+    assert bounce["settled"] and bounce["final_state"] == "open"  # the long title: settled, both peaks
+    result = types.SimpleNamespace(waveforms=w, bounce=bounce, closed_intervals=closed_iv,
+                                   openings=pd.DataFrame(bounce["openings"]),
+                                   scene=types.SimpleNamespace(t_end=t_end))
+    for whole_run in (False, True):
+        fig = plot_waveforms(result, whole_run=whole_run)
+        renderer = FigureCanvasAgg(fig).get_renderer()
+        (title,) = [x for x in fig.findobj(Text) if "bounce(s), settled" in x.get_text()]
+        box, width = title.get_window_extent(renderer), fig.bbox.width
+        assert 0.0 <= box.x0 and box.x1 <= width, (title.get_text(), box, width)
 
 if __name__ == "__main__":
     raise SystemExit(pytest.main([__file__, "-q"]))
