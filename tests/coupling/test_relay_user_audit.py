@@ -16,7 +16,7 @@ from coupling.app.cli import main
 from coupling.app.sweep import Sweep, run_sweep_inline
 from coupling.core.master import run
 from coupling.core.metrics import bounce_metrics
-from coupling.core.scene import builtin_scene_text, scene_from_dict
+from coupling.core.scene import builtin_scene_text, load_scene, scene_from_dict
 
 # A rigid bar falling 0.5 m/s from 1 mm above the block for 0.1 ms: it travels 50 um, so
 # the contact never closes and the open contact holds the whole supply (coupled, cheap).
@@ -96,6 +96,66 @@ def test_a_zener_the_drivers_avalanche_would_beat_is_refused_by_its_key(tmp_path
     assert line.startswith(f"switchsim: error: {path}: coil.zener_voltage = {zener:g} V")
     assert "coil.switch_breakdown = 100 V" in line
     assert f"allowed zener_voltage < switch_breakdown - voltage = {100 - voltage:g} V" in line
+
+# The default relay's load and its coil's drive as a user's netlist (the coil by its XCOIL line).
+RELAY_NETLIST = """* 24 V into 10 ohm; the coil's 12 V supply switched by a low-side driver, a freewheeling diode
+Vsrc src 0 24
+XCONTACT src b
+VLOAD b load 0
+Rload load 0 10
+Vcoil csup 0 12
+XCOIL csup cdrv
+Sdrv cdrv 0 ctl 0 swmod
+Vctl ctl 0 PULSE(0 1 1m 1u 1u 8m 100m)
+.model swmod SW(VT=0.5 RON=0.1 ROFF=1e9)
+Dsupp cdrv csup dmod
+.model dmod D(IS=1e-9 N=1.8)
+"""
+
+
+def _netlist_relay(folder, coil_lines: str):
+    """The default relay with its [circuit] a netlist and its [coil] as given: the scene file."""
+    text = builtin_scene_text("default")
+    coil_at, magnet_at = text.index("[coil]"), text.index("[magnet]")
+    text = text[:coil_at] + "[coil]\n" + coil_lines + "\n" + text[magnet_at:]
+    circuit_at, coupling_at = text.index("[circuit]"), text.index("[coupling]")
+    text = text[:circuit_at] + '[circuit]\ntemplate = "netlist"\nnetlist = "relay.cir"\narc = true\n\n' + \
+        text[coupling_at:]
+    (folder / "relay.cir").write_text(RELAY_NETLIST)
+    path = folder / "relay.toml"
+    path.write_text(text)
+    return path
+
+
+def test_coil_drive_keys_beside_a_netlist_that_drives_the_coil_are_refused(tmp_path):
+    """With template "netlist" the netlist drives its XCOIL: [coil] voltage, on_time,
+    off_time, suppression ... were silently ignored (a user's 'voltage = 24' changed nothing).
+    Each is named; resistance and turns alone build."""
+    path = _netlist_relay(tmp_path, "resistance = 360.0\nturns = 4500\nvoltage = 12.0\non_time = 1e-3\n"
+                                    'suppression = "diode"')
+    line = assert_one_line_error(*run_cli(["run", str(path), "--out", str(tmp_path / "out")]))
+    assert line.startswith(f"switchsim: error: {path}: coil.voltage, coil.on_time, coil.suppression do(es) not "
+                           "apply with circuit.template = \"netlist\"")
+    assert "[coil] takes resistance and turns" in line
+    scene = load_scene(_netlist_relay(tmp_path, "resistance = 360.0\nturns = 4500"))
+    assert scene.raw["coil"] == {"resistance": 360.0, "turns": 4500}
+
+
+def test_a_netlist_driving_its_xcoil_operates_the_relay_as_the_template_does(tmp_path):
+    """Two routes to the same relay: the default scene with suppression = "diode" (the
+    template's drive), and a user's netlist holding the same supplies, a switch turned on at
+    1 ms over 1 us and the diode, with the coil as its XCOIL line. The armature leaves its
+    rest at the same current (the magnet's force against the preload: to 1e-6), and the
+    contact makes and the armature arrives within the driver's 1 us edge (the SW element
+    switches at its half, the template's conductance ramps through it)."""
+    netlist = run(load_scene(_netlist_relay(tmp_path, "resistance = 360.0\nturns = 4500")))
+    template = run(default_scene().set("coil.suppression", "diode"))
+    assert netlist.status.value == template.status.value == "ok"
+    a, b = netlist.relay, template.relay
+    assert a["pull_in_current"] == pytest.approx(b["pull_in_current"], rel=1e-6)
+    assert abs(a["armature_arrival"] - b["armature_arrival"]) < 1e-6
+    assert abs(netlist.bounce["first_make"] - template.bounce["first_make"]) < 1e-6
+
 
 def test_the_waveform_plots_title_is_inside_the_figure():
     """The title of waveforms.png (bounces, settling, peaks, arc energy) was centred over the
