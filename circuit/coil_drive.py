@@ -71,7 +71,8 @@ class CoilDrive:
         "none", unit="-",
         doc='"none" (the driver avalanches at `switch_breakdown`), "diode" (freewheeling), "zener" (a diode in '
             'series with a zener), "rc"')
-    zener_voltage: float = scene_key(24.0, unit="V", doc='"zener" only')
+    zener_voltage: float = scene_key(
+        24.0, unit="V", doc='"zener" only; < `switch_breakdown` - `voltage` (else the driver avalanches before it clamps)')
     rc_resistance: float = scene_key(100.0, unit="ohm", doc='"rc" only')
     rc_capacitance: float = scene_key(100e-9, unit="F", doc='"rc" only')
     switch_resistance: float = scene_key(0.1, unit="ohm", doc="the driver when on")
