@@ -157,6 +157,22 @@ def test_a_netlist_driving_its_xcoil_operates_the_relay_as_the_template_does(tmp
     assert abs(netlist.bounce["first_make"] - template.bounce["first_make"]) < 1e-6
 
 
+@pytest.mark.parametrize("material_line, words", [
+    ('material = "steel"', ["magnet.iron[0].material: unknown magnetic material 'steel'", "allowed: 9SMnPb28"]),
+    ("", ["magnet.iron[0] needs material: a built-in name"]),
+])
+def test_an_iron_material_error_says_how_to_give_the_yokes_own_curve(tmp_path, material_line, words):
+    """One steel is built in; a relay's yoke is often another. The error named only
+    9SMnPb28 (and a missing material read "expected a table of keys, got None"): it now says
+    how to give a curve of one's own, as docs/magnet.md's keys allow."""
+    text = builtin_scene_text("default").replace('material = "9SMnPb28"', material_line, 1)
+    path = tmp_path / "relay.toml"
+    path.write_text(text)
+    line = assert_one_line_error(*run_cli(["run", str(path), "--out", str(tmp_path / "out")]))
+    for w in words + ["{relative_permeability = ...}", "{flux_density = [...], field_strength = [...]} (T, A/m)"]:
+        assert w in line, line
+
+
 def test_the_waveform_plots_title_is_inside_the_figure():
     """The title of waveforms.png (bounces, settling, peaks, arc energy) was centred over the
     axes, which the legends outside them make narrower than the figure: on the default relay
