@@ -71,7 +71,8 @@ class CoilDrive:
         "none", unit="-",
         doc='"none" (the driver avalanches at `switch_breakdown`), "diode" (freewheeling), "zener" (a diode in '
             'series with a zener), "rc"')
-    zener_voltage: float = scene_key(24.0, unit="V", doc='"zener" only')
+    zener_voltage: float = scene_key(
+        24.0, unit="V", doc='"zener" only; < `switch_breakdown` - `voltage` (else the driver avalanches before it clamps)')
     rc_resistance: float = scene_key(100.0, unit="ohm", doc='"rc" only')
     rc_capacitance: float = scene_key(100e-9, unit="F", doc='"rc" only')
     switch_resistance: float = scene_key(0.1, unit="ohm", doc="the driver when on")
@@ -107,6 +108,13 @@ class CoilDrive:
         if self.switch_breakdown <= self.voltage:
             raise ValueError(f"{name}.switch_breakdown = {self.switch_breakdown:g} V: must exceed the supply "
                              f"{name}.voltage = {self.voltage:g} V (the driver would conduct while off)")
+        if self.suppression == "zener" and self.voltage + self.zener_voltage >= self.switch_breakdown:
+            # the driver's node reaches voltage + V_z + V_d before the zener conducts: the
+            # driver's avalanche clamps first and the zener is never in the circuit
+            raise ValueError(f"{name}.zener_voltage = {self.zener_voltage:g} V: the driver avalanches at "
+                             f"{name}.switch_breakdown = {self.switch_breakdown:g} V before the zener clamps "
+                             f"(supply {name}.voltage = {self.voltage:g} V); allowed zener_voltage < "
+                             f"switch_breakdown - voltage = {self.switch_breakdown - self.voltage:g} V")
         check_range(name, "diode_saturation_current", self.diode_saturation_current, "A", 1e-20, 1e-3,
                     low_open=True)
 

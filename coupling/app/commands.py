@@ -173,7 +173,8 @@ def _result_lines(summary: dict) -> None:
                   else b.get("settle_note") or f"final state {b.get('final_state')}")
         print(f"switchsim: first make {_ms(b.get('first_make'))}, last make {_ms(b.get('last_make'))}, "
               f"{b.get('bounces')} bounce(s), {settle}, "
-              f"peak contact voltage {peak or 0:.3g} V, arc energy {b.get('arc_energy') or 0:.3g} J")
+              f"peak contact voltage {'none (no opening)' if peak is None else f'{peak:.3g} V'}, "
+              f"arc energy {b.get('arc_energy') or 0:.3g} J")
     relay = summary.get("relay")
     if relay:
         parts = [f"operate time {_ms(relay['operate_time'])}" if relay.get("operate_time") is not None else None,

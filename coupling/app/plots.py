@@ -168,7 +168,7 @@ def plot_waveforms(result, whole_run: bool = False):
     axes[-1].set_xlabel("time (ms)")
     title = "whole run" if whole_run else "bounce window"
     if "contact_voltage" not in cols:
-        axes[0].set_title(f"{title}: coil and armature (no contact)", fontsize=9)
+        axes[0].set_title(f"{title}: coil and armature (no contact)", fontsize=9, loc="left")
         fig.tight_layout()
         return fig
     peak = b.get("peak_bounce_voltage")
@@ -178,7 +178,7 @@ def plot_waveforms(result, whole_run: bool = False):
     axes[0].set_title(f"{title}: {b.get('bounces', 0)} bounce(s), {settle}; "
                       + (f"peak in bounces {peak:.3g} V" if peak is not None else "no bounce peak")
                       + (f", final opening {final:.3g} V" if final else "")
-                      + f"; arc energy {b.get('arc_energy') or 0:.3g} J", fontsize=9)
+                      + f"; arc energy {b.get('arc_energy') or 0:.3g} J", fontsize=9, loc="left")
     fig.tight_layout()
     return fig
 

@@ -482,7 +482,8 @@ _RUN_LOCK = threading.Lock()  # one ngspice per process: never two runs of this 
 
 def flatten_summary(summary: dict, prefix: str = "") -> dict:
     """Every scalar of a summary.json document, keys joined with dots (lists left out,
-    except ``flags``, joined with '; ')."""
+    except ``flags``, joined with '; ', and ``warnings``, one per line: a warning may hold a
+    '; ' itself, never a line break; "" when the run has none)."""
     out: dict = {}
     for key, value in summary.items():
         full = f"{prefix}{key}"
@@ -490,6 +491,8 @@ def flatten_summary(summary: dict, prefix: str = "") -> dict:
             out.update(flatten_summary(value, f"{full}."))
         elif key == "flags" and isinstance(value, list):
             out[full] = "; ".join(map(str, value))
+        elif key == "warnings" and isinstance(value, list):
+            out[full] = "\n".join(" ".join(str(w).split()) for w in value)
         elif value is None or isinstance(value, (bool, int, float, str)):
             out[full] = value
     return out

@@ -152,8 +152,14 @@ def flux_tube_magnet(table: dict, turns: float):
                               name="magnet.pole_leakage")
 
     def material(where: str, value):
+        own = "your own curve, {relative_permeability = ...} or {flux_density = [...], field_strength = [...]} (T, A/m)"
+        if value is None:
+            raise ValueError(f"{where.rsplit('.', 1)[0]} needs material: a built-in name or {own}")
         if isinstance(value, str):
-            return magnetic_material(value, where)
+            try:
+                return magnetic_material(value, where)
+            except ValueError as err:  # the built-in names are few: say how to give the yoke's own steel
+                raise ValueError(f"{err}; or {own}") from None
         value = _table(where, value)
         if "relative_permeability" in value:
             return LinearMaterial(**_fields(where, value, LinearMaterial), name=where)

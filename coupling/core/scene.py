@@ -524,6 +524,14 @@ def _circuit(table: dict, base_dir: Path, current_factor: str | None, device=Non
         if template == "netlist":
             if "netlist" not in table:
                 raise ValueError("template \"netlist\" needs netlist = \"file.cir\" (with one 'XCONTACT a b' line)")
+            if device is not None:
+                from coupling.core.device import drive_keys
+
+                ignored = [k for k in drive_keys() if k in device.coil]
+                if ignored:
+                    raise ValueError(f"coil.{', coil.'.join(ignored)} do(es) not apply with circuit.template = "
+                                     "\"netlist\": the netlist drives its XCOIL line (put the supply, the driver and "
+                                     "the suppression in the netlist); [coil] takes resistance and turns")
             path = _input_file("circuit.netlist", table["netlist"], base_dir)
             coil = {} if device is None else dict(coil_resistance=device.resistance,
                                                   coil_current=device.current_law())
