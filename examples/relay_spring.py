@@ -126,6 +126,9 @@ def closing_metrics(result, release: float) -> dict:
     # weights where ngspice stepped finely)
     held = float(np.trapezoid(fn, tw) / (tw[-1] - tw[0])) if len(tw) > 1 else float(fn.mean())
     out.update(held_force=held, held_force_min=float(np.min(fn)), held_force_max=float(np.max(fn)))
+    # the summary's own figure (operations[].held.force): the median over the whole held closure
+    out["summary_held_force"] = next((op["held"]["force"] for op in result.operations
+                                      if "force" in op.get("held", {})), None)
     return out
 
 

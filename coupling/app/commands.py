@@ -171,6 +171,10 @@ def _result_lines(summary: dict) -> None:
         peak = b.get("peak_contact_voltage")
         settle = (f"settled closed {_ms(b['settle_time'])} after the first make" if b.get("settled")
                   else b.get("settle_note") or f"final state {b.get('final_state')}")
+        held = next((op["held"] for op in summary.get("operations") or () if "force" in op.get("held", {})), None)
+        if held is not None:  # the first held closure: the datasheet's contact force and resistance
+            settle += f", held at {held['force']:.3g} N" + (
+                f" (R_c {held['contact_resistance'] * 1e3:.3g} mohm)" if held.get("contact_resistance") else "")
         print(f"switchsim: first make {_ms(b.get('first_make'))}, last make {_ms(b.get('last_make'))}, "
               f"{b.get('bounces')} bounce(s), {settle}, "
               f"peak contact voltage {'none (no opening)' if peak is None else f'{peak:.3g} V'}, "

@@ -368,7 +368,7 @@ def operation_duty(result, ops: list[dict]) -> list[dict]:
     return out
 
 
-def _held(duty: DutySettings, t, i_contact, force, resistance, span) -> dict | None:
+def _held(duty: DutySettings | None, t, i_contact, force, resistance, span) -> dict | None:
     """The held closure's figures (None without a held closure).
 
     force: the closure's median normal force in time (N: half of the closure at a force
@@ -378,7 +378,8 @@ def _held(duty: DutySettings, t, i_contact, force, resistance, span) -> dict | N
     (V): the room-temperature voltage of the contact held at its force. (The waveform's own
     voltage also shows the parting at the closure's end, where the force and the spot
     vanish and the voltage passes the melting voltage: that is the bridge of the break,
-    not the held contact.)"""
+    not the held contact.) With ``duty`` also the a-spot and the blow-off currents at that
+    force."""
     if span is None:
         return None
     sel = (t >= span[0]) & (t <= span[1])
@@ -393,11 +394,32 @@ def _held(duty: DutySettings, t, i_contact, force, resistance, span) -> dict | N
     f = time_median(ts, force[sel]) if force is not None else None
     if f is None or not f > 0.0:
         return out
+    out["force"] = f
+    if duty is None:
+        return out
     a = float(duty.spot_radius(f))
-    out.update(force=f, spot_radius=a,
+    out.update(spot_radius=a,
                conductor_radius=duty.conductor_radius,
                blow_off_current=float(blow_off_current(f, a, duty.conductor_radius)),
                shrinking_blow_off_current=shrinking_blow_off_current(f, duty.hardness, duty.conductor_radius))
+    return out
+
+
+def held_closures(result, ops: list[dict]) -> list[dict]:
+    """The operations (coupling.core.metrics.operations) with each one's ``held`` closure
+    (force, R_c, current, contact voltage; ``_held``) where it has one: what a datasheet
+    calls the contact force, reported with or without a [duty] section (``operation_duty``
+    adds the rest). New dicts; ``ops`` is left as it was."""
+    w = result.waveform_columns
+    if w is None or not len(w.get("time", ())) or not ops:
+        return ops
+    t = np.asarray(w["time"], float)
+    force = np.asarray(w["normal_force"], float) if "normal_force" in w else None
+    t_end = result.scene.t_end
+    out = []
+    for op, span in zip(ops, _spans(ops, t_end)):
+        held = _held(None, t, w["contact_current"], force, w.get("contact_resistance"), _held_span(op, span, t_end))
+        out.append({**op, "held": held} if held is not None else dict(op))
     return out
 
 

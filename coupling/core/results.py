@@ -267,6 +267,10 @@ class CoupledResult:
                     from coupling.core.duty import operation_duty
 
                     ops = operation_duty(self, ops)
+                else:  # the held closure's force and R_c, a datasheet's figures
+                    from coupling.core.duty import held_closures
+
+                    ops = held_closures(self, ops)
             self._cache["operations"] = ops
         return self._cache["operations"]
 
