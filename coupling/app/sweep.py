@@ -482,8 +482,9 @@ _RUN_LOCK = threading.Lock()  # one ngspice per process: never two runs of this 
 
 def flatten_summary(summary: dict, prefix: str = "") -> dict:
     """Every scalar of a summary.json document, keys joined with dots (lists left out,
-    except ``flags``, joined with '; ', and ``warnings``, one per line: a warning may hold a
-    '; ' itself, never a line break; "" when the run has none)."""
+    except ``flags``, joined with '; ', ``warnings``, one per line: a warning may hold a
+    '; ' itself, never a line break; "" when the run has none, and the first of
+    ``operations``, as ``operations.0.``)."""
     out: dict = {}
     for key, value in summary.items():
         full = f"{prefix}{key}"
@@ -493,6 +494,10 @@ def flatten_summary(summary: dict, prefix: str = "") -> dict:
             out[full] = "; ".join(map(str, value))
         elif key == "warnings" and isinstance(value, list):
             out[full] = "\n".join(" ".join(str(w).split()) for w in value)
+        elif key == "operations" and not prefix and isinstance(value, list) and value:
+            # the first operation (make, break, held closure): a study of a relay's gap or
+            # spring reads its held force and its break's arc from the row
+            out.update(flatten_summary(value[0], f"{full}.0."))
         elif value is None or isinstance(value, (bool, int, float, str)):
             out[full] = value
     return out

@@ -67,8 +67,9 @@ def test_bounce_units_are_those_of_docs_coupling():
 
 
 def _summaries():
-    """Summaries of a run of each kind: coupled with material laws (the default relay),
-    coupled with fitted laws (their parameters), mechanics only, a prescribed schedule."""
+    """Summaries of a run of each kind: the coil-driven default relay (relay, armature and
+    coil blocks, a make and a break), coupled with material laws (relay_force), coupled with
+    fitted laws (their parameters), mechanics only, a prescribed schedule."""
     from coupling import builtin_scene, load_scene, run
     from coupling.core.scene import scene_from_dict
 
@@ -77,8 +78,9 @@ def _summaries():
         "template": "resistive", "voltage": 24.0, "load_resistance": 12.0,
         "schedule": {"make": [2e-4], "break": [1e-3], "closed_resistance": 0.01}}}, name="schedule")
     fitted = load_scene(Path(__file__).resolve().parents[2] / "examples" / "resistive_bounce.toml")
-    scenes = (relay, fitted.set("solver.t_end", 1e-3), relay.without("circuit", "tribology", "coupling"), schedule)
-    assert [s.kind for s in scenes] == ["coupled", "coupled", "mechanics", "circuit"]
+    scenes = (builtin_scene("default"), relay, fitted.set("solver.t_end", 1e-3),
+              relay.without("circuit", "tribology", "coupling"), schedule)
+    assert [s.kind for s in scenes] == ["coupled", "coupled", "coupled", "mechanics", "circuit"]
     return [run(s).summary for s in scenes]
 
 
