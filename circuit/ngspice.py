@@ -202,6 +202,11 @@ class NgspiceSession:
         self._arc_from = math.nan  # accepted time the arc's step bounds below apply from
         self._arc_step = math.inf
         self._arc_land = math.inf
+        # Every step ngspice rejected since the circuit was loaded: (the accepted time it retries
+        # from, s; True if Newton failed, else its truncation-error test), from the sync
+        # callback's redo flag. ngspice cuts a step that failed to converge to exactly 1/8
+        # (dctran.c); a truncation-error rejection proposes its own estimate instead.
+        self.rejections: list[tuple[float, bool]] = []
         self._commands_sent = 0
         self._encoded: dict[str, bytes] = {}
         self.owner: weakref.ref | None = None
@@ -323,6 +328,8 @@ class NgspiceSession:
         return 0
 
     def _on_sync(self, ckttime, pdelta, olddelta, redostep, ident, loc, user):
+        if redostep:
+            self.rejections.append((ckttime, pdelta[0] == 0.125 * olddelta))
         if self._failure is None and time.monotonic() > self._deadline:
             self._failure = SimulationTimeout("wall-clock limit reached (SimulationOptions.wall_timeout)")
         if self._failure is not None:
@@ -402,6 +409,7 @@ class NgspiceSession:
         self._reset_callback_state()
 
     def _reset_callback_state(self) -> None:
+        self.rejections = []
         self._channels = {}
         self._by_pointer = {}
         self._target = math.inf

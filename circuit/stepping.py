@@ -120,6 +120,7 @@ class Stepper:
         self._finished = False
         self._failure: BaseException | None = None
         self._final: dict[str, np.ndarray] | None = None  # the columns kept at close
+        self._rejections: list[tuple[float, bool]] | None = None  # ngspice's rejected steps, kept at close
         self._steps = 0
         self._length = 0
         self._ngspice_seconds = 0.0
@@ -374,9 +375,19 @@ class Stepper:
         return self._read_last(self._active())[2][column]
 
     @property
+    def rejections(self) -> tuple[np.ndarray, np.ndarray]:
+        """Every step ngspice rejected in this run: (the accepted time it was retried from, s;
+        True where Newton failed to converge, False where ngspice's truncation-error test
+        rejected it). docs/circuit.md, "What ngspice does after the arc's chop"."""
+        found = self._rejections if self._rejections is not None else (
+            self._session.rejections if self._session is not None and self._started else [])
+        return (np.array([t for t, _ in found], dtype=float), np.array([n for _, n in found], dtype=bool))
+
+    @property
     def stats(self) -> dict[str, float]:
         """Macro steps, accepted ngspice points, conductance and gap evaluations (and a coil's gap,
-        with a coil), seconds inside ngspice, arc state changes."""
+        with a coil), seconds inside ngspice, arc state changes (the steps ngspice rejected:
+        ``rejections``)."""
         points = len(self._final["time"]) if self._final is not None else (self._active().length() if self._started else 0)
         calls = self._session.channel_calls if self._session is not None else {}
         conductances = {c.conductance_source.lower() for c in self.probes.contacts}
@@ -452,6 +463,7 @@ class Stepper:
                         self._final = self.probes.columns(session.vector)
                     except KeyError:
                         self._final = None
+                    self._rejections = list(session.rejections)
                 with session.exclusive():
                     session.clear()
         finally:
