@@ -262,6 +262,10 @@ class CoSimulation:
                     else:
                         slope = 0.0
                         if contact is not None:
+                            # (no curvature, unlike the coil's: a touching contact's steps stay
+                            # within 4 macro steps at the current's peaks, and the curvature of
+                            # its last points spans each make's rise, stopping the growth for
+                            # no accuracy: docs/coupling.md, "The contact current at its peaks")
                             t_next, slope = policy.plan(t, t_next, t_end, touching=touching,
                                                         jumped=jump_since_prev, current=i_now, rate=rate,
                                                         scale=scale)
