@@ -1,4 +1,4 @@
-"""What a relay designer met using switchsim as the README says (session 33's audit): each
+"""What a relay designer met using switchsim as the README says: each
 test reproduces a finding through the command line or the sweep API and holds its fix."""
 
 from __future__ import annotations
@@ -209,6 +209,3 @@ def test_the_waveform_plots_title_is_inside_the_figure():
         (title,) = [x for x in fig.findobj(Text) if "bounce(s), settled" in x.get_text()]
         box, width = title.get_window_extent(renderer), fig.bbox.width
         assert 0.0 <= box.x0 and box.x1 <= width, (title.get_text(), box, width)
-
-if __name__ == "__main__":
-    raise SystemExit(pytest.main([__file__, "-q"]))
