@@ -37,6 +37,10 @@ class ContactBlock:
     leakage_conductance: S, the open contact's conductance.
     current_factor: optional ngspice expression g(I) of the contact current I (A).
     arc: optional ArcModel of the opening gap (circuit.arc).
+    load_probe: optional name of a 0 V voltage source in series with this contact's own load
+        (a changeover's throw: ``Vload_no``); its branch current is the contact's load current,
+        result column ``load_current_<name>`` (A). Only a named contact has one: the circuit's
+        ``load_current`` is the supply's, through every contact.
     """
 
     name: str
@@ -45,6 +49,7 @@ class ContactBlock:
     leakage_conductance: float = DEFAULT_LEAKAGE
     current_factor: str | None = None
     arc: ArcModel | None = None
+    load_probe: str | None = None
 
     def __post_init__(self) -> None:
         check_block_name("ContactBlock.name", self.name)
@@ -56,6 +61,11 @@ class ContactBlock:
         check_current_factor("ContactBlock", self.current_factor)
         if self.arc is not None and not isinstance(self.arc, ArcModel):
             raise ValueError(f"ContactBlock.arc = {self.arc!r}: must be an ArcModel or None")
+        if self.load_probe is not None and not (
+                self.name and isinstance(self.load_probe, str) and self.load_probe[:1] in "vV"
+                and self.load_probe.split() == [self.load_probe] and len(self.load_probe) > 1):
+            raise ValueError(f"ContactBlock.load_probe = {self.load_probe!r}: the name of a voltage source "
+                             "(V..., one word), on a named contact only")
 
     @property
     def suffix(self) -> str:
@@ -85,6 +95,11 @@ class ContactBlock:
     def arc_current_vector(self) -> str | None:
         """ngspice vector of the arc path's current (A, a to b), None without an arc."""
         return None if self.arc is None else f"{self.element(ARC_SENSE)}#branch"
+
+    @property
+    def load_vector(self) -> str | None:
+        """ngspice vector of this contact's own load current (A), None without ``load_probe``."""
+        return None if self.load_probe is None else f"{self.load_probe.lower()}#branch"
 
     @property
     def conductance_source(self) -> str:

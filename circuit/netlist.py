@@ -26,7 +26,11 @@ ngspice sees them: see ``netlist_check`` and docs/circuit.md (threat model).
 Several contacts: name each, ``XCONTACT_<name> node_a node_b`` (a letter, then letters
 and digits: ``XCONTACT_NO``, ``XCONTACT_NC``); each becomes its own contact block with its
 own conductance, gap, arc and result columns (``contact_voltage_no``, ...). A plain
-``XCONTACT`` is the one unnamed contact and cannot be combined with named ones.
+``XCONTACT`` is the one unnamed contact and cannot be combined with named ones. A 0 V
+source ``VLOAD_<name>`` (the load probe's name, then the contact's) in series with a
+contact's own load (a changeover's throw) gives its load current, column
+``load_current_<name>``, and the current its friction coefficient mu(I) follows (else the
+supply's, ``VLOAD``'s: right for contacts in series, one current through all).
 
 The relay's own coil (with ``coil_resistance`` and ``coil_current``, the magnet's current
 law): one line ``XCOIL node_p node_n`` in the coil's drive circuit, replaced by the coil
@@ -38,6 +42,8 @@ _geff), arc_*, xcoil_*.
 """
 
 from __future__ import annotations
+
+import dataclasses
 
 import math
 import re
@@ -149,6 +155,7 @@ class NetlistCircuit:
         placed: list[tuple[int, ContactBlock]] = []
         coils: list[tuple[int, CoilBlock]] = []
         has_load_probe = False
+        heads: set[str] = set()
         for i, line in enumerate(lines):
             if i == 0:
                 continue
@@ -188,6 +195,7 @@ class NetlistCircuit:
                 raise NetlistInputError(f"{where}: node names contact_s, contact_g, arc_*, xcoil_* are reserved")
             if self.load_probe is not None and head.lower() == self.load_probe.lower():
                 has_load_probe = True
+            heads.add(head.lower())
         if not placed:
             raise NetlistInputError(
                 "the netlist must contain a contact line, 'XCONTACT node_a node_b' (or one 'XCONTACT_<name> "
@@ -199,6 +207,11 @@ class NetlistCircuit:
         if len(placed) > 1 and any(not b.name for _, b in placed):
             raise NetlistInputError("a netlist with several contacts names each one, 'XCONTACT_<name> node_a node_b' "
                                     "(a plain XCONTACT is the one contact of a single-contact netlist)")
+        if self.load_probe is not None:
+            # a named contact's own load probe, <load_probe>_<name> (VLOAD_NO): its load current,
+            # the current its mu(I) follows (a changeover's throws, as the template's)
+            placed = [(i, dataclasses.replace(b, load_probe=f"{self.load_probe}_{b.name}".lower())
+                       if b.name and f"{self.load_probe}_{b.name}".lower() in heads else b) for i, b in placed]
         return lines, placed, coils, has_load_probe
 
     @property

@@ -30,7 +30,7 @@ CLOSED_CONDUCTANCE = 1e-6  # S: above it the contact voltage is I/G (see Probes.
 # the per-block result columns that are one ngspice vector as it stands: base name -> the
 # block's attribute naming it (Probes.vector_of; an arc's is None without an arc model)
 RAW_CONTACT_COLUMNS = {"contact_current": "current_vector", "contact_conductance": "conductance_node",
-                       "arc_current": "arc_current_vector"}
+                       "arc_current": "arc_current_vector", "load_current": "load_vector"}
 RAW_COIL_COLUMNS = {"coil_current": "current_vector", "coil_flux_linkage": "flux_node"}
 
 
@@ -60,22 +60,28 @@ class Probes:
         if len(set(names)) != len(names) or not (names or self.coils):
             raise ValueError(f"Probes.contacts: contacts with distinct names (or none, beside a coil), got {names!r}")
 
+    @staticmethod
+    def contact_columns(c: ContactBlock) -> tuple[str, ...]:
+        """A contact's column base names: CONTACT_COLUMNS, and load_current where it has its
+        own load probe (a changeover's throw)."""
+        return CONTACT_COLUMNS + (("load_current",) if c.load_probe is not None else ())
+
     @property
     def column_names(self) -> tuple[str, ...]:
         """Every result column, in order: COLUMNS for one unnamed contact; else time,
-        load_current, then each contact's CONTACT_COLUMNS with its suffix."""
+        load_current, then each contact's columns with its suffix (``contact_columns``)."""
         coils = tuple(f"{name}{c.suffix}" for c in self.coils for name in COIL_COLUMNS)
         if not self.contacts:  # a coil's drive alone (an actuator)
             return ("time",) + coils
         if len(self.contacts) == 1 and not self.contacts[0].name:
             return COLUMNS + coils
         return ("time", "load_current") + tuple(
-            f"{name}{c.suffix}" for c in self.contacts for name in CONTACT_COLUMNS) + coils
+            f"{name}{c.suffix}" for c in self.contacts for name in self.contact_columns(c)) + coils
 
     def contact(self, column: str) -> tuple[ContactBlock, str]:
         """(the contact, the column's base name) of a per-contact column such as contact_voltage_no."""
         for c in self.contacts:
-            for base in CONTACT_COLUMNS:
+            for base in self.contact_columns(c):
                 if column == base + c.suffix:
                     return c, base
         raise KeyError(f"unknown result column {column!r}; known: {', '.join(self.column_names)}")

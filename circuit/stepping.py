@@ -129,6 +129,7 @@ class Stepper:
             names += [c.current_vector, c.node_a, c.node_b]
         names.append(self.probes.load_current)
         names += [c.arc_current_vector for c in self.probes.contacts]
+        names += [c.load_vector for c in self.probes.contacts]
         for c in self.probes.coils:
             names += [c.current_vector, c.node_p, c.node_n, c.flux_node]
         self._last_names = tuple(dict.fromkeys(n.lower() for n in names if n and n.lower() not in ("0", "gnd")))
@@ -305,6 +306,8 @@ class Stepper:
             plan.append(("contact_voltage" + c.suffix, node(c.node_a), node(c.node_b), 0.0))
             plan.append(vector("contact_current" + c.suffix, c.current_vector, math.nan))
             plan.append(vector("arc_current" + c.suffix, c.arc_current_vector, 0.0))
+            if c.load_vector is not None:
+                plan.append(vector("load_current" + c.suffix, c.load_vector, math.nan))
         for c in p.coils:
             plan.append(vector("coil_current" + c.suffix, c.current_vector, math.nan))
             plan.append(("coil_voltage" + c.suffix, node(c.node_p), node(c.node_n), 0.0))

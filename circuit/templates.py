@@ -624,7 +624,9 @@ class ChangeoverCircuit(SwitchCircuit):
     def contacts(self) -> tuple[ContactBlock, ...]:
         """(NO, NC): each from the common to its throw."""
         args = (self.leakage_conductance, self.contact_current_factor, self.arc)
-        return tuple(ContactBlock(n, NODE_A, f"throw_{n.lower()}", *args) for n in self.contact_names)
+        # each throw's own load current (its probe Vload_<name>, build): its mu(I), its columns
+        return tuple(ContactBlock(n, NODE_A, f"throw_{n.lower()}", *args, load_probe=f"Vload_{n.lower()}")
+                     for n in self.contact_names)
 
     def build(self) -> Circuit:
         c = Circuit(self.title)

@@ -266,13 +266,18 @@ def scene_quantity(key: str) -> Quantity | None:
 
 
 def waveform_quantity(column: str) -> Quantity | None:
-    """A waveform or history column ("contact_voltage", "normal_force_1", "v(snubber)")."""
+    """A waveform or history column ("contact_voltage", "normal_force_1", "load_current_NO",
+    "v(snubber)")."""
     if column in WAVEFORM:
         return WAVEFORM[column]
     base = re.sub(r"_[01]$", "", column)  # per contact point: normal_force_0 -> normal_force
     if base != column and base in WAVEFORM:
         q = WAVEFORM[base]
         return Quantity(f"{q.name}, contact point {column[-1]}", q.unit)
+    named = re.fullmatch(r"(\w+)_([A-Za-z][A-Za-z0-9]*)", column)  # a named contact's: load_current_NO
+    if named and named.group(1) in WAVEFORM:
+        q = WAVEFORM[named.group(1)]
+        return Quantity(f"{q.name}, {named.group(2)}", q.unit)
     if column[:2].lower() == "v(":
         return Quantity(column, "V")
     if column[:2].lower() == "i(":

@@ -199,6 +199,10 @@ class Tail:
         return end_derivatives(self.t, self.v, span)
 
 
+#: A: below this supply current a contact's share of it is not taken (both throws open)
+SHARE_FLOOR = 1e-9
+
+
 class ContactLink:
     """A circuit contact fed by contact points of the mechanics (SI units).
 
@@ -208,14 +212,23 @@ class ContactLink:
     laws: the contact laws (``coupling.laws.tribology.ContactLaws``): R_c(F_n) and mu(I).
     onset: m, the penetration over which a point's conduction ramps in (``conduction_onset``).
     feedback: mu follows the current (False: mu = mu(0) throughout).
+    load_column: the contact's own load current ("load_current_<name>": a changeover's
+        throw, in its own branch), or None where the supply's current runs through it (one
+        contact, contacts in series). The coupling extrapolates one current, the supply's;
+        a contact in its own branch takes its ``share`` of it at each step's start (its
+        own over the supply's), so that while both throws of a make-before-break changeover
+        are closed each one's mu(I) follows its own current, not their sum.
     """
 
-    def __init__(self, label: str, points: tuple[int, ...], laws, onset: float, feedback: bool = True):
+    def __init__(self, label: str, points: tuple[int, ...], laws, onset: float, feedback: bool = True,
+                 load_column: str | None = None):
         self.label = label
         self.points = tuple(points)
         self.laws = laws
         self.onset = onset
         self.feedback = feedback
+        self.load_column = load_column
+        self.share = 1.0  # of the supply's current through this contact (observe)
         self.tail = Tail()
         self.mu_log: list[tuple[float, float, float, float]] = []
 
@@ -345,8 +358,17 @@ class ContactLink:
         return float(step.values["contact_current" + suffix])
 
     def observe(self, step, jumped: bool) -> None:
-        """Keep the circuit's last points of the current (for its rate and time scale)."""
+        """Keep the circuit's last points of the current (for its rate and time scale), and
+        the contact's share of it at the step's end (``load_column``)."""
         self.tail.observe(step.reader("time"), step.reader("load_current"), jumped)
+        if self.load_column is not None:
+            own, supply = float(step.values[self.load_column]), float(step.values["load_current"])
+            # (both open, the supply's current is leakage: the share is then of no consequence)
+            self.share = own / supply if np.isfinite(own) and abs(supply) > SHARE_FLOOR else 1.0
+
+    def own(self, current: float) -> float:
+        """A: this contact's part of the supply's current ``current`` (A): its ``share``."""
+        return self.share * current
 
     # -- results --
 

@@ -148,7 +148,8 @@ class CoSimulation:
         if contacts and self.scene.mech.bar is not None:
             for block, points in zip(contacts, contact_feeds(self.scene.mech, contacts)):
                 links.append(ContactLink(block.label, points, self.laws, self.scene.coupling.onset_penetration,
-                                         self.feedback))
+                                         self.feedback, load_column=None if block.load_probe is None
+                                         else "load_current" + block.suffix))
         coils = getattr(circuit, "coils", ())
         if coils:
             from coupling.core.device import device
@@ -328,15 +329,16 @@ class CoSimulation:
         def current_at(s):
             return policy.extrapolate(i_now, slope, s - t, horizon)
 
-        mu0 = [link.mu(current_at(t)) for link in links]
+        mu0 = [link.mu(link.own(current_at(t))) for link in links]
         arm = mech.armature_now() if coil is not None else None
 
         def drives(end: float) -> dict:
             """The mechanics' drives over [t, end]: each link's, extrapolated to the step's end."""
             out = {}
             for link, mu in zip(links, mu0):
-                out.update(link.drives(mech, mu, link.mu(current_at(end)))
-                           | link.repulsion(mech, self.scene.duty, current_at, t, end))
+                out.update(link.drives(mech, mu, link.mu(link.own(current_at(end))))
+                           | link.repulsion(mech, self.scene.duty, lambda s, link=link: link.own(current_at(s)),
+                                            t, end))
             if coil is not None:
                 out.update(coil.drives(t, end, arm, self.coil_policy))
             return out
@@ -374,7 +376,7 @@ class CoSimulation:
                 aligned = end is not None
         self.stats["mech_seconds"] += time.perf_counter() - tick
         for link, mu in zip(links, mu0):
-            link.mu_log.append((t, t_next, mu, link.mu(current_at(t_next))))
+            link.mu_log.append((t, t_next, mu, link.mu(link.own(current_at(t_next)))))
         breakpoints = sorted({s for s in switching if t < s <= t_next})
         inputs = {}
         for link in links:
@@ -429,9 +431,10 @@ class CoSimulation:
         inputs, drives = {}, {}
         state = mech.contact_now()
         for link in self.contacts:
-            mu = link.mu(i_now)
+            mu = link.mu(link.own(i_now))
             inputs.update(link.held_inputs(state, stepper.uses_gap))
-            drives.update(link.drives(mech, mu, mu) | link.repulsion(mech, self.scene.duty, lambda s: i_now, t, t_next))
+            drives.update(link.drives(mech, mu, mu) | link.repulsion(mech, self.scene.duty,
+                                                                     lambda s, link=link: link.own(i_now), t, t_next))
             link.mu_log.append((t, t_next, mu, mu))
         tick = time.perf_counter()
         mech.advance(t_next, drives)

@@ -298,18 +298,52 @@ def test_an_arc_still_burning_at_the_other_throws_make_is_a_warning():
         assert (len(lines) == 1 and "NC's arc still burns when NO makes at 2 ms" in lines[0]) is burning
 
 
-def test_a_make_before_break_changeover_opening_both_throws_burns_both_arcs():
+def _make_before_break(**circuit) -> dict:
     """The bridge contactor's motion (examples/bridge_contactor.toml: both rivets closed at
-    once, then pulled off together) wired as a changeover: both throws open on the wiring's
-    current and both arcs burn at once. The run goes to its end (it had aborted, "timestep
-    too small" at the common: not the two arcs, but a 1e-19 s step where an arc's landing
-    fell an ulp before a macro step's end), and wherever both burn each holds at least its
-    burning voltage U_min (the arc model's dead zone: |v| = U_min + E_col d + R_arc |i|)."""
+    once, then pulled off together) wired as a changeover, NO and NC."""
     bridge = tomllib.loads((EXAMPLE.parent / "bridge_contactor.toml").read_text())
     names = iter(("NO", "NC"))
     for fixed in bridge["fixed"]:
         fixed["name"] = next(names)
     bridge["circuit"]["template"] = "changeover"
+    bridge["circuit"].update(circuit)
+    return bridge
+
+
+def test_while_both_throws_are_closed_each_ones_mu_follows_its_own_current():
+    """Make before break with NC's load three times NO's (12 and 36 ohm on 36 V): while both
+    throws are closed NO carries ~3 A and NC ~1 A, the supply ~4 A. The friction coefficient
+    each throw's contact points get must be mu(I) of that throw's own current (its load
+    probe's), not of the supply's (the illustrative law: mu(4 A) is 0.335, mu(1 A) 0.273).
+    The mechanics gets mu linear over each macro step from the extrapolated current, hence
+    the 1e-4."""
+    result = run(scene_from_dict(_make_before_break(nc_load_resistance=36.0), base_dir=EXAMPLE.parent))
+    assert result.status == "ok", result.message
+    w, mu = result.waveform_columns, result.scene.tribology.laws.mu
+    overlaps = result.summary["changeover"]["overlaps"]
+    assert overlaps
+    for a, b in overlaps:
+        inner = (w["time"] > a + 0.1 * (b - a)) & (w["time"] < b - 0.1 * (b - a))
+        assert np.count_nonzero(inner) > 10
+        shares = {}
+        for name in ("NO", "NC"):
+            own = np.array([mu(i) for i in w[f"load_current_{name}"][inner]])
+            assert np.max(np.abs(w[f"mu_{name}"][inner] - own)) < 1e-4, name
+            shares[name] = np.median(w[f"load_current_{name}"][inner] / w["load_current"][inner])
+        # Kirchhoff: the throws' own currents are the supply's, shared as their loads say
+        assert shares["NO"] + shares["NC"] == pytest.approx(1.0, abs=1e-3)
+        assert shares["NO"] / shares["NC"] == pytest.approx(3.0, rel=0.02)
+        supply = np.array([mu(i) for i in w["load_current"][inner]])
+        assert np.min(np.abs(w["mu_NC"][inner] - supply)) > 0.05  # (what the supply's current gave)
+
+
+def test_a_make_before_break_changeover_opening_both_throws_burns_both_arcs():
+    """The bridge contactor's motion (``_make_before_break``) wired as a changeover: both
+    throws open on the wiring's current and both arcs burn at once. The run goes to its end (it had aborted, "timestep
+    too small" at the common: not the two arcs, but a 1e-19 s step where an arc's landing
+    fell an ulp before a macro step's end), and wherever both burn each holds at least its
+    burning voltage U_min (the arc model's dead zone: |v| = U_min + E_col d + R_arc |i|)."""
+    bridge = _make_before_break()
     result = run(scene_from_dict(bridge, base_dir=EXAMPLE.parent))
     assert result.status == "ok", result.message
     assert result.summary["changeover"]["break_before_make"] is False

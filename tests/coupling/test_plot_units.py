@@ -149,3 +149,14 @@ def test_sweep_plots_say_quantity_and_unit_on_every_axis(tmp_path):
     assert [t.get_text() for t in ax.get_yticklabels()][-1] == "open"
     assert fig.legends[0].get_texts()[0].get_text() == "circuit snubber resistance = 22 ohm"
     assert_every_axis_has_a_unit(fig, "plot_overlay")
+
+
+def test_a_named_contacts_columns_have_their_base_columns_unit():
+    """A circuit of several contacts writes each one's columns with its name (a changeover's
+    load_current_NO, mu_NC): each has its base column's unit, named after its contact."""
+    from coupling.app.quantities import quantity
+
+    for column, base in (("load_current_NO", "load_current"), ("contact_voltage_NC", "contact_voltage"),
+                         ("mu_a", "mu"), ("gap_b", "gap")):
+        q = quantity(column)
+        assert q is not None and q.unit == quantity(base).unit and q.name.endswith(column.rsplit("_", 1)[1])
