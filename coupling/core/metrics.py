@@ -368,7 +368,8 @@ def operations(intervals, t_end: float, t=None, v=None, i_loop=None, i_contact=N
     - break: from the first separation after the last held closure through any chatter to
       the arc's end. ``time`` (s), ``current_at_break`` (A, the loop current just before),
       ``arc_duration`` (s, time with |i_arc| > 1 mA), ``arc_energy`` (J), ``peak_voltage``
-      (V), ``complete`` (False when the run ended with the arc still burning; then
+      (V, the largest |v| from the break to the next make or the run's end: the arc and
+      the recovery transient after it), ``complete`` (False when the run ended with the arc still burning; then
       ``more_time_needed`` (s) estimates how much longer it needed to reach I_min, or None).
     An episode that never holds is a make that did not settle; if it then opens, its break
     follows. A run that starts closed begins with a held closure (no make).
@@ -427,7 +428,11 @@ def operations(intervals, t_end: float, t=None, v=None, i_loop=None, i_contact=N
                     brk["arc_duration"], brk["arc_energy"] = 0.0, 0.0
                 makes_after = [a for a, _ in group[last_held + 1:]]
                 excluded = make_instant_mask(t, makes_after, guard)
-                brk["peak_voltage"] = _peak(v, (t >= brk_time) & (t <= end) & ~excluded)
+                # the peak to the next make (or the run's end): after the arc goes out the
+                # load loop rings the open contact, the break's recovery voltage (on the
+                # default relay three times the arc's), part of what the break puts on the gap
+                recovered = groups[g + 1][0][0] if g + 1 < len(groups) else t_end
+                brk["peak_voltage"] = _peak(v, (t >= brk_time) & (t <= max(end, recovered)) & ~excluded)
                 if arc_out is None:
                     brk["complete"] = False
                     brk["more_time_needed"] = _more_arc_time(t, i_arc, min_arc_current)
