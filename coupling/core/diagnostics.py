@@ -36,6 +36,11 @@ Each is one line that says what was seen, when, and what to add to the scene. Ch
    remedy when the travel is meant to be smooth.
 9. The coil-armature interface's residual above solver.energy_tolerance of the energy into
    the coil (``interface_audit_warning``).
+10. coil.on_time or coil.off_time at or after [solver] t_end (``coil_time_warnings``).
+11. A relay's armature not seated at the pole when its drive ends (``pole_seat_warning``).
+12. A relay's armature at the pole with its contact never made (``no_make_warning``).
+13. A DC break whose arc the source holds above min_current at the run's largest gap: its
+    still-burning arc is not a matter of t_end (``uncleared_break_advice``).
 """
 
 from __future__ import annotations
@@ -233,7 +238,8 @@ POLE_ADVICE = ("give more ampere-turns (coil.voltage, coil.turns), a weaker retu
 def pole_seat_warning(result) -> str | None:
     """Item 11: the line for a relay whose coil is on while its armature is not seated at the
     pole when the drive ends (coil.off_time, or the run's end with the coil on): it never got
-    there, or left it while the coil was on. The magnet's pull then does not overcome the
+    there, or left it while the coil was on and its contact is closed then (held off by the
+    contact spring; without a closed contact it is rebounding off its stop, no line). The magnet's pull then does not overcome the
     return spring and the contact spring's load at the pole, and the contact force is the
     magnet's balance against the contact spring (it follows the coil current), not the
     overtravel's. Shortfall (m of the pole face's travel) and the coil current against its
@@ -243,7 +249,11 @@ def pole_seat_warning(result) -> str | None:
         return None
     on, end, name = window
     seated, left = _pole_state(result.mechanics.events, end)
-    if seated:
+    arrived = result.relay.get("armature_arrival") if result.relay else None
+    reached = arrived is not None and arrived <= end
+    # Off the pole after reaching it is a hold-off only while the contact spring pushes back
+    # (the contact closed): an armature without one in flight at `end` is rebounding off its stop.
+    if seated or (reached and not any(a <= end <= b for a, b in result.closed_intervals)):
         return None
     from coupling.core.device import device
 
@@ -258,8 +268,7 @@ def pole_seat_warning(result) -> str | None:
     i_end = abs(float(np.interp(end, t, w["coil_current"])))
     steady = abs(drive.voltage) / float(spec.resistance)
     current = f"the coil current {i_end * 1e3:.3g} mA of its steady {steady * 1e3:.3g} mA (coil.voltage / resistance)"
-    arrived = result.relay.get("armature_arrival") if result.relay else None
-    if arrived is None or arrived > end:
+    if not reached:
         what = (f"the armature never reached the pole while the coil was on ({_ms(on)} to {_ms(end)}, {name}): "
                 f"it came within {_mm(max(nearest, 0.0))} of it ({current} at {_ms(end)})")
     else:
@@ -268,7 +277,8 @@ def pole_seat_warning(result) -> str | None:
                 f"{_mm(max(at_end, 0.0))} short of it, {current})")
     makes = [op["make"]["time"] for op in result.operations if "make" in op and op["make"]["time"] <= end]
     force = ("the contact force is then the magnet's balance against the contact spring (it follows the coil "
-             "current), not the overtravel's" if makes else "the contact did not make")
+             "current), not the overtravel's" if makes else
+             "the contact did not make" if result.has_contact else "the armature carries no contact")
     return (f"relay: {what}: the magnet's pull does not hold the armature at the pole against the return "
             f"spring and the contact spring; {force}, and the operate and release figures are not those of a "
             f"seated relay; {POLE_ADVICE}")
