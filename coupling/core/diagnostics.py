@@ -188,8 +188,10 @@ def coil_time_warnings(result) -> list[str]:
     (on_time beyond t_end, on_time's default being a step at 0) is how a de-energized relay is
     shaken or timed, and a coil left on (off_time beyond t_end) is the operate part alone;
     an error would also stop a sweep over t_end at the points it crosses."""
+    if result.relay is None:  # first: a scene without a coil imports nothing of the circuit
+        return []
     drive = result.coil_drive
-    if drive is None or result.relay is None:
+    if drive is None:
         return []
     end = result.scene.t_end
     if drive.on_time >= end:
@@ -244,8 +246,10 @@ def pole_seat_warning(result) -> str | None:
     magnet's balance against the contact spring (it follows the coil current), not the
     overtravel's. Shortfall (m of the pole face's travel) and the coil current against its
     steady coil.voltage / coil.resistance say how far it was."""
+    if result.relay is None or result.mechanics is None:
+        return None
     window = _drive_window(result)
-    if window is None or result.mechanics is None:
+    if window is None:
         return None
     on, end, name = window
     seated, left = _pole_state(result.mechanics.events, end)
@@ -526,11 +530,15 @@ def run_warnings(result) -> list[str]:
         line = interface_audit_warning(result)
         if line:
             out.append(line)
-        out += coil_time_warnings(result)
-        for check in (release_warning, pole_seat_warning, no_make_warning):
-            line = check(result)
-            if line:
-                out.append(line)
+        line = release_warning(result)
+        if line:
+            out.append(line)
+        if result.relay is not None:  # (without a coil nothing of the circuit is imported)
+            out += coil_time_warnings(result)
+            for check in (pole_seat_warning, no_make_warning):
+                line = check(result)
+                if line:
+                    out.append(line)
     w = result.waveform_columns
     if w is not None and len(w["time"]) and "contact_voltage" in w:  # (an actuator's coil drive has no contact)
         t = w["time"]
