@@ -36,6 +36,11 @@ Each is one line that says what was seen, when, and what to add to the scene. Ch
    remedy when the travel is meant to be smooth.
 9. The coil-armature interface's residual above solver.energy_tolerance of the energy into
    the coil (``interface_audit_warning``).
+10. coil.on_time or coil.off_time at or after [solver] t_end (``coil_time_warnings``).
+11. A relay's armature not seated at the pole when its drive ends (``pole_seat_warning``).
+12. A relay's armature at the pole with its contact never made (``no_make_warning``).
+13. A DC break whose arc the source holds above min_current at the run's largest gap: its
+    still-burning arc is not a matter of t_end (``uncleared_break_advice``).
 """
 
 from __future__ import annotations
@@ -167,6 +172,210 @@ def release_warning(result) -> str | None:
     return (f"relay: the contact was still closed when the run ended, {(end - off) * 1e3:.3g} ms after the coil "
             f"was switched off (coil.off_time = {off * 1e3:.4g} ms; {where}): release_time is missing, not "
             f"measured; run longer ([solver] t_end)")
+
+
+def _ms(x: float) -> str:
+    return f"{x * 1e3:.4g} ms"
+
+
+def _mm(x: float) -> str:
+    return f"{x * 1e6:.3g} um" if abs(x) < 1e-4 else f"{x * 1e3:.4g} mm"
+
+
+def coil_time_warnings(result) -> list[str]:
+    """Item 10: a line for coil.on_time, and one for coil.off_time, at or beyond the run's end:
+    that switching is not simulated. Warnings, not errors: a coil kept off through the run
+    (on_time beyond t_end, on_time's default being a step at 0) is how a de-energized relay is
+    shaken or timed, and a coil left on (off_time beyond t_end) is the operate part alone;
+    an error would also stop a sweep over t_end at the points it crosses."""
+    if result.relay is None:  # first: a scene without a coil imports nothing of the circuit
+        return []
+    drive = result.coil_drive
+    if drive is None:
+        return []
+    end = result.scene.t_end
+    if drive.on_time >= end:
+        return [f"relay: coil.on_time = {_ms(drive.on_time)} is at or after the run's end ([solver] t_end = "
+                f"{_ms(end)}): the coil is never switched on and nothing of the relay operates; if it is meant "
+                "to, set coil.on_time before t_end (0: a step at the start) or run longer"]
+    if drive.off_time is not None and drive.off_time >= end:
+        return [f"relay: coil.off_time = {_ms(drive.off_time)} is at or after the run's end ([solver] t_end = "
+                f"{_ms(end)}): the coil is never switched off, the release is not simulated and release_time "
+                "and drop_out_current stay null; to see it, set [solver] t_end a few ms beyond coil.off_time "
+                "(or omit coil.off_time: the coil then stays on)"]
+    return []
+
+
+def _drive_window(result):
+    """(on, end, end's name) s: the coil on from its driver's on_time to its off_time or the
+    run's last sample, whichever comes first; None without a template coil's drive, a
+    waveform, or when the coil is never on within the run."""
+    drive = result.coil_drive
+    w = result.waveform_columns
+    if drive is None or w is None or not len(w["time"]) or "armature_position" not in w:
+        return None
+    last = float(w["time"][-1])
+    off = drive.off_time
+    end, name = (off, "coil.off_time") if off is not None and off < last else (last, "the run's end")
+    if not drive.on_time < end:
+        return None
+    return drive.on_time, end, name
+
+
+def _pole_state(events: list[dict], when: float) -> tuple[bool, float | None]:
+    """(seated at ``when``, the last time the armature left the pole before it or None): the
+    mechanics' pole stop events, an arrival or a seat putting it on, a departure taking it off."""
+    pole = sorted((float(e["time"]), e["kind"]) for e in events
+                  if e.get("stop") == "pole" and e["kind"] in ("armature_stop_start", "armature_seat",
+                                                              "armature_stop_end") and float(e["time"]) <= when)
+    left = [t for t, kind in pole if kind == "armature_stop_end"]
+    return bool(pole) and pole[-1][1] != "armature_stop_end", (left[-1] if left else None)
+
+
+POLE_ADVICE = ("give more ampere-turns (coil.voltage, coil.turns), a weaker return spring (armature.spring_preload, "
+               "armature.spring_rate) or less overtravel (a larger [initial] height or armature.card_free_travel), "
+               "or keep the coil on longer (coil.off_time) if its current was still rising")
+
+
+def pole_seat_warning(result) -> str | None:
+    """Item 11: the line for a relay whose coil is on while its armature is not seated at the
+    pole when the drive ends (coil.off_time, or the run's end with the coil on): it never got
+    there, or left it while the coil was on and its contact is closed then (held off by the
+    contact spring; without a closed contact it is rebounding off its stop, no line). The magnet's pull then does not overcome the
+    return spring and the contact spring's load at the pole, and the contact force is the
+    magnet's balance against the contact spring (it follows the coil current), not the
+    overtravel's. Shortfall (m of the pole face's travel) and the coil current against its
+    steady coil.voltage / coil.resistance say how far it was."""
+    if result.relay is None or result.mechanics is None:
+        return None
+    window = _drive_window(result)
+    if window is None:
+        return None
+    on, end, name = window
+    seated, left = _pole_state(result.mechanics.events, end)
+    arrived = result.relay.get("armature_arrival") if result.relay else None
+    reached = arrived is not None and arrived <= end
+    # Off the pole after reaching it is a hold-off only while the contact spring pushes back
+    # (the contact closed): an armature without one in flight at `end` is rebounding off its stop.
+    if seated or (reached and not any(a <= end <= b for a, b in result.closed_intervals)):
+        return None
+    from coupling.core.device import device
+
+    spec = device(result.scene.raw)
+    w = result.waveform_columns
+    t = np.asarray(w["time"], float)
+    pole = spec.lever * float(result.scene.mech.armature.travel)  # m: the pole face's travel to the pole
+    sel = (t >= on) & (t <= end)
+    nearest = pole - float(np.max(np.asarray(w["armature_position"], float)[sel])) if sel.any() else pole
+    at_end = pole - float(np.interp(end, t, w["armature_position"]))
+    drive = result.coil_drive
+    i_end = abs(float(np.interp(end, t, w["coil_current"])))
+    steady = abs(drive.voltage) / float(spec.resistance)
+    current = f"the coil current {i_end * 1e3:.3g} mA of its steady {steady * 1e3:.3g} mA (coil.voltage / resistance)"
+    if not reached:
+        what = (f"the armature never reached the pole while the coil was on ({_ms(on)} to {_ms(end)}, {name}): "
+                f"it came within {_mm(max(nearest, 0.0))} of it ({current} at {_ms(end)})")
+    else:
+        when = f"at {_ms(left)}" if left is not None and left >= on else "before the coil was switched on"
+        what = (f"the armature left the pole {when} while the coil was on and was not back at {_ms(end)} ({name}; "
+                f"{_mm(max(at_end, 0.0))} short of it, {current})")
+    makes = [op["make"]["time"] for op in result.operations if "make" in op and op["make"]["time"] <= end]
+    force = ("the contact force is then the magnet's balance against the contact spring (it follows the coil "
+             "current), not the overtravel's" if makes else
+             "the contact did not make" if result.has_contact else "the armature carries no contact")
+    return (f"relay: {what}: the magnet's pull does not hold the armature at the pole against the return "
+            f"spring and the contact spring; {force}, and the operate and release figures are not those of a "
+            f"seated relay; {POLE_ADVICE}")
+
+
+def no_make_warning(result) -> str | None:
+    """Item 12: the line for a relay whose armature reached the pole while its contact never
+    made (a contact open at the start that stayed open): the card's travel at the pole
+    (armature.card_lever x travel - card_free_travel, m at the card) against the contact gap
+    ([initial] height) and the gap left with the armature at the pole."""
+    relay = result.relay
+    arrived = relay.get("armature_arrival") if relay else None
+    if arrived is None or result.mechanics is None or not result.has_contact:
+        return None
+    bounce = result.bounce
+    if bounce.get("first_make") is not None or bounce.get("initial_state") != "open":
+        return None
+    mech = result.scene.mech
+    arm, gap = mech.armature, float(mech.initial.height)
+    w = result.waveform_columns
+    left = (f", and the contact was still {_mm(float(np.interp(arrived, w['time'], w['gap'])))} open with the "
+            "armature there" if w is not None and "gap" in w else "")
+    if arm.card_position is None:
+        card = "the armature has no card (armature.card_position) to push the contact spring"
+        fix = "give the armature a card (armature.card_position, card_lever)"
+    else:
+        travel = arm.card_lever * arm.travel - arm.card_free_travel
+        card = (f"the card's travel at the pole is {_mm(travel)} (armature.card_lever x travel - card_free_travel) "
+                f"against a contact gap of {_mm(gap)} ([initial] height)")
+        fix = ("check [initial] height (a gap in mm written as m?) and the card's travel (armature.card_lever, "
+               "travel, card_free_travel): the card must push the contact spring across the gap before the pole")
+    return (f"relay: the armature reached the pole at {_ms(arrived)} but the contact never made: {card}{left}; "
+            f"{fix}")
+
+
+def arc_floor(arc, gap: float, current: float) -> float:
+    """V: the arc model's burning voltage at a gap (m) and current (A) (circuit.arc.ArcModel,
+    docs/circuit.md section 7): U_min + E_col d + R_arc I, or with the Ayrton characteristic
+    U_min + E_col d + (C + D d) / I."""
+    u = arc.min_voltage + arc.column_gradient * gap
+    if arc.characteristic == "ayrton":
+        return u + (arc.ayrton_c + arc.ayrton_d * gap) / current
+    return u + arc.resistance * current
+
+
+def held_arc_current(arc, gap: float, source: float, loop: float) -> float | None:
+    """A: the current a DC source (V) behind a resistance (ohm) holds in the arc at a fixed gap
+    (m), its steady operating point on the arc model's characteristic; None where there is
+    none (the source cannot hold an arc there)."""
+    a = arc.min_voltage + arc.column_gradient * gap
+    if arc.characteristic == "ayrton":  # source - loop I = a + b / I: the larger root is the stable one
+        b = arc.ayrton_c + arc.ayrton_d * gap
+        disc = (source - a) ** 2 - 4.0 * loop * b
+        if source <= a or disc < 0.0 or loop <= 0.0:
+            return None
+        return ((source - a) + math.sqrt(disc)) / (2.0 * loop)
+    return (source - a) / (loop + arc.resistance) if source > a else None
+
+
+def uncleared_break_advice(result) -> str | None:
+    """Item 13: for a coupled run's one template contact with a DC source and a resistive (or
+    resistive-inductive) load, the advice that no t_end clears its break when at the largest
+    gap of the run the source still holds at least the arc's minimum current I_min through
+    the arc (``held_arc_current``): its voltage there (``arc_floor``) is below the source's.
+    None otherwise (the arc would go out: run longer is the advice)."""
+    scene = result.scene
+    circ = getattr(scene.circuit, "circuit", None)
+    arc = getattr(circ, "arc", None)
+    w = result.waveform_columns
+    if (arc is None or result.mechanics is None or w is None or "gap" not in w
+            or len(getattr(circ, "contacts", ())) != 1):
+        return None
+    source, load, wiring = getattr(circ, "source", None), getattr(circ, "load", None), getattr(circ, "wiring", None)
+    if (source is None or hasattr(source, "compliance_voltage") or wiring is None
+            or not hasattr(load, "load_resistance") or hasattr(load, "load_capacitance")):
+        return None
+    rest = float(scene.mech.initial.height)
+    gap = max(float(np.nanmax(w["gap"])), rest)  # the blade may swing past its rest gap at a release
+    e = abs(float(source.voltage))
+    loop = float(source.source_resistance) + float(wiring.wiring_resistance) + float(load.load_resistance)
+    held = held_arc_current(arc, gap, e, loop)
+    if held is None or held < arc.min_current:
+        return None
+    law = ("min_voltage + column_gradient d + (ayrton_c + ayrton_d d) / I" if arc.characteristic == "ayrton"
+           else "min_voltage + column_gradient d + resistance I")
+    return (f"this break cannot clear in this gap, whatever t_end: at the run's largest gap, d = {_mm(gap)} "
+            f"([initial] height {_mm(rest)}), the arc's voltage ({law}, circuit.arc) is "
+            f"{arc_floor(arc, gap, held):.4g} V, below the {e:.4g} V source, which holds I = {held:.3g} A through "
+            f"it behind {loop:.4g} ohm, "
+            f"above its min_current {arc.min_current:.3g} A; a DC break needs an arc voltage above the source "
+            "at the full gap: a larger gap ([initial] height), a higher arc voltage (circuit.arc column_gradient, "
+            "as a blow-out magnet or arc splitters give, which the model does not follow), a lower source "
+            "voltage or a load that holds the current below min_current")
 
 
 def overcurrent_warning(t, currents: dict, limit: float, source: str) -> str | None:
@@ -324,6 +533,12 @@ def run_warnings(result) -> list[str]:
         line = release_warning(result)
         if line:
             out.append(line)
+        if result.relay is not None:  # (without a coil nothing of the circuit is imported)
+            out += coil_time_warnings(result)
+            for check in (pole_seat_warning, no_make_warning):
+                line = check(result)
+                if line:
+                    out.append(line)
     w = result.waveform_columns
     if w is not None and len(w["time"]) and "contact_voltage" in w:  # (an actuator's coil drive has no contact)
         t = w["time"]
@@ -350,7 +565,7 @@ def run_warnings(result) -> list[str]:
         line = toggle_warning(toggles, settings.arc_toggle_limit if settings is not None else 50)
         if line:
             out.append(line)
-        out += incomplete_break_warnings(result.operations)
+        out += incomplete_break_warnings(result.operations, uncleared_break_advice(result))
         ranges = _law_ranges(scene)
         if ranges is not None and "normal_force" in w:
             name, force_range, current_range, note = ranges
@@ -366,20 +581,25 @@ def run_warnings(result) -> list[str]:
     return out
 
 
-def incomplete_break_warnings(operations: list[dict]) -> list[str]:
+def incomplete_break_warnings(operations: list[dict], cannot_clear: str | None = None) -> list[str]:
     """One line per break whose arc still burned when the run ended: its arc duration,
-    energy and peak voltage are those of a truncated arc."""
+    energy and peak voltage are those of a truncated arc. The advice is to run longer,
+    unless ``cannot_clear`` (``uncleared_break_advice``) says no run length would do."""
     out = []
     for op in operations:
         brk = op.get("break")
         if brk is None or brk.get("complete", True):
             continue
-        more = brk.get("more_time_needed")
-        need = (f"about {more * 1e3:.3g} ms more at the rate its current falls" if more is not None else
-                "its current was not falling, so how much longer cannot be estimated")
+        if cannot_clear is not None:
+            advice = cannot_clear
+        else:
+            more = brk.get("more_time_needed")
+            need = (f"about {more * 1e3:.3g} ms more at the rate its current falls" if more is not None else
+                    "its current was not falling, so how much longer cannot be estimated")
+            advice = f"run longer ([solver] t_end): {need}"
         out.append(f"the break at t = {brk['time'] * 1e3:.4g} ms: its arc still burned when the run ended (after "
                    f"{(brk['arc_duration'] or 0.0) * 1e3:.3g} ms): arc duration, energy and peak voltage are "
-                   f"truncated; run longer ([solver] t_end): {need}")
+                   f"truncated; {advice}")
     return out
 
 

@@ -27,7 +27,8 @@ Definitions (SI: s, V, A, J), documented for users in docs/coupling.md ("Bounce 
   voltage. Samples with make <= t <= make + guard (``make_guard``, default
   max(1e-12 s, 1e-9 t_end)) produce no voltage metric.
 - the arc burns where |arc current| > ARC_BURNING_CURRENT (1 mA: an extinguished gap's
-  1 nS leakage stays below it up to 1 MV).
+  1 nS leakage stays below it up to 1 MV); arc durations and arc energies count only the
+  sample intervals whose left sample burns (``burning_steps``).
 """
 
 from __future__ import annotations
@@ -162,14 +163,35 @@ def _left_value(t: np.ndarray, y: np.ndarray, at: float, guard: float) -> float 
     return float(y[k - 1]) if k >= 1 else None
 
 
+def burning_steps(i_arc: np.ndarray) -> np.ndarray:
+    """Per sample interval (len(i_arc) - 1 of them): True where the arc burns over it, i.e.
+    its left sample's |i| > ARC_BURNING_CURRENT. The one definition arc_duration and
+    arc_energy share: an extinguished gap's 1 nS leakage counts in neither."""
+    burning = np.abs(np.asarray(i_arc, float)) > ARC_BURNING_CURRENT
+    return burning[:-1]
+
+
 def arc_duration(t: np.ndarray, i_arc: np.ndarray, start: float, end: float) -> float:
-    """s: time the arc burns (|i| > ARC_BURNING_CURRENT) within [start, end], summed over the
-    sample intervals whose left sample burns."""
+    """s: time the arc burns (``burning_steps``) within [start, end]."""
     sel = (t >= start) & (t <= end)
-    ts, burning = t[sel], np.abs(i_arc[sel]) > ARC_BURNING_CURRENT
+    ts = t[sel]
     if len(ts) < 2:
         return 0.0
-    return float(np.sum(np.diff(ts)[burning[:-1]]))
+    return float(np.sum(np.diff(ts)[burning_steps(i_arc[sel])]))
+
+
+def arc_energy(t: np.ndarray, v: np.ndarray, i_arc: np.ndarray, start: float = -math.inf,
+               end: float = math.inf) -> float:
+    """J: the arc's energy, the trapezoid of |v i_arc| over the sample intervals within
+    [start, end] where it burns (``burning_steps``, as ``arc_duration``): an open gap's
+    leakage current through the arc branch is not an arc."""
+    sel = (t >= start) & (t <= end)
+    ts = t[sel]
+    if len(ts) < 2:
+        return 0.0
+    power = np.abs(v[sel] * i_arc[sel])
+    steps = 0.5 * (power[1:] + power[:-1]) * np.diff(ts)
+    return float(np.sum(steps[burning_steps(i_arc[sel])]))
 
 
 def arc_toggles(i_arc: np.ndarray) -> int:
@@ -184,18 +206,16 @@ def opening_table(t, v, i_loop, i_arc, openings, makes, guard) -> list[dict]:
     the break: what the opening contact interrupts), peak_voltage (V, largest |v| in [start, end] outside
     make-instant samples), arc_duration (s), arc_energy (J)."""
     excluded = make_instant_mask(t, makes, guard)
-    power = np.abs(v * i_arc) if i_arc is not None else None
     rows = []
     for start, end, reclosed in openings:
         sel = (t >= start) & (t <= end)
-        ts = t[sel]
         rows.append(dict(
             start=start, end=end, open_duration=end - start, reclosed=reclosed,
             kind="bounce" if reclosed else "final",
             current_at_break=_left_value(t, i_loop, start, guard),
             peak_voltage=_peak(v, sel & ~excluded),
             arc_duration=arc_duration(t, i_arc, start, end) if i_arc is not None else 0.0,
-            arc_energy=trapezoid(ts, power[sel]) if power is not None else 0.0,
+            arc_energy=arc_energy(t, v, i_arc, start, end) if i_arc is not None else 0.0,
         ))
     return rows
 
@@ -270,7 +290,7 @@ def bounce_metrics(intervals, t_end: float, closed_at_end: bool, t=None, v=None,
                                     arc_duration=last["arc_duration"], arc_energy=last["arc_energy"],
                                     peak_voltage=last["peak_voltage"])
     if i_arc is not None:
-        out["arc_energy"] = trapezoid(t, np.abs(v * i_arc))
+        out["arc_energy"] = arc_energy(t, v, i_arc)
         out["arc_toggles"] = arc_toggles(i_arc)
     return out
 
@@ -383,7 +403,6 @@ def operations(intervals, t_end: float, t=None, v=None, i_loop=None, i_contact=N
         i_loop = np.asarray(i_loop, float) if i_loop is not None else np.zeros_like(t)
         i_contact = np.asarray(i_contact, float) if i_contact is not None else i_loop
         i_arc = np.asarray(i_arc, float) if i_arc is not None else None
-        power = np.abs(v * i_arc) if i_arc is not None else None
         dissipated = v * (i_contact + (i_arc if i_arc is not None else 0.0))
     out = []
     groups = episodes(intervals, window)
@@ -406,10 +425,8 @@ def operations(intervals, t_end: float, t=None, v=None, i_loop=None, i_contact=N
                 make["peak_current"], make["i2t"] = _current_window(t, i_loop, makes[0], end)
                 sel = (t >= makes[0]) & (t <= end)
                 make["make_energy"] = trapezoid(t[sel], dissipated[sel])
-                bounce_sel = np.zeros_like(t, bool)
-                for (_, b), (a_next, _) in zip(make_part[:-1], make_part[1:]):
-                    bounce_sel |= (t >= b) & (t <= a_next)
-                make["arc_energy"] = trapezoid(t, np.where(bounce_sel, power, 0.0)) if power is not None else 0.0
+                make["arc_energy"] = sum((arc_energy(t, v, i_arc, b, a_next) for (_, b), (a_next, _)
+                                          in zip(make_part[:-1], make_part[1:])), 0.0) if i_arc is not None else 0.0
             op["make"] = make
         if not ends_closed:
             last_held = held[-1] if held else len(group) - 1
@@ -422,8 +439,7 @@ def operations(intervals, t_end: float, t=None, v=None, i_loop=None, i_contact=N
                 brk["current_at_break"] = _left_value(t, i_loop, brk_time, guard)
                 if i_arc is not None:
                     brk["arc_duration"] = arc_duration(t, i_arc, brk_time, end)
-                    sel = (t >= brk_time) & (t <= end)
-                    brk["arc_energy"] = trapezoid(t[sel], power[sel])
+                    brk["arc_energy"] = arc_energy(t, v, i_arc, brk_time, end)
                 else:
                     brk["arc_duration"], brk["arc_energy"] = 0.0, 0.0
                 makes_after = [a for a, _ in group[last_held + 1:]]
