@@ -22,6 +22,8 @@ from coupling.laws.duty import (
 )
 from coupling.laws.materials import MATERIALS, material, plastic_radius
 
+from coupling.core.metrics import arc_energy
+
 NODES = ("a", "b")
 WELD_LEVELS = ("none", "possible", "likely")
 STOP_ON_WELD = ("likely", "possible", "never")
@@ -300,10 +302,6 @@ def time_median(t: np.ndarray, y: np.ndarray) -> float | None:
     return float(y[order][int(np.searchsorted(cumulative, 0.5 * cumulative[-1]))])
 
 
-def _trapezoid(t, y) -> float:
-    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(t))) if len(t) > 1 else 0.0
-
-
 def _spans(ops: list[dict], t_end: float, t_start: float = 0.0) -> list[tuple[float, float]]:
     """Each operation's share of the run: from its first make (the run's start for the first
     one) to the next operation's, the last to the end of the run."""
@@ -441,13 +439,12 @@ def _weld(duty, make, held, t, v, loop, i_arc, force, intervals, law, guard) -> 
     force_law = law is None or getattr(law, "load_exponent", 1.0) > 0.0
     for (_, parting), (remake, _) in zip(closures[:-1], closures[1:]):
         current = _left(t, loop, parting, guard) or 0.0
-        sel = (t >= parting) & (t <= remake)
         burning = _left(t, i_arc, remake, guard)
         separations.append(dict(
             time=parting, current=current,
             # a force law's R_c grows without bound as the force goes: the voltage passes U_m
             voltage=None if force_law else abs(current) * float(law.resistance(1.0)),
-            arc_energy=_trapezoid(t[sel], np.abs(v[sel] * i_arc[sel])),
+            arc_energy=arc_energy(t, v, i_arc, parting, remake),  # where the arc burns, as the openings'
             arc_at_remake=bool(burning is not None and abs(burning) > 1e-3)))
     verdict = weld_verdict(duty.pair, held_force=held_force, peak_current=float(make.get("peak_current") or 0.0),
                            held_voltage=held_voltage, separations=separations, margin=duty.weld_margin,
