@@ -1,0 +1,183 @@
+"""An AC load's break with the arc model: the arc ends at a current zero, or re-ignites by its rule.
+
+A relay's 250 V / 50 Hz resistive load (353.6 V peak, 0.05 ohm + 1 uH of wiring, 15.6 ohm)
+through a user netlist. While the arc burns, the loop is V_s(t) = (R_w + R_L + R_arc) i + U_min
+(the wiring's omega L / R = 2e-5 is negligible), so the arc current follows
+    i(t) = (V_p sin(omega t) - U_min) / R_t,   R_t = R_w + R_L + R_arc,
+down to I_min, where the arc goes out (the model's rule): at
+    omega t_x = pi - asin((U_min + R_t I_min) / V_p),
+0.28 ms before the load current's natural zero. Afterwards the gap stays dark unless its
+voltage reaches V_bd(d) = V_bd0 + E_bd d: with V_bd0 below the peak it re-ignites in the next
+half cycle where |V_s| = V_bd0 and burns to the next current zero; with a breakdown gradient
+the gap's strength outgrows the peak and the arc stays out.
+An arc going out with an inductor's current and nothing across the contact has no finite
+solution: such a netlist is refused before anything runs (circuit.arc.chopped_inductors).
+SI units.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from circuit import ArcModel, ContactSchedule, NetlistCircuit, SimulationOptions, run_transient
+from circuit.arc import chopped_inductors
+from circuit.errors import NetlistInputError
+
+V_P, F = 353.6, 50.0
+OMEGA = 2 * math.pi * F
+R_W, L_W, R_L = 0.05, 1e-6, 15.6
+R_CLOSED = 0.01
+T_BREAK = 2e-3  # in the positive half cycle: the first current zero is near 10 ms
+ARC = ArcModel()  # U_min 12 V, I_min 0.4 A, R_arc 0.05 ohm
+R_T = R_W + R_L + ARC.resistance
+
+AUDIT = """250 V AC, 16 A resistive load
+Vmains mains 0 SIN(0 353.6 50 0 0 0)
+Rwire mains w1 0.05
+Lwire w1 contact_a 1u
+XCONTACT contact_a contact_b
+VLOAD contact_b load 0
+Rload load 0 15.6
+"""
+WELL_POSED = AUDIT.replace("XCONTACT contact_a contact_b\n",
+                           "XCONTACT contact_a contact_b\nCcontact contact_a contact_b 100p\n")
+
+
+def t_out() -> float:
+    """The closed form's extinction instant, s."""
+    return (math.pi - math.asin((ARC.min_voltage + R_T * ARC.min_current) / V_P)) / OMEGA
+
+
+def run(arc: ArcModel, t_end: float, speed: float | None = None):
+    schedule = ContactSchedule(((0.0, T_BREAK),), closed_resistance=R_CLOSED, opening_speed=speed)
+    # 20 us steps: 1/1000 of the period, so the sine's samples and the trapezoid integrals
+    # below are within ~1e-6 of the closed forms.
+    return run_transient(NetlistCircuit(WELL_POSED, arc=arc), schedule, t_end,
+                         options=SimulationOptions(max_step=20e-6))
+
+
+def arc_spans(df, threshold=1e-3):
+    """(start, end) times of the runs of samples with the arc carrying more than 1 mA (its
+    extinguished gap's 1 GOhm leaks at most 0.35 uA here)."""
+    t, on = df.time.to_numpy(), np.abs(df.arc_current.to_numpy()) > threshold
+    edges = np.flatnonzero(np.diff(on.astype(int)))
+    starts = [t[k + 1] for k in edges if not on[k]]
+    ends = [t[k] for k in edges if on[k]]
+    if on[-1]:
+        ends.append(t[-1])
+    return list(zip(starts, ends))
+
+
+@pytest.fixture(scope="module")
+def no_reignition():
+    return run(ARC, 15e-3)
+
+
+def test_closed_contact_current_is_the_sine_over_the_loop(no_reignition):
+    df = no_reignition
+    t, i = df.time.to_numpy(), df.load_current.to_numpy()
+    closed = (t > 0.1e-3) & (t < T_BREAK - 0.1e-3)
+    expected = V_P * np.sin(OMEGA * t[closed]) / (R_W + R_L + R_CLOSED)
+    # The wiring's phase lag omega L / R = 2e-5 rad: 2e-5 of the peak current.
+    assert np.max(np.abs(i[closed] - expected)) < 1e-4 * V_P / R_L
+
+
+def test_arc_burns_from_the_break_to_the_current_zero_and_stays_out(no_reignition):
+    df = no_reignition
+    spans = arc_spans(df)
+    assert len(spans) == 1
+    start, end = spans[0]
+    assert start == pytest.approx(T_BREAK, abs=1e-6)
+    # It goes out where its current falls to I_min: the closed form's instant, to the event
+    # location's 1e-5 of I_min (a 1.3 ns error in time) and the sampling's 1 mA threshold.
+    assert end == pytest.approx(t_out(), abs=0.2e-6)
+    assert end < 1 / (2 * F)  # before the load current's natural zero, within the half cycle
+    t, i_arc = df.time.to_numpy(), df.arc_current.to_numpy()
+    last = np.flatnonzero(t <= end)[-1]
+    assert abs(i_arc[last]) == pytest.approx(ARC.min_current, rel=1e-3)
+    # The next half cycle drives -353 V across the dark gap: no current through it.
+    after = t > end + 50e-6
+    assert np.max(np.abs(i_arc[after])) < 1e-6
+    assert np.min(df.contact_voltage.to_numpy()[after]) < -0.99 * V_P
+
+
+def test_arc_current_and_energy_follow_the_closed_form(no_reignition):
+    df = no_reignition
+    t, i_arc, v = df.time.to_numpy(), df.arc_current.to_numpy(), df.contact_voltage.to_numpy()
+    burning = (t > T_BREAK + 5e-6) & (t < t_out() - 5e-6)
+    expected = (V_P * np.sin(OMEGA * t[burning]) - ARC.min_voltage) / R_T
+    assert np.max(np.abs(i_arc[burning] - expected)) < 2e-3  # omega L i / R_t: 0.3 mA
+    # The arc's energy, integral of v i over the arc, against the closed form's
+    # integral of (U_min + R_arc i) i, by the same trapezoid rule on a fine grid.
+    window = (t >= T_BREAK) & (t <= t_out() + 1e-6)
+    energy = np.trapezoid((v * i_arc)[window], t[window])
+    fine = np.linspace(T_BREAK, t_out(), 200_001)
+    i_fine = (V_P * np.sin(OMEGA * fine) - ARC.min_voltage) / R_T
+    closed = np.trapezoid((ARC.min_voltage + ARC.resistance * i_fine) * i_fine, fine)
+    assert energy == pytest.approx(closed, rel=1e-3)  # the break's 10 ns ramp, the 20 us trapezoid
+
+
+def test_a_gap_below_the_peak_reignites_and_burns_the_next_half_cycle():
+    v_bd = 200.0
+    df = run(ArcModel(breakdown_voltage=v_bd), 25e-3)
+    spans = arc_spans(df)
+    assert spans[0][1] == pytest.approx(t_out(), abs=0.2e-6)
+    # struck again where V_s = -V_bd: the first strike dumps the 100 pF through the arc (a
+    # 100 ohm, 10 ns ring that reverses its current below I_min), the gap recovers to V_bd
+    # within 20 ns and strikes again, and that arc burns to the next current zero
+    restrike = (math.pi + math.asin(v_bd / V_P)) / OMEGA
+    second = [s for s in spans if restrike - 25e-6 < s[0] < t_out() + 1 / (2 * F)]
+    assert second[0][0] == pytest.approx(restrike, abs=25e-6)  # the 20 us steps
+    assert second[-1][0] - second[0][0] < 1e-6
+    assert second[-1][1] == pytest.approx(t_out() + 1 / (2 * F), abs=0.2e-6)
+
+
+def test_a_gap_whose_strength_outgrows_the_peak_stays_out():
+    # 0.2 m/s: 1.6 mm at the first zero, V_bd = 200 V + 3e5 V/m * 1.6 mm = 680 V > 353.6 V.
+    df = run(ArcModel(breakdown_voltage=200.0, breakdown_gradient=3e5), 25e-3, speed=0.2)
+    spans = arc_spans(df)
+    assert len(spans) == 1
+    assert spans[0][1] == pytest.approx(t_out(), abs=0.2e-6)
+
+
+# -- a chopped inductor current: refused before anything runs ---------------------------
+
+
+def test_the_audit_netlist_is_refused_naming_the_inductor_and_the_fix():
+    with pytest.raises(NetlistInputError, match=r"line 5: XCONTACT contact_a contact_b .*Lwire.*capacitance") as err:
+        NetlistCircuit(AUDIT, arc=ARC)
+    assert "\n" not in str(err.value)
+
+
+def test_without_the_arc_or_with_a_path_across_the_contact_it_is_accepted():
+    NetlistCircuit(AUDIT)  # no arc: the contact's conductance falls continuously, nothing chops
+    NetlistCircuit(WELL_POSED, arc=ARC)
+    snubber = AUDIT.replace("XCONTACT contact_a contact_b\n",
+                            "XCONTACT contact_a contact_b\nRsn contact_a s 100\nCsn s contact_b 100n\n")
+    NetlistCircuit(snubber, arc=ARC)
+    to_ground = AUDIT + "Cstray contact_a 0 10p\n"  # a capacitance to ground closes the loop too
+    NetlistCircuit(to_ground, arc=ARC)
+
+
+@pytest.mark.parametrize("elements, chopped", [
+    # L in series with the contact, nothing across: chopped
+    ([["V1", "s", "0", "1"], ["L1", "s", "a", "1u"], ["R1", "b", "0", "1"]], ("L1",)),
+    # two inductors in parallel, both feeding the contact: both chopped
+    ([["V1", "s", "0", "1"], ["L1", "s", "a", "1u"], ["L2", "s", "a", "2u"], ["R1", "b", "0", "1"]],
+     ("L1", "L2")),
+    # a current source's output capacitance is a path; the relay coil (XCOIL) is inductive
+    ([["I1", "0", "s", "1"], ["XCOIL", "s", "a"], ["R1", "b", "0", "1"]], ("XCOIL",)),
+    ([["I1", "0", "s", "1"], ["C1", "s", "0", "1n"], ["L1", "s", "a", "1u"], ["R1", "b", "0", "1"],
+      ["C2", "a", "0", "1p"]], ()),
+    # a behavioural current source is no path, a behavioural voltage source is
+    ([["V1", "s", "0", "1"], ["L1", "s", "a", "1u"], ["R1", "b", "0", "1"], ["B1", "a", "b", "I=1e-3*V(a)"]],
+     ("L1",)),
+    ([["V1", "s", "0", "1"], ["L1", "s", "a", "1u"], ["R1", "b", "0", "1"], ["B1", "a", "b", "V=0"]], ()),
+    # an inductor behind a subcircuit is not seen: never refused by mistake
+    ([["V1", "s", "0", "1"], ["X1", "s", "a", "wiring"], ["R1", "b", "gnd", "1"]], ()),
+])
+def test_chopped_inductors_finds_the_inductor_cut(elements, chopped):
+    assert chopped_inductors(elements, "a", "b") == chopped
