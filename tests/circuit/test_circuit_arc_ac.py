@@ -184,3 +184,54 @@ def test_without_the_arc_or_with_a_path_across_the_contact_it_is_accepted():
 ])
 def test_chopped_inductors_finds_the_inductor_cut(elements, chopped):
     assert chopped_inductors(elements, "a", "b") == chopped
+
+
+# -- the templates' AC source: [circuit] frequency (Hz) and phase_deg, voltage the RMS value --
+
+
+@pytest.mark.parametrize("phase_deg", [0.0, 90.0, -30.0])
+def test_template_ac_source_drives_the_rms_sine_through_a_resistive_load(phase_deg):
+    from circuit import DCSource, ResistiveLoad, SwitchCircuit, Wiring
+
+    v_rms, r_load = 250.0, 15.6
+    circuit = SwitchCircuit(DCSource(v_rms, 0.05, frequency=F, phase_deg=phase_deg), ResistiveLoad(r_load),
+                            wiring=Wiring(0.0, 1e-6))
+    df = run_transient(circuit, ContactSchedule(((0.0, 1.0),), closed_resistance=R_CLOSED), 25e-3,
+                       options=SimulationOptions(max_step=20e-6))
+    t, i = df.time.to_numpy(), df.load_current.to_numpy()
+    r = 0.05 + R_CLOSED + r_load  # source, contact, load (no wiring resistance)
+    lag = 1e-6 / r
+    expected = v_rms * math.sqrt(2) / r * np.sin(OMEGA * (t - lag) + math.radians(phase_deg))
+    # from t = 0: the operating point is the source's value at t = 0 (a 90 deg phase starts at
+    # the peak); 2e-5 of the peak: the 1 uH's transient at t = 0 (L/R = 64 ns) and the lag's
+    # second-order terms
+    steady = t > 1e-6
+    assert np.max(np.abs(i[steady] - expected[steady])) < 2e-5 * v_rms * math.sqrt(2) / r
+    assert i[0] == pytest.approx(v_rms * math.sqrt(2) / r * math.sin(math.radians(phase_deg)), abs=1e-3)
+    # its RMS over the last full period: V_rms / R (the samples interpolated linearly onto a
+    # uniform grid: (omega h)^2 / 8 = 5e-6 at h = 20 us)
+    grid = np.linspace(5e-3, 25e-3, 200_001)
+    rms = math.sqrt(np.trapezoid(np.interp(grid, t, i) ** 2, grid) / 20e-3)
+    assert rms == pytest.approx(v_rms / r, rel=2e-5)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"frequency": -50.0}, r"circuit\.frequency = -50"),
+    ({"frequency": float("nan")}, r"circuit\.frequency"),
+    ({"frequency": 2e6}, r"circuit\.frequency = 2e\+06"),
+    ({"frequency": 50.0, "phase_deg": 400.0}, r"circuit\.phase_deg = 400"),
+    ({"phase_deg": 30.0}, r"circuit\.phase_deg = 30 deg applies to an AC source.*circuit\.frequency"),
+])
+def test_template_ac_source_bad_values_are_one_line_errors(kwargs, match):
+    from circuit import DCSource
+
+    with pytest.raises(ValueError, match=match) as err:
+        DCSource(230.0, **kwargs)
+    assert "\n" not in str(err.value)
+
+
+def test_template_dc_source_is_the_netlist_it_always_was():
+    from circuit import DCSource, ResistiveLoad, SwitchCircuit
+
+    deck = str(SwitchCircuit(DCSource(24.0), ResistiveLoad(10.0)).build())
+    assert "Vsource src 0 24.0\n" in deck and "SIN" not in deck
