@@ -92,6 +92,7 @@ ringing against the series RLC closed form).
 from __future__ import annotations
 
 import math
+import re
 from bisect import bisect_left, insort
 from dataclasses import dataclass
 from typing import Callable, ClassVar, Sequence
@@ -469,3 +470,61 @@ class ArcState:
         # rate t + growth t^2 / 2 = room (without cancellation)
         rate += growth * (t - middle)
         return max(2.0 * room / (rate + math.sqrt(rate * rate + 2.0 * growth * room)), floor)
+
+
+# Element letters whose branch (between the nodes listed) gives a chopped inductor current a
+# path: a finite impedance, or a voltage source. I, F, G (and a B with I=) are current sources:
+# no path; L and the relay's coil block are the inductors themselves. Devices with more
+# terminals count as joining all of them (their junctions); an unknown subcircuit too, so a
+# netlist whose inductor sits behind one is never refused by mistake.
+_PATH_NODES = {"r": 2, "c": 2, "v": 2, "d": 2, "e": 2, "h": 2, "s": 2, "w": 2,
+               "q": 3, "j": 3, "m": 4, "t": 4, "o": 4, "u": 3, "z": 3}
+_GROUND = ("0", "gnd")
+
+
+def chopped_inductors(elements: Sequence[Sequence[str]], node_a: str, node_b: str) -> tuple[str, ...]:
+    """The inductors whose current an arc going out across (node_a, node_b) would chop.
+
+    elements: the tokens of the netlist's top-level element lines (name first), the contact's
+    own line left out, the relay's coil block (``XCOIL``) included. An arc goes out at I_min
+    with its current still flowing; when every other path from node_a's side of the circuit to
+    node_b's runs through an inductor (or a current source) -- no capacitance, resistance or
+    voltage source across the contact -- that inductor's current must jump to zero: L di/dt
+    has no finite value, and ngspice, with only the open gap's 1 GOhm, rings at L * 1e-9 s
+    (1e-15 s for 1 uH) and stops ('timestep too small'). Empty when the circuit is well posed.
+    """
+    parent: dict[str, str] = {}
+
+    def find(node: str) -> str:
+        node = "0" if node.lower() in _GROUND else node.lower()
+        parent.setdefault(node, node)
+        while parent[node] != node:
+            parent[node] = parent[parent[node]]
+            node = parent[node]
+        return node
+
+    def join(nodes: Sequence[str]) -> None:
+        roots = [find(n) for n in nodes]
+        for root in roots[1:]:
+            parent[root] = roots[0]
+            find(roots[0])
+
+    inductors: list[tuple[str, str, str]] = []
+    for tokens in elements:
+        if len(tokens) < 3:
+            continue
+        head = tokens[0].lower()
+        letter = head[0]
+        if letter == "l" or head == "xcoil":
+            inductors.append((tokens[0], tokens[1], tokens[2]))
+        elif letter == "b":
+            if not re.search(r"(^|\s)i\s*=", " ".join(tokens[3:]).lower()):
+                join(tokens[1:3])
+        elif letter == "x":
+            join([t for t in tokens[1:-1] if "=" not in t] or tokens[1:2])
+        elif letter in _PATH_NODES:
+            join(tokens[1:1 + _PATH_NODES[letter]])
+    side_a, side_b = find(node_a), find(node_b)
+    if side_a == side_b:
+        return ()
+    return tuple(name for name, n1, n2 in inductors if (find(n1) == side_a) != (find(n2) == side_a))

@@ -53,7 +53,7 @@ from typing import ClassVar
 
 from PySpice.Spice.Netlist import Circuit
 
-from .arc import ArcModel
+from .arc import ArcModel, chopped_inductors
 from .blocks import CoilBlock, ContactBlock
 from .contact import DEFAULT_LEAKAGE, check_current_factor
 from .errors import NetlistInputError
@@ -126,7 +126,9 @@ class NetlistCircuit:
         if (self.coil_resistance is None) != (self.coil_current is None):
             raise ValueError("NetlistCircuit.coil_resistance and NetlistCircuit.coil_current: give both (a coil) "
                              "or neither")
-        self._parse()  # fail early, before anything runs
+        lines, placed, _, _ = self._parse()  # fail early, before anything runs
+        if self.arc is not None:
+            _check_arc_chop(lines, placed)
 
     @classmethod
     def from_file(cls, path: str | Path, **kwargs) -> "NetlistCircuit":
@@ -283,6 +285,29 @@ class NetlistCircuit:
             texts[row] = "\n".join(line for line in str(scratch).splitlines()[1:] if line.strip())
         expanded = [DECK_TITLE] + texts[1:]
         return "\n".join(part for text in expanded for part in text.split("\n") if part.strip().lower() != ".end")
+
+
+def _check_arc_chop(lines: list[NetlistLine], placed: list[tuple[int, ContactBlock]]) -> None:
+    """Refuse a contact whose arc, going out, would chop an inductor's current (arc.chopped_inductors)."""
+    elements, depth = [], 0
+    for line in lines[1:]:
+        tokens = line.text.split()
+        head = tokens[0].lower() if tokens else "*"
+        depth += head.startswith(".subckt") - head.startswith(".ends")
+        if not depth and head[0].isalpha():
+            elements.append(tokens)
+    for row, block in placed:
+        head = lines[row].text.split()[0]
+        others = [t for t in elements if t[0].lower() != head.lower()]
+        chopped = chopped_inductors(others, block.node_a, block.node_b)
+        if chopped:
+            where = f"netlist {lines[row].file} line {lines[row].line}"
+            raise NetlistInputError(
+                f"{where}: {head} {block.node_a} {block.node_b} with the arc model: when its arc goes out it "
+                f"chops the current of {', '.join(chopped)}, which has no other path across the contact (an "
+                "inductor's current cannot jump: ngspice stops with 'timestep too small'); add the contact's "
+                f"stray capacitance across it, e.g. 'C{head[1:]} {block.node_a} {block.node_b} 100p' (the "
+                "templates' default), or a snubber")
 
 
 def _param_values(params) -> tuple[tuple[str, float], ...]:

@@ -13,7 +13,8 @@ Loads: ``ResistiveLoad`` (R), ``InductiveLoad`` (R + L in series: relay coil, mo
 supply-input inrush). ``Vload`` is a 0 V probe: its current is the load current, which
 keeps flowing through it when the flyback diode freewheels.
 
-Sources: ``DCSource`` (a voltage source E behind its internal resistance) or
+Sources: ``DCSource`` (a voltage source E behind its internal resistance; AC, E the RMS
+value, with ``frequency`` > 0) or
 ``CurrentSource`` (a supply in constant-current mode: I_set with its output resistance
 and capacitance and a compliance clamp; see its docstring for the netlist)::
 
@@ -49,16 +50,43 @@ LOAD_PROBE = "Vload"
 
 @dataclass(frozen=True)
 class DCSource:
-    """DC supply: open-circuit voltage (V, positive) and its internal resistance
-    ``source_resistance`` (ohm)."""
+    """A voltage source behind its internal resistance ``source_resistance`` (ohm): DC, or AC
+    with ``frequency`` > 0.
+
+    voltage: V (positive): the DC open-circuit voltage, or with ``frequency`` > 0 the RMS
+        value of the sine (a relay's load is rated in V AC): amplitude sqrt(2) * voltage.
+    frequency: Hz; 0 (default): DC. > 0: v(t) = sqrt(2) voltage sin(2 pi frequency t + phase).
+    phase_deg: the sine's phase at t = 0, degrees (only with ``frequency`` > 0; 0: the source
+        starts at its rising zero, 90: at its positive peak).
+    """
 
     SECTION: ClassVar[str] = "circuit"  # the scene section of its keys: [circuit] voltage, ...
-    voltage: float = scene_key(24.0, unit="V", doc="source; mcu_input: the logic supply Vcc")
+    voltage: float = scene_key(
+        24.0, unit="V", doc="source: DC, or RMS with `frequency` > 0; mcu_input: the logic supply Vcc")
     source_resistance: float = scene_key(0.01, unit="ohm")
+    frequency: float = scene_key(0.0, unit="Hz", doc="source: 0 DC; > 0 a sine of RMS `voltage`")
+    phase_deg: float = scene_key(0.0, unit="deg", doc="source: the sine's phase at t = 0 (`frequency` > 0)")
 
     def __post_init__(self) -> None:
         check_range(self.SECTION, "voltage", self.voltage, "V", 0.0, 1e5, low_open=True)
         check_range(self.SECTION, "source_resistance", self.source_resistance, "ohm", 0.0, 1e6)
+        # mains and aircraft supplies (50-400 Hz) up to ultrasound; a slip of units (rad/s, kHz) shows
+        check_range(self.SECTION, "frequency", self.frequency, "Hz", 0.0, 1e6)
+        check_range(self.SECTION, "phase_deg", self.phase_deg, "deg", -360.0, 360.0)
+        if self.frequency == 0.0 and self.phase_deg != 0.0:
+            raise ValueError(f"{self.SECTION}.phase_deg = {self.phase_deg:g} deg applies to an AC source: set "
+                             f"{self.SECTION}.frequency (Hz, > 0), or leave phase_deg out for DC")
+
+    @property
+    def amplitude(self) -> float:
+        """V: the largest voltage the source puts out (sqrt(2) voltage for AC, voltage for DC)."""
+        return math.sqrt(2.0) * self.voltage if self.frequency > 0.0 else self.voltage
+
+    def spice_value(self) -> float | str:
+        """The source's SPICE value: the DC volts, or ``SIN(0 amplitude frequency 0 0 phase)``."""
+        if self.frequency == 0.0:
+            return float(self.voltage)
+        return f"SIN(0 {self.amplitude!r} {float(self.frequency)!r} 0 0 {float(self.phase_deg)!r})"
 
 
 @dataclass(frozen=True)
@@ -385,7 +413,7 @@ class SwitchCircuit:
             c.V("clamp", "clamp", gnd, float(source.clamp_source_voltage))
             r_source = 0.0
         else:
-            c.V("source", "src", gnd, float(source.voltage))
+            c.V("source", "src", gnd, source.spice_value())
             r_source = source.source_resistance
         series = [
             (kind, name, value)
@@ -852,11 +880,12 @@ class ShortCircuit(SwitchCircuit):
 
     def fault_current(self, contact_resistance: float = 0.0) -> float:
         """A: the steady current through the closed contact (``contact_resistance``, ohm) with
-        the short in place (inductances carry no voltage then; an inductive load's L is a short)."""
+        the short in place (inductances carry no voltage then; an inductive load's L is a short);
+        with an AC source the amplitude its peak voltage drives, the inductances neglected."""
         load = self.load.load_resistance
         parallel = load * self.fault_resistance / (load + self.fault_resistance)
         loop = self.source.source_resistance + self.wiring.wiring_resistance + contact_resistance + parallel
-        return self.source.voltage / loop
+        return self.source.amplitude / loop
 
     def fault_vertices(self) -> list[tuple[float, float]]:
         """(time s, conductance S) of the short's PWL."""

@@ -68,6 +68,9 @@ def series_loop(circuit) -> SeriesLoop:
     if not isinstance(circuit.source, ck.DCSource):
         raise ValueError("monolithic reference: the source is a CurrentSource; the reference covers a "
                          "voltage source only")
+    if circuit.source.frequency > 0.0:
+        raise ValueError(f"monolithic reference: the source is AC (circuit.frequency = {circuit.source.frequency:g} "
+                         "Hz); the reference covers a DC source only")
     if circuit.contact_capacitance <= 0.0:
         raise ValueError("monolithic reference: contact_capacitance must be > 0 (it carries the loop "
                          "current while the contact is open)")

@@ -255,7 +255,7 @@ def _circuit_current_bound(scene) -> float | None:
     spec = getattr(scene, "circuit", None)
     circ = getattr(spec, "circuit", None)
     try:
-        voltage = circ.source.voltage
+        voltage = circ.source.amplitude  # an AC source's peak
         load = circ.load.load_resistance
         series = circ.source.source_resistance + circ.wiring.wiring_resistance + load
     except AttributeError:  # a netlist circuit: its topology is the user's

@@ -400,7 +400,7 @@ NEEDS_COMPANIONS = {"bar.width", "bar.thickness", "mount.base_motion", "force.ti
                     "tribology.fit", "tribology.data", "tribology.mu", "tribology.resistance",
                     "circuit.schedule", "circuit.snubber", "circuit.flyback", "circuit.arc", "metrics.logic",
                     "duty.life", "contact.damping", "block.shape", "armature.kind", "tribology.source",
-                    "circuit.arc.ayrton_c", "contact.calibration",
+                    "circuit.arc.ayrton_c", "contact.calibration", "circuit.phase_deg",
                     # another contact point, a sphere's radius with it, height instead of gap
                     "fixed.point", "fixed.shape", "fixed.height",
                     # a table magnet's keys in a flux-tube scene, and the choice between them
