@@ -357,6 +357,7 @@ def uncleared_break_advice(result) -> str | None:
         return None
     source, load, wiring = getattr(circ, "source", None), getattr(circ, "load", None), getattr(circ, "wiring", None)
     if (source is None or hasattr(source, "compliance_voltage") or wiring is None
+            or getattr(source, "frequency", 0.0) > 0.0  # (an AC arc goes out at a current zero)
             or not hasattr(load, "load_resistance") or hasattr(load, "load_capacitance")):
         return None
     rest = float(scene.mech.initial.height)
@@ -634,5 +635,5 @@ def _current_limit(scene):
     r = float(source.source_resistance) + float(wiring.wiring_resistance)
     if r <= 0.0:
         return None
-    e = abs(float(source.voltage))
+    e = abs(float(getattr(source, "amplitude", source.voltage)))  # (an AC source's peak)
     return e / r, f"the {e:.4g} V source can drive through its own {r:.4g} ohm (source + wiring)"
