@@ -56,6 +56,22 @@ def test_steady_arc_sits_on_ayrtons_characteristic(r_load):
     assert u > a + 0.5  # the falling term is there: more than A + B d at these currents
 
 
+@pytest.mark.parametrize("chgtol", [1e-14, 1e-10])
+def test_the_arc_that_forms_does_not_depend_on_where_ngspices_steps_fall(chgtol):
+    """The 10 ohm case above with ngspice's charge tolerance loosened: other steps through the
+    parting, the same steady arc (the stable root to 1e-4). The Ayrton arc's held current
+    I_f was set at the first point its branch carried I_min, mid-way through taking over the
+    parting contact's 5 A: at CHGTOL 1e-10 that point carried 0.404 A, (C + D d)/I_f put the
+    arc at 123 V on the 100 V supply and it went out."""
+    gap = 2e-3
+    arc = ArcModel(min_current=0.4, characteristic="ayrton", **CARBON)
+    df = run_transient(resistive(100.0, 10.0, arc), ContactSchedule(((0.0, T_BREAK),), closed_resistance=0.01),
+                       1e-3, options=SimulationOptions(max_step=10e-6, chgtol=chgtol), gap=gap)
+    a, c = CARBON["min_voltage"] + CARBON["column_gradient"] * gap, CARBON["ayrton_c"] + CARBON["ayrton_d"] * gap
+    assert abs(df.arc_current.iloc[-1]) == pytest.approx(stable_current(100.0, R_S + 10.0 + AYRTON_RESISTANCE, a, c),
+                                                         rel=1e-4)
+
+
 def test_short_arc_voltage_does_not_grow_with_current():
     """A short Ag arc (C = D = 0) on 60 V through 0.06 ohm: the linear model carries 434 A at
     U_min + R_arc I = 33.7 V (the issue's figure); the Ayrton one carries 790 A at
