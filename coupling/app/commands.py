@@ -164,6 +164,21 @@ def _write_partial(folder, partial, extra: dict, message: str, code: int) -> int
     return code
 
 
+def _armature_part(relay: dict, armature: dict) -> str:
+    """The relay line's armature: its first arrival at the pole, how often it rebounded and
+    when it last arrived (the default relay's armature rebounds on the pole for 3 ms), and
+    when it left (the release, or, with a warning of its own, while the coil was on)."""
+    if relay.get("armature_arrival") is None:
+        return "armature never at the pole"
+    text = f"armature at the pole {_ms(relay['armature_arrival'])}"
+    bounces, last, left = armature.get("pole_bounces"), armature.get("last_arrival"), armature.get("left_pole")
+    if bounces and last is not None:
+        text += f" ({bounces} rebound(s), last arrival {_ms(last)})"
+    if left is not None:
+        text += f", left it {_ms(left)}"
+    return text
+
+
 def _result_lines(summary: dict) -> None:
     """The results (kept with --quiet): stdout, one line each."""
     if "bounce" in summary:
@@ -183,8 +198,7 @@ def _result_lines(summary: dict) -> None:
     if relay:
         parts = [f"operate time {_ms(relay['operate_time'])}" if relay.get("operate_time") is not None else None,
                  f"release time {_ms(relay['release_time'])}" if relay.get("release_time") is not None else None,
-                 f"armature at the pole {_ms(relay['armature_arrival'])}" if relay.get("armature_arrival") is not None
-                 else "armature never at the pole",
+                 _armature_part(relay, summary.get("armature") or {}),
                  f"pull-in at {relay['pull_in_current'] * 1e3:.4g} mA" if relay.get("pull_in_current") is not None
                  else None]
         energy = relay.get("energy") or {}

@@ -169,8 +169,14 @@ def test_an_actuator_alone_writes_its_folder_and_plots(tmp_path, capsys):
     assert main(["run", str(scene), "--out", str(out), "--plots", "--quiet"]) == 0
     (line,) = [x for x in capsys.readouterr().out.splitlines() if x.startswith("switchsim: relay:")]
     assert line.startswith("switchsim: relay: armature at the pole")
+    # the plunger rebounds on its pole for the whole run (its stops' restitution is 0.99): the
+    # line says how often and when it last arrived, as summary.json's armature block has them
+    summary = json.loads((out / "summary.json").read_text())
+    arm = summary["armature"]
+    assert arm["pole_bounces"] > 10 and arm["last_arrival"] > arm["first_arrival"]
+    assert f"({arm['pole_bounces']} rebound(s), last arrival {arm['last_arrival'] * 1e3:.4f} ms)" in line
     # the coil's two audits, as summary.json's relay.energy gives them
-    energy = json.loads((out / "summary.json").read_text())["relay"]["energy"]
+    energy = summary["relay"]["energy"]
     assert f"coil energy residual {energy['relative_residual']:.2g}" in line
     assert f"coil-armature interface {energy['interface_relative_residual']:.2g}" in line
     assert (out / "waveforms.png").stat().st_size > 10_000
