@@ -1,4 +1,4 @@
-"""Shared by the command line's tests: a small scene (DROP), and the command line run
+"""Shared by the command line's tests: small scenes (DROP, FAR), and the command line run
 in-process for input tests with the simulation replaced by an assertion."""
 
 from __future__ import annotations
@@ -24,6 +24,20 @@ DROP = textwrap.dedent("""
     t_end = 0.001
     [output]
     plots = false
+    """)
+
+
+# A rigid bar falling 0.5 m/s from 1 mm above the block for 0.1 ms: it travels 50 um and
+# never touches (the cheapest scene that runs; input tests add their sections to it).
+FAR = textwrap.dedent("""
+    [bar]
+    modes = 0
+    [initial]
+    height = 1e-3
+    angle_deg = 90.0
+    velocity = [0, 0, -0.5]
+    [solver]
+    t_end = 1e-4
     """)
 
 

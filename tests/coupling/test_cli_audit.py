@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from cli_checks import assert_one_line_error, run_cli
+from cli_checks import FAR, assert_one_line_error, run_cli
 from fit_compare import assert_same_fit
 
 from coupling.app.cli import main
@@ -22,17 +22,7 @@ from coupling.core.scene import load_scene
 from coupling.laws.tribology import default_fit, illustrative_data_path
 
 REPO = Path(__file__).resolve().parents[2]
-MECH = """\
-[bar]
-modes = 0
-[initial]
-height = 1e-3
-angle_deg = 90.0
-velocity = [0, 0, -0.5]
-[solver]
-t_end = 1e-4
-"""
-COUPLED = MECH + '[tribology]\nsource = "illustrative"\n'
+COUPLED = FAR + '[tribology]\nsource = "illustrative"\n'
 NETLIST = "relay\nV1 s 0 24\nXCONTACT s b\nVLOAD b c 0\nR1 c 0 12\n{extra}\n"
 SHIPPED = illustrative_data_path().read_text()
 HEADER_AT = SHIPPED.splitlines().index("load_N,current_A,friction_N,resistance_ohm,run")
@@ -118,7 +108,7 @@ def test_a_byte_order_mark_is_read_as_written(tmp_path, capsys):
     saved = json.loads((tmp_path / "fit" / "fit.json").read_text())
     assert_same_fit(saved["laws"], default_fit().to_dict()["laws"])
     scene = tmp_path / "bom.toml"
-    scene.write_bytes(b"\xef\xbb\xbf" + MECH.replace("t_end = 1e-4", "t_end = 1e-5").encode())
+    scene.write_bytes(b"\xef\xbb\xbf" + FAR.replace("t_end = 1e-4", "t_end = 1e-5").encode())
     assert main(["run", str(scene), "--out", str(tmp_path / "run"), "--quiet"]) == 0
     assert json.loads((tmp_path / "run" / "summary.json").read_text())["status"] == "ok"
     capsys.readouterr()

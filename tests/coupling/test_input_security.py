@@ -5,24 +5,15 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from cli_checks import FAR
 
 from coupling.app.cli import main
 
-MECH = """
-[bar]
-modes = 0
-[initial]
-height = 1e-3
-angle_deg = 90.0
-velocity = [0, 0, -0.5]
-[solver]
-t_end = 1e-4
-"""
 
 
 def scene(folder: Path, text: str) -> Path:
     path = folder / "scene.toml"
-    path.write_text(MECH + text)
+    path.write_text(FAR + text)
     return path
 
 

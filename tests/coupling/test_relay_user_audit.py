@@ -9,7 +9,7 @@ import types
 import numpy as np
 import pandas as pd
 import pytest
-from cli_checks import assert_one_line_error, run_cli
+from cli_checks import FAR, assert_one_line_error, run_cli
 
 from coupling import default_scene
 from coupling.app.cli import main
@@ -18,17 +18,9 @@ from coupling.core.master import run
 from coupling.core.metrics import bounce_metrics
 from coupling.core.scene import builtin_scene_text, load_scene, scene_from_dict
 
-# A rigid bar falling 0.5 m/s from 1 mm above the block for 0.1 ms: it travels 50 um, so
-# the contact never closes and the open contact holds the whole supply (coupled, cheap).
-NEVER_CLOSES = textwrap.dedent("""
-    [bar]
-    modes = 0
-    [initial]
-    height = 1e-3
-    angle_deg = 90.0
-    velocity = [0, 0, -0.5]
-    [solver]
-    t_end = 1e-4
+# The bar that never touches (cli_checks.FAR), coupled: the open contact holds the whole
+# supply for the run.
+NEVER_CLOSES = FAR + textwrap.dedent("""
     [tribology]
     source = "illustrative"
     [circuit]
