@@ -100,6 +100,7 @@ from typing import Callable, ClassVar, Sequence
 from PySpice.Spice.Netlist import Circuit
 
 from .contact import check_block_name, named
+from .names import GROUND
 from .validation import check_range, scene_key
 
 SENSE_SOURCE = "Varc"
@@ -313,16 +314,15 @@ class ArcState:
         # the EXTERNAL source whose last value is G at an accepted point (saves a vector read)
         self.conductance_source = conductance_source
         self._tau = arc.formation_time / math.log(2.0)
-        ground = ("0", "gnd")
         self._conductance = (conductance.lower(),)
         self._names_on = (current.lower(),)
-        nodes = tuple(n.lower() for n in (node_a, node_b) if n.lower() not in ground)
+        nodes = tuple(n.lower() for n in (node_a, node_b) if n.lower() not in GROUND)
         self._names_off = self._names_on + nodes
         self._gap_gradient = float(arc.breakdown_gradient) if arc.breakdown_voltage is not None else 0.0
         if self._gap_gradient > 0.0:
             self._names_off += (gap.lower(),)
-        self._sign_b = node_b.lower() not in ground  # v = V(a) - V(b); a grounded node reads 0
-        self._sign_a = node_a.lower() not in ground
+        self._sign_b = node_b.lower() not in GROUND  # v = V(a) - V(b); a grounded node reads 0
+        self._sign_a = node_a.lower() not in GROUND
         self._ayrton = arc.characteristic == "ayrton"
         self.start(False)
 
@@ -486,7 +486,6 @@ class ArcState:
 # netlist whose inductor sits behind one is never refused by mistake.
 _PATH_NODES = {"r": 2, "c": 2, "v": 2, "d": 2, "e": 2, "h": 2, "s": 2, "w": 2,
                "q": 3, "j": 3, "m": 4, "t": 4, "o": 4, "u": 3, "z": 3}
-_GROUND = ("0", "gnd")
 
 
 def chopped_inductors(elements: Sequence[Sequence[str]], node_a: str, node_b: str) -> tuple[str, ...]:
@@ -503,7 +502,7 @@ def chopped_inductors(elements: Sequence[Sequence[str]], node_a: str, node_b: st
     parent: dict[str, str] = {}
 
     def find(node: str) -> str:
-        node = "0" if node.lower() in _GROUND else node.lower()
+        node = "0" if node.lower() in GROUND else node.lower()
         parent.setdefault(node, node)
         while parent[node] != node:
             parent[node] = parent[parent[node]]

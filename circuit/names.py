@@ -9,6 +9,9 @@ from __future__ import annotations
 
 import re
 
+#: SPICE's names of the ground node (compared in lower case)
+GROUND = ("0", "gnd")
+
 #: A block's name: a letter, then letters and digits ("" is a circuit's one unnamed block of a kind).
 BLOCK_NAME = re.compile(r"[A-Za-z][A-Za-z0-9]{0,15}")
 

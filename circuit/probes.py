@@ -9,6 +9,7 @@ from typing import Callable
 import numpy as np
 
 from .blocks import CoilBlock, ContactBlock
+from .names import GROUND
 
 #: Result columns of a circuit with one unnamed contact, in order (SI: s, V, A, A, ohm, S, A).
 COLUMNS = (
@@ -25,7 +26,6 @@ CONTACT_COLUMNS = ("contact_voltage", "contact_current", "contact_resistance", "
 #: Per coil, its columns (SI: A, V, Wb; each with the coil's suffix).
 COIL_COLUMNS = ("coil_current", "coil_voltage", "coil_flux_linkage")
 
-_GROUND = ("0", "gnd")
 CLOSED_CONDUCTANCE = 1e-6  # S: above it the contact voltage is I/G (see Probes._contact_voltage)
 # the per-block result columns that are one ngspice vector as it stands: base name -> the
 # block's attribute naming it (Probes.vector_of; an arc's is None without an arc model)
@@ -173,7 +173,7 @@ class Probes:
 
     @staticmethod
     def _node(vec: Callable[[str], np.ndarray], node: str, time: np.ndarray) -> np.ndarray:
-        if node.lower() in _GROUND:
+        if node.lower() in GROUND:
             return np.zeros_like(time)
         return vec(node)
 
@@ -285,7 +285,7 @@ def probe_columns(probes, read: Callable[[str], np.ndarray], lines) -> dict[str,
     time = read("time")
 
     def node(n: str) -> np.ndarray:
-        return np.zeros_like(time) if n in _GROUND else read(n)
+        return np.zeros_like(time) if n in GROUND else read(n)
 
     out: dict[str, np.ndarray] = {}
     for p in probes:

@@ -37,6 +37,7 @@ import numpy as np
 from .contact import Conductance, checked_breakpoints, left_limited, snapped
 from .deck import CircuitLike, arc_states, build_deck, input_sources
 from .errors import ConductanceError, GapError, SessionBusyError
+from .names import GROUND
 from .ngspice import NgspiceSession, get_session
 from .options import SimulationOptions
 from .probes import COLUMNS, probe_columns
@@ -132,7 +133,7 @@ class Stepper:
         names += [c.load_vector for c in self.probes.contacts]
         for c in self.probes.coils:
             names += [c.current_vector, c.node_p, c.node_n, c.flux_node]
-        self._last_names = tuple(dict.fromkeys(n.lower() for n in names if n and n.lower() not in ("0", "gnd")))
+        self._last_names = tuple(dict.fromkeys(n.lower() for n in names if n and n.lower() not in GROUND))
         self._scalar_plan = self._plan_scalars()
         self._columns = self.probes.column_names  # (a property that builds its tuple: once, not per step)
         # the columns that are one ngspice vector as it stands, by its (lower-case) name
@@ -295,7 +296,7 @@ class Stepper:
         index = {name: k for k, name in enumerate(self._last_names)}
 
         def node(name: str) -> int:
-            return -1 if name.lower() in ("0", "gnd") else index[name.lower()]
+            return -1 if name.lower() in GROUND else index[name.lower()]
 
         def vector(key: str, name: str | None, otherwise: float) -> tuple[str, int, int, float]:
             return (key, index[name.lower()], -1, 0.0) if name else (key, _FIXED, -1, otherwise)
