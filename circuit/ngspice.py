@@ -7,6 +7,7 @@ module talks to the shared library.
 
 from __future__ import annotations
 
+import bisect
 import contextlib
 import locale
 import math
@@ -23,6 +24,7 @@ from pathlib import Path
 from typing import Callable, Mapping
 
 import numpy as np
+from greenlet import getcurrent, greenlet
 
 from ._ngspice_ffi import ffi
 from .contact import LANDING_TOLERANCE
@@ -169,7 +171,10 @@ class NgspiceSession:
     - the EXTERNAL voltage source gets its value from a Python function of time set
       with ``set_channels`` (by source name); the GetSyncData callback (installed once: ngspice cannot
       uninstall it) shortens steps to land exactly on the next macro time, and aborts
-      the run on a callback failure or a wall-clock timeout.
+      the run on a callback failure or a wall-clock timeout;
+    - a transient is one ``run`` in its own greenlet: ``transient`` switches into it, and the
+      SendData callback (after each accepted point is stored) switches back at the pause's
+      target, with ngspice suspended inside its time loop (no command per pause).
 
     The library is reached through cffi's out-of-line ABI module (no C parser at a
     start), not through PySpice's NgSpiceShared, which parses its header at each start;
@@ -194,9 +199,14 @@ class NgspiceSession:
         self._max_step = math.inf  # s: the step bound of the current pause (transient's max_step)
         self._deadline = math.inf
         self._failure: BaseException | None = None
-        # a stop condition met at the analysis' last point leaves ngspice's pause request set
-        # (the analysis ended first): the next run of any circuit would pause at its start
-        self._stale_pause = False
+        # The loaded circuit's transient runs in its own greenlet ("run", one ngspice
+        # command for the whole analysis); at a pause it switches back to the caller of
+        # transient() from ngspice's per-point data callback and is resumed from there.
+        self._run: greenlet | None = None
+        self._caller: greenlet | None = None
+        self._pause_at = math.inf  # s: the accepted point at or after this time pauses the run
+        self._accepting = -math.inf  # s: time of the point ngspice is accepting (sync callback, loc 1)
+        self._landings: list[float] = []  # s: the breakpoints set for the current pause, ascending
         self._arcs: dict[str, object] = {}  # the ArcState of each arc, by its EXTERNAL current source
         self._arc_by_pointer: dict[object, object] = {}
         self._arc_from = math.nan  # accepted time the arc's step bounds below apply from
@@ -232,11 +242,13 @@ class NgspiceSession:
         self._sync_c = ffi.callback(
             "int(double, double *, double, int, int, int, void *)", self._on_sync, onerror=self._on_callback_error
         )
+        self._data_c = ffi.callback("int(void *, int, int, void *)", self._on_data, onerror=self._on_callback_error)
+        self._init_data_c = ffi.callback("int(void *, int, void *)", self._on_init_data)
         self._ident_c = ffi.new("int *", 0)
         with isolated_start():
             rc = self._ngspice_shared.ngSpice_Init(
-                self._send_char_c, self._send_stat_c, self._exit_c, ffi.NULL, ffi.NULL, self._background_c,
-                self._self_c)
+                self._send_char_c, self._send_stat_c, self._exit_c, ffi.cast("void *", self._data_c),
+                ffi.cast("void *", self._init_data_c), self._background_c, self._self_c)
         if rc:
             raise NgspiceError(f"ngSpice_Init returned {rc}", _message(self._lines))
         rc = self._ngspice_shared.ngSpice_Init_Sync(
@@ -272,6 +284,17 @@ class NgspiceSession:
         return int(exit_status)
 
     # -- our callbacks --
+
+    @staticmethod
+    def _on_init_data(info, ngspice_id, user_data):
+        return 0
+
+    def _on_data(self, values, count, ngspice_id, user_data):
+        # Each accepted point, after ngspice stored it: the pause (back to transient()'s caller).
+        if self._accepting >= self._pause_at and self._failure is None:
+            self._pause_at = math.inf
+            self._caller.switch()
+        return 0
 
     def _on_vsrc(self, out, t, name, ident, user):
         # Called at every Newton iteration and on rejected trial points: the value must
@@ -330,6 +353,8 @@ class NgspiceSession:
     def _on_sync(self, ckttime, pdelta, olddelta, redostep, ident, loc, user):
         if redostep:
             self.rejections.append((ckttime, pdelta[0] == 0.125 * olddelta))
+        elif loc:
+            self._accepting = ckttime
         if self._failure is None and time.monotonic() > self._deadline:
             self._failure = SimulationTimeout("wall-clock limit reached (SimulationOptions.wall_timeout)")
         if self._failure is not None:
@@ -357,6 +382,13 @@ class NgspiceSession:
                     pdelta[0] = self._arc_step
                 if self._arc_land < target:
                     target = self._arc_land
+        landings = self._landings
+        while landings and landings[0] <= ckttime + stop_margin(landings[0]):
+            landings.pop(0)
+        if landings and landings[0] < target:
+            # ngspice cuts its step at our next breakpoint (a make/break): that is where
+            # this step lands, and the rule below aims at it instead of the target beyond
+            target = landings[0]
         remaining = target - ckttime
         # Within transient()'s stop margin of the target the pause is reached: a step aimed
         # at the target from there would be a sliver (an arc's landing an ulp before a
@@ -388,8 +420,14 @@ class NgspiceSession:
             )
 
     def command(self, text: str) -> list[str]:
-        """Run one ngspice command; returns the lines it printed ("stdout ..."/"stderr ...")."""
+        """Run one ngspice command; returns the lines it printed ("stdout ..."/"stderr ...").
+        SessionBusyError while a transient is paused (an open Stepper's run): ngspice is
+        inside it, and a command would run inside its time loop."""
         self._check_alive()
+        run = self._run
+        if run is not None and not run.dead and getcurrent() is not run:
+            raise SessionBusyError(f"ngspice is paused inside a transient (an open Stepper's run): close it "
+                                   f"before the command {text!r}")
         if self._commands_sent >= _COMMANDS_BEFORE_HISTORY_RELEASE:
             self._ngspice_shared.ngSpice_Command(ffi.NULL)
             self._commands_sent = 0
@@ -404,6 +442,7 @@ class NgspiceSession:
 
     def clear(self) -> None:
         """Forget every plot, circuit and stop condition of earlier runs."""
+        self._abandon_run()
         for cmd in ("delete all", "destroy all", "remcirc"):
             self.command(cmd)
         self._reset_callback_state()
@@ -480,6 +519,7 @@ class NgspiceSession:
         self._lines = []
         if not ok:
             raise NgspiceError(f"ngspice refused a breakpoint at t = {t!r} s", _message(printed))
+        bisect.insort(self._landings, float(t))
 
     def transient(self, target: float | None, first: bool, wall_timeout: float | None, t_end: float,
                   end_tolerance: float = 0.0, max_step: float = math.inf) -> None:
@@ -498,54 +538,57 @@ class NgspiceSession:
         self._target = math.inf if target is None else float(target)
         self._max_step = float(max_step)
         ended = t_end - max(1e-9 * t_end, end_tolerance)  # ngspice ends a run within this of t_end
+        # ngspice parses no number: the margin only keeps a point a rounding short of the
+        # target from counting as early
+        threshold = ended if target is None else target - stop_margin(target)
         try:
-            if target is None:
-                if not first and self.last_time() >= ended:
-                    # ngspice ended the run at its last pause, within CKTminBreak of t_end (a
-                    # macro step landed there): a "resume" would start the analysis over from
-                    # t = 0 (measured: a 5.75 ns final step made ngspice restart and its
-                    # pause at t = 0 read as Ctrl-C)
-                    return
-                printed = self._unstale(self.command("run" if first else "resume"))
-                self._raise_if_failed(printed)
-                # ngspice ends a run once within CKTminBreak (5e-5 TMAX) of t_end: after
-                # rejected steps near the end its last point can be that early (measured
-                # 0.88 ns before t_end with TMAX = 30 us).
-                self._check_reached(printed, t_end - max(1e-9 * t_end, end_tolerance))
-                return
             if first:
-                # 'stop when time >= x' given before 'run' also becomes a breakpoint at x,
-                # which would cut the step below the target: pause on the first point.
-                printed = self.command("stop when time > 0; run; delete all")
-                self._stale_pause = False  # (consumed by this run's first point, if it was set)
-                self._raise_if_failed(printed)
-                self._check_reached(printed, -math.inf)
-            # ngspice parses the number itself; the margin keeps its rounding harmless.
-            threshold = target - stop_margin(target)
-            if first and self.last_time() >= threshold:
-                return
-            for _ in range(8):
-                # One command line per pause (ngspice runs ';'-separated commands in turn).
-                printed = self.command(f"stop when time >= {threshold!r}; resume; delete all")
-                self._raise_if_failed(printed)
-                # A point can fall inside the margin just before the target (a breakpoint
-                # there): then resume again, the step clipping lands on the target.
-                if self._check_reached(printed, threshold):
-                    self._stale_pause = self.last_time() >= ended
+                self._abandon_run()
+                self._run = greenlet(self._run_body)
+                self._accepting = -math.inf  # (the last run's last point)
+            elif self._run is None:
+                # ngspice ended the run at the last pause, within CKTminBreak of t_end (a
+                # macro step landed there): nothing is left to run
+                if self.last_time() >= threshold:
                     return
-            raise SimulationAborted(f"ngspice did not reach t = {target!r} s after repeated resumes")
+                raise SimulationAborted(f"ngspice's transient ended at t = {self.last_time()!r} s, "
+                                        f"before {threshold!r} s")
+            self._pause_at = math.inf if target is None else threshold
+            self._caller = getcurrent()
+            printed = self._run.switch()
+            if not self._run.dead:
+                return  # paused at a point at or after the threshold (_on_data)
+            self._run = None
+            self._raise_if_failed(printed)
+            # ngspice ends a run once within CKTminBreak (5e-5 TMAX) of t_end: after
+            # rejected steps near the end its last point can be that early (measured
+            # 0.88 ns before t_end with TMAX = 30 us).
+            self._check_reached(printed, threshold)
         finally:
             self._target = math.inf
             self._max_step = math.inf
             self._deadline = math.inf
+            self._landings = []
 
-    def _unstale(self, printed: list[str]) -> list[str]:
-        """A run that paused at its start on the pause request a previous run left
-        (``_stale_pause``) is resumed: that pause was ours, not a Ctrl-C."""
-        stale, self._stale_pause = self._stale_pause, False
-        if stale and self.last_time() == 0.0 and any("pause requested" in line for line in printed):
-            return self.command("resume")
-        return printed
+    def _run_body(self) -> list[str]:
+        """The whole transient of the loaded circuit: one "run" (its greenlet pauses inside)."""
+        return self.command("run")
+
+    def _abandon_run(self) -> None:
+        """A transient left paused (a run failed or closed early) is stopped: resumed with a
+        failure set, which makes the sync callback abort it at its next step."""
+        run, self._run = self._run, None
+        if run is None or run.dead:
+            return
+        self._failure = SimulationAborted("the run was abandoned")
+        self._pause_at = math.inf
+        self._caller = getcurrent()
+        try:
+            run.switch()
+        except Exception:  # noqa: BLE001 - the abort's own error
+            pass
+        finally:
+            self._failure = None
 
     def _check_reached(self, printed: list[str], threshold: float) -> bool:
         """True if ngspice got to ``threshold``; a pause that was not ours is a user interrupt."""

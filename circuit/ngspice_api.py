@@ -54,8 +54,9 @@ int ngSpice_Circ(char **);
 bool ngSpice_SetBkpt(double);
 """
 # (ngSpice_Init's fourth and fifth arguments, the SendData and SendInitData callbacks, are
-# always NULL here: switchsim reads vectors after each pause instead of taking every point
-# through a callback. They are declared as void * so that their structures need no copy.)
+# declared as void *: switchsim passes its callbacks cast to void * and reads neither
+# structure. SendData only marks where a pause falls, after each accepted point is stored;
+# the vectors are read through ngGet_Vec_Info. So their structures need no copy here.)
 
 #: Functions of ``DECLARATIONS`` (the test compares each with PySpice's header).
 FUNCTIONS = ("ngSpice_Init", "ngSpice_Init_Sync", "ngSpice_Command", "ngGet_Vec_Info", "ngSpice_Circ",

@@ -134,12 +134,15 @@ def openings_of(intervals, t_start: float, t_end: float, tol: float) -> list[tup
 
 
 def make_instant_mask(t: np.ndarray, makes, guard: float) -> np.ndarray:
-    """True for samples with make <= t <= make + guard for some make (they show the open
-    contact the make has just ended)."""
+    """True for samples with make < t <= make + guard for some make: the closing transient,
+    where R_c falls from infinity and the contact still shows the open-circuit voltage for
+    as long as ngspice's first steps happen to fall there. The sample at the make itself is
+    the open contact's left limit, the last voltage of the opening the make ends: not
+    masked (an RC that charges through the opening peaks there)."""
     t = np.asarray(t, float)
     mask = np.zeros(len(t), bool)
     for m in makes:
-        mask |= (t >= m) & (t <= m + guard)
+        mask |= (t > m) & (t <= m + guard)
     return mask
 
 
@@ -203,8 +206,8 @@ def arc_toggles(i_arc: np.ndarray) -> int:
 def opening_table(t, v, i_loop, i_arc, openings, makes, guard) -> list[dict]:
     """One row per opening: start, end (s; the next make, or the end of the run), open_duration
     (s), reclosed, kind ("bounce" or "final"), current_at_break (A, the loop current i_loop at
-    the break: what the opening contact interrupts), peak_voltage (V, largest |v| in [start, end] outside
-    make-instant samples), arc_duration (s), arc_energy (J)."""
+    the break: what the opening contact interrupts), peak_voltage (V, largest |v| in [start, end],
+    the left limit at the make that ends it included), arc_duration (s), arc_energy (J)."""
     excluded = make_instant_mask(t, makes, guard)
     rows = []
     for start, end, reclosed in openings:

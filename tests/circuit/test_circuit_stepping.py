@@ -170,6 +170,98 @@ def test_a_make_just_after_the_macro_time_restarts_the_integration(ringing_circu
     assert np.sum((times > t0) & (times < t0 + delta + 10e-9)) >= 3
 
 
+@pytest.mark.parametrize("delta", [5e-12, 1.2e-10, 2e-9])
+def test_a_break_just_before_the_macro_time_is_a_point_with_the_closed_current(ringing_circuit, delta):
+    """A break ``delta`` before the end of its macro step (the mechanics' step cut at a
+    break ends a round-off past it; the coupled run's conductance drops there at once) is
+    a point of the waveform, where the contact's left limit holds: still closed, 24 V over
+    the source, load and contact (12.06 ohm). Through ngspice's `stop when` pauses a break
+    within CKTminBreak (5e-11 s here) of the macro time was stepped over (the pause's condition
+    merged with the break's breakpoint), and the current at the break was read from the
+    point before it."""
+    from circuit import SimulationOptions
+
+    t_break = 0.3e-3
+
+    def conductance(t):
+        return 100.0 if t < t_break else 0.0
+
+    with Stepper(ringing_circuit, 0.32e-3, SimulationOptions(max_step=1e-6)) as stepper:
+        stepper.advance(0.29e-3, conductance)
+        step = stepper.advance(t_break + delta, conductance, [t_break])
+        frame = step.frame()
+        after = stepper.advance(0.32e-3, conductance).frame()
+    times = frame.time.to_numpy()
+    assert t_break in times, f"nearest point {times[np.argmin(abs(times - t_break))] - t_break:+.3g} s from the break"
+    at = frame[frame.time == t_break].iloc[0]
+    assert at.contact_conductance == 100.0  # the left limit: still closed
+    # the wiring's inductance has long settled 0.3 ms after the start
+    assert at.contact_current == pytest.approx(24.0 / 12.06, rel=1e-6)
+    assert times[-1] == pytest.approx(t_break + delta, rel=1e-12)
+    # and the contact is open from the next point on: the wiring's current rings into the
+    # 100 pF across it
+    assert (after.contact_conductance.to_numpy()[1:] == 0.0).all()
+    assert frame.contact_conductance.to_numpy()[-1] == 0.0
+
+
+@pytest.mark.parametrize("delta", [4.6e-15, 1e-13, 2e-11, 1e-9])
+def test_a_make_just_after_the_macro_time_discharges_the_contact_capacitance_as_the_closed_form(
+        ringing_circuit, delta):
+    """The open contact's 100 pF holds 24 V; at the make its conductance grows as
+    G = a (t - t_make), a = 1e11 S/s. The wiring's 1 uH carries nothing over the ~30 ps
+    the charge takes to leave, so dV/dt = -G V / C: V = V0 exp(-a s^2 / 2C) and the
+    contact's current a s V peaks at V0 sqrt(a C) exp(-1/2) = 46.0 A, s = sqrt(C / a)
+    after the make, having passed C V0 = 2.4 nC within the first ns. Through ngspice's
+    `stop when` pauses a make within CKTminBreak (5e-11 s here) after the macro time was
+    not a breakpoint (it merged with the one at the macro time), and ngspice's first step
+    (14 ns on the bridge contactor, where it was found) passed the whole discharge: a peak
+    of 2.0 A, no point in the first ns."""
+    from circuit import SimulationOptions
+
+    a, capacitance, v0 = 1e11, 100e-12, 24.0
+    t0 = 0.4e-3
+    t_make = t0 + delta
+
+    def conductance(t):
+        return 0.0 if t <= t_make else min(100.0, a * (t - t_make))
+
+    with Stepper(ringing_circuit, 0.41e-3, SimulationOptions(max_step=1e-6)) as stepper:
+        stepper.advance(t0, conductance)
+        frame = stepper.advance(t0 + 2.5e-7, conductance, [t_make]).frame()
+        stepper.advance(0.41e-3, conductance)
+    t, i = frame.time.to_numpy(), frame.contact_current.to_numpy()
+    assert i.max() == pytest.approx(v0 * math.sqrt(a * capacitance) * math.exp(-0.5), rel=0.02)
+    first = (t >= t_make) & (t <= t_make + 1e-9)
+    assert np.trapezoid(i[first], t[first]) == pytest.approx(capacitance * v0, rel=0.02)
+
+
+def test_a_command_while_a_run_is_paused_is_refused_and_a_run_left_open_is_stopped(ringing_circuit, bounce_options):
+    """The transient is one ngspice `run`, paused inside its time loop between macro steps:
+    a command then would run inside that loop, so it is refused; a Stepper dropped without
+    close leaves its run paused, and the next circuit's load stops it first. The second run
+    is the same as a run in a fresh session."""
+    from circuit.errors import SessionBusyError
+    from circuit.ngspice import get_session
+
+    stepper = Stepper(ringing_circuit, 0.4e-3, bounce_options)
+    stepper.advance(0.2e-3, 1.0)
+    with pytest.raises(SessionBusyError, match="paused inside a transient"):
+        get_session().command("rusage all")
+    del stepper  # never closed: its run stays paused
+    with Stepper(ringing_circuit, 0.4e-3, bounce_options) as again:
+        again.advance(0.2e-3, 1.0)
+        again.advance(0.4e-3, 1.0)
+        first = again.results()
+        # the run has ended: commands are ngspice's again
+        assert any("Rejected timepoints" in line for line in get_session().command("rusage all"))
+    with Stepper(ringing_circuit, 0.4e-3, bounce_options) as fresh:
+        fresh.advance(0.2e-3, 1.0)
+        fresh.advance(0.4e-3, 1.0)
+        second = fresh.results()
+    for column in first.columns:
+        assert np.array_equal(first[column].to_numpy(), second[column].to_numpy()), column
+
+
 def test_a_final_step_shorter_than_ngspice_s_end_tolerance_ends_the_run(ringing_circuit, bounce_options):
     """A macro step landing within CKTminBreak of t_end finishes ngspice's analysis; the final
     step after it (5.75 ns in the study that found it) used to 'resume' a finished analysis,
