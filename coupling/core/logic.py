@@ -16,10 +16,12 @@ summary (``logic`` in summary.json, ``logic_metrics``; documented in docs/coupli
 - ``first_edge``, ``last_edge`` (s): the level is stable from ``last_edge`` to the end of
   the run; ``edge_burst`` = last_edge - first_edge (s), how long the input chatters: what a
   software debounce would have to wait out;
-- ``final_level`` and ``stable_margin`` (V): after the last edge (without edges: over the
-  whole run), how close the voltage came to the threshold that would switch the level
+- ``final_level`` and ``stable_margin`` (V): from the last edge on (without edges: over
+  the whole run), how close the voltage came to the threshold that would switch the level
   back, v - low for a high level, high - v for a low one: a near miss shows as a small
-  margin.
+  margin. The edge itself counts (the voltage is at the threshold it crossed there, a
+  margin of high - low), so a voltage that goes on moving away from the other threshold
+  gives the hysteresis whatever the samples; only a later dip gives less.
 """
 
 from __future__ import annotations
@@ -145,6 +147,10 @@ def logic_metrics(t, v, logic: LogicInput) -> dict:
         out["first_edge"], out["last_edge"] = edges[0][0], edges[-1][0]
         out["edge_burst"] = edges[-1][0] - edges[0][0]
         after = v[int(np.flatnonzero(levels[1:] != levels[:-1])[-1]) + 1:]
+        # the edge itself, where the voltage stood at the threshold it crossed: the first
+        # sample after it is wherever ngspice's step put it (the tactile switch's margin
+        # moved from 1.43 to 1.59 V between two step sequences of the same run)
+        after = np.append(after, logic.high if levels[-1] else logic.low)
     else:
         after = v
     out["stable_margin"] = float(np.min(after - logic.low) if levels[-1] else np.min(logic.high - after))

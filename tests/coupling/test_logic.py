@@ -42,6 +42,24 @@ def test_ripple_between_the_thresholds_gives_no_edge():
     assert schmitt_edges(t, v, LOW, HIGH) == []
 
 
+def test_the_margin_after_the_last_edge_counts_the_edge_and_not_where_the_samples_fall():
+    """A rise through HIGH that goes on rising: the margin is the hysteresis, HIGH - LOW,
+    whether the first sample after the crossing is 0.1 or 0.3 V above it (it was that
+    sample's distance from LOW: 1.43 or 1.59 V on the tactile switch for two step sequences of
+    one run). A dip after the edge to 1.5 V, not below LOW, is the margin: 1.5 - LOW. Falling
+    through LOW the same, mirrored."""
+    for first_after in (HIGH + 0.1, HIGH + 0.3):
+        t = np.array([0.0, 1e-3, 2e-3, 3e-3, 4e-3])
+        v = np.array([0.0, 2.0, first_after, 3.0, 3.3])
+        m = logic_metrics(t, v, LogicInput("v(pin)", LOW, HIGH))
+        assert m["edges"] == 1 and m["final_level"] == "high"
+        assert m["stable_margin"] == pytest.approx(HIGH - LOW, rel=1e-12)
+        dipped = logic_metrics(t, np.array([0.0, 2.0, first_after, 1.5, 3.3]), LogicInput("v(pin)", LOW, HIGH))
+        assert dipped["stable_margin"] == pytest.approx(1.5 - LOW, rel=1e-12)
+        falling = logic_metrics(t, 3.3 - v, LogicInput("v(pin)", 3.3 - HIGH, 3.3 - LOW))
+        assert falling["final_level"] == "low" and falling["stable_margin"] == pytest.approx(HIGH - LOW, rel=1e-12)
+
+
 def test_sine_across_both_thresholds_edges_at_the_analytic_crossings():
     """v = mid + A sin(w t), A beyond both thresholds: it falls below LOW at
     w t = pi + asin((mid - LOW)/A) and rises above HIGH at w t = 2 pi + asin((HIGH - mid)/A),
