@@ -206,6 +206,7 @@ class NgspiceSession:
         self._caller: greenlet | None = None
         self._pause_at = math.inf  # s: the accepted point at or after this time pauses the run
         self._accepting = -math.inf  # s: time of the point ngspice is accepting (sync callback, loc 1)
+        self._run_thread: threading.Thread | None = None  # the thread whose greenlet self._run is
         self._landings: list[float] = []  # s: the breakpoints set for the current pause, ascending
         self._arcs: dict[str, object] = {}  # the ArcState of each arc, by its EXTERNAL current source
         self._arc_by_pointer: dict[object, object] = {}
@@ -545,7 +546,11 @@ class NgspiceSession:
             if first:
                 self._abandon_run()
                 self._run = greenlet(self._run_body)
+                self._run_thread = threading.current_thread()
                 self._accepting = -math.inf  # (the last run's last point)
+            elif self._run is not None and not self._resumable():
+                self._run = None
+                raise SimulationAborted("the thread that started this transient has ended: it cannot be resumed")
             elif self._run is None:
                 # ngspice ended the run at the last pause, within CKTminBreak of t_end (a
                 # macro step landed there): nothing is left to run
@@ -574,11 +579,29 @@ class NgspiceSession:
         """The whole transient of the loaded circuit: one "run" (its greenlet pauses inside)."""
         return self.command("run")
 
+    def _resumable(self) -> bool:
+        """True if the paused transient can be resumed from this thread: a greenlet lives in
+        the thread that made it. SessionBusyError while that thread is alive; False once it
+        has ended (its transient can never run on)."""
+        thread = self._run_thread
+        if thread is None or thread is threading.current_thread():
+            return True
+        if thread.is_alive():
+            raise SessionBusyError("ngspice is paused inside a transient started by another thread: advance or "
+                                   "close that Stepper from the thread that started it")
+        return False
+
     def _abandon_run(self) -> None:
         """A transient left paused (a run failed or closed early) is stopped: resumed with a
-        failure set, which makes the sync callback abort it at its next step."""
-        run, self._run = self._run, None
+        failure set, which makes the sync callback abort it at its next step. One left by a
+        thread that has ended is only forgotten."""
+        run = self._run
         if run is None or run.dead:
+            self._run = None
+            return
+        resumable = self._resumable()  # (SessionBusyError while its own thread may still resume it)
+        self._run = None
+        if not resumable:
             return
         self._failure = SimulationAborted("the run was abandoned")
         self._pause_at = math.inf

@@ -262,6 +262,45 @@ def test_a_command_while_a_run_is_paused_is_refused_and_a_run_left_open_is_stopp
         assert np.array_equal(first[column].to_numpy(), second[column].to_numpy()), column
 
 
+def test_a_paused_transient_is_resumed_only_from_its_own_thread(ringing_circuit, bounce_options):
+    """The transient pauses in a greenlet of the thread that started it: another thread gets
+    SessionBusyError, to advance it or to load a circuit over it, while that thread lives;
+    once it has ended, a new run in this thread starts as in a fresh session."""
+    import gc
+    import threading
+
+    from circuit.errors import SessionBusyError
+
+    started, release, done = threading.Event(), threading.Event(), threading.Event()
+    holder = {}
+
+    def other():
+        holder["stepper"] = Stepper(ringing_circuit, 0.4e-3, bounce_options)
+        holder["stepper"].advance(0.2e-3, 1.0)
+        started.set()
+        release.wait(30)
+        done.set()  # ends without closing: its run stays paused
+
+    thread = threading.Thread(target=other)
+    thread.start()
+    assert started.wait(30)
+    try:
+        with pytest.raises(SessionBusyError, match="another thread"):
+            holder["stepper"].advance(0.3e-3, 1.0)
+        del holder["stepper"]  # dropped unclosed: the next Stepper may claim ngspice, but not load over the run
+        gc.collect()
+        with pytest.raises(SessionBusyError, match="another thread"):
+            Stepper(ringing_circuit, 0.4e-3, bounce_options)
+    finally:
+        release.set()
+        thread.join(30)
+    with Stepper(ringing_circuit, 0.4e-3, bounce_options) as again:
+        again.advance(0.2e-3, 1.0)
+        again.advance(0.4e-3, 1.0)
+        # closed through 1 ohm (1 S): 24 V over 12.05 + 1 ohm
+        assert again.finished and again.load_current == pytest.approx(24.0 / 13.05, rel=1e-4)
+
+
 def test_a_final_step_shorter_than_ngspice_s_end_tolerance_ends_the_run(ringing_circuit, bounce_options):
     """A macro step landing within CKTminBreak of t_end finishes ngspice's analysis; the final
     step after it (5.75 ns in the study that found it) used to 'resume' a finished analysis,
