@@ -613,20 +613,16 @@ class NgspiceSession:
         finally:
             self._failure = None
 
-    def _check_reached(self, printed: list[str], threshold: float) -> bool:
-        """True if ngspice got to ``threshold``; a pause that was not ours is a user interrupt."""
+    def _check_reached(self, printed: list[str], threshold: float) -> None:
+        """The run ended (its `run` command returned): it must have got to ``threshold``;
+        ended earlier, it was paused by Ctrl-C (ngspice's own SIGINT handler:
+        KeyboardInterrupt) or stopped (SimulationAborted with ngspice's message)."""
         if self.last_time() >= threshold:
-            return True
-        ours = any("condition met" in line for line in printed)
-        if not ours and any("interrupted" in line for line in printed):
+            return
+        if any("interrupted" in line for line in printed):
             raise KeyboardInterrupt(f"ngspice paused by an interrupt at t = {self.last_time()!r} s")
-        if threshold == -math.inf:
-            return True
-        if not ours:
-            raise SimulationAborted(
-                f"ngspice stopped at t = {self.last_time()!r} s before {threshold!r} s", _message(printed)
-            )
-        return False
+        raise SimulationAborted(f"ngspice stopped at t = {self.last_time()!r} s before {threshold!r} s",
+                                _message(printed))
 
     def _raise_if_failed(self, printed: list[str]) -> None:
         failure, self._failure = self._failure, None
