@@ -157,8 +157,8 @@ _ERROR_LINE = re.compile(r"error|abort|fail|too small|trouble with|singular|iter
 
 
 def stop_margin(target: float) -> float:
-    """s: how far before a pause's target (s) a point counts as reaching it (ngspice parses
-    the stop time itself; the margin keeps its rounding harmless)."""
+    """s: how far before a pause's target (s) a point counts as reaching it: a step aimed at
+    the target can end a rounding short of it, and a step from there would be a sliver."""
     return max(1e-12 * abs(target), 1e-300)
 
 
@@ -442,9 +442,9 @@ class NgspiceSession:
         return lines
 
     def clear(self) -> None:
-        """Forget every plot, circuit and stop condition of earlier runs."""
+        """Forget every plot and circuit of earlier runs (a run left paused is stopped first)."""
         self._abandon_run()
-        for cmd in ("delete all", "destroy all", "remcirc"):
+        for cmd in ("destroy all", "remcirc"):
             self.command(cmd)
         self._reset_callback_state()
 
@@ -526,9 +526,8 @@ class NgspiceSession:
                   end_tolerance: float = 0.0, max_step: float = math.inf) -> None:
         """Start (``first``) or resume the loaded transient and pause exactly at ``target`` (s).
 
-        ``target=None`` runs to ``t_end``, the end time of the ``.tran`` line (a stop
-        condition at the final time would leave ngspice paused for the next run, so none
-        is set). Raises the ngspice error, or the exception a callback raised, after
+        ``target=None`` runs to ``t_end``, the end time of the ``.tran`` line, where the
+        run ends (no pause). Raises the ngspice error, or the exception a callback raised, after
         ngspice has stopped; KeyboardInterrupt if Ctrl-C paused ngspice (ngspice installs
         its own SIGINT handler while it runs, which pauses instead of raising).
         ``end_tolerance``: how early (s) ngspice may end a run to ``t_end``
@@ -539,8 +538,6 @@ class NgspiceSession:
         self._target = math.inf if target is None else float(target)
         self._max_step = float(max_step)
         ended = t_end - max(1e-9 * t_end, end_tolerance)  # ngspice ends a run within this of t_end
-        # ngspice parses no number: the margin only keeps a point a rounding short of the
-        # target from counting as early
         threshold = ended if target is None else target - stop_margin(target)
         try:
             if first:
