@@ -68,7 +68,9 @@ def _pair(kind: DriveKind, value, label: str) -> tuple[float, float]:
     """(start, end) of one channel's value over a step (a number is constant), checked
     against its kind; ``label`` names the value in an error."""
     try:
-        if isinstance(value, (int, float, np.number)) and not isinstance(value, bool):
+        if type(value) is tuple and len(value) == 2 and type(value[0]) is float and type(value[1]) is float:
+            start, end = value  # (what a co-simulation passes at every macro step: np.shape is ~2 us)
+        elif isinstance(value, (int, float, np.number)) and not isinstance(value, bool):
             start = end = float(value)
         elif isinstance(value, (tuple, list, np.ndarray)) and np.shape(value) == (2,):
             start, end = float(value[0]), float(value[1])
