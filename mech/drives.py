@@ -13,14 +13,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
 
 import numpy as np
 
 from .kernel_layout import CONTACT_DRIVES, D_SLOPE, D_T0, D_VALUE
+from .frozen import frozen
 
 
-@dataclass(frozen=True)
+@frozen
 class DriveKind:
     """What a kind of drive channel is.
 

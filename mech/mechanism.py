@@ -34,9 +34,10 @@ from .kernel_layout import (
 )
 from .modal_basis import ModalBasis
 from .parameters import MechScene
+from .frozen import frozen
 
 
-@dataclass(frozen=True)
+@frozen
 class ContactPoint:
     """One contact cap: ``position`` m from tip 0, ``offset`` m along b3, cap ``radius`` m,
     its material (Pa, -), and a name for messages and results."""
@@ -49,7 +50,7 @@ class ContactPoint:
     poisson_ratio: float
 
 
-@dataclass(frozen=True)
+@frozen
 class ContactPair:
     """A contact point and the fixed contact it strikes (SI). fixed: the fixed contact's
     name ("block" for [block]); key: where the scene gives it ("block", "fixed[1]"), for

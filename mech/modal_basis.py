@@ -18,19 +18,19 @@ entries (``sparse_invariants``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 
 from .modes import axial_shape, bending_shape, free_free_roots
 from .parameters import Bar
+from .frozen import frozen
 
 FAMILY_DIRECTION = {"axial": 0, "bend2": 1, "bend3": 2}
 _QUAD_POINTS = 400
 
 
-@dataclass(frozen=True)
+@frozen
 class ModalBasis:
     """Modes and invariants of one bar (SI: kg, m, N/m).
 

@@ -21,16 +21,16 @@ Measured in docs/accuracy-modes.md.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
+from .frozen import frozen
 
 SAFETY = 3.0  # f_cut = SAFETY / t_c
 CAP = 40  # the largest count bar.modes accepts
 FLOOR = 3  # the paper's count, and never fewer than an explicit default used to give
 
 
-@dataclass(frozen=True)
+@frozen
 class ModeCount:
     """The count chosen per family and why. cutoff: Hz. contact_time: s. impact_speed: m/s."""
 

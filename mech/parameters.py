@@ -11,7 +11,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from dataclasses import dataclass, field
 from typing import Callable, Literal, Union
 
 import numpy as np
@@ -22,6 +21,7 @@ from .validation import (
     check_bool, check_choice, check_count, check_finite, check_magnitude, check_name, check_nonnegative,
     check_position, check_positive, check_range, check_table, check_vector3, check_whole, internal, scene_key,
 )
+from .frozen import frozen
 
 MuLike = Union[float, Callable[[float], float]]
 
@@ -54,7 +54,7 @@ RIVETS_WITH_BLOCK = 2  # [[rivet]] entries with the one fixed contact [block] (e
 DIRECTION_MAX = 1e6  # components of a force's direction before it is normalized
 
 
-@dataclass(frozen=True)
+@frozen
 class Bar:
     """The slender bar with rounded (spherical-cap) tips at both ends.
 
@@ -166,7 +166,7 @@ class Bar:
         return math.asin(min(1.0, self.section_half_width / self.tip_radius))
 
 
-@dataclass(frozen=True)
+@frozen
 class Block:
     """The fixed contact: a massive elastic body. youngs_modulus: Pa; poisson_ratio: -.
 
@@ -204,7 +204,7 @@ class Block:
 CONTACT_LAWS = ("paper", "hunt_crossley", "lankarani_nikravesh", "flores")
 
 
-@dataclass(frozen=True)
+@frozen
 class Contact:
     """Normal contact law F_n = k y^1.5 + c y^beta dy/dt, clipped at F_n >= 0.
 
@@ -254,7 +254,7 @@ class Contact:
         return 1.0 if self.law == "paper" else 1.5
 
 
-@dataclass(frozen=True)
+@frozen
 class Friction:
     """Generalized friction |F_t| = mu F_n^(1-gamma) (gamma = 0: Coulomb).
 
@@ -298,7 +298,7 @@ class Friction:
         return float(self.mu)
 
 
-@dataclass(frozen=True)
+@frozen
 class Initial:
     """Initial state at release.
 
@@ -351,7 +351,7 @@ class Initial:
 RTOL_MAX = 1e-5
 
 
-@dataclass(frozen=True)
+@frozen
 class SolverOptions:
     """Integration settings.
 
@@ -405,7 +405,7 @@ class SolverOptions:
 MOUNT_KINDS = ("free", "clamp", "pivot")
 
 
-@dataclass(frozen=True)
+@frozen
 class Mount:
     """Where the bar is held.
 
@@ -484,7 +484,7 @@ class Mount:
         return self.kind != "free"
 
 
-@dataclass(frozen=True)
+@frozen
 class PointForce:
     """An actuator force on the bar (an armature, a finger).
 
@@ -588,7 +588,7 @@ def share_table(name: str, travel, share) -> tuple[tuple, tuple]:
 SPRING_ENDS = ("frame", "armature")
 
 
-@dataclass(frozen=True)
+@frozen
 class Spring:
     """A spring and dashpot from a fixed world ``anchor`` (m) to the bar at ``position`` (m
     from tip 0); damping: N s/m. Either linear: stiffness N/m (> 0), with ``preload`` (N,
@@ -761,7 +761,7 @@ def _travel_table(name: str, travel, values, key: str, check_value, *, needs: st
     return xs, vs
 
 
-@dataclass(frozen=True)
+@frozen
 class Rivet:
     """A spherical contact cap on the bar (a contact rivet): a contact point.
 
@@ -804,7 +804,7 @@ FIXED_SHAPES = ("plane", "sphere")
 FACINGS = ("up", "down")
 
 
-@dataclass(frozen=True)
+@frozen
 class FixedContact:
     """A fixed contact struck by one contact point of the moving part: a counter-contact
     (the NO or NC contact of a changeover, one of a bridge's two) or, with
@@ -893,7 +893,7 @@ class FixedContact:
 ARMATURE_KINDS = ("none", "plunger", "clapper")
 
 
-@dataclass(frozen=True)
+@frozen
 class Armature:
     """The relay's armature: a rigid body on one coordinate q, its travel from the rest stop
     (m for a plunger, rad for a clapper; 0 <= q <= travel between its stops), driven by the
@@ -1050,7 +1050,7 @@ def _gain_table(table, travel: float) -> dict:
     return out
 
 
-@dataclass(frozen=True)
+@frozen
 class MechScene:
     """Everything the impact solver needs. gravity: m/s^2 (>= 0), acting along -z.
 

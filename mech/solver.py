@@ -48,6 +48,7 @@ from .recorder import MEMORY_LIMIT, Recorder, history_memory
 from .results import ImpactResult, seat_credit
 from .scipy_backend import METHODS as SCIPY_METHODS, ScipyStepper
 from .stepping import CompiledStepper, Stepper
+from .frozen import frozen
 
 REGIME_NAMES = ("free", "slip", "stick")
 EVENT_KINDS = ("contact", "clip", "slip", "stick", "compression")
@@ -66,7 +67,7 @@ class MechSolverError(RuntimeError):
         self.partial_result = partial
 
 
-@dataclass(frozen=True)
+@frozen
 class CoupledStates:
     """Extra states integrated in the same solve as the mechanics (scipy backends only).
 
@@ -231,7 +232,6 @@ class Segment:
             return self._last_forces
         if not (self.t_start - 1e-15 <= t <= self.t_end + 1e-15):
             raise ValueError(f"t = {t!r}: outside the segment [{self.t_start!r}, {self.t_end!r}] s")
-        m = self._model
         if len(self._t_valid) == 0 or t <= self.t_start:
             c = self.contact(t)
             forces = (float(c[0, 2]), float(c[1, 2]), float(max(0.0, -np.max(c[:, 0]))),
@@ -934,7 +934,6 @@ class ImpactSolver:
         with zero speeds (see _watch_rest), crediting the energy this removes to the audit.
         Returns False, and leaves the state as it was, if no equilibrium is found or a
         contact would then change its regime."""
-        m = self.model
         rec = self.recorder
         n = rec.n
         first = int(np.searchsorted(rec.t[:n], self._rest_t0, side="left"))

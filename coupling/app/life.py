@@ -45,6 +45,7 @@ import sys
 import time
 from pathlib import Path
 
+from mech.frozen import frozen
 from coupling.app.sweep import _FolderLock, _sweep_folder, _write_parquet_atomic
 
 LIFE_COLUMNS = (
@@ -61,7 +62,7 @@ class LifeError(ValueError):
     """A life study that cannot go on for a reason of its input (a one-line message)."""
 
 
-@dataclasses.dataclass(frozen=True)
+@frozen
 class LifeStudy:
     """How long a life study runs: ``operations`` N (>= 1) sampled ``every`` K (>= 1) operations."""
 
@@ -84,7 +85,7 @@ class LifeStudy:
 # --- the contact's geometry and its wear ------------------------------------------------------
 
 
-@dataclasses.dataclass(frozen=True)
+@frozen
 class ContactGeometry:
     """What a life study wears, from the base scene (SI): the moving rivet's cap (height,
     sphere radius, centre offset from the bar's axis), the fixed contact's cap (height and
@@ -539,7 +540,7 @@ def life_command(path: str | None, out_dir: str, operations: int, every: int, *,
             report = life_sweep(path, study, out_dir, workers=workers, scheduler=scheduler, resume=resume,
                                 progress=not quiet)
         except KeyboardInterrupt:
-            print(f"switchsim life: interrupted; continue with --resume", file=sys.stderr)
+            print("switchsim life: interrupted; continue with --resume", file=sys.stderr)
             return 130
         if report.interrupted:
             print(f"switchsim life: interrupted; {report.skipped + report.done} of {report.total} designs have rows "

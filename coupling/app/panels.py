@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from mech.frozen import frozen
 from coupling.app.quantities import WAVEFORM, Quantity
 
 
@@ -42,7 +43,7 @@ SCALES = ("voltage", "spikes", "linear", "log", "resistance")
 WHEN = ("present", "finite", "nonzero")
 
 
-@dataclass(frozen=True)
+@frozen
 class Trace:
     """One curve of a panel: a waveform column (or a glob over columns, e.g. "v(*"; the
     column is then the label), its legend label and colour (hex: matplotlib and plotly
@@ -62,7 +63,7 @@ class Trace:
             raise ValueError(f"Trace({self.column!r}).when = {self.when!r}: allowed {', '.join(WHEN)}")
 
 
-@dataclass(frozen=True)
+@frozen
 class Panel:
     """One axis: ``quantity`` (its name and SI unit: the axis label), the traces, the scale
     rule (a key of SCALES), and for the PNG a display unit with its factor from SI (the

@@ -11,10 +11,10 @@ column (tests/coupling/test_plot_units.py compares the two).
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from mech.frozen import frozen
 
 
-@dataclass(frozen=True)
+@frozen
 class Quantity:
     """What an axis shows: ``name`` (words) and ``unit`` (SI, "-" for a pure number)."""
 

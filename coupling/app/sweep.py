@@ -72,7 +72,7 @@ import time
 import tomllib
 import uuid
 from pathlib import Path
-from typing import Any
+from mech.frozen import frozen
 
 DESIGNS = ("grid", "cases", "random", "lhs", "tolerance")
 _SWEEP_KEYS = {"scene", "design", "samples", "seed", "waveforms", "set", "grid", "cases", "ranges", "tolerances",
@@ -98,7 +98,7 @@ _MAX_RETRIES = 3
 # --- the design ------------------------------------------------------------------------
 
 
-@dataclasses.dataclass(frozen=True)
+@frozen
 class Run:
     """One run of a sweep: its id (file-safe, unique), optional name and "section.key" values."""
 
@@ -107,7 +107,7 @@ class Run:
     params: dict
 
 
-@dataclasses.dataclass(frozen=True)
+@frozen
 class Sweep:
     """A base scene document and the runs to make of it (validated: see ``check``).
 

@@ -14,12 +14,12 @@ line and takes only resistance and turns from [coil] (its drive is the netlist's
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
 from typing import Any
 
 from coupling.core.scene import _field_default, key_fields, section_keys
 from coupling.laws.magnet import FluxTubeMagnet, TableMagnet
 from mech.validation import check_choice, check_keys, check_positive, internal, scene_key
+from mech.frozen import frozen
 
 MAGNET_MODELS = ("flux_tubes", "table", "plunger_solenoid")
 
@@ -40,7 +40,7 @@ def coil_keys() -> tuple[str, ...]:
     return tuple(section_keys(CoilDrive))
 
 
-@dataclass(frozen=True, kw_only=True)
+@frozen(kw_only=True)
 class DeviceSpec:
     """The relay's coil and magnet as a scene gives them; its scene-key fields are [magnet]'s
     own keys, whatever the model (the model's keys are its magnet's fields).

@@ -8,13 +8,14 @@ throughout). docs/contact_duty.md, "In a run", says what each key is.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import fields
 
 import numpy as np
 
 from mech.validation import (
     check_bool, check_choice, check_keys, check_nonnegative, check_positive, scene_key,
 )
+from mech.frozen import frozen
 
 from coupling.laws.duty import (
     MELT_FRACTION, TRANSITION_GAP, ContactPair, arc_stage_energies, blow_off_current, constriction_repulsion,
@@ -51,7 +52,7 @@ def _pair_of(name: str, value) -> tuple:
     return value, value
 
 
-@dataclass(frozen=True)
+@frozen
 class LifeLimits:
     """[duty.life]: when `switchsim life` stops before its operation count (SI).
 
@@ -88,7 +89,7 @@ class LifeLimits:
         check_choice("duty.life.stop_on_weld", self.stop_on_weld, STOP_ON_WELD)
 
 
-@dataclass(frozen=True)
+@frozen
 class DutySettings:
     """The scene's [duty] section, resolved and validated (SI units).
 

@@ -27,11 +27,11 @@ summary (``logic`` in summary.json, ``logic_metrics``; documented in docs/coupli
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from mech.validation import check_keys
+from mech.frozen import frozen
 
 #: The keys of ``[metrics] logic``.
 LOGIC_KEYS = ("node", "low", "high")
@@ -43,7 +43,7 @@ def _volts(key: str, value) -> float:
     return float(value)
 
 
-@dataclass(frozen=True)
+@frozen
 class LogicInput:
     """``[metrics] logic``: a Schmitt-trigger input on one node (SI: V).
 

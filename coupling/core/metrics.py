@@ -34,11 +34,11 @@ Definitions (SI: s, V, A, J), documented for users in docs/coupling.md ("Bounce 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from mech.validation import check_nonnegative, check_whole, scene_key
+from mech.frozen import frozen
 
 from coupling.core.logic import LogicInput
 
@@ -47,7 +47,7 @@ DEFAULT_SETTLE_WINDOW = 1e-3  # s
 DEFAULT_ARC_TOGGLE_LIMIT = 50  # arc on/off changes in one run above which a warning is given
 
 
-@dataclass(frozen=True)
+@frozen
 class MetricSettings:
     """The scene's [metrics] section (SI).
 

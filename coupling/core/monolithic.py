@@ -18,19 +18,19 @@ coupling error plus both routes' integration errors, so compare at tight toleran
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import brentq
 
 from mech import CoupledStates, ImpactSolver
+from mech.frozen import frozen
 
 from coupling.core.exchange import conduction_onset
 from coupling.core.results import CoupledResult
 from coupling.core.scene import Scene
 
 
-@dataclass(frozen=True)
+@frozen
 class SeriesLoop:
     """The loop's constants (SI): V, R, L, C_p, G_leak, and C, R_bleed of a capacitive load (else 0)."""
 

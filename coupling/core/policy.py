@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
+from mech.frozen import frozen
 
 PROBE_TIME = 1e-4  # s: the step right after a current jump is H^2 / PROBE_TIME (O(H^2): second order)
 # A step extrapolates the current over at most this fraction of its local time scale
@@ -42,7 +43,7 @@ GROWTH_CAP = 4.0  # macro steps: the longest step in a closed contact with a ste
 TAIL_POINTS = 8  # circuit points kept across macro steps for the slope and its curvature
 
 
-@dataclass(frozen=True)
+@frozen
 class StepPolicy:
     """The co-simulation's step rules, pure (no solver, no ngspice): where a macro step ends
     and how the loop current is extrapolated over it. Times in s, currents in A.

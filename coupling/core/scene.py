@@ -27,7 +27,7 @@ import copy
 import dataclasses
 import re
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import field
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -42,6 +42,7 @@ from mech.validation import (
     internal,
     scene_key,
 )
+from mech.frozen import frozen
 from coupling.core.policy import (
     COIL_POINT_FRACTION, COIL_STEP_POINTS, COIL_TIME_SCALE_FRACTION, GAP_CHANGE_FRACTION, TIME_SCALE_FRACTION,
 )
@@ -73,7 +74,7 @@ def _table(where: str, value) -> dict:
     return value
 
 
-@dataclass(frozen=True)
+@frozen
 class CouplingOptions:
     """How mechanics and circuit exchange data (SI).
 
@@ -142,7 +143,7 @@ class CouplingOptions:
         return self.macro_step if self.max_macro_step is None or self.scheme == "jacobi" else self.max_macro_step
 
 
-@dataclass(frozen=True)
+@frozen
 class OutputOptions:
     """What a run writes besides summary.json: csv, parquet, plots (PNG), history (mechanics CSV),
     html (waveforms.html, the interactive waveform page).
@@ -179,7 +180,7 @@ class OutputOptions:
         return max(self.history_resolution, budget)
 
 
-@dataclass(frozen=True)
+@frozen
 class TribologySpec:
     """The contact laws (mu(I), gamma, R_c(F_n, I)), where they came from, and the fit if any;
     its fields declare [tribology]'s keys (TRIBOLOGY_KEYS)."""
@@ -199,7 +200,7 @@ class TribologySpec:
     fit: Any = internal(None)  # coupling.laws.tribology.TribometerFit, when the laws come from a fit
 
 
-@dataclass(frozen=True)
+@frozen
 class CircuitSpec:
     """The circuit, its ngspice options, and an optional prescribed contact schedule."""
 
@@ -227,7 +228,7 @@ class CircuitSpec:
         "changeover)")
 
 
-@dataclass(frozen=True)
+@frozen
 class Scene:
     """A validated scene. ``raw`` is the TOML document it was built from; ``set`` edits it."""
 

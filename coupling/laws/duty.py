@@ -19,11 +19,11 @@ docs/contact_duty.md gives each model's source, validity and what it leaves out.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from mech.validation import check_finite, check_nonnegative, check_positive
+from mech.frozen import frozen
 
 from .materials import Material, material
 
@@ -122,7 +122,7 @@ def constriction_voltage(temperature, ambient: float = AMBIENT):
     return 2.0 * np.sqrt(LORENZ * np.maximum(t * t - ambient ** 2, 0.0))
 
 
-@dataclass(frozen=True)
+@frozen
 class ContactPair:
     """The two contact materials (library names; rivet and counter-contact, or the electrodes a
     and b of a circuit contact) and the bulk temperature ``ambient`` (K), with the pair's figures

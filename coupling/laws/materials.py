@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, field
+from dataclasses import field
 from importlib import resources
 from typing import Any
 
@@ -44,6 +44,7 @@ import numpy as np
 from mech.validation import (
     check_choice, check_finite, check_keys, check_nonnegative, check_positive, check_whole, unknown,
 )
+from mech.frozen import frozen
 
 MIN_SPOT_RADIUS = 0.1e-6  # m: a >> the electron mean free path (Holm's diffusive constriction)
 YIELD_PRESSURE_OVER_HARDNESS = 0.57  # Hertz peak pressure at first yield / hardness
@@ -90,7 +91,7 @@ def film_resistance(film_resistivity, area):
 # --- the material library --------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
+@frozen
 class Material:
     """A contact material: resistivity (ohm m), hardness (Pa), Young's modulus (Pa), Poisson
     ratio, and the contact-duty data (None where the library has no figure; SI units, listed
@@ -236,7 +237,7 @@ class _ForceLaw:
         return "1"
 
 
-@dataclass(frozen=True)
+@frozen
 class ConstantResistance(_ForceLaw):
     """R_c = value (ohm) whenever the contact is closed (F > 0)."""
 
@@ -259,7 +260,7 @@ class ConstantResistance(_ForceLaw):
         return {"law": "constant", "value": self.value}
 
 
-@dataclass(frozen=True)
+@frozen
 class HolmResistance(_ForceLaw):
     """Holm / Greenwood constriction plus film resistance between two materials (SI).
 

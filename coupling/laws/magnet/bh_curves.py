@@ -21,11 +21,11 @@ curve and how far the sampled table lies from the approximation.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 
+from mech.frozen import frozen
 from coupling.laws.magnet.pwl import Linear, OddPwl
 from coupling.laws.magnet.validation import check_finite, check_numbers, unknown
 
@@ -39,7 +39,7 @@ def roschke_relative_permeability(flux_density, mu_i, b_mumax, c_a, c_b, n):
     return 1.0 + (mu_i - 1.0 + c_a * b) / (1.0 + c_b * b + b ** n)
 
 
-@dataclass(frozen=True)
+@frozen
 class LinearMaterial:
     """Iron of constant relative permeability ``relative_permeability`` (>= 1): H = B / (mu0 mu_r)."""
 
@@ -68,7 +68,7 @@ class LinearMaterial:
         return self.curve.integral(flux_density)
 
 
-@dataclass(frozen=True)
+@frozen
 class TabulatedMaterial:
     """Iron given by its B-H curve: ``flux_density`` (T) and ``field_strength`` (A/m), both
     starting at 0 and increasing strictly, each segment's differential permeability dB/dH

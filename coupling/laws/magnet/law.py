@@ -23,7 +23,6 @@ is its exact inverse.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
@@ -36,6 +35,7 @@ from coupling.laws.magnet.tubes import (
 )
 from coupling.laws.magnet.validation import check_instance, check_positive
 from mech.validation import internal, scene_key
+from mech.frozen import frozen
 
 
 def _out(x):
@@ -144,7 +144,7 @@ class Magnet:
         return " + ".join(parts)
 
 
-@dataclass(frozen=True)
+@frozen
 class FluxTubeMagnet(Magnet):
     """A magnet drawn from flux tubes: the coil of ``turns`` N drives its flux through the
     ``iron`` tubes and the ``fixed_gap`` places in series with the ``working_gap`` and, in

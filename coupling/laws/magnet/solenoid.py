@@ -14,8 +14,8 @@ the space between pole, armature and yoke.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
+from mech.frozen import frozen
 from coupling.laws.magnet.bh_curves import STEEL_9SMNPB28
 from coupling.laws.magnet.law import FluxTubeMagnet
 from coupling.laws.magnet.tubes import (
@@ -50,7 +50,7 @@ LEAKAGE_RADIUS = 3e-3
 BOTTOM_LEAKAGE_RATIO = 8.0
 
 
-@dataclass(frozen=True)
+@frozen
 class PlungerSolenoid:
     """The built-in solenoid: its ``magnet``, ``coil_resistance`` (ohm), the moving
     ``armature_mass`` (kg, armature and load), ``rest_gap`` and ``closed_gap`` (m, the

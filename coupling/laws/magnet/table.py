@@ -23,7 +23,6 @@ times the co-energy drop over the whole gap range at that current.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
@@ -32,6 +31,7 @@ from coupling.laws.magnet.law import Magnet
 from coupling.laws.magnet.pwl import OddPwl, number
 from coupling.laws.magnet.validation import check_finite, check_increasing, check_numbers, check_positive
 from mech.validation import internal, scene_key
+from mech.frozen import frozen
 
 
 def power_law_work(gap0: float, gap1: float, force0: float, force1: float) -> float:
@@ -73,7 +73,7 @@ def table_consistency(currents, gaps, flux_linkages, forces):
     return worst
 
 
-@dataclass(frozen=True)
+@frozen
 class TableMagnet(Magnet):
     """A magnet from tables: ``currents`` i_j (A, from 0, increasing strictly), ``gaps`` g_k
     (m, > 0, increasing strictly), ``flux_linkages`` psi(i_j, g_k) (Wb) and ``forces``

@@ -29,10 +29,10 @@ notes that the book swaps this formula with a neighbouring one), depend on the g
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
+from mech.frozen import frozen
 from coupling.laws.magnet.bh_curves import MU0, LinearMaterial, TabulatedMaterial
 from coupling.laws.magnet.pwl import Linear, OddPwl
 from coupling.laws.magnet.validation import check_instance, check_nonnegative, check_positive
@@ -62,7 +62,7 @@ class _Iron:
         return self.material.curve.initial_slope * self.path_length / self.path_area
 
 
-@dataclass(frozen=True)
+@frozen
 class IronPath(_Iron):
     """Iron of ``length`` (m, along the flux) and uniform cross-section ``area`` (m^2)."""
 
@@ -87,7 +87,7 @@ class IronPath(_Iron):
         return self.area
 
 
-@dataclass(frozen=True)
+@frozen
 class AxialIron(_Iron):
     """A cylinder (``inner_radius`` = 0) or tube magnetised along its axis: flux area
     pi (r_o^2 - r_i^2), path ``length`` (m)."""
@@ -119,7 +119,7 @@ class AxialIron(_Iron):
         return math.pi * (self.outer_radius ** 2 - self.inner_radius ** 2)
 
 
-@dataclass(frozen=True)
+@frozen
 class RadialIron(_Iron):
     """A disc or annulus of axial ``thickness`` t magnetised radially from ``inner_radius``
     r_i to ``outer_radius`` r_o (the bottom of a pot-shaped yoke). Its linear reluctance
@@ -156,7 +156,7 @@ class RadialIron(_Iron):
 IRON_SHAPES = {"prism": IronPath, "axial": AxialIron, "radial": RadialIron}
 
 
-@dataclass(frozen=True)
+@frozen
 class AxialGap:
     """An air gap of ``length`` (m) over ``area`` (m^2): G = mu0 A / l."""
 
@@ -175,7 +175,7 @@ class AxialGap:
         return MU0 * self.area / self.length
 
 
-@dataclass(frozen=True)
+@frozen
 class RadialGap:
     """The radial air gap of a slide guiding: a hollow cylinder of ``inner_radius`` r (m),
     radial ``thickness`` t (m) and axial ``length`` l (m): G = 2 pi mu0 l / ln(1 + t / r)."""
@@ -197,7 +197,7 @@ class RadialGap:
         return 2.0 * math.pi * MU0 * self.length / math.log1p(self.thickness / self.inner_radius)
 
 
-@dataclass(frozen=True)
+@frozen
 class QuarterCylinder:
     """Leakage from an edge to the perpendicular face along ``length`` l (m; 2 pi r around a
     round pole): G = 0.52 mu0 l (Roters)."""
@@ -215,7 +215,7 @@ class QuarterCylinder:
         return QUARTER_CYLINDER_FACTOR * MU0 * self.length
 
 
-@dataclass(frozen=True)
+@frozen
 class QuarterHollowCylinder:
     """Leakage through a quarter annulus of inner radius r and thickness t, ``ratio`` = t / r,
     along ``length`` l (m): G = 2 mu0 l ln(1 + t / r) / pi (Roters)."""
@@ -238,7 +238,7 @@ class QuarterHollowCylinder:
 AIR_SHAPES = {cls.shape: cls for cls in (AxialGap, RadialGap, QuarterCylinder, QuarterHollowCylinder)}
 
 
-@dataclass(frozen=True)
+@frozen
 class FixedGap:
     """One place of the flux path where it crosses air that does not move with the
     armature: its air tubes ``tube`` (a list) in parallel. Reluctance 1 / (sum of permeances)."""
@@ -286,7 +286,7 @@ def pole_leakage_permeance_slope(width: float, radius: float, gap):
     return -MU0 * width * radius / (g * (g + math.pi * radius))
 
 
-@dataclass(frozen=True)
+@frozen
 class WorkingGap:
     """The working air gap over the pole face of ``area`` (m^2); its length g (m) follows
     the armature. Below ``minimum`` (m, default 1 um: pole faces touch at their roughness)
@@ -301,7 +301,7 @@ class WorkingGap:
         check_positive(f"{self.name}.minimum", self.minimum, "m")
 
 
-@dataclass(frozen=True)
+@frozen
 class PoleLeakage:
     """The leakage flux around the poles, in parallel with the working gap: ``width`` w (m,
     the leakage field's mean circumference around a round pole) and ``radius`` r (m, its

@@ -25,12 +25,12 @@ reason are reported in the fit (and fit.json, and `switchsim fit`).
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Mapping
 
 import numpy as np
 
+from mech.frozen import frozen
 from coupling.laws.tribology.data import validate_tribometer_frame
 from coupling.laws.tribology.laws import ContactLaws, MuLaw, ResistanceLaw
 from coupling.laws.tribology.models import CURRENT_FAMILIES, LOAD_FAMILIES, MU_FAMILIES, load_law_parameters
@@ -50,7 +50,7 @@ FORMAT_VERSION = 1
 # Result objects
 
 
-@dataclass(frozen=True)
+@frozen
 class ParameterEstimate:
     """A fitted parameter: value, standard error and 95 % interval (None when not estimable), unit."""
 
@@ -69,7 +69,7 @@ class ParameterEstimate:
         return cls(d["name"], d["value"], d["stderr"], None if d["ci95"] is None else tuple(d["ci95"]), d["unit"])
 
 
-@dataclass(frozen=True)
+@frozen
 class Outlier:
     """A data row left out of a fit: its position in the table (0-based), where it is
     ("line 57" of the CSV, or "row 12"), the column and value, and why (the rule)."""
@@ -89,7 +89,7 @@ class Outlier:
         return cls(int(d["row"]), str(d["where"]), str(d["column"]), float(d["value"]), str(d["reason"]))
 
 
-@dataclass(frozen=True)
+@frozen
 class ModelFit:
     """One fitted candidate and its goodness of fit (all in log space).
 
@@ -150,7 +150,7 @@ class ModelFit:
         )
 
 
-@dataclass(frozen=True)
+@frozen
 class ModelSelection:
     """Candidates ranked by the criterion (lowest first); `chosen` is the first.
 
@@ -197,7 +197,7 @@ class ModelSelection:
                    tuple(tuple(s) for s in d["skipped"]))
 
 
-@dataclass(frozen=True)
+@frozen
 class CoulombComparison:
     """Free gamma against Coulomb (gamma = 0), both with one free mu per current level.
 
@@ -232,7 +232,7 @@ class CoulombComparison:
                    d["f_statistic"], d["p_value"], d["delta_aicc"], d["delta_bic"])
 
 
-@dataclass(frozen=True)
+@frozen
 class CurrentLevelMu:
     """mu at one measured current level (free-mu power-law fit): N^gamma, 95 % interval."""
 
@@ -251,7 +251,7 @@ class CurrentLevelMu:
         return cls(d["current_A"], d["n_points"], d["mu"], d["stderr_log"], tuple(d["ci95"]))
 
 
-@dataclass(frozen=True)
+@frozen
 class DataRange:
     """What the data span: the validity range of the fitted laws (N, A)."""
 
@@ -276,7 +276,7 @@ class DataRange:
         return cls(d["n_points"], tuple(d["loads_N"]), tuple(d["currents_A"]))
 
 
-@dataclass(frozen=True)
+@frozen
 class FrictionFit:
     """gamma and mu(I): per-current estimates, the Coulomb test and the chosen mu(I) model."""
 
@@ -306,7 +306,7 @@ class FrictionFit:
                    int(d.get("n_outliers", 0)))
 
 
-@dataclass(frozen=True)
+@frozen
 class ResistanceFit:
     """R_c(F_n, I): the ranked candidates (load law x current factor) and the chosen law."""
 
@@ -325,7 +325,7 @@ class ResistanceFit:
                    tuple(Outlier.from_dict(o) for o in d.get("outliers", ())), int(d.get("n_outliers", 0)))
 
 
-@dataclass(frozen=True)
+@frozen
 class TribometerFit:
     """Everything fitted from one tribometer dataset, and the laws the coupling calls.
 
@@ -430,7 +430,7 @@ class TribometerFit:
 # Least-squares machinery
 
 
-@dataclass(frozen=True)
+@frozen
 class _Problem:
     """The used rows reduced to their (load, |I|) cells (see the module docstring).
 
@@ -454,7 +454,7 @@ class _Problem:
         return len(self.load)
 
 
-@dataclass(frozen=True)
+@frozen
 class _Response:
     """A ln response over the cells: cell means, within-cell and total sums of squares."""
 

@@ -9,12 +9,12 @@ other laws to check that the fits recover what was put in.
 from __future__ import annotations
 
 import io
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from mech.frozen import frozen
 from coupling.laws.tribology.laws import ContactLaws, MuLaw, ResistanceLaw
 from coupling.laws.tribology.models import hertz_contact_radius, holm_constriction_resistance
 
@@ -25,7 +25,7 @@ ILLUSTRATIVE_CSV = Path(__file__).resolve().parent.parent / "data" / "tribometer
 ILLUSTRATIVE_SEED = 2024
 
 
-@dataclass(frozen=True)
+@frozen
 class SyntheticDesign:
     """A tribometer test plan and its scatter.
 

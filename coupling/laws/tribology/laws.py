@@ -15,11 +15,11 @@ and validates it once, naming the field and the allowed values.
 from __future__ import annotations
 
 from contextlib import contextmanager
-from dataclasses import dataclass
 from typing import Any, Mapping
 
 import numpy as np
 
+from mech.frozen import frozen
 from coupling.laws.tribology.models import (
     CURRENT_FAMILIES,
     LOAD_FAMILIES,
@@ -87,7 +87,7 @@ def _check_keys(where: str, data: Mapping[str, Any], required: tuple[str, ...], 
         )
 
 
-@dataclass(frozen=True)
+@frozen
 class MuLaw:
     """Generalized friction law |F_t| = mu(|I|) F_n^(1 - gamma) with a fitted mu(I).
 
@@ -154,7 +154,7 @@ class MuLaw:
             return cls(data["gamma"], data["model"], tuple(data["params"].items()), tuple(data["current_range_A"]))
 
 
-@dataclass(frozen=True)
+@frozen
 class ResistanceLaw:
     """Contact resistance R_c(F_n, I) = g(|I|) (R_f + R_1 (F_n / 1 N)^(-m)).
 
@@ -275,7 +275,7 @@ class ResistanceLaw:
                        tuple(data["current_range_A"]))
 
 
-@dataclass(frozen=True)
+@frozen
 class ContactLaws:
     """The two laws the coupling needs: friction mu(I) (with gamma) and R_c(F_n, I).
 

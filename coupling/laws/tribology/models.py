@@ -10,10 +10,10 @@ Every function takes numpy arrays or scalars; currents enter as given (the laws 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
+from mech.frozen import frozen
 
 # ---------------------------------------------------------------------------------
 # Physics building blocks
@@ -137,7 +137,7 @@ def current_factor_exponential_floor(current_A, current_scale_A, floor_fraction)
 # Candidate registries: names, parameters with units, bounds for the fits
 
 
-@dataclass(frozen=True)
+@frozen
 class Family:
     """One candidate family: its law, parameter names, units and fit bounds."""
 
@@ -175,7 +175,7 @@ MU_FAMILIES: dict[str, Family] = {
 }
 
 
-@dataclass(frozen=True)
+@frozen
 class LoadFamily:
     """A load law R(F) = R_f + R_1 F^-m with some of (R_f, R_1, m) fixed."""
 
