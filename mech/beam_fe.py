@@ -38,12 +38,12 @@ and for a bar held at x >= L/2; x = L for a bar held nearer tip 0).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Sequence
 
 import numpy as np
 
 from .validation import check_choice, check_finite, check_nonnegative, check_positive, check_whole
+from .frozen import frozen
 
 FAMILIES = ("axial", "bend2", "bend3")
 SUPPORTS = ("free", "clamp", "pivot")
@@ -65,7 +65,7 @@ _G3_XI, _G3_W = np.polynomial.legendre.leggauss(3)
 _GAUSS3 = (0.5 * (_G3_XI + 1.0), 0.5 * _G3_W)  # on [0, 1], exact for degree 5
 
 
-@dataclass(frozen=True)
+@frozen
 class PointMass:
     """A rivet on the bar's axis: position m from tip 0, mass kg, rotary_inertia kg m^2.
 
@@ -83,7 +83,7 @@ class PointMass:
         check_nonnegative("point_mass.rotary_inertia", self.rotary_inertia)
 
 
-@dataclass(frozen=True)
+@frozen
 class FEBeam:
     """A uniform straight beam for the finite-element modes (SI).
 
@@ -174,7 +174,7 @@ class FEBeam:
         return "pin"
 
 
-@dataclass(frozen=True)
+@frozen
 class BeamModes:
     """Elastic modes of one family, evaluable anywhere on the bar.
 
@@ -233,7 +233,7 @@ class BeamModes:
         return self.shape(x, 2)
 
 
-@dataclass(frozen=True)
+@frozen
 class FESystem:
     """Assembled (unconstrained) matrices of one family, with point masses included.
 
@@ -250,7 +250,7 @@ class FESystem:
     constrained: np.ndarray
 
 
-@dataclass(frozen=True)
+@frozen
 class BeamInvariants:
     """Inertia invariants of the floating-frame model about the body origin x0 (SI).
 
@@ -521,6 +521,43 @@ def _generalized_eigh(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndar
         return mu, inv.T @ w
 
 
+def _shift_inverted(beam: FEBeam, system: FESystem, cond: str, count: int):
+    """The reduced matrices of ``_solve``'s shift-inverted problem: (Kr, Mr, sigma, free dof
+    indices, rigid shapes), after checking that the mesh has ``count`` elastic modes."""
+    K, M = system.stiffness, system.mass
+    ndof = K.shape[0]
+    free = np.ones(ndof, dtype=bool)  # (np.setdiff1d would import numpy.ma, ~10 ms of a run's start)
+    free[system.constrained] = False
+    keep = np.flatnonzero(free)
+    x_ref = beam.centroid if cond == "free" else float(beam.support_position)
+    rigid = _rigid_shapes(system, cond, x_ref)
+    if count + len(rigid) > len(keep):
+        raise ValueError(
+            f"count = {count!r}: the mesh of {len(system.nodes) - 1} elements has only "
+            f"{len(keep) - len(rigid)} elastic modes in family {system.family!r}; use more elements"
+        )
+    modulus = beam.modulus(system.family)
+    rho_a = beam.density * beam.area
+    power = 2 if system.family == "axial" else 4
+    sigma = modulus / (rho_a * beam.length**power)
+    return K[np.ix_(keep, keep)], M[np.ix_(keep, keep)], sigma, keep, rigid
+
+
+def _lowest(mu: np.ndarray, sigma: float, count: int, r: int, family: str) -> np.ndarray:
+    """The count + r lowest eigenvalues lambda (ascending) of the shift-inverted problem's mu
+    (ascending), its r rigid (zero) ones checked."""
+    nk = len(mu)
+    lam = 1.0 / mu[:nk - count - r - 1:-1] - sigma  # the count + r largest mu: ascending lambda
+    if r:
+        first = lam[r]
+        if np.any(np.abs(lam[:r]) > 1e-3 * abs(first)):
+            raise RuntimeError(
+                f"family {family!r}: expected {r} rigid (zero) eigenvalues, got {lam[:r]!r} "
+                f"against the first elastic {first!r}"
+            )
+    return lam
+
+
 def _solve(beam: FEBeam, system: FESystem, cond: str, count: int):
     """Lowest ``count`` elastic eigenpairs: (omega^2 (count,), full dof vectors (count, dof)).
 
@@ -531,36 +568,15 @@ def _solve(beam: FEBeam, system: FESystem, cond: str, count: int):
     modes to a relative eps-level. omega^2 is then the Rayleigh quotient of each vector
     with the strain energy from its curvature (error second order in the vector's).
     """
-    K, M = system.stiffness, system.mass
-    ndof = K.shape[0]
-    free = np.ones(ndof, dtype=bool)  # (np.setdiff1d would import numpy.ma, ~10 ms of a run's start)
-    free[system.constrained] = False
-    keep = np.flatnonzero(free)
-    x_ref = beam.centroid if cond == "free" else float(beam.support_position)
-    rigid = _rigid_shapes(system, cond, x_ref)
+    M = system.mass
+    ndof = M.shape[0]
+    Kr, Mr, sigma, keep, rigid = _shift_inverted(beam, system, cond, count)
     r = len(rigid)
-    if count + r > len(keep):
-        raise ValueError(
-            f"count = {count!r}: the mesh of {len(system.nodes) - 1} elements has only "
-            f"{len(keep) - r} elastic modes in family {system.family!r}; use more elements"
-        )
-    modulus = beam.modulus(system.family)
-    rho_a = beam.density * beam.area
-    power = 2 if system.family == "axial" else 4
-    sigma = modulus / (rho_a * beam.length**power)
-    Kr = K[np.ix_(keep, keep)]
-    Mr = M[np.ix_(keep, keep)]
     nk = len(keep)
     mu, vec = _generalized_eigh(Mr, Kr + sigma * Mr)
-    lam = 1.0 / mu[:nk - count - r - 1:-1] - sigma  # the count + r largest mu: ascending lambda
+    _lowest(mu, sigma, count, r, system.family)
     vec = vec[:, :nk - count - r - 1:-1]
     if r:
-        first = lam[r]
-        if np.any(np.abs(lam[:r]) > 1e-3 * abs(first)):
-            raise RuntimeError(
-                f"family {system.family!r}: expected {r} rigid (zero) eigenvalues, got {lam[:r]!r} "
-                f"against the first elastic {first!r}"
-            )
         vec = vec[:, r:]
     full = np.zeros((count, ndof))
     full[:, keep] = vec.T
@@ -575,7 +591,7 @@ def _solve(beam: FEBeam, system: FESystem, cond: str, count: int):
         norm = np.sqrt(np.einsum("ij,ij->i", rm, rigid))[:, None]
         if np.any(np.abs(cross) > 1e-10 * norm):
             raise RuntimeError(f"family {system.family!r}: elastic modes not orthogonal to the rigid motions")
-    omega2 = modulus * _strain_integral(system.family, system.nodes, full)  # v' M v = 1
+    omega2 = beam.modulus(system.family) * _strain_integral(system.family, system.nodes, full)  # v' M v = 1
     full *= math.sqrt(beam.total_mass)  # generalized mass m_total
     return omega2, full
 
@@ -631,6 +647,28 @@ def beam_modes(beam: FEBeam, family: str, count: int, elements: int | None = Non
     else:
         lam, full = _solve(beam, system, cond, count)
     return _package(beam, family, cond, system, lam, full)
+
+
+def beam_frequencies(beam: FEBeam, family: str, count: int) -> np.ndarray:
+    """Hz: the lowest ``count`` elastic frequencies of ``family`` on ``beam_modes``'s mesh,
+    from the shift-inverted problem's eigenvalues alone (no shapes: about a third of the
+    cost; mech.model.frequencies_below, which only counts modes below a cutoff). They
+    agree with ``beam_modes``'s, whose squares are the shapes' Rayleigh quotients, to the
+    eigenvalue's round-off, eps x lambda_count / lambda_1 relative
+    (tests/mech/test_beam_fe.py)."""
+    count = check_whole("count", count)
+    system = assemble(beam, family, None, max(count, 1))
+    if count == 0:
+        return np.zeros(0)
+    cond = beam.condition(family)
+    Kr, Mr, sigma, _, rigid = _shift_inverted(beam, system, cond, count)
+    with _one_blas_thread():
+        low = np.linalg.cholesky(Kr + sigma * Mr)
+        inv = np.linalg.solve(low, np.eye(len(low)))
+        c = inv @ Mr @ inv.T
+        mu = np.linalg.eigvalsh(0.5 * (c + c.T))
+    lam = _lowest(mu, sigma, count, len(rigid), family)[len(rigid):]
+    return np.sqrt(lam) / (2.0 * math.pi)
 
 
 def beam_basis(beam: FEBeam, axial: int, bending: int, planar: bool = False,

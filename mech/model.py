@@ -10,12 +10,12 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 
 import numpy as np
 
 from .armature import gain_table
-from .beam_fe import beam_modes
+from .beam_fe import beam_frequencies
 from .contact_laws import damping_formula, hertz_impact, hertz_stiffness
 from .damping_calibration import calibrate_damping
 from .drives import ARMATURE_DRIVE, DriveKind, kind_of
@@ -42,6 +42,7 @@ from .modes import axial_frequencies, bending_frequencies, bending_shape, free_f
 from .parameters import MechScene
 from .travel_spring import travel_force
 from .rotations import matrix_to_quaternion, quat_to_matrix, rotation_y, rotation_z  # noqa: F401
+from .frozen import frozen
 
 
 def is_planar(scene: MechScene, tol: float = 1e-12) -> bool:
@@ -61,7 +62,7 @@ def is_planar(scene: MechScene, tol: float = 1e-12) -> bool:
     return abs(v @ normal) <= tol * scale_v and np.linalg.norm(w - (w @ normal) * normal) <= tol * scale_w
 
 
-@dataclass(frozen=True)
+@frozen
 class ContactScales:
     """Contact constants and the scales the error control and step bound use (SI)."""
 
@@ -436,7 +437,7 @@ def state_slices(n: int, planar: bool, nq: int, armature: bool = False, bar: boo
 ARMATURE_TIME_SCALE = 1e-3  # s
 
 
-@dataclass(frozen=True)
+@frozen
 class ArmatureScales:
     """The armature's scales (SI; m or rad for a clapper): its reference speed, the stops'
     penetration at that speed, an energy, and the shortest contact time of its stops and
@@ -494,7 +495,7 @@ def armature_parameters(arm, card_z0: float = 0.0, card_mobility: float = 0.0) -
     return apar
 
 
-@dataclass(frozen=True)
+@frozen
 class BarModel:
     """The compiled model's arrays plus what Python needs to interpret the state.
 
@@ -1193,11 +1194,13 @@ def frequencies_below(beam, family: str, cutoff: float, cap: int, first: int = 8
     about 4e-5 of its converged frequency (default_elements), so a count of modes below
     the cutoff differs from the finest mesh's only for a mode that close to the cutoff;
     the cap's mesh (255 elements, ~0.3 s of eigen-solves for a blade's two families)
-    was most of the start of a held bar's run.
+    was most of the start of a held bar's run. The frequencies are the eigenvalues alone
+    (beam_fe.beam_frequencies: no shapes, a third of the cost), which the shapes' Rayleigh
+    quotients of beam_modes match to their round-off.
     """
     count = max(1, min(first, cap))
     while True:
-        f = beam_modes(beam, family, count).frequencies
+        f = beam_frequencies(beam, family, count)
         if count >= cap or f[-1] >= cutoff:
             return f
         top = f[-1]
