@@ -51,42 +51,37 @@ class OurChild(OurBase):
     z: tuple = (1, 2)
 
 
-@dataclasses.dataclass(frozen=True, kw_only=True)
-class StdKw:
-    a: int
-    b: int = 3
+def _keyword_only(decorate, name):
+    class Kw:
+        a: int
+        b: int = 3
+
+    Kw.__name__ = Kw.__qualname__ = name
+    return decorate(Kw)
 
 
-@frozen(kw_only=True)
-class OurKw:
-    a: int
-    b: int = 3
+def _own_methods(decorate, name):
+    class Own:
+        a: int
+
+        def __eq__(self, other):
+            return isinstance(other, type(self)) and abs(self.a - other.a) <= 1
+
+        def __repr__(self):
+            return "own"
+
+    Own.__name__ = Own.__qualname__ = name
+    return decorate(Own)
 
 
-@dataclasses.dataclass(frozen=True)
-class StdOwn:
-    a: int
-
-    def __eq__(self, other):
-        return isinstance(other, type(self)) and abs(self.a - other.a) <= 1
-
-    def __repr__(self):
-        return "own"
-
-
-@frozen
-class OurOwn:
-    a: int
-
-    def __eq__(self, other):
-        return isinstance(other, type(self)) and abs(self.a - other.a) <= 1
-
-    def __repr__(self):
-        return "own"
+StdKw = _keyword_only(dataclasses.dataclass(frozen=True, kw_only=True), "StdKw")
+OurKw = _keyword_only(frozen(kw_only=True), "OurKw")
+StdOwn = _own_methods(dataclasses.dataclass(frozen=True), "StdOwn")
+OurOwn = _own_methods(frozen, "OurOwn")
 
 
 def _outcome(call):
-    """(type of the result, its repr) or (exception type, None)."""
+    """(the result's class name without its Std/Our prefix, None) or (exception type, None)."""
     try:
         value = call()
     except Exception as exc:  # noqa: BLE001 -- the exception's type is what is compared
