@@ -130,11 +130,20 @@ PHASES = textwrap.dedent("""
     folder = ResultFolder.check(sys.argv[2], scene_identity(scene, None), overwrite=True)
     gc.freeze()  # the scene built (run_command): frozen, the collector on for the run
     gc.enable()
+    from coupling.app.table_writer import TableWriter, wanted
+    writer = TableWriter.start() if wanted(scene) else None  # as run_command: the large tables' helper
+    if writer is not None:
+        timed(TableWriter, "submit", "large tables handed to the table writer")
+        timed(TableWriter, "collect", "waiting for the table writer")
     result = run(scene, progress=False)
     mark("run (model build, ngspice start, co-simulation)")
     soundness = assess(result)
     mark("soundness")
-    folder.write(result, {"soundness": soundness})
+    folder.write(result, {"soundness": soundness}, writer)
+    if writer is not None:
+        for path, seconds in writer.seconds.items():
+            parts[os.path.basename(path) + " (by the table writer, meanwhile)"] = seconds
+        writer.close(wait=False)
     mark("write the default outputs")
     stats = result.stats
     parts["Python's cyclic collector (gc.callbacks; imports to files written)"] = collector.get("s", 0.0)
@@ -367,7 +376,7 @@ def main() -> None:
     lines.append(f"| (of the run: its own wall_time) | {cells(r['wall_time'] for r in runs)} |")
     lines.append("| (of that: mechanics / circuit, coupled) | - | " + " | ".join(
         f"{r['mech'] or 0:.3f} s / {r['circuit'] or 0:.3f} s" for r in runs[1:]) + " |")
-    for name in coupled_phases["parts"]:
+    for name in dict.fromkeys([*coupled_phases["parts"], *mech_phases["parts"], *plunger_phases["parts"]]):
         lines.append(f"| (inside: {name}) | {cells(r['parts'].get(name) for r in runs)} |")
     lines.append(f"| (mechanics steps) | {cells(r['steps'] for r in runs)} |")
     lines.append(f"| (macro steps of the co-simulation) | - | {cells(r['macro_steps'] for r in runs[1:])} |")

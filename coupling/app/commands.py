@@ -46,9 +46,7 @@ def run_command(scene_path: str | None, out_dir: str | None, *, quiet: bool = Fa
 
 
 def _run(scene_path, out_dir, quiet, overwrite, check, plots, one_shot) -> int:
-    from coupling.core.master import CoupledRunError, RunInterrupted, run
     from coupling.app.output import ResultFolder, project_matplotlib, recover, scene_identity
-    from coupling.core.results import RunStatus
     from coupling.core.scene import default_scene, load_scene
 
     scene = default_scene() if scene_path is None else load_scene(scene_path)  # validates before running
@@ -63,19 +61,35 @@ def _run(scene_path, out_dir, quiet, overwrite, check, plots, one_shot) -> int:
         _say(restored)
     folder = ResultFolder.check(out_dir, scene_identity(scene, scene_path), overwrite=overwrite)
     extra = {"scene_file": folder.identity["scene_file"]}
-    out = folder.path
+    writer = None
     if one_shot:  # the scene built: what exists now lives to the process's end
         gc.freeze()
         gc.enable()
+        from coupling.app.table_writer import TableWriter, wanted
+
+        if wanted(scene):  # the large tables' helper, readied while the run goes on
+            writer = TableWriter.start()
+    try:
+        return _run_and_write(scene, folder, extra, writer, quiet, check)
+    finally:
+        if writer is not None:
+            writer.close(wait=False)  # (this process ends next: the system reaps it)
+
+
+def _run_and_write(scene, folder, extra, writer, quiet, check) -> int:
+    from coupling.core.master import CoupledRunError, RunInterrupted, run
+    from coupling.core.results import RunStatus
+
+    out = folder.path
     _chatter(quiet, f"running {scene.name} ({scene.kind}, t_end = {scene.t_end * 1e3:g} ms)")
     try:
         result = run(scene, progress=not quiet, check=check)
     except RunInterrupted as err:
-        return _write_partial(folder, err.partial, extra, f"{err}", EXIT_INTERRUPTED)
+        return _write_partial(folder, err.partial, extra, f"{err}", EXIT_INTERRUPTED, writer)
     except CoupledRunError as err:
-        return _write_partial(folder, err.partial, extra, f"{err}", EXIT_FAILED)
+        return _write_partial(folder, err.partial, extra, f"{err}", EXIT_FAILED, writer)
     try:
-        folder.write(result, extra)
+        folder.write(result, extra, writer)
     except KeyboardInterrupt:
         _say(f"interrupted while writing the result; {out} was left as it was")
         return EXIT_INTERRUPTED
@@ -146,13 +160,13 @@ def plot_command(result_dir: str) -> int:
     return EXIT_OK
 
 
-def _write_partial(folder, partial, extra: dict, message: str, code: int) -> int:
+def _write_partial(folder, partial, extra: dict, message: str, code: int, writer=None) -> int:
     message = " ".join(message.split())  # one line, whatever the cause quotes
     if partial is None:
         _say(f"{message}; nothing could be kept, nothing written")
         return code
     try:
-        folder.write(partial, extra)
+        folder.write(partial, extra, writer)
     except KeyboardInterrupt:
         _say(f"{message}; interrupted again while writing: nothing written")
         return EXIT_INTERRUPTED

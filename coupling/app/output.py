@@ -180,9 +180,10 @@ class ResultFolder:
         before = frozenset(os.listdir(path)) if path.is_dir() else None
         return cls(path=path.absolute(), identity=identity, overwrite=overwrite, before=before)
 
-    def write(self, result, summary_extra: dict | None = None) -> Path:
-        """Write ``result`` (a CoupledResult) and put it in place; returns the folder."""
-        return self.publish(lambda staging: write_files(result, staging, summary_extra))
+    def write(self, result, summary_extra: dict | None = None, writer=None) -> Path:
+        """Write ``result`` (a CoupledResult) and put it in place; returns the folder
+        (``writer``: write_files's)."""
+        return self.publish(lambda staging: write_files(result, staging, summary_extra, writer))
 
     def publish(self, fill) -> Path:
         """``fill(folder)`` writes the files into a fresh hidden folder, which then takes the
@@ -357,43 +358,70 @@ def save_result(result, out_dir, *, overwrite: bool = False, scene_path: str | N
     return folder.write(result)
 
 
-def write_files(result, folder: Path, summary_extra: dict | None = None) -> None:
+def write_files(result, folder: Path, summary_extra: dict | None = None, writer=None) -> None:
     """Write all of a result's files into ``folder``, summary.json last: the waveforms (CSV,
     parquet, the interactive waveforms.html), openings.csv, the mechanics tables (history.csv
     thinned to ``[output] history_resolution``) and PNG plots, as the scene's [output] asks.
-    The one writer of result folders: ``switchsim run`` and ``CoupledResult.save``."""
+    The one writer of result folders: ``switchsim run`` and ``CoupledResult.save``.
+
+    writer: a ``coupling.app.table_writer.TableWriter`` (``switchsim run``'s own process):
+    waveforms.parquet, waveforms.csv and history.csv go to it, the rest is written here
+    meanwhile; a table it did not write is written here, and an error here stops it."""
     from coupling.core.results import REGIME_NAMES, event_columns
 
     opts = result.scene.output
     summary = result.summary
-    if result.waveform_columns is not None:
-        if getattr(opts, "html", True):
-            from coupling.app.waveview import write_waveform_html
+    sent = []  # (function, path, args) the writer has
+    writers = {"write_csv": write_csv, "write_parquet": write_parquet}  # (by name: the writer's protocol)
+    history = None  # summary["history"], entered after waveforms_html (the summary's order as before)
 
-            html = write_waveform_html(result, folder / "waveforms.html")
-            summary["waveforms_html"] = "waveforms.html" if html == "written" else html
+    def large(name, path, *args):
+        if writer is not None and writer.submit(name, path, *args):
+            sent.append((writers[name], path, args))
+        else:
+            writers[name](path, *args)
+
+    try:
         waves = result.waveform_columns
-        if opts.parquet:  # first: with pyarrow loaded, the large CSVs take write_csv's Arrow route
-            write_parquet(folder / "waveforms.parquet", waves)
-        if opts.csv:
-            write_csv(folder / "waveforms.csv", waves)
-        if result.scene.circuit is not None:
-            write_csv(folder / "openings.csv", result.opening_columns)
-            for name in result.contact_results:  # each contact of several: its own table
-                write_csv(folder / f"openings_{name}.csv", result.contact_opening_columns(name))
-    m = result.mechanics
-    if m is not None:
-        if opts.history:
+        if waves is not None:
+            if opts.parquet:  # first: with pyarrow loaded, the large CSVs take write_csv's Arrow route
+                large("write_parquet", folder / "waveforms.parquet", waves)
+            if opts.csv:
+                large("write_csv", folder / "waveforms.csv", waves)
+        m = result.mechanics
+        if m is not None and opts.history:
             t = m.t
             interval = opts.history_interval(float(t[-1] - t[0]) if len(t) else 0.0)
             kept = thin_history(m, interval)
-            write_csv(folder / "history.csv", thin_result(m, kept).history_columns,
-                      codes={"regime_0": REGIME_NAMES, "regime_1": REGIME_NAMES})
-            summary["history"] = {"file": "history.csv", "resolution": interval,
-                                  "rows": int(len(kept)), "solver_records": int(len(t))}
-        write_csv(folder / "contacts.csv", m.contact_columns)
-        write_csv(folder / "phases.csv", m.phase_columns)
-        write_csv(folder / "events.csv", event_columns(m.events))
+            large("write_csv", folder / "history.csv", thin_result(m, kept).history_columns,
+                  {"regime_0": REGIME_NAMES, "regime_1": REGIME_NAMES})
+            history = {"file": "history.csv", "resolution": interval,
+                       "rows": int(len(kept)), "solver_records": int(len(t))}
+        if waves is not None:
+            if getattr(opts, "html", True):
+                from coupling.app.waveview import write_waveform_html
+
+                html = write_waveform_html(result, folder / "waveforms.html")
+                summary["waveforms_html"] = "waveforms.html" if html == "written" else html
+            if result.scene.circuit is not None:
+                write_csv(folder / "openings.csv", result.opening_columns)
+                for name in result.contact_results:  # each contact of several: its own table
+                    write_csv(folder / f"openings_{name}.csv", result.contact_opening_columns(name))
+        if history is not None:
+            summary["history"] = history
+        if m is not None:
+            write_csv(folder / "contacts.csv", m.contact_columns)
+            write_csv(folder / "phases.csv", m.phase_columns)
+            write_csv(folder / "events.csv", event_columns(m.events))
+        if sent:
+            done = writer.collect()
+            for function, path, args in sent:
+                if done.get(str(path), "not answered") is not None:
+                    function(path, *args)  # written here: the helper's failure costs time, not the file
+    except BaseException:
+        if sent:
+            writer.abort()  # nothing more written into a folder the caller now removes
+        raise
     if opts.plots:
         from coupling.app.plots import save_plots
 

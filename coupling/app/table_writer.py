@@ -1,0 +1,225 @@
+"""A second process that writes a run's large tables while the command's own process
+writes the rest.
+
+``switchsim run`` forks it once its scene is built, before the co-simulation. While the run
+goes on (one core) it imports pyarrow and readies the Arrow route of
+``coupling.app.output.write_csv`` (~40 ms that no longer wait for the run's end); after the
+run it writes waveforms.parquet, waveforms.csv and history.csv into the result's staging
+folder while the command's process writes waveforms.html, the small tables and, last,
+summary.json. The files are the same bytes as those written in one process: the same
+functions write them (tests/coupling/test_table_writer.py).
+
+What it is sent (one pickled message a table: the function's name, the path, its
+arguments) is put into memory the two processes share (mapped before the fork), and only
+where it lies goes through a pipe: the command never waits for the helper to take a table
+(a pipe holds 64 KiB, history.csv's columns are a few MiB) and the helper needs no thread
+to read it. Its answers (the path, None or the error's text, and the seconds it took) come back through a
+second pipe. A table too large for the shared memory (``SHARED_BYTES``) is written by the
+command itself. It
+writes nothing it was not sent, answers each table when it is on disk, and ends at the end
+of its input, when the command's process ends for any reason, or when the command closes
+it (at once: everything it was sent is written or given up by then).
+It ignores the user's Ctrl-C, which is the command's to handle: an interrupted run's partial
+result still gets its tables through it. A table it could not write (it failed, or died) is
+written by the command itself, so the helper can cost time but never a file; when the
+command gives up writing a result it stops the helper first, so nothing more appears in a
+folder that is being removed.
+
+Only where ``os.fork`` is there (Linux); elsewhere, and inside a caller's process (tests,
+``CoupledResult.save``, sweeps), everything is written in one process as before.
+"""
+
+from __future__ import annotations
+
+import mmap
+import os
+import pickle
+import signal
+import struct
+import sys
+import time
+from pathlib import Path
+
+_LENGTH = struct.Struct("<Q")  # each answer: its pickle's length, then the pickle
+_WHERE = struct.Struct("<QQ")  # each table: where its pickle lies in the shared memory (offset, length)
+SHARED_BYTES = 256 << 20  # the shared memory's size: address space, pages only where a table was put
+
+
+def wanted(scene, cpus: int | None = None) -> bool:
+    """Whether a run of ``scene`` is worth a helper: a co-simulation (a circuit: the run
+    outlasts the helper's start) that writes at least one of the large tables, on a machine
+    that lets this process use two CPUs or more (``cpus``; None: as the system says). On one
+    CPU the helper would take its time from the run: the pair costs more CPU time than one
+    process (the fork, pyarrow's import, the tables' copies: ~20-30 ms a relay run,
+    docs/benchmarks.md), which only a second CPU hides."""
+    if cpus is None:
+        cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    opts = scene.output
+    return cpus >= 2 and scene.circuit is not None and (opts.parquet or opts.csv or opts.history)
+
+
+class TableWriter:
+    """The parent's end of the helper (module docstring). ``start()`` forks it; ``submit``
+    sends a table, ``collect`` waits for every table sent, ``close`` ends the helper."""
+
+    WRITERS = ("write_csv", "write_parquet")  # what it may be asked to call (coupling.app.output)
+
+    def __init__(self, pid: int, shared: mmap.mmap, jobs: int, replies: int):
+        self.pid = pid
+        self._shared = shared
+        self._used = 0  # bytes of the shared memory holding tables not yet answered
+        self._jobs = jobs  # fd: where each table lies
+        self._replies = os.fdopen(replies, "rb")
+        self._pending: list[str] = []
+        self._broken = False
+        self.seconds: dict[str, float] = {}  # path -> the helper's time writing it (benchmarks)
+
+    @classmethod
+    def start(cls) -> "TableWriter | None":
+        """Fork the helper; None where fork is not there or fails (then one process writes)."""
+        if not hasattr(os, "fork") or not sys.platform.startswith("linux"):
+            return None
+        try:
+            shared = mmap.mmap(-1, SHARED_BYTES)  # (anonymous: shared with the child)
+        except (OSError, ValueError):
+            return None
+        try:
+            jobs_r, jobs_w = os.pipe()
+            replies_r, replies_w = os.pipe()
+        except OSError:
+            shared.close()
+            return None
+        try:
+            pid = os.fork()
+        except OSError:
+            for fd in (jobs_r, jobs_w, replies_r, replies_w):
+                os.close(fd)
+            shared.close()
+            return None
+        if pid == 0:  # the helper: never returns into the command's code
+            code = 1
+            try:
+                os.close(jobs_w)
+                os.close(replies_r)
+                _serve(shared, jobs_r, replies_w)
+                code = 0
+            finally:
+                os._exit(code)  # no atexit handlers, no flush of the parent's buffers
+        os.close(jobs_r)
+        os.close(replies_w)
+        return cls(pid, shared, jobs_w, replies_r)
+
+    def submit(self, function: str, path: Path, *args) -> bool:
+        """Send one table (``function`` of coupling.app.output called with ``path, *args``);
+        False if the helper is gone or the table does not fit (the caller then writes it)."""
+        if function not in self.WRITERS:
+            raise ValueError(f"function = {function!r}: allowed values are {', '.join(self.WRITERS)}")
+        if self._broken:
+            return False
+        data = pickle.dumps((function, str(path), args), protocol=pickle.HIGHEST_PROTOCOL)
+        start, end = self._used, self._used + len(data)
+        if end > len(self._shared):
+            return False
+        self._shared[start:end] = data
+        try:
+            _write_all(self._jobs, _WHERE.pack(start, len(data)))
+        except OSError:  # (BrokenPipeError: it died)
+            self._broken = True
+            return False
+        self._used = end
+        self._pending.append(str(path))
+        return True
+
+    def collect(self) -> dict:
+        """Wait for every table sent: path -> None (written) or why it was not (its error's
+        text, or that the helper ended before answering)."""
+        done = {}
+        pending, self._pending = self._pending, []
+        for path in pending:
+            reply = None if self._broken else _read(self._replies)
+            if reply is None:
+                self._broken = True
+                done[path] = "the table writer ended before writing it"
+                continue
+            written, error, seconds = reply
+            done[written] = error
+            self.seconds[written] = seconds
+        self._used = 0  # every table answered: the shared memory is free again
+        return done
+
+    def close(self, wait: bool = True) -> None:
+        """End the helper now. It holds nothing of its own: every table sent was collected,
+        or is being given up with its folder (``write_files``), and one still importing
+        pyarrow after a run that wrote no tables need not finish. ``wait``: until it has
+        ended (its memory's teardown takes ~5 ms); otherwise a process about to end itself
+        leaves it to the system (its parent's end makes init reap it)."""
+        if self.pid:
+            try:
+                os.kill(self.pid, signal.SIGKILL)
+            except OSError:
+                pass
+        self._broken = True
+        if self._jobs >= 0:
+            os.close(self._jobs)
+            self._jobs = -1
+            self._replies.close()
+            self._shared.close()
+        if self.pid:
+            try:
+                os.waitpid(self.pid, 0 if wait else os.WNOHANG)
+            except ChildProcessError:
+                pass
+            self.pid = 0
+
+    abort = close  # (write_files's name for it after an error: nothing more is written)
+
+    def __enter__(self) -> "TableWriter":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+def _serve(shared: mmap.mmap, jobs_fd: int, replies_fd: int) -> None:
+    """The helper's life: ready the Arrow route, then write each table it is sent."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    from coupling.app import arrow_text, output
+
+    try:  # while the command runs: what the tables' first write would otherwise wait for
+        if arrow_text.available():
+            import pyarrow._parquet  # noqa: F401 - write_parquet's writer
+    except Exception:  # noqa: BLE001 - no pyarrow, or a broken one: write_csv's other route, and the error below
+        pass
+    writers = {name: getattr(output, name) for name in TableWriter.WRITERS}
+    view = memoryview(shared)
+    with os.fdopen(jobs_fd, "rb") as jobs:
+        while len(where := jobs.read(_WHERE.size)) == _WHERE.size:
+            start, size = _WHERE.unpack(where)
+            function, path, args = pickle.loads(view[start:start + size])
+            tick = time.perf_counter()
+            try:
+                writers[function](Path(path), *args)
+                error = None
+            except Exception as err:  # noqa: BLE001 - reported; the command writes the table itself
+                error = f"{type(err).__name__}: {err}"
+            del args  # (the table's arrays freed before the next one comes)
+            data = pickle.dumps((path, error, time.perf_counter() - tick), protocol=pickle.HIGHEST_PROTOCOL)
+            _write_all(replies_fd, _LENGTH.pack(len(data)) + data)
+
+
+def _read(stream):
+    """The next message of ``stream`` (a buffered binary file), or None at its end."""
+    head = stream.read(_LENGTH.size)
+    if len(head) < _LENGTH.size:
+        return None
+    (size,) = _LENGTH.unpack(head)
+    data = stream.read(size)
+    if len(data) < size:
+        return None
+    return pickle.loads(data)
+
+
+def _write_all(fd: int, data: bytes) -> None:
+    view = memoryview(data)
+    while view:
+        view = view[os.write(fd, view):]
