@@ -10,12 +10,14 @@ summary.json. The files are the same bytes as those written in one process: the 
 functions write them (tests/coupling/test_table_writer.py).
 
 What it is sent (one pickled message a table: the function's name, the path, its
-arguments) is put into memory the two processes share (mapped before the fork), and only
+arguments) is written into an in-memory file the two processes share (``memfd_create``,
+made before the fork, grown as tables come and emptied when all are answered), and only
 where it lies goes through a pipe: the command never waits for the helper to take a table
-(a pipe holds 64 KiB, history.csv's columns are a few MiB) and the helper needs no thread
-to read it. Its answers (the path, None or the error's text, and the seconds it took) come back through a
-second pipe. A table too large for the shared memory (``SHARED_BYTES``) is written by the
-command itself. It
+(a pipe holds 64 KiB, history.csv's columns are a few MiB), the helper needs no thread to
+read it, and neither process maps it (a cap on the address space, ``ulimit -v``, sees
+nothing of it). Its answers (the path, None or the error's text, and the seconds it took)
+come back through a second pipe. A table that cannot be put there (no memory) is written by
+the command itself. It
 writes nothing it was not sent, answers each table when it is on disk, and ends at the end
 of its input, when the command's process ends for any reason, or when the command closes
 it (at once: everything it was sent is written or given up by then).
@@ -31,7 +33,6 @@ Only where ``os.fork`` is there (Linux); elsewhere, and inside a caller's proces
 
 from __future__ import annotations
 
-import mmap
 import os
 import pickle
 import signal
@@ -41,8 +42,7 @@ import time
 from pathlib import Path
 
 _LENGTH = struct.Struct("<Q")  # each answer: its pickle's length, then the pickle
-_WHERE = struct.Struct("<QQ")  # each table: where its pickle lies in the shared memory (offset, length)
-SHARED_BYTES = 256 << 20  # the shared memory's size: address space, pages only where a table was put
+_WHERE = struct.Struct("<QQ")  # each table: where its pickle lies in the shared file (offset, length)
 
 
 def wanted(scene, cpus: int | None = None) -> bool:
@@ -64,10 +64,10 @@ class TableWriter:
 
     WRITERS = ("write_csv", "write_parquet")  # what it may be asked to call (coupling.app.output)
 
-    def __init__(self, pid: int, shared: mmap.mmap, jobs: int, replies: int):
+    def __init__(self, pid: int, shared: int, jobs: int, replies: int):
         self.pid = pid
-        self._shared = shared
-        self._used = 0  # bytes of the shared memory holding tables not yet answered
+        self._shared = shared  # fd: the in-memory file the tables are put into
+        self._used = 0  # bytes of it holding tables not yet answered
         self._jobs = jobs  # fd: where each table lies
         self._replies = os.fdopen(replies, "rb")
         self._pending: list[str] = []
@@ -77,25 +77,19 @@ class TableWriter:
     @classmethod
     def start(cls) -> "TableWriter | None":
         """Fork the helper; None where fork is not there or fails (then one process writes)."""
-        if not hasattr(os, "fork") or not sys.platform.startswith("linux"):
+        if not (hasattr(os, "fork") and hasattr(os, "memfd_create") and sys.platform.startswith("linux")):
             return None
+        fds = []
         try:
-            shared = mmap.mmap(-1, SHARED_BYTES)  # (anonymous: shared with the child)
-        except (OSError, ValueError):
-            return None
-        try:
-            jobs_r, jobs_w = os.pipe()
-            replies_r, replies_w = os.pipe()
-        except OSError:
-            shared.close()
-            return None
-        try:
+            fds.append(shared := os.memfd_create("switchsim-tables", os.MFD_CLOEXEC))
+            fds.extend(jobs := os.pipe())
+            fds.extend(replies := os.pipe())
             pid = os.fork()
         except OSError:
-            for fd in (jobs_r, jobs_w, replies_r, replies_w):
+            for fd in fds:
                 os.close(fd)
-            shared.close()
             return None
+        (jobs_r, jobs_w), (replies_r, replies_w) = jobs, replies
         if pid == 0:  # the helper: never returns into the command's code
             code = 1
             try:
@@ -117,16 +111,19 @@ class TableWriter:
         if self._broken:
             return False
         data = pickle.dumps((function, str(path), args), protocol=pickle.HIGHEST_PROTOCOL)
-        start, end = self._used, self._used + len(data)
-        if end > len(self._shared):
+        start = self._used
+        try:
+            os.ftruncate(self._shared, start + len(data))
+            if os.pwrite(self._shared, data, start) != len(data):
+                return False
+        except OSError:  # (no memory for it)
             return False
-        self._shared[start:end] = data
         try:
             _write_all(self._jobs, _WHERE.pack(start, len(data)))
         except OSError:  # (BrokenPipeError: it died)
             self._broken = True
             return False
-        self._used = end
+        self._used = start + len(data)
         self._pending.append(str(path))
         return True
 
@@ -144,7 +141,11 @@ class TableWriter:
             written, error, seconds = reply
             done[written] = error
             self.seconds[written] = seconds
-        self._used = 0  # every table answered: the shared memory is free again
+        self._used = 0  # every table answered: the shared file's memory is given back
+        try:
+            os.ftruncate(self._shared, 0)
+        except OSError:
+            pass
         return done
 
     def close(self, wait: bool = True) -> None:
@@ -163,7 +164,7 @@ class TableWriter:
             os.close(self._jobs)
             self._jobs = -1
             self._replies.close()
-            self._shared.close()
+            os.close(self._shared)
         if self.pid:
             try:
                 os.waitpid(self.pid, 0 if wait else os.WNOHANG)
@@ -180,7 +181,7 @@ class TableWriter:
         self.close()
 
 
-def _serve(shared: mmap.mmap, jobs_fd: int, replies_fd: int) -> None:
+def _serve(shared: int, jobs_fd: int, replies_fd: int) -> None:
     """The helper's life: ready the Arrow route, then write each table it is sent."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     from coupling.app import arrow_text, output
@@ -191,11 +192,10 @@ def _serve(shared: mmap.mmap, jobs_fd: int, replies_fd: int) -> None:
     except Exception:  # noqa: BLE001 - no pyarrow, or a broken one: write_csv's other route, and the error below
         pass
     writers = {name: getattr(output, name) for name in TableWriter.WRITERS}
-    view = memoryview(shared)
     with os.fdopen(jobs_fd, "rb") as jobs:
         while len(where := jobs.read(_WHERE.size)) == _WHERE.size:
             start, size = _WHERE.unpack(where)
-            function, path, args = pickle.loads(view[start:start + size])
+            function, path, args = pickle.loads(_pread_all(shared, size, start))
             tick = time.perf_counter()
             try:
                 writers[function](Path(path), *args)
@@ -217,6 +217,18 @@ def _read(stream):
     if len(data) < size:
         return None
     return pickle.loads(data)
+
+
+def _pread_all(fd: int, size: int, offset: int) -> bytes:
+    parts = []
+    while size:
+        part = os.pread(fd, size, offset)
+        if not part:
+            raise EOFError("the shared file ends before the table does")
+        parts.append(part)
+        size -= len(part)
+        offset += len(part)
+    return b"".join(parts)
 
 
 def _write_all(fd: int, data: bytes) -> None:
