@@ -10,16 +10,20 @@ just-in-time route and the ahead-of-time build), before any compiled function is
 
 from __future__ import annotations
 
-import hashlib
 import os
 from pathlib import Path
+
+try:  # CPython's own SHA-1: the same digest as hashlib's without loading OpenSSL (~2.5 ms a start)
+    from _sha1 import sha1
+except ImportError:  # an interpreter built without it
+    from hashlib import sha1
 
 PACKAGE = Path(__file__).resolve().parent
 
 
 def source_key(folder: Path = PACKAGE) -> str:
     """12 hex digits of the SHA-1 of the package's .py files (names and contents, in order)."""
-    digest = hashlib.sha1()
+    digest = sha1()
     for path in sorted(folder.glob("*.py")):
         digest.update(path.name.encode())
         digest.update(path.read_bytes())

@@ -8,7 +8,6 @@ parameters, and `TribometerFit.from_json` for a saved fit. See docs/tribology.md
 from __future__ import annotations
 
 import dataclasses
-import hashlib
 import json
 from functools import cache
 from pathlib import Path
@@ -48,6 +47,8 @@ _FIT_SOURCES = ("data.py", "fits.py", "laws.py", "models.py")
 
 def default_fit_key() -> str:
     """sha256 of the illustrative CSV and of the modules that read and fit it."""
+    import hashlib  # (here: a scene with inline laws never asks, and hashlib loads OpenSSL, ~2.5 ms)
+
     digest = hashlib.sha256(Path(illustrative_data_path()).read_bytes())
     for name in _FIT_SOURCES:
         digest.update((Path(__file__).resolve().parent / name).read_bytes())
