@@ -222,7 +222,7 @@ class ResultFolder:
             try:
                 os.rename(staging, path)
                 return None
-            except OSError as err:  # the folder appeared during the run
+            except OSError:  # the folder appeared during the run
                 if not (path.exists() or path.is_symlink()):
                     raise
         if path.is_symlink() or not path.is_dir():
