@@ -347,7 +347,7 @@ def main() -> None:
 
     lines = [f"`.venv/bin/python benchmarks/bench_startup.py --repeat {args.repeat}` "
              f"(load average {load:.1f} at the end; median of {args.repeat}, whole process, "
-             f"peak RSS from wait4); {_bytecode_note()}", "",
+             f"peak RSS from wait4: the command's own process, not its table writer's); {_bytecode_note()}", "",
              "| command | wall | best | / `import numpy` | peak RSS |", "|---|---|---|---|---|"]
     for label, med, best, rss in rows:
         lines.append(f"| {label} | {med:.3f} s | {best:.3f} s | {med / base:.1f}x | {rss:.0f} MiB |")
