@@ -419,7 +419,7 @@ def write_files(result, folder: Path, summary_extra: dict | None = None, writer=
                     function(path, *args)  # written here: the helper's failure costs time, not the file
     except BaseException:
         if sent:
-            writer.abort()  # nothing more written into a folder the caller now removes
+            writer.close()  # nothing more written into a folder the caller now removes
         raise
     if opts.plots:
         from coupling.app.plots import save_plots

@@ -72,6 +72,8 @@ import time
 import tomllib
 import uuid
 from pathlib import Path
+
+from coupling.app import usable_cpus
 from mech.frozen import frozen
 
 DESIGNS = ("grid", "cases", "random", "lhs", "tolerance")
@@ -836,14 +838,6 @@ class _ProgressLine:
             print(line, file=self.stream, flush=True)
 
 
-def default_workers() -> int:
-    """Worker processes for a local cluster: the CPUs this process may use."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # not on Linux
-        return max(1, os.cpu_count() or 1)
-
-
 def _sweep_folder(out_dir) -> Path:
     """The --out folder, created if missing; one line for a file, a device or no permission."""
     if not isinstance(out_dir, (str, os.PathLike)) or not str(out_dir).strip():
@@ -1124,7 +1118,7 @@ def _run_locked(sweep, out: Path, workers, scheduler, client, resume, progress, 
             client = _scheduler_client(scheduler)
             n = max(1, len(client.scheduler_info().get("workers", {})))
         else:
-            n = workers or default_workers()
+            n = workers or usable_cpus()  # (a local cluster: a worker a CPU)
             cluster, client = _start_local(n)
         _manifest(sweep, out, resume)
         if progress:  # only now: bad input before this point is one line and nothing else

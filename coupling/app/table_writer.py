@@ -16,19 +16,18 @@ where it lies goes through a pipe: the command never waits for the helper to tak
 (a pipe holds 64 KiB, history.csv's columns are a few MiB), the helper needs no thread to
 read it, and neither process maps it (a cap on the address space, ``ulimit -v``, sees
 nothing of it). Its answers (the path, None or the error's text, and the seconds it took)
-come back through a second pipe. A table that cannot be put there (no memory) is written by
-the command itself. It
-writes nothing it was not sent, answers each table when it is on disk, and ends at the end
-of its input, when the command's process ends for any reason, or when the command closes
-it (at once: everything it was sent is written or given up by then).
-It ignores the user's Ctrl-C, which is the command's to handle: an interrupted run's partial
-result still gets its tables through it. A table it could not write (it failed, or died) is
-written by the command itself, so the helper can cost time but never a file; when the
-command gives up writing a result it stops the helper first, so nothing more appears in a
-folder that is being removed.
+come back through a second pipe, each when its table is on disk.
 
-Only where ``os.fork`` is there (Linux); elsewhere, and inside a caller's process (tests,
-``CoupledResult.save``, sweeps), everything is written in one process as before.
+A table the helper did not write (it failed or died, or there was no memory to hand it
+over) is written by the command itself: the helper can cost time, never a file. It ignores
+the user's Ctrl-C, which is the command's to handle: an interrupted run's partial result
+still gets its tables through it. It ends at the end of its input (the command's process
+ended, for any reason) or when the command closes it, at once: by then everything it was
+sent is written, or given up with a folder that is being removed.
+
+Only where ``os.fork`` is there (Linux) and the process may use two CPUs (``wanted``);
+elsewhere, and inside a caller's process (tests, ``CoupledResult.save``, sweeps),
+everything is written in one process as before.
 """
 
 from __future__ import annotations
@@ -40,6 +39,8 @@ import struct
 import sys
 import time
 from pathlib import Path
+
+from coupling.app import usable_cpus
 
 _LENGTH = struct.Struct("<Q")  # each answer: its pickle's length, then the pickle
 _WHERE = struct.Struct("<QQ")  # each table: where its pickle lies in the shared file (offset, length)
@@ -53,7 +54,7 @@ def wanted(scene, cpus: int | None = None) -> bool:
     process (the fork, pyarrow's import, the tables' copies: ~20-30 ms a relay run,
     docs/benchmarks.md), which only a second CPU hides."""
     if cpus is None:
-        cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+        cpus = usable_cpus()
     opts = scene.output
     return cpus >= 2 and scene.circuit is not None and (opts.parquet or opts.csv or opts.history)
 
@@ -171,14 +172,6 @@ class TableWriter:
             except ChildProcessError:
                 pass
             self.pid = 0
-
-    abort = close  # (write_files's name for it after an error: nothing more is written)
-
-    def __enter__(self) -> "TableWriter":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
 
 
 def _serve(shared: int, jobs_fd: int, replies_fd: int) -> None:

@@ -86,7 +86,7 @@ def test_a_table_the_helper_cannot_write_is_answered_with_its_error(tmp_path):
     assert writer.submit("write_csv", there / "t.csv", wave)
     answers = writer.collect()
     writer.close()
-    print(json.dumps({k: v for k, v in answers.items()}))
+    print(json.dumps(answers))
     """, str(tmp_path), str(tmp_path))
     assert seen[str(tmp_path / "t.csv")] is None
     assert seen[str(tmp_path / "missing" / "t.csv")].startswith("FileNotFoundError")
