@@ -24,6 +24,7 @@ from bisect import bisect_right
 
 import numpy as np
 
+from coupling.core.policy import BEND_FRACTION
 from coupling.core.policy import TAIL_POINTS, end_derivatives, end_rate, time_scale
 
 CONTACT_EVENTS = ("contact_start", "contact_end")
@@ -421,6 +422,7 @@ class CoilLink:
         # the watched signal (``signal``: psi^2 or psi) at the last step's end, its rate (per s),
         # time scale (s) and the slope the step rules chose to extrapolate it with
         self.value, self.rate, self.scale, self.slope = 0.0, 0.0, math.inf, 0.0
+        self.horizon = math.inf  # s: how far the drive is extrapolated along the slope (``drives``)
         self.curvature = 0.0  # its second derivative (per s^2) there, from the last three points
         self.bound_by = "curvature"  # the rule that set ``scale``: "curvature", "size" or "gap"
         self.gap_scale = math.inf  # s: the gap rule's time scale (inf: the armature does not move)
@@ -466,7 +468,7 @@ class CoilLink:
         points by the step rules (``policy.extrapolate`` with this link's slope and time scale;
         psi^2 kept >= 0); the armature's (q, q_dot) at t in ``arm`` (a table magnet's gap at the
         end predicted from them)."""
-        s0 = policy.extrapolate(self.value, self.slope, 0.0, self.scale)
+        s0 = policy.extrapolate(self.value, self.slope, 0.0, self.horizon)
         # the step's end with the last chord's slope and the curvature of the last three
         # points (none after a jump, whose slope is 0: the zero-order hold): the drive stays
         # linear in time over the step, a secant of that parabola instead of the chord's
@@ -474,7 +476,7 @@ class CoilLink:
         # current at 50 ms 24 times; docs/coupling.md "The coil's steps"; the chord's lag
         # of half its length behind the end's slope, corrected, did worse on the operate
         # times: -1.6 against -1.1 us on the default relay)
-        s1 = policy.extrapolate(self.value, self.slope, end - t, self.scale,
+        s1 = policy.extrapolate(self.value, self.slope, end - t, self.horizon,
                                 self.curvature if self.slope != 0.0 else 0.0)
         if self.separable:
             return {"armature.force": (max(s0, 0.0), max(s1, 0.0))}
@@ -508,10 +510,12 @@ class CoilLink:
 
     def observe(self, step, seg, policy) -> None:
         """After a step: the flux linkage at its end, its rate and time scale from the circuit's
-        last points (differences over at least 1e-3 of the policy's macro step), bounded by the
-        change-by-its-size and gap rules (``policy.gap_change_fraction``; ``bound_by`` names
-        the rule that set it), and the armature's travel at the step's circuit points (for the
-        result's columns)."""
+        last points (differences over at least 1e-3 of the policy's macro step; for the step
+        rules no shorter than BEND_FRACTION of the curvature's own time to move it by its size
+        plus the rated value), bounded by the change-by-its-size and gap rules
+        (``policy.gap_change_fraction``; ``bound_by`` names the rule that set it; ``horizon``:
+        the same without that floor), and the armature's travel at the step's circuit points
+        (for the result's columns)."""
         times = step.reader("time")
         psi = step.reader(self._flux_column)
         self.tail.observe(times, self.signal(psi), False)
@@ -520,11 +524,24 @@ class CoilLink:
         self.value = self.signal(self.flux(step))
         self.rate, curvature = self.tail.derivatives(policy.macro_step)
         self.curvature = curvature or 0.0
-        scales = [(time_scale(self.rate, curvature, self.tail.v[-1] if self.rate != 0.0 else 0.0), "curvature")]
+        curve = time_scale(self.rate, curvature, self.tail.v[-1] if self.rate != 0.0 else 0.0)
+        # what the drive is extrapolated over (policy.extrapolate's horizon): the time scales
+        # as they are; what the step rules take: the curvature's no shorter than BEND_FRACTION
+        # of the time the curvature alone takes to move the signal by its size plus the rated
+        # value. |rate / curvature| vanishes wherever psi^2 is stationary (a zero of psi as a
+        # released coil rings, an extremum as the armature bounces), though psi^2 hardly
+        # moves there: the default relay's steps fell geometrically to the probe step
+        # (0.25 us) at each of the ringing's zeros, 120 macro steps in 0.35 ms
+        # (docs/coupling.md, "The coil's steps")
+        horizons = [curve]
+        if curvature:
+            curve = max(curve, BEND_FRACTION * math.sqrt(2.0 * (abs(self.value) + self.floor) / abs(curvature)))
+        scales = [(curve, "curvature")]
         if self.rate != 0.0:
             # not beyond the time it takes to change by its own size (plus the floor): a signal
             # falling linearly to zero (a clamped coil's release) has no curvature
             scales.append(((abs(self.value) + self.floor) / abs(self.rate), "size"))
+            horizons.append(scales[-1][0])
         q, q_dot = seg.armature(seg.t_end)[:2]
         span = seg.t_end - seg.t_start
         speed = self.lever * abs(float(q_dot))  # m/s of the working gap
@@ -539,7 +556,9 @@ class CoilLink:
             # for an armature leaving its stop has no speed yet
             self.gap_scale = gap_time(policy.gap_change_fraction * max(self.gap(float(q)), 0.0), speed, accel)
             scales.append((self.gap_scale, "gap"))
+            horizons.append(self.gap_scale)
         self.scale, self.bound_by = min(scales)
+        self.horizon = min(horizons)
         new = times[1:] if self._sampled else times
         self._sampled = True
         lo, hi = seg.t_start, seg.t_end

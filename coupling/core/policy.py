@@ -34,6 +34,12 @@ COIL_STEP_POINTS = 2
 # ... and, while the coil's flux changes, steps of at most this fraction of the coil's time
 # constant L/R (at the rest gap, unsaturated): 80 points a time constant
 COIL_POINT_FRACTION = 0.0125
+# The coil's curvature time scale |rate / curvature| is taken no shorter than this fraction of
+# sqrt(2 (|psi^2| + rated psi^2) / |curvature|), the time the curvature alone takes to move
+# psi^2 by its size plus its rated value (CoilLink.observe): the first vanishes where psi^2 is
+# stationary, though psi^2 then hardly moves. At a quarter it leaves an exponential above a
+# seventh of the rated value to |rate / curvature| (its time constant), as before
+BEND_FRACTION = 0.25
 # a step in which the seated armature leaves its stop ends this fraction of the way there
 # (StepPolicy.approach_end): the extrapolated drive decides the unseat only from close by
 APPROACH_FRACTION = 0.5
