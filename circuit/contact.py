@@ -114,19 +114,26 @@ def placed_contacts(circuit: Circuit) -> dict[str, tuple[str, str, float, str | 
 LANDING_TOLERANCE = 1e-9
 
 
-def snapped(breakpoints: Sequence[float], t_stop: float, span: float) -> list[float]:
-    """Breakpoints as ngspice will land on them: those within ``LANDING_TOLERANCE * span``
-    before ``t_stop`` (s) are moved onto it (sorted, de-duplicated).
+def snapped(breakpoints: Sequence[float], t_stop: float, span: float, merge: float = 0.0) -> list[float]:
+    """Breakpoints as ngspice will land on them: those within ``LANDING_TOLERANCE * span``,
+    or ``merge`` (s), before ``t_stop`` (s) are moved onto it (sorted, de-duplicated).
 
     ngspice would otherwise clip its step to the breakpoint and the landing rule would
     lengthen it to ``t_stop`` again, so the breakpoint would be stepped over: measured, a
     make 77 ulp before a 2 us macro time was never landed on (no restart at the make).
+    ``merge`` (``SimulationOptions.sliver``): a breakpoint that close before the pause's
+    target would leave a sliver step after ngspice's restart at it (order 1, Newton from
+    the jump), and with an inductor in the loop its companion L/h made that step's Newton
+    fail until the step fell below ngspice's smallest: measured, a make 1.1e-13 s and
+    another 3e-15 s before a macro time aborted two changeover runs with "timestep too
+    small" (100 mH and 10 mH loads with flyback diodes).
     """
-    return sorted({t_stop if 0.0 <= t_stop - b <= LANDING_TOLERANCE * span else float(b) for b in breakpoints})
+    tolerance = max(LANDING_TOLERANCE * span, merge)
+    return sorted({t_stop if 0.0 <= t_stop - b <= tolerance else float(b) for b in breakpoints})
 
 
 def left_limited(conductance: Conductance, breakpoints: Sequence[float], span: float,
-                 t_stop: float | None = None) -> Conductance:
+                 t_stop: float | None = None, merge: float = 0.0) -> Conductance:
     """``conductance`` evaluated as its left limit at each breakpoint.
 
     ngspice evaluates the source at the breakpoint time itself, and that value closes
@@ -137,12 +144,12 @@ def left_limited(conductance: Conductance, breakpoints: Sequence[float], span: f
     it up to rounding, and ends a run at t_end (1 - 2.2e-13) whatever t_end (measured),
     so a make at t_end was otherwise missed. The left limit is taken ``1e-9 * span``
     before it (``span``: the macro step length, s). With
-    ``t_stop`` (the macro time), breakpoints moved onto it by ``snapped`` keep their own
-    left limit.
+    ``t_stop`` (the macro time), breakpoints moved onto it by ``snapped`` (with ``merge``)
+    keep their own left limit.
     """
     befores: dict[float, float] = {}
     for b in sorted(float(b) for b in breakpoints):
-        at = snapped((b,), t_stop, span)[0] if t_stop is not None else b
+        at = snapped((b,), t_stop, span, merge)[0] if t_stop is not None else b
         before = b - max(1e-9 * span, 64.0 * math.ulp(b))
         befores[at] = min(before, befores.get(at, math.inf))
     if not befores:

@@ -155,7 +155,7 @@ class Stepper:
     def advance(
         self, t_next: float, conductance: Conductance | float | None = None, breakpoints: Iterable[float] = (),
         gap: Gap | float | None = None, *, inputs: Mapping[str, Conductance | float] | None = None,
-        max_step: float = math.inf,
+        max_step: float = math.inf, restart: bool = False,
     ) -> StepResult:
         """Integrate from the current time to ``t_next`` (s).
 
@@ -169,6 +169,9 @@ class Stepper:
             over the step (a coil's flux) asks for points in it.
         breakpoints: make/break instants (s) in (t_current, t_next]; ngspice lands on
             each, and every input is read as its left limit there (the pre-event state).
+        restart: a make/break at the current time itself (within a sliver after it, where no
+            step can land): ngspice restarts there (order 1, a short first step), as at a
+            breakpoint.
         gap: required when the arc model depends on the gap (``uses_gap``; without it
             ValueError before anything runs); otherwise ignored (a number is still checked).
         """
@@ -201,10 +204,11 @@ class Stepper:
                 for arc in self._arcs.values():
                     arc.start(float(functions[arc.conductance_source](0.0)) > 0.0)
             span = t_next - t0
-            session.set_channels({source: left_limited(f, points, span, t_next) for source, f in functions.items()},
-                                 self._errors)
-            landings = snapped(points, t_next, t_next - t0)
-            if self._started and landings and landings[0] - t0 <= self.options.min_break(self.t_end):
+            merge = self.options.sliver(self.t_end)  # (no sliver step after a breakpoint)
+            session.set_channels({source: left_limited(f, points, span, t_next, merge)
+                                  for source, f in functions.items()}, self._errors)
+            landings = snapped(points, t_next, t_next - t0, merge)
+            if self._started and (restart or (landings and landings[0] - t0 <= self.options.min_break(self.t_end))):
                 # ngspice drops a breakpoint within CKTminBreak after its current time
                 # (measured at TMAX 1 us: 4e-11 s after it dropped, 1e-10 s landed), so a make
                 # 2.6e-17 s after a macro time accumulated as t + H had its 10 ns ramp taken in

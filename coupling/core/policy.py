@@ -74,7 +74,8 @@ class StepPolicy:
       current's time scale (an exponential approach extrapolated over its time constant
       lands on its asymptote).
     - ``aligned_end``: where a step that saw a make/break at t_e is cut: at t_e inside it,
-      at t + probe when t_e is at its start, else not cut (None).
+      at t + probe when t_e is at its start, else not cut (None); "at" a step's start or
+      end is within ``resolution`` (the circuit's shortest step) or 1e-9 macro steps of it.
     - ``approach_end``: where a step in which the seated armature left its stop is cut:
       halfway there while the unseat is more than H ahead, else H past it.
     """
@@ -89,6 +90,9 @@ class StepPolicy:
     gap_change_fraction: float = GAP_CHANGE_FRACTION
     circuit_points: int = 1
     point_fraction: float = math.inf
+    # s: the circuit's shortest step (circuit.SimulationOptions.sliver, 1000 times ngspice's
+    # smallest): a make/break nearer a step's start or end counts as there
+    resolution: float = 0.0
 
     def __post_init__(self):
         for name in ("macro_step", "free_step", "probe_time", "time_scale_fraction", "current_floor", "growth_cap",
@@ -104,13 +108,15 @@ class StepPolicy:
             raise ValueError(f"StepPolicy.point_fraction = {self.point_fraction!r}: must be > 0")
         if not (math.isfinite(self.change_fraction) and self.change_fraction >= 0):
             raise ValueError(f"StepPolicy.change_fraction = {self.change_fraction!r}: must be a finite number >= 0")
+        if not (math.isfinite(self.resolution) and self.resolution >= 0):
+            raise ValueError(f"StepPolicy.resolution = {self.resolution!r}: must be a finite number >= 0")
 
     @classmethod
-    def from_options(cls, options) -> "StepPolicy":
+    def from_options(cls, options, resolution: float = 0.0) -> "StepPolicy":
         """The contact current's rules from a scene's CouplingOptions (macro_step, free_step,
-        time_scale_fraction)."""
+        time_scale_fraction); ``resolution``: the circuit's shortest step (s)."""
         return cls(macro_step=float(options.macro_step), free_step=float(options.free_step),
-                   time_scale_fraction=float(options.time_scale_fraction))
+                   time_scale_fraction=float(options.time_scale_fraction), resolution=float(resolution))
 
     def for_coil(self, options, floor: float) -> "StepPolicy":
         """The coil's rules: the same steps, its own time-scale fraction and gap rule from the
@@ -193,9 +199,19 @@ class StepPolicy:
             return event + self.macro_step
         return None
 
+    @property
+    def guard(self) -> float:
+        """s: how near a step's start or end a make/break counts as there: 1e-9 macro steps,
+        at least ``resolution``."""
+        return max(1e-9 * self.macro_step, self.resolution)
+
     def aligned_end(self, t: float, t_next: float, event: float) -> float | None:
         """s: where to end a step [t, t_next] in which the first make/break is at ``event``; None: keep it."""
-        guard = 1e-9 * self.macro_step
+        # (the mechanics locate an event to ~1e-9 of their own step, and ngspice cannot take
+        # a sliver of a step: an event found 5e-15 s after a step cut at it asked for a
+        # 5e-15 s step, and with a 10 mH load behind a flyback diode ngspice's Newton failed
+        # on it until "timestep too small")
+        guard = self.guard
         if t + guard < event < t_next - guard:
             return event
         if event <= t + guard and t_next - t > self.probe * (1.0 + 1e-9):

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from circuit import ContactSchedule, SimulationOptions, run_pwl_reference, run_transient, left_limited
+from circuit.contact import snapped
 
 from circuit_scenes import BOUNCE_BREAKS, BOUNCE_MAKES
 
@@ -84,3 +85,17 @@ def test_left_limited_takes_the_value_before_a_jump_only_at_the_breakpoint():
     assert g(1e-3 + 1e-12) == 5.0
     assert g(0.9e-3) == 0.0
     assert left_limited(jump, [], 1e-5) is jump
+
+
+def test_a_jump_closer_to_the_pause_than_ngspice_resolves_is_taken_at_the_pause():
+    """A jump 1e-13 s before a macro time t_stop: beyond the landing tolerance (1e-9 of the
+    5 us step), within ``merge`` (ngspice's CKTminBreak, here 1.2e-8 s). With it the jump
+    lands on t_stop, whose value is still the one before the jump (its left limit); without,
+    it stays where it is and ngspice would be left a 1e-13 s step after it."""
+    b, t_stop = 1e-3 - 1e-13, 1e-3
+    jump = lambda t: 0.0 if t < b else 5.0  # noqa: E731
+    assert snapped([b], t_stop, 5e-6) == [b]
+    assert snapped([b], t_stop, 5e-6, merge=1.2e-8) == [t_stop]
+    assert snapped([t_stop - 2e-8], t_stop, 5e-6, merge=1.2e-8) == [t_stop - 2e-8]  # farther: kept
+    g = left_limited(jump, [b], 5e-6, t_stop, merge=1.2e-8)
+    assert g(t_stop) == 0.0 and g(t_stop + 1e-12) == 5.0

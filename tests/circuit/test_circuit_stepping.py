@@ -170,6 +170,28 @@ def test_a_make_just_after_the_macro_time_restarts_the_integration(ringing_circu
     assert np.sum((times > t0) & (times < t0 + delta + 10e-9)) >= 3
 
 
+def test_a_make_at_the_macro_time_itself_restarts_the_integration_when_asked(ringing_circuit):
+    """A make a sliver (1e-15 s) after the macro time, where no step can land, given as no
+    breakpoint: ``advance(..., restart=True)`` makes ngspice restart at its current time,
+    order 1 with a short first step, as at a breakpoint; without it ngspice's next step
+    takes the make's 10 ns ramp whole."""
+    from circuit import ContactSchedule, SimulationOptions
+
+    t0 = 0.4e-3
+    schedule = ContactSchedule(((0.0, 0.1e-3), (t0 + 1e-15, math.inf)), closed_resistance=0.01)
+    first = {}
+    for restart in (False, True):
+        with Stepper(ringing_circuit, 0.41e-3, SimulationOptions(max_step=1e-6)) as stepper:
+            stepper.advance(t0, schedule, schedule.breakpoints(0.0, t0))
+            step = stepper.advance(0.41e-3, schedule, (), restart=restart)
+            times = step.frame().time.to_numpy()
+        assert times[0] == t0
+        first[restart] = times[1] - t0
+        if restart:
+            assert np.sum((times > t0) & (times < t0 + 10e-9)) >= 3  # the ramp resolved
+    assert first[True] < 2e-9 < first[False]
+
+
 @pytest.mark.parametrize("delta", [5e-12, 1.2e-10, 2e-9])
 def test_a_break_just_before_the_macro_time_is_a_point_with_the_closed_current(ringing_circuit, delta):
     """A break ``delta`` before the end of its macro step (the mechanics' step cut at a
