@@ -79,7 +79,7 @@ def test_a_coil_audit_above_the_tolerance_but_within_five_times_it_is_a_warning(
     (0.2: with psi^2's curvature bounding the steps after the switch-on, the default fraction
     left this audit at the tolerance itself, 1.0005e-3): ngspice steps as long as the macro
     steps through the coil's rise, and the audit leaves 2.1e-3 of the energy into the coil
-    (4.2e-5 at the default rules):
+    (3.3e-5 at the default rules):
     above solver.energy_tolerance, below five times it. The run stays "ok" and carries one
     warning naming the key and what to cap (as Hertz's validity: warned from 1 %, unsound from
     5 %); a coil drawing 5 % too much current (the test above, 1.5e-2) is unsound."""
