@@ -24,8 +24,7 @@ from bisect import bisect_right
 
 import numpy as np
 
-from coupling.core.policy import BEND_FRACTION
-from coupling.core.policy import TAIL_POINTS, end_derivatives, end_rate, time_scale
+from coupling.core.policy import BEND_FRACTION, TAIL_POINTS, end_derivatives, end_rate, time_scale
 
 CONTACT_EVENTS = ("contact_start", "contact_end")
 # the step rules' floor of the coil's signal (psi^2 or psi), as a fraction of its value at the

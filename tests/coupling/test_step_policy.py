@@ -132,9 +132,24 @@ def test_a_step_is_cut_at_a_make_inside_it_and_after_a_probe_at_its_start():
     assert p.aligned_end(t, t + p.probe, t) is None  # already a probe step
 
 
+def test_a_make_a_sliver_from_a_steps_edge_counts_as_there():
+    """With the circuit's shortest step as ``resolution`` (here 2.4e-12 s, the default
+    relay's sliver), a make 5e-15 s after the step's start is at its start (a probe step,
+    no femtosecond step for ngspice) and one 3e-15 s before its end is at its end (the step
+    is kept); without, each cuts the step there (the guard is 1e-9 macro steps, 5e-15 s)."""
+    t, t_next = 1e-3, 1e-3 + H
+    plain, sliver = policy(), policy(resolution=2.4e-12)
+    assert plain.aligned_end(t, t_next, t + 5.1e-15) == t + 5.1e-15
+    assert sliver.aligned_end(t, t_next, t + 5.1e-15) == pytest.approx(t + sliver.probe)
+    assert plain.aligned_end(t, t_next, t_next - 5.1e-15) == t_next - 5.1e-15
+    assert sliver.aligned_end(t, t_next, t_next - 5.1e-15) is None
+    assert sliver.guard == 2.4e-12 and plain.guard == pytest.approx(1e-9 * H)
+
+
 @pytest.mark.parametrize("field, value", [("macro_step", 0.0), ("free_step", 1e-9), ("probe_time", math.nan),
                                           ("change_fraction", -1.0), ("circuit_points", 0), ("circuit_points", 2.0),
-                                          ("point_fraction", 0.0), ("point_fraction", math.nan)])
+                                          ("point_fraction", 0.0), ("point_fraction", math.nan),
+                                          ("resolution", -1e-12), ("resolution", math.inf)])
 def test_bad_policy_values_are_named(field, value):
     with pytest.raises(ValueError, match=field):
         policy(**{field: value})
@@ -371,3 +386,36 @@ def test_a_step_approaches_the_armatures_unseat_by_halves_and_ends_a_macro_step_
         lead -= end - t
         steps += 1
     assert steps == math.ceil(math.log2(600e-6 / H)) and 0.5 * H < lead <= H
+
+
+def test_the_coils_time_scale_at_a_zero_of_its_flux_is_the_curvatures_not_zero():
+    """A released coil ringing through a zero of its flux linkage, psi = A sin(w t) with A a
+    tenth of the rated psi: psi^2's slope vanishes at the zero and |rate / curvature| with
+    it, though psi^2 is ~0 there and its curvature, 2 A^2 w^2, moves it by the rated value
+    only in sqrt(2 (psi^2 + rated) / curvature) ~ 7 / w. The step rules' scale is at least
+    BEND_FRACTION of that; the drive's extrapolation horizon keeps |rate / curvature|."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from coupling.core.exchange import CoilLink
+    from coupling.core.policy import BEND_FRACTION
+
+    rated, w = 0.036, 2 * math.pi * 3.5e3  # Wb (the default relay's psi at its rated current), rad/s
+    link = CoilLink("coil", magnet=None, rest_gap=5e-4, floor=rated ** 2)
+    link.separable = True  # (psi^2 is the signal, as for a flux-tube magnet)
+    p = policy()
+    t_zero = 1e-3
+    for k, end in enumerate((t_zero - 3e-6, t_zero - 1e-6, t_zero + 0.5e-7)):
+        times = np.array([end - 2e-6, end - 1e-6, end])
+        psi = 0.1 * rated * np.sin(w * (times - t_zero))
+        step = SimpleNamespace(reader=lambda name, times=times, psi=psi: times if name == "time" else psi,
+                               values={"coil_flux_linkage": float(psi[-1])})
+        seg = SimpleNamespace(t_start=times[0], t_end=end, armature=lambda s: (0.0, 0.0))
+        link.observe(step, seg, p)
+    curvature = 2 * (0.1 * rated) ** 2 * w ** 2
+    bend = math.sqrt(2 * (link.value + rated ** 2) / curvature)
+    assert link.bound_by == "curvature"
+    assert link.scale == pytest.approx(BEND_FRACTION * bend, rel=0.05)
+    assert link.horizon == pytest.approx(abs(link.rate / link.curvature), rel=1e-9)
+    assert link.horizon < 1e-2 * link.scale  # (what the step rules took before: the steps fell to the probe)
