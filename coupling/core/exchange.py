@@ -532,7 +532,7 @@ class CoilLink:
         # moves there: the default relay's steps fell geometrically to the probe step
         # (0.25 us) at each of the ringing's zeros, 120 macro steps in 0.35 ms
         # (docs/coupling.md, "The coil's steps")
-        horizons = [curve]
+        plain = curve
         if curvature:
             curve = max(curve, BEND_FRACTION * math.sqrt(2.0 * (abs(self.value) + self.floor) / abs(curvature)))
         scales = [(curve, "curvature")]
@@ -540,7 +540,6 @@ class CoilLink:
             # not beyond the time it takes to change by its own size (plus the floor): a signal
             # falling linearly to zero (a clamped coil's release) has no curvature
             scales.append(((abs(self.value) + self.floor) / abs(self.rate), "size"))
-            horizons.append(scales[-1][0])
         q, q_dot = seg.armature(seg.t_end)[:2]
         span = seg.t_end - seg.t_start
         speed = self.lever * abs(float(q_dot))  # m/s of the working gap
@@ -555,9 +554,8 @@ class CoilLink:
             # for an armature leaving its stop has no speed yet
             self.gap_scale = gap_time(policy.gap_change_fraction * max(self.gap(float(q)), 0.0), speed, accel)
             scales.append((self.gap_scale, "gap"))
-            horizons.append(self.gap_scale)
         self.scale, self.bound_by = min(scales)
-        self.horizon = min(horizons)
+        self.horizon = min([plain, *(scale for scale, _ in scales[1:])])  # (the curvature's without its floor)
         new = times[1:] if self._sampled else times
         self._sampled = True
         lo, hi = seg.t_start, seg.t_end
