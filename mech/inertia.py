@@ -234,6 +234,30 @@ def _linear_and_modal(n, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, f_e, sv):
 
 
 @njit_borrowing
+def held_modal_terms(n, q, eta, sp_ptr, sp_idx, sp_val, f_e, f_r, sv):
+    """The inertia terms of a bar whose frame does not turn (w = 0: a clamped bar): f_e =
+    -K q - C eta, f_r and dJ/dt w (sv[0:3]) zero; J, B and the Schur complement are not
+    formed (a clamped bar's accelerations do not use them: kernel._solve_mounted). Every
+    other term of the full routes carries a factor of w and adds an exact zero there, and
+    the K and C entries are summed in the list's order as they sum them: the same bits at
+    a fraction of the cost. Returns the modal damping power eta' C eta (W)."""
+    for a in range(3):
+        f_r[a] = 0.0
+        sv[a] = 0.0
+    for j in range(n):
+        f_e[j] = 0.0
+    for e in range(np.uint64(sp_ptr[SEC_K]), np.uint64(sp_ptr[SEC_K + 1])):
+        f_e[np.uint64(sp_idx[e, 0])] -= sp_val[e] * q[np.uint64(sp_idx[e, 1])]
+    d_modal = 0.0
+    for e in range(np.uint64(sp_ptr[SEC_C]), np.uint64(sp_ptr[SEC_C + 1])):
+        j = np.uint64(sp_idx[e, 0])
+        ce = sp_val[e] * eta[np.uint64(sp_idx[e, 1])]
+        f_e[j] -= ce
+        d_modal += eta[j] * ce
+    return d_modal
+
+
+@njit_borrowing
 def _rotational_rhs(n, m, w, eta, Jm, B, sv, f_r, Amat, Ainv):
     """f_r = -w x (J w + B eta) - dJ/dt w; Schur complement J - B B'/m and its inverse."""
     h0 = Jm[0, 0] * w[0] + Jm[0, 1] * w[1] + Jm[0, 2] * w[2]

@@ -35,7 +35,8 @@ from . import (
     travel_spring as _travel_spring,
 )
 from .jit import njit, njit_borrowing
-from .inertia import inertia_matrix, inertia_matrix_sparse, inertia_terms, inertia_terms_sparse, schur_complement
+from .inertia import (held_modal_terms, inertia_matrix, inertia_matrix_sparse, inertia_terms, inertia_terms_sparse,
+                      schur_complement)
 from .kernel_layout import (  # noqa: F401  (re-exported: the kernel's own names)
     F_MASS, F_G, F_K, F_C, F_BETA, F_GAMMA, F_MAX_RATIO, F_RTIP, D_VALUE, D_SLOPE, D_T0, K_MU, K_REPULSION,
     F_VREG, F_BAUM, F_VBOUND, F_PIV_K, F_PIV_C, F_PIV_T0, F_PIV_PHI0, F_PIV_SIGN, C_Z, C_N, MAX_PAIRS,
@@ -606,14 +607,18 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
     # Inertia, centrifugal, gyroscopic, stiffness and damping terms (mech/inertia.py):
     # the Gram-product route for the analytic free-free basis, the sparse-list route for a
     # finite-element basis (its families are orthogonal in the full mass, rivets' rotary
-    # inertia included, not in the plain product the Gram route relies on)
-    if ipar[I_INERTIA] == INERTIA_GRAM:
-        d_modal = inertia_terms(n, m, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, B, f_e, sv, f_r, Amat, Ainv)
+    # inertia included, not in the plain product the Gram route relies on); a clamped bar,
+    # whose frame does not turn, needs only their stiffness and damping terms
+    if mount == MOUNT_CLAMP and w[0] == 0.0 and w[1] == 0.0 and w[2] == 0.0:
+        d_modal = held_modal_terms(n, q, eta, sp_ptr, sp_idx, sp_val, f_e, f_r, sv)
     else:
-        d_modal = inertia_terms_sparse(n, m, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, B, f_e, sv, f_r, Amat,
-                                       Ainv)
-    if mount != MOUNT_FREE:
-        _add_rotational_coupling(n, m, w, eta, cL, Jm, B, f_r, Amat, Ainv)
+        if ipar[I_INERTIA] == INERTIA_GRAM:
+            d_modal = inertia_terms(n, m, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, B, f_e, sv, f_r, Amat, Ainv)
+        else:
+            d_modal = inertia_terms_sparse(n, m, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, B, f_e, sv, f_r,
+                                           Amat, Ainv)
+        if mount != MOUNT_FREE:
+            _add_rotational_coupling(n, m, w, eta, cL, Jm, B, f_r, Amat, Ainv)
     F[0] = 0.0
     F[1] = 0.0
     F[2] = -m * fpar[F_G]

@@ -5,7 +5,9 @@ J2 and S tensors (O(n^2), the kernel's former route) and contracting the modal
 coordinates with the modes' norms and the axial-bending Gram matrix (O(n_axial
 n_bending / 2) + O(n)). They must agree to round-off on random states, in 3D and
 planar, for equal and unequal mode counts and with a family absent; J(q) and B(q) also
-against the basis' dense invariants.
+against the basis' dense invariants. A bar whose frame does not turn (clamped, w = 0) has
+modal forces -K q - C eta only: the kernel's short route for it against both full routes
+(the same bits: every term it leaves out carries a factor of w) and the dense K and C.
 """
 
 from __future__ import annotations
@@ -13,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mech.inertia import inertia_matrix, inertia_terms, inertia_terms_sparse
+from mech.inertia import held_modal_terms, inertia_matrix, inertia_terms, inertia_terms_sparse
 from mech.modal_basis import build_modal_basis, sparse_invariants
 from mech.parameters import Bar
 
@@ -65,3 +67,37 @@ def test_mass_matrix_blocks_match_the_dense_invariants(planar, n_axial, n_bendin
     inertia_matrix.py_func(b.n, q, b.J0, *sparse_invariants(b), J, B)
     np.testing.assert_allclose(J, J_ref, rtol=0, atol=1e-13 * np.max(np.abs(J_ref)))
     np.testing.assert_allclose(B, B_ref, rtol=0, atol=1e-12 * max(np.max(np.abs(B_ref)), 1e-300))
+
+
+@pytest.mark.parametrize("planar,n_axial,n_bending", CASES)
+def test_a_frame_that_does_not_turn_leaves_only_the_elastic_and_damping_modal_forces(planar, n_axial, n_bending):
+    bar = Bar(diameter=0.006, tip_radius=0.003, axial_modes=n_axial, bending_modes=n_bending,
+              modal_damping=0.01)
+    basis = build_modal_basis(bar, planar)
+    sparse = sparse_invariants(basis)
+    n = basis.n
+    rng = np.random.default_rng(n_axial * 10 + n_bending + 1000 * planar)
+    w = np.zeros(3)
+    for _trial in range(3):
+        q = rng.normal(scale=3e-3, size=n)
+        eta = rng.normal(scale=0.5, size=n)
+        f_e, f_r, sv = np.full(n, np.nan), np.full(3, np.nan), np.full(3, np.nan)
+        d_modal = held_modal_terms.py_func(n, q, eta, *sparse, f_e, f_r, sv)
+        # the closed form from the basis' dense matrices
+        ce = basis.damping @ eta
+        np.testing.assert_allclose(f_e, -basis.stiffness @ q - ce, rtol=1e-12,
+                                   atol=1e-13 * np.max(np.abs(basis.stiffness @ q)))
+        np.testing.assert_allclose(d_modal, eta @ ce, rtol=1e-12)
+        assert not f_r.any() and not sv.any()
+        # both full routes at w = 0, to the bit (the kernel takes the short route for a
+        # clamped bar on the strength of this)
+        for fn in (inertia_terms_sparse, inertia_terms.py_func, inertia_terms):
+            d_ref, _, _, f_ref, sv_ref, r_ref, _, _ = _outputs(fn, basis, sparse, q, eta, w)
+            assert d_ref[0] == d_modal
+            assert np.array_equal(f_ref, f_e)
+            assert not sv_ref.any() and not r_ref.any()
+        # a turning frame adds centrifugal and gyroscopic modal forces the short route lacks
+        if n_axial and n_bending:
+            spin = np.array([0.0, 300.0, 0.0])
+            _, _, _, f_spin, _, _, _, _ = _outputs(inertia_terms_sparse, basis, sparse, q, eta, spin)
+            assert np.max(np.abs(f_spin - f_e)) > 1e-6 * np.max(np.abs(f_e))
