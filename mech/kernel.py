@@ -1177,19 +1177,25 @@ def energies(y, mdl, work, out, arm=None):
     v = work[22][15:18]
     unpack(y, n, planar, r, R, q, V, w, eta)
     m = fpar[F_MASS]
-    if ipar[I_INERTIA] == INERTIA_GRAM:
-        inertia_matrix(n, q, J0, sp_ptr, sp_idx, sp_val, Jm, B)
-    else:
-        inertia_matrix_sparse(n, q, J0, sp_ptr, sp_idx, sp_val, Jm, B)
-    for j in range(n):  # H_j, the q-independent coupling of a held bar's modes (0 when free)
-        for a in range(3):
-            B[a, j] += cL[a, n + 1 + j]
     kin = 0.5 * m * (V[0] ** 2 + V[1] ** 2 + V[2] ** 2)
-    for a in range(3):
-        for b in range(3):
-            kin += 0.5 * w[a] * Jm[a, b] * w[b]
-    for j in range(n):
-        kin += (w[0] * B[0, j] + w[1] * B[1, j] + w[2] * B[2, j]) * eta[j] + 0.5 * m * eta[j] ** 2
+    if ipar[I_MOUNT] == MOUNT_CLAMP and w[0] == 0.0 and w[1] == 0.0 and w[2] == 0.0:
+        # a clamped bar's frame does not turn: 1/2 w J w and w B eta add exact zeros, so
+        # J and B are not formed (the same bits; as in dynamics)
+        for j in range(n):
+            kin += 0.5 * m * eta[j] ** 2
+    else:
+        if ipar[I_INERTIA] == INERTIA_GRAM:
+            inertia_matrix(n, q, J0, sp_ptr, sp_idx, sp_val, Jm, B)
+        else:
+            inertia_matrix_sparse(n, q, J0, sp_ptr, sp_idx, sp_val, Jm, B)
+        for j in range(n):  # H_j, the q-independent coupling of a held bar's modes (0 when free)
+            for a in range(3):
+                B[a, j] += cL[a, n + 1 + j]
+        for a in range(3):
+            for b in range(3):
+                kin += 0.5 * w[a] * Jm[a, b] * w[b]
+        for j in range(n):
+            kin += (w[0] * B[0, j] + w[1] * B[1, j] + w[2] * B[2, j]) * eta[j] + 0.5 * m * eta[j] ** 2
     # first moment c + L q and its body rate L eta
     cq0 = cL[0, 0]
     cq1 = cL[1, 0]
