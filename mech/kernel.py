@@ -135,6 +135,15 @@ def make_work(n):
 
 
 @njit_borrowing
+def frame_still(mount, w):
+    """Whether the bar's frame does not turn: a clamped bar (the clamp gives it no angular
+    acceleration; a scene cannot start it turning). Its inertia terms are then -K q - C eta
+    and its kinetic energy has no w J w or w B eta: every other term is an exact zero
+    (dynamics, energies)."""
+    return mount == MOUNT_CLAMP and w[0] == 0.0 and w[1] == 0.0 and w[2] == 0.0
+
+
+@njit_borrowing
 def drive_at(t, drive, row):
     """Value of the drive channel in row ``row`` at t (s): linear in time within a step."""
     return drive[row, D_VALUE] + drive[row, D_SLOPE] * (t - drive[row, D_T0])
@@ -607,9 +616,9 @@ def dynamics(t, y, mdl, regime, eref, dy, aux, work, arm=None):
     # Inertia, centrifugal, gyroscopic, stiffness and damping terms (mech/inertia.py):
     # the Gram-product route for the analytic free-free basis, the sparse-list route for a
     # finite-element basis (its families are orthogonal in the full mass, rivets' rotary
-    # inertia included, not in the plain product the Gram route relies on); a clamped bar,
-    # whose frame does not turn, needs only their stiffness and damping terms
-    if mount == MOUNT_CLAMP and w[0] == 0.0 and w[1] == 0.0 and w[2] == 0.0:
+    # inertia included, not in the plain product the Gram route relies on); a bar whose
+    # frame does not turn needs only their stiffness and damping terms
+    if frame_still(mount, w):
         d_modal = held_modal_terms(n, q, eta, sp_ptr, sp_idx, sp_val, f_e, f_r, sv)
     else:
         if ipar[I_INERTIA] == INERTIA_GRAM:
@@ -1178,9 +1187,8 @@ def energies(y, mdl, work, out, arm=None):
     unpack(y, n, planar, r, R, q, V, w, eta)
     m = fpar[F_MASS]
     kin = 0.5 * m * (V[0] ** 2 + V[1] ** 2 + V[2] ** 2)
-    if ipar[I_MOUNT] == MOUNT_CLAMP and w[0] == 0.0 and w[1] == 0.0 and w[2] == 0.0:
-        # a clamped bar's frame does not turn: 1/2 w J w and w B eta add exact zeros, so
-        # J and B are not formed (the same bits; as in dynamics)
+    if frame_still(ipar[I_MOUNT], w):
+        # 1/2 w J w and w B eta add exact zeros: J and B are not formed (the same bits)
         for j in range(n):
             kin += 0.5 * m * eta[j] ** 2
     else:
