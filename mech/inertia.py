@@ -223,29 +223,14 @@ def _linear_and_modal(n, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, f_e, sv):
         Jm[a, b] += v * q[j]
         f_e[j] += 0.5 * v * w[a] * w[b]
         sv[a] += v * eta[j] * w[b]
-    for e in range(sp_ptr[SEC_K], sp_ptr[SEC_K + 1]):
-        f_e[sp_idx[e, 0]] -= sp_val[e] * q[sp_idx[e, 1]]
-    d_modal = 0.0
-    for e in range(sp_ptr[SEC_C], sp_ptr[SEC_C + 1]):
-        ce = sp_val[e] * eta[sp_idx[e, 1]]
-        f_e[sp_idx[e, 0]] -= ce
-        d_modal += eta[sp_idx[e, 0]] * ce
-    return d_modal
+    return elastic_and_damping(q, eta, sp_ptr, sp_idx, sp_val, f_e)
 
 
 @njit_borrowing
-def held_modal_terms(n, q, eta, sp_ptr, sp_idx, sp_val, f_e, f_r, sv):
-    """The inertia terms of a bar whose frame does not turn (w = 0: a clamped bar): f_e =
-    -K q - C eta, f_r and dJ/dt w (sv[0:3]) zero; J, B and the Schur complement are not
-    formed (a clamped bar's accelerations do not use them: kernel._solve_mounted). Every
-    other term of the full routes carries a factor of w and adds an exact zero there, and
-    the K and C entries are summed in the list's order as they sum them: the same bits at
-    a fraction of the cost. Returns the modal damping power eta' C eta (W)."""
-    for a in range(3):
-        f_r[a] = 0.0
-        sv[a] = 0.0
-    for j in range(n):
-        f_e[j] = 0.0
+def elastic_and_damping(q, eta, sp_ptr, sp_idx, sp_val, f_e):
+    """Subtract the modal stiffness and damping forces K q + C eta (N) from f_e, the K and C
+    entries of the sparse list in its order (every inertia route's last terms). Returns the
+    modal damping power eta' C eta (W)."""
     for e in range(np.uint64(sp_ptr[SEC_K]), np.uint64(sp_ptr[SEC_K + 1])):
         f_e[np.uint64(sp_idx[e, 0])] -= sp_val[e] * q[np.uint64(sp_idx[e, 1])]
     d_modal = 0.0
@@ -255,6 +240,22 @@ def held_modal_terms(n, q, eta, sp_ptr, sp_idx, sp_val, f_e, f_r, sv):
         f_e[j] -= ce
         d_modal += eta[j] * ce
     return d_modal
+
+
+@njit_borrowing
+def held_modal_terms(n, q, eta, sp_ptr, sp_idx, sp_val, f_e, f_r, sv):
+    """The inertia terms of a bar whose frame does not turn (w = 0: a clamped bar): f_e =
+    -K q - C eta, f_r and dJ/dt w (sv[0:3]) zero; J, B and the Schur complement are not
+    formed (a clamped bar's accelerations do not use them: kernel._solve_mounted). Every
+    other term of the full routes carries a factor of w and adds an exact zero there, and
+    the K and C terms are theirs (``elastic_and_damping``): the same bits at a fraction of
+    the cost. Returns the modal damping power eta' C eta (W)."""
+    for a in range(3):
+        f_r[a] = 0.0
+        sv[a] = 0.0
+    for j in range(n):
+        f_e[j] = 0.0
+    return elastic_and_damping(q, eta, sp_ptr, sp_idx, sp_val, f_e)
 
 
 @njit_borrowing
@@ -413,14 +414,7 @@ def inertia_terms_sparse(n, m, q, eta, w, J0, sp_ptr, sp_idx, sp_val, Jm, B, f_e
         v = sp_val[e]
         B[a, kk] += v * q[j]
         f_e[j] += 2.0 * v * w[a] * eta[kk]
-    for e in range(np.uint64(sp_ptr[SEC_K]), np.uint64(sp_ptr[SEC_K + 1])):
-        f_e[np.uint64(sp_idx[e, 0])] -= sp_val[e] * q[np.uint64(sp_idx[e, 1])]
-    d_modal = 0.0
-    for e in range(np.uint64(sp_ptr[SEC_C]), np.uint64(sp_ptr[SEC_C + 1])):
-        j = np.uint64(sp_idx[e, 0])
-        ce = sp_val[e] * eta[np.uint64(sp_idx[e, 1])]
-        f_e[j] -= ce
-        d_modal += eta[j] * ce
+    d_modal = elastic_and_damping(q, eta, sp_ptr, sp_idx, sp_val, f_e)
     h0 = Jm[0, 0] * w[0] + Jm[0, 1] * w[1] + Jm[0, 2] * w[2]
     h1 = Jm[1, 0] * w[0] + Jm[1, 1] * w[1] + Jm[1, 2] * w[2]
     h2 = Jm[2, 0] * w[0] + Jm[2, 1] * w[1] + Jm[2, 2] * w[2]
