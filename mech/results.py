@@ -74,6 +74,11 @@ class ImpactResult:
     # and the extremes of the rows dropped: max_abs_residual, max_kinetic, max_drive_work (J),
     # max_speed (m/s), max_penetration (m, per contact point)
     thinning: dict | None = None
+    # (5,) J: the energies (energy_table's row) of the run's first record, where this result
+    # holds a later stretch of the run's records only (a piece of its history written while
+    # the run goes on): the energy audit's columns are then measured from the run's start,
+    # as the whole run's are. None: this result starts with the run's first record.
+    energy_origin: np.ndarray | None = None
     _cache: dict = field(default_factory=dict, repr=False)
 
     # --- frames -------------------------------------------------------------------------
@@ -103,12 +108,12 @@ class ImpactResult:
             omega = np.einsum("kij,kj->ki", R, w_body)
             return pos, quat, vel, omega
         Rz = rotation_z(m.azimuth)
+        zero = np.zeros(len(Y))
         xz = Y[:, sl["pos"]]
-        pos = np.column_stack([xz[:, 0], np.zeros(len(Y)), xz[:, 1]]) @ Rz.T
+        pos = _rotated(Rz, xz[:, 0], zero, xz[:, 1])
         v = Y[:, sl["vel"]]
-        vel = np.column_stack([v[:, 0], np.zeros(len(Y)), v[:, 1]]) @ Rz.T
-        wy = Y[:, sl["omega"]][:, 0]
-        omega = np.column_stack([np.zeros(len(Y)), wy, np.zeros(len(Y))]) @ Rz.T
+        vel = _rotated(Rz, v[:, 0], zero, v[:, 1])
+        omega = _rotated(Rz, zero, Y[:, sl["omega"]][:, 0], zero)
         quat = planar_quaternions(m.azimuth, Y[:, sl["angle"]][:, 0])
         return pos, quat, vel, omega
 
@@ -118,6 +123,28 @@ class ImpactResult:
             return xy
         c, s = math.cos(self.model.azimuth), math.sin(self.model.azimuth)
         return np.column_stack([c * xy[:, 0] - s * xy[:, 1], s * xy[:, 0] + c * xy[:, 1]])
+
+    def select(self, kept: np.ndarray) -> "ImpactResult":
+        """This result restricted to the records ``kept`` (indices, ascending): its tables
+        hold those records' rows, each as this result's own table holds it (the energy audit
+        still measured from this result's first record); events, statistics and the stick
+        projections' credit (at the last record, which a thinned history keeps) as they were."""
+        kept = np.asarray(kept)
+        if len(kept) == len(self.t):
+            return self
+        extra = None if self.extra_states is None else self.extra_states[kept]
+        return ImpactResult(model=self.model, t=self.t[kept], states=self.states[kept], aux=self.aux[kept],
+                            peak_force=self.peak_force[kept], regimes=self.regimes[kept], events=self.events,
+                            stats=self.stats, projection_energy=self.projection_energy, extra_states=extra,
+                            energy_origin=self.energy_origin_row())
+
+    def energy_origin_row(self) -> np.ndarray:
+        """(5,) J: the energies (kinetic, elastic, potential, contact stored, spring stored) the
+        energy audit is measured from: the run's first record's."""
+        if self.energy_origin is not None:
+            return self.energy_origin
+        m = self.model
+        return energy_table(self.states[:1], m.arrays, m.armature_arrays)[0]
 
     # --- tables ---------------------------------------------------------------------------
 
@@ -129,8 +156,9 @@ class ImpactResult:
             m = self.model
             E = energy_table(self.states, m.arrays, m.armature_arrays)
             qd = self.states[:, m.slices()["quad"]]
-            c = {"time": self.t, **audit_terms(E, qd, E[0])}
-            c["residual"] = audit_residual(E, qd, E[0]) + self._projection_series()
+            first = E[0] if self.energy_origin is None else self.energy_origin
+            c = {"time": self.t, **audit_terms(E, qd, first)}
+            c["residual"] = audit_residual(E, qd, first) + self._projection_series()
             self._cache["energy_columns"] = c
         return self._cache["energy_columns"]
 
@@ -580,6 +608,17 @@ def audit_residual(E: np.ndarray, qd: np.ndarray, first: np.ndarray) -> np.ndarr
              + c["friction_dissipation"] + c["modal_dissipation"] + c["spring_stored"]
              + c["load_dissipation"] - c["work_in"])
     return e0 - total
+
+
+def _rotated(R: np.ndarray, x: np.ndarray, y: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """(records, 3): R @ (x, y, z) of every record, each row's three products summed left to
+    right. Element-wise, so a record's result does not depend on how many are computed at once
+    (a matrix product hands the rows to BLAS, whose kernels may sum a row otherwise at another
+    row count): the history written in pieces while a run goes on is the whole table's bytes."""
+    out = np.empty((len(x), 3))
+    for i in range(3):
+        out[:, i] = x * R[i, 0] + y * R[i, 1] + z * R[i, 2]
+    return out
 
 
 def planar_quaternions(azimuth: float, angles: np.ndarray) -> np.ndarray:

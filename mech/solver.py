@@ -552,6 +552,23 @@ class ImpactSolver:
             thinning=dict(th, max_penetration=list(th["max_penetration"])) if th["rows_dropped"] else None,
         )
 
+    def records(self, kept: np.ndarray) -> ImpactResult:
+        """The history's records ``kept`` (indices into the records so far, ascending) as a
+        result of their own, its energy audit measured from the run's first record and no
+        stick-projection credit (that is the last record's, at the run's end): the rows the
+        whole run's result gives them, for a caller that writes the history while the run
+        goes on. Indices hold until a thinning (``thinning["rows_dropped"]`` grows) or a
+        ``restore`` to a checkpoint taken before them."""
+        rec = self.recorder
+        kept = np.asarray(kept, dtype=np.int64)
+        if len(kept) and not (0 <= kept[0] and kept[-1] < rec.n and np.all(np.diff(kept) > 0)):
+            raise ValueError(f"records: indices must ascend within the {rec.n} records so far")
+        m = self.model
+        origin = energy_table(rec.y[:1], m.arrays, m.armature_arrays)[0]
+        return ImpactResult(model=m, t=rec.t[kept], states=rec.y[kept], aux=rec.aux[kept],
+                            peak_force=rec.fmax[kept], regimes=rec.regime[kept], events=list(self.events),
+                            stats={}, extra_states=rec.ext[kept], energy_origin=origin)
+
     # --- memory: the history in proportion to what is kept ------------------------------
 
     def release_dense(self) -> None:
