@@ -28,6 +28,7 @@ import csv
 import dataclasses
 import errno
 import fcntl
+import io
 import itertools
 import json
 import math
@@ -366,7 +367,7 @@ def write_files(result, folder: Path, summary_extra: dict | None = None, writer=
     writer: a ``coupling.app.table_writer.TableWriter`` (``switchsim run``'s own process):
     waveforms.parquet, waveforms.csv and history.csv go to it, the rest is written here
     meanwhile; a table it did not write is written here, and an error here stops it."""
-    from coupling.core.results import REGIME_NAMES, event_columns
+    from coupling.core.results import event_columns
 
     opts = result.scene.output
     summary = result.summary
@@ -392,8 +393,15 @@ def write_files(result, folder: Path, summary_extra: dict | None = None, writer=
             t = m.t
             interval = opts.history_interval(float(t[-1] - t[0]) if len(t) else 0.0)
             kept = thin_history(m, interval)
-            large("write_csv", folder / "history.csv", thin_result(m, kept).history_columns,
-                  {"regime_0": REGIME_NAMES, "regime_1": REGIME_NAMES})
+            codes = history_codes()
+            path = folder / "history.csv"
+            stream = writer.history if writer is not None else None  # its rows sent during the run
+            rest = stream.finish(m, kept, interval) if stream is not None else None
+            if rest is not None and writer.submit("write_csv_pieces", path, stream.stream,
+                                                  thin_result(m, rest).history_columns, codes, len(stream.pieces)):
+                sent.append((lambda where: write_csv(where, thin_result(m, kept).history_columns, codes), path, ()))
+            else:
+                large("write_csv", path, thin_result(m, kept).history_columns, codes)
             history = {"file": "history.csv", "resolution": interval,
                        "rows": int(len(kept)), "solver_records": int(len(t))}
         if waves is not None:
@@ -429,6 +437,13 @@ def write_files(result, folder: Path, summary_extra: dict | None = None, writer=
     _write_text(folder / "summary.json", json.dumps(_jsonable(summary), indent=2))
 
 
+def history_codes() -> dict:
+    """history.csv's columns written as names: the first two contact rows' regimes."""
+    from coupling.core.results import REGIME_NAMES
+
+    return {"regime_0": REGIME_NAMES, "regime_1": REGIME_NAMES}
+
+
 def thin_history(mres, resolution: float) -> np.ndarray:
     """Indices of the records history.csv keeps: the first and last, those on either side
     of every event and regime change, and of the rest the first in each interval of
@@ -456,13 +471,7 @@ def thin_history(mres, resolution: float) -> np.ndarray:
 
 def thin_result(mres, kept: np.ndarray):
     """The mechanics result restricted to the records ``kept`` (for its history table)."""
-    if len(kept) == len(mres.t):
-        return mres
-    cls = type(mres)
-    extra = None if mres.extra_states is None else mres.extra_states[kept]
-    return cls(model=mres.model, t=mres.t[kept], states=mres.states[kept], aux=mres.aux[kept],
-               peak_force=mres.peak_force[kept], regimes=mres.regimes[kept], events=mres.events,
-               stats=mres.stats, projection_energy=mres.projection_energy, extra_states=extra)
+    return mres.select(kept)
 
 
 def write_csv(path: Path, columns: dict, codes: dict | None = None) -> None:
@@ -480,10 +489,35 @@ def write_csv(path: Path, columns: dict, codes: dict | None = None) -> None:
     per-field quoting scan cost ~30 ms of a default run's history.csv (2 900 rows x 61
     columns) for the same bytes. Otherwise, and for a single column (where csv writes an
     empty field as ""), csv.writer writes the file."""
+    with open(path, "wb") as fh:
+        _write_table(fh, columns, codes, header=True)
+
+
+def csv_rows(columns: dict, codes: dict | None = None) -> bytes:
+    """The lines ``write_csv`` writes after its header line, for the same columns: a table
+    written in pieces (history.csv while the run goes on) is its header line and its pieces'
+    rows, the bytes of the whole table written at once."""
+    buffer = io.BytesIO()
+    _write_table(buffer, columns, codes, header=False)
+    return buffer.getvalue()
+
+
+def write_csv_pieces(path: Path, rest: dict, codes: dict | None, pieces: list) -> None:
+    """A CSV file of a table whose earlier rows are ``pieces`` (``csv_rows`` of each, in
+    order) and whose last rows are the columns ``rest`` (their names the table's): the bytes
+    ``write_csv`` writes for the whole table."""
+    with open(path, "wb") as fh:
+        _write_table(fh, {name: [] for name in rest}, None, header=True)  # (its header line as write_csv's)
+        fh.writelines(pieces)
+        _write_table(fh, rest, codes, header=False)
+
+
+def _write_table(fh, columns: dict, codes: dict | None, header: bool) -> None:
+    """write_csv into the binary file ``fh``, its header line only where ``header``."""
     codes = codes or {}
     names = list(columns)
     plain = len(names) > 1 and not _NEEDS_QUOTES.search("".join(names))
-    if plain and _write_numbers(path, names, columns, codes):
+    if plain and _write_numbers(fh, names, columns, codes, header):
         return
     cells = []
     for name in names:
@@ -492,17 +526,24 @@ def write_csv(path: Path, columns: dict, codes: dict | None = None) -> None:
             col = [c if type(c) is str else str(c) for c in col]  # as csv.writer: str() of the rest
             plain = not _NEEDS_QUOTES.search("".join(col))
         cells.append(col)
-    with open(path, "w", newline="") as fh:
+    # (text in the encoding open() would give a text file: the locale's)
+    text = io.TextIOWrapper(fh, newline="", write_through=True)
+    try:
         if not plain:
-            writer = csv.writer(fh, lineterminator="\n")
-            writer.writerow(names)
+            writer = csv.writer(text, lineterminator="\n")
+            if header:
+                writer.writerow(names)
             writer.writerows(zip(*cells))
             return
-        fh.write(",".join(names) + "\n")
+        if header:
+            text.write(",".join(names) + "\n")
         rows = zip(*cells)
         # in pieces of 200 lines: the whole text is never held (peak RSS as with csv.writer)
         while chunk := list(itertools.islice(rows, 200)):
-            fh.write("\n".join(map(",".join, chunk)) + "\n")
+            text.write("\n".join(map(",".join, chunk)) + "\n")
+    finally:
+        text.flush()
+        text.detach()
 
 
 # write_csv's Arrow route from these sizes on, in cells (rows x columns), where it saves
@@ -515,8 +556,9 @@ ARROW_FIRST_MIN_CELLS = 30_000  # pyarrow loaded (waveforms.parquet is written f
 ARROW_IMPORT_MIN_CELLS = 200_000  # pyarrow not loaded
 
 
-def _write_numbers(path: Path, names: list, columns: dict, codes: dict) -> bool:
-    """write_csv's Arrow route: writes the file and returns True where every column is a
+def _write_numbers(fh, names: list, columns: dict, codes: dict, header: bool) -> bool:
+    """write_csv's Arrow route: writes the table into the binary file ``fh`` (its header line
+    where ``header``) and returns True where every column is a
     1-D numpy array of floats or integers in the machine's byte order (codes: integers
     within their names, which need no quoting), all of one length, the names and codes
     ASCII (the bytes then do not depend on the locale's encoding), and the table is large
@@ -544,9 +586,9 @@ def _write_numbers(path: Path, names: list, columns: dict, codes: dict) -> bool:
         labels.append(label)
     if not arrow_text.available():
         return False
-    with open(path, "wb") as fh:
+    if header:
         fh.write((",".join(names) + "\n").encode())
-        arrow_text.write_rows(fh, arrays, labels)
+    arrow_text.write_rows(fh, arrays, labels)
     return True
 
 

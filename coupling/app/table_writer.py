@@ -63,7 +63,9 @@ class TableWriter:
     """The parent's end of the helper (module docstring). ``start()`` forks it; ``submit``
     sends a table, ``collect`` waits for every table sent, ``close`` ends the helper."""
 
-    WRITERS = ("write_csv", "write_parquet")  # what it may be asked to call (coupling.app.output)
+    # what it may be asked to write (coupling.app.output's functions of these names);
+    # write_csv_pieces: a table whose rows came before in pieces (``send_piece``)
+    WRITERS = ("write_csv", "write_parquet", "write_csv_pieces")
 
     def __init__(self, pid: int, shared: int, jobs: int, replies: int):
         self.pid = pid
@@ -74,6 +76,9 @@ class TableWriter:
         self._pending: list[str] = []
         self._broken = False
         self.seconds: dict[str, float] = {}  # path -> the helper's time writing it (benchmarks)
+        # a coupling.app.history_stream.HistoryStream sending history.csv's rows while the run
+        # goes on (write_files asks it for the rest), or None
+        self.history = None
 
     @classmethod
     def start(cls) -> "TableWriter | None":
@@ -109,9 +114,25 @@ class TableWriter:
         False if the helper is gone or the table does not fit (the caller then writes it)."""
         if function not in self.WRITERS:
             raise ValueError(f"function = {function!r}: allowed values are {', '.join(self.WRITERS)}")
+        if not self._put((function, str(path), args)):
+            return False
+        self._pending.append(str(path))
+        return True
+
+    def send_piece(self, stream: int, columns: dict, codes: dict | None = None) -> bool:
+        """Send rows of a table written in pieces (coupling.app.history_stream): the helper
+        turns them into text at once, while the run goes on, and keeps it for the
+        ``write_csv_pieces`` table of the same ``stream`` (a number), which writes the pieces
+        in the order sent. No answer comes for a piece: a piece that failed fails that table
+        (the command then writes it whole). False if the helper is gone or the piece does
+        not fit."""
+        return self._put(("csv_piece", "", (stream, columns, codes)))
+
+    def _put(self, message: tuple) -> bool:
+        """Put one message into the shared file and say where through the pipe."""
         if self._broken:
             return False
-        data = pickle.dumps((function, str(path), args), protocol=pickle.HIGHEST_PROTOCOL)
+        data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
         start = self._used
         try:
             os.ftruncate(self._shared, start + len(data))
@@ -125,7 +146,6 @@ class TableWriter:
             self._broken = True
             return False
         self._used = start + len(data)
-        self._pending.append(str(path))
         return True
 
     def collect(self) -> dict:
@@ -184,11 +204,32 @@ def _serve(shared: int, jobs_fd: int, replies_fd: int) -> None:
             import pyarrow._parquet  # noqa: F401 - write_parquet's writer
     except Exception:  # noqa: BLE001 - no pyarrow, or a broken one: write_csv's other route, and the error below
         pass
-    writers = {name: getattr(output, name) for name in TableWriter.WRITERS}
+    writers = {name: getattr(output, name) for name in ("write_csv", "write_parquet")}
+    pieces: dict[int, list | str] = {}  # stream -> its pieces' text, or why one failed
+
+    def write_csv_pieces(path, stream, rest, codes, count):
+        held = pieces.pop(stream, [])
+        if isinstance(held, str):
+            raise RuntimeError(f"a piece of its rows failed: {held}")
+        if len(held) != count:
+            raise RuntimeError(f"{len(held)} pieces of its rows came, not {count}")
+        output.write_csv_pieces(path, rest, codes, held)
+
+    writers["write_csv_pieces"] = write_csv_pieces
     with os.fdopen(jobs_fd, "rb") as jobs:
         while len(where := jobs.read(_WHERE.size)) == _WHERE.size:
             start, size = _WHERE.unpack(where)
             function, path, args = pickle.loads(_pread_all(shared, size, start))
+            if function == "csv_piece":  # no answer: its text is kept for its table
+                stream, columns, codes = args
+                held = pieces.setdefault(stream, [])
+                if not isinstance(held, str):
+                    try:
+                        held.append(output.csv_rows(columns, codes))
+                    except Exception as err:  # noqa: BLE001 - fails its table, which the command then writes
+                        pieces[stream] = f"{type(err).__name__}: {err}"
+                del args, columns
+                continue
             tick = time.perf_counter()
             try:
                 writers[function](Path(path), *args)
