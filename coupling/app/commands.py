@@ -69,6 +69,11 @@ def _run(scene_path, out_dir, quiet, overwrite, check, plots, one_shot) -> int:
 
         if wanted(scene):  # the large tables' helper, readied while the run goes on
             writer = TableWriter.start()
+            if writer is not None and scene.output.history and not check:
+                from coupling.app.history_stream import HistoryStream
+                from coupling.app.output import history_codes
+
+                writer.history = HistoryStream(writer, scene, history_codes())
     try:
         return _run_and_write(scene, folder, extra, writer, quiet, check)
     finally:
@@ -83,7 +88,8 @@ def _run_and_write(scene, folder, extra, writer, quiet, check) -> int:
     out = folder.path
     _chatter(quiet, f"running {scene.name} ({scene.kind}, t_end = {scene.t_end * 1e3:g} ms)")
     try:
-        result = run(scene, progress=not quiet, check=check)
+        result = run(scene, progress=not quiet, check=check,
+                     watch=writer.history if writer is not None else None)
     except RunInterrupted as err:
         return _write_partial(folder, err.partial, extra, f"{err}", EXIT_INTERRUPTED, writer)
     except CoupledRunError as err:

@@ -123,7 +123,11 @@ class Progress:
 class CoSimulation:
     """Runs a coupled scene (mechanics + tribology + circuit)."""
 
-    def __init__(self, scene: Scene, *, progress: bool = False):
+    def __init__(self, scene: Scene, *, progress: bool = False, watch=None):
+        """watch: None, or a callable given the mechanics solver (mech.ImpactSolver) after every
+        macro step, when every record it holds is final (no later step returns before them):
+        for a caller that consumes the history as the run goes on (``switchsim run`` writes
+        history.csv's rows then). It must not raise or change the solver."""
         if scene.kind != "coupled":
             raise ValueError(f"CoSimulation needs a coupled scene (mechanics, [tribology] and [circuit]); "
                              f"this one is {scene.kind!r}: use coupling.run")
@@ -131,6 +135,7 @@ class CoSimulation:
         self.laws = scene.tribology.laws if scene.tribology is not None else None
         self.feedback = scene.tribology.feedback if scene.tribology is not None else False
         self.progress_enabled = progress
+        self.watch = watch
         # (a make/break a sliver from a step's end or start counts as there)
         self.policy = StepPolicy.from_options(scene.coupling, scene.circuit.options.sliver(scene.t_end))
         self._reset()
@@ -299,6 +304,8 @@ class CoSimulation:
                     self.stats["macro_steps"] += 1
                     self.stats["contact_steps"] += int(touching)
                     self.progress(t)
+                    if self.watch is not None:
+                        self.watch(mech)
                 self.stats["wall_time"] = time.perf_counter() - tick
                 return self._result(mech, stepper)
         except KeyboardInterrupt as err:  # Ctrl-C: keep what was computed
@@ -524,11 +531,13 @@ class CoSimulation:
                     waves[name] = waves[name + suffix]
 
 
-def run(scene: Scene, *, progress: bool = False, check: bool = False) -> CoupledResult:
+def run(scene: Scene, *, progress: bool = False, check: bool = False, watch=None) -> CoupledResult:
     """Run any scene: mechanics only, circuit only (prescribed schedule) or coupled, and judge
     the result (``CoupledResult.judge``: ok or unsound). check: also rerun it refined and
     write summary.accuracy (coupling/app/accuracy.py). A failed or interrupted run raises
-    CoupledRunError or RunInterrupted with what it computed (status failed or interrupted)."""
+    CoupledRunError or RunInterrupted with what it computed (status failed or interrupted).
+    watch: a coupled run's ``CoSimulation`` watcher (its docstring); a run again with refined
+    modes gives it the new run's solver. Not with check."""
     if not isinstance(scene, Scene):
         hint = f"load_scene({str(scene)!r})" if isinstance(scene, str) or hasattr(scene, "__fspath__") else \
             "load_scene('scene.toml'), default_scene() or scene_from_dict(document)"
@@ -536,13 +545,16 @@ def run(scene: Scene, *, progress: bool = False, check: bool = False) -> Coupled
     for name, value in (("progress", progress), ("check", check)):
         if not isinstance(value, bool):
             raise TypeError(f"run({name}={value!r:.60}): pass True or False")
+    if watch is not None and (check or not callable(watch)):
+        raise ValueError(f"run(watch={watch!r:.60}): a callable, and only without check (the checked "
+                         "route runs the scene several times)")
     if check:
         from coupling.app.accuracy import run_checked
 
         return run_checked(scene, progress=progress)
     if scene.kind == "circuit":
         return _run_schedule(scene).judge()
-    result = _run_once(scene, progress)
+    result = _run_once(scene, progress, watch)
     refined = _refined_modes(scene, result)
     if refined is not None:
         # the run's own impacts were faster (shorter) than the estimate its "auto" count
@@ -550,14 +562,14 @@ def run(scene: Scene, *, progress: bool = False, check: bool = False) -> Coupled
         # would only move the cutoff by v^(1/5))
         first = result.mechanics.model.mode_count
         modes = {"axial": refined.axial, "bending": refined.bending}
-        result = _run_once(scene.set("bar.modes", modes), progress)
+        result = _run_once(scene.set("bar.modes", modes), progress, watch)
         result.stats["modes_refined"] = {"first": first.reason, "rule": refined.reason, "modes": modes}
     return result.judge()
 
 
-def _run_once(scene: Scene, progress: bool) -> CoupledResult:
+def _run_once(scene: Scene, progress: bool, watch=None) -> CoupledResult:
     if scene.kind == "coupled":
-        return CoSimulation(scene, progress=progress).run()
+        return CoSimulation(scene, progress=progress, watch=watch).run()
     return _run_mechanics(scene)
 
 

@@ -151,6 +151,13 @@ ONE_SHOT = """
         return answers
     tw.TableWriter.start = classmethod(started)
     tw.TableWriter.collect = collected
+    import coupling.app.history_stream as hs
+    hs.PIECE_ROWS = int(sys.argv[3])  # (pieces of a short run's history)
+    send_piece = tw.TableWriter.send_piece
+    def sent_piece(self, *args):
+        used["pieces"] = used.get("pieces", 0) + 1
+        return send_piece(self, *args)
+    tw.TableWriter.send_piece = sent_piece
     from coupling.app.cli import main
     sys.argv = ["switchsim", "run", sys.argv[1], "--out", sys.argv[2], "--quiet"]
     code = main()
@@ -158,18 +165,22 @@ ONE_SHOT = """
 """
 
 
-def test_the_command_lines_own_process_writes_the_large_tables_through_the_helper(tmp_path):
+@pytest.mark.parametrize("piece_rows", [64, 100_000])
+def test_the_command_lines_own_process_writes_the_large_tables_through_the_helper(tmp_path, piece_rows):
     """The same folder as CoupledResult.save's (one process), every table but the summary's
-    timings byte for byte; the helper wrote waveforms.parquet, waveforms.csv, history.csv."""
+    timings byte for byte; the helper wrote waveforms.parquet, waveforms.csv, history.csv,
+    history.csv's rows in pieces sent while the run went on (coupling.app.history_stream) or,
+    with pieces longer than the run's history, whole after it."""
     from coupling.core.scene import builtin_scene_text
 
     path = tmp_path / "s.toml"
     path.write_text(builtin_scene_text("relay_force").replace("t_end = 0.005", "t_end = 0.001"))
-    seen = python(ONE_SHOT, str(path), str(tmp_path / "cli"))
+    seen = python(ONE_SHOT, str(path), str(tmp_path / "cli"), str(piece_rows))
     if len(os.sched_getaffinity(0)) < 2:
         pytest.skip("one CPU: the command writes in one process")
     assert seen["code"] == 0 and seen["started"]
     assert seen["answers"] == {"waveforms.parquet": None, "waveforms.csv": None, "history.csv": None}
+    assert (seen.get("pieces", 0) >= 2) == (piece_rows == 64)
 
     from coupling import run
 
