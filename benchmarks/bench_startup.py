@@ -132,10 +132,16 @@ PHASES = textwrap.dedent("""
     gc.enable()
     from coupling.app.table_writer import TableWriter, wanted
     writer = TableWriter.start() if wanted(scene) else None  # as run_command: the large tables' helper
+    watch = None
     if writer is not None:
         timed(TableWriter, "submit", "large tables handed to the table writer")
         timed(TableWriter, "collect", "waiting for the table writer")
-    result = run(scene, progress=False)
+        if scene.output.history:  # as run_command: history.csv's rows sent while the run goes on
+            from coupling.app.history_stream import HistoryStream
+            from coupling.app.output import history_codes
+            timed(HistoryStream, "__call__", "history.csv's pieces (during the run: rows decided, computed, sent)")
+            watch = writer.history = HistoryStream(writer, scene, history_codes())
+    result = run(scene, progress=False, watch=watch)
     mark("run (model build, ngspice start, co-simulation)")
     soundness = assess(result)
     mark("soundness")

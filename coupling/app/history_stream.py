@@ -30,6 +30,8 @@ import numpy as np
 
 from mech.results import seat_credit
 
+from coupling.app.output import kept_records
+
 # records a piece: ~500 rows of a relay's 75 columns (37 500 cells, Arrow's route in the
 # helper); the last piece, sent after the run, is at most about this long
 PIECE_ROWS = 512
@@ -74,37 +76,15 @@ class HistoryStream:
         stop = rec.n - 1  # the last record's row depends on what comes after it
         if stop - self.decided < PIECE_ROWS:
             return
-        kept = self._decide(rec.t[:rec.n], rec.regime[:rec.n], solver.events, self.decided, stop)
+        kept = (np.arange(self.decided, stop) if self.interval <= 0.0 else
+                kept_records(rec.t[:rec.n], rec.regime[:rec.n], np.array([e["time"] for e in solver.events], float),
+                             self.interval, self.decided, stop))
         piece = solver.records(kept)
         if not self.writer.send_piece(self.stream, piece.history_columns, self.codes):
             self.sending = False
             return
         self.pieces.append((kept, piece.t, piece.states, piece.aux, piece.regimes, piece.events))
         self.decided = stop
-
-    def _decide(self, t: np.ndarray, regimes: np.ndarray, events: list, start: int, stop: int) -> np.ndarray:
-        """Indices in [start, stop) that ``output.thin_history`` keeps, from the records so far
-        (t, regimes) and the events so far; ``stop`` < the records so far."""
-        if self.interval <= 0.0:
-            return np.arange(start, stop)
-        keep = np.zeros(stop - start, bool)
-        if start == 0:
-            keep[0] = True
-        lo = max(start - 1, 0)
-        bins = np.floor((t[lo:stop] - t[0]) / self.interval)
-        up = np.flatnonzero(np.diff(bins) > 0) + lo + 1  # records whose bin is new
-        keep[up - start] = True
-        change = np.flatnonzero(np.any(regimes[lo + 1:stop + 1] != regimes[lo:stop], axis=1)) + lo
-        for k in (change, change + 1):  # either side of every change of a regime
-            k = k[(k >= start) & (k < stop)]
-            keep[k - start] = True
-        if events:
-            times = np.array([e["time"] for e in events], dtype=float)
-            k = np.searchsorted(t, times)  # (unclipped: an event past the last record keeps none here)
-            for j in (k, k - 1):
-                j = j[(j >= start) & (j < stop)]
-                keep[j - start] = True
-        return np.flatnonzero(keep) + start
 
     def finish(self, mres, kept: np.ndarray, interval: float) -> np.ndarray | None:
         """The records of ``kept`` (the whole table's, ``output.thin_history`` of the run's

@@ -453,20 +453,42 @@ def thin_history(mres, resolution: float) -> np.ndarray:
     n = len(t)
     if n <= 2 or resolution <= 0.0:
         return np.arange(n)
-    keep = np.zeros(n, bool)
-    keep[[0, -1]] = True
-    bins = np.floor((t - t[0]) / resolution)
-    keep[np.flatnonzero(np.diff(bins) > 0) + 1] = True
-    reg = np.asarray(mres.regimes)
-    change = np.flatnonzero(np.any(reg[1:] != reg[:-1], axis=tuple(range(1, reg.ndim)))) if n > 1 else []
-    for k in change:
-        keep[k:k + 2] = True
     times = np.array([e["time"] for e in mres.events], dtype=float)
-    if len(times):
-        k = np.clip(np.searchsorted(t, times), 0, n - 1)
-        keep[k] = True
-        keep[np.maximum(k - 1, 0)] = True
-    return np.flatnonzero(keep)
+    return kept_records(t, np.asarray(mres.regimes), times, resolution, 0, n)
+
+
+def kept_records(t: np.ndarray, regimes: np.ndarray, event_times: np.ndarray, resolution: float,
+                 start: int, stop: int) -> np.ndarray:
+    """Indices in [start, stop) of the records ``thin_history`` keeps (its rule), from the
+    records' times t (s) and regimes and the events' times (s). With ``stop`` = len(t), the
+    whole history's (its last record kept); with ``stop`` < len(t), the records so far of a
+    run that goes on (coupling.app.history_stream), whose decisions for [start, stop) the
+    records and events after them cannot change: a record's bin follows from the record
+    before, a change of regime from the record after, and an event after the records so far
+    keeps none of them."""
+    n = len(t)
+    whole = stop == n
+    keep = np.zeros(stop - start, bool)
+    if start == 0:
+        keep[0] = True
+    if whole:
+        keep[-1] = True
+    lo = max(start - 1, 0)
+    bins = np.floor((t[lo:stop] - t[0]) / resolution)
+    keep[np.flatnonzero(np.diff(bins) > 0) + lo + 1 - start] = True
+    last = min(stop, n - 1)  # (a change between record k and k + 1, k < last)
+    change = np.flatnonzero(np.any(regimes[lo + 1:last + 1] != regimes[lo:last],
+                                   axis=tuple(range(1, regimes.ndim)))) + lo
+    marks = [change, change + 1]
+    if len(event_times):
+        k = np.searchsorted(t, event_times)
+        if whole:
+            k = np.clip(k, 0, n - 1)
+        marks += [k, np.maximum(k - 1, 0)]
+    for k in marks:  # either side of every change of a regime and every event
+        k = k[(k >= start) & (k < stop)]
+        keep[k - start] = True
+    return np.flatnonzero(keep) + start
 
 
 def thin_result(mres, kept: np.ndarray):
