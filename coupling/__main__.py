@@ -23,6 +23,6 @@ def drop_working_folder() -> None:
 
 if __name__ == "__main__":
     drop_working_folder()
-    from coupling.app.cli import main
+    from coupling.app.cli import entry
 
-    sys.exit(main())
+    entry()
