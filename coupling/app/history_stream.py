@@ -35,6 +35,11 @@ from coupling.app.output import kept_records
 # records a piece: ~500 rows of a relay's 75 columns (37 500 cells, Arrow's route in the
 # helper); the last piece, sent after the run, is at most about this long
 PIECE_ROWS = 512
+# records sent in pieces at most: the helper holds their text until the end (~1.1 kB a row of
+# the default relay's 75 columns: ~18 MB) and this process a copy of their records to check
+# them against the result (~0.6 kB a row); a longer history's later rows go in the last
+# piece, as the whole table did (history.csv keeps at most [output] history_max_rows, 50 000)
+STREAM_ROWS_MAX = 16_384
 
 
 class HistoryStream:
@@ -57,6 +62,7 @@ class HistoryStream:
         self.sending = solver is not None
         self.decided = 0  # records [0, decided) are decided: kept and sent, or left out
         self.pieces: list[tuple] = []  # each piece's (kept indices, t, states, aux, regimes, events)
+        self.rows = 0  # rows sent
 
     def __call__(self, solver) -> None:
         try:
@@ -79,11 +85,15 @@ class HistoryStream:
         kept = (np.arange(self.decided, stop) if self.interval <= 0.0 else
                 kept_records(rec.t[:rec.n], rec.regime[:rec.n], np.array([e["time"] for e in solver.events], float),
                              self.interval, self.decided, stop))
+        if self.rows + len(kept) > STREAM_ROWS_MAX:  # (the rest goes in the last piece)
+            self.sending = False
+            return
         piece = solver.records(kept)
         if not self.writer.send_piece(self.stream, piece.history_columns, self.codes):
             self.sending = False
             return
         self.pieces.append((kept, piece.t, piece.states, piece.aux, piece.regimes, piece.events))
+        self.rows += len(kept)
         self.decided = stop
 
     def finish(self, mres, kept: np.ndarray, interval: float) -> np.ndarray | None:
