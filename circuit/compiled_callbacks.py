@@ -35,6 +35,8 @@ import sysconfig
 import tempfile
 from pathlib import Path
 
+from ._callbacks_ffi import ffi
+
 PACKAGE = Path(__file__).resolve().parent
 SOURCE = PACKAGE / "callbacks.c"
 LIBRARY = "libswitchsim_callbacks.so"
@@ -97,6 +99,34 @@ LAYOUT = tuple(("sw_channel", f) for f in ("name", "kind", "last_t", "last_value
                                     "arcs_used", "arcs_size", "arcs"))
 
 
+def fill_table(cell, table) -> None:
+    """Point the C channel ``cell`` (a ``sw_channel *``) at a TableChannel's numbers and arrays
+    (the table must stay alive while the cell is read)."""
+    buffer = ffi.from_buffer
+    cell.kind = TABLE
+    cell.lo, cell.hi, cell.start = table.lo, table.hi, table.start
+    cell.offset, cell.scale = table.offset, table.scale
+    cell.n = len(table.ends)
+    cell.ends = buffer("double[]", table.ends)
+    cell.t0 = buffer("double[]", table.t0)
+    cell.h = buffer("double[]", table.h)
+    cell.coefficients = buffer("double[]", table.coefficients)
+    windows = table.windows
+    if windows is None:
+        cell.windows = 0
+    else:
+        cell.windows = len(windows[0])
+        cell.lows, cell.highs, cell.befores = (buffer("double[]", w) for w in windows)
+
+
+def table_values(library, table, times) -> list[float]:
+    """The compiled callbacks' values of the TableChannel ``table`` at ``times`` (s), as the
+    vsrc callback computes them (tests hold them to the table's Python function)."""
+    cell = ffi.new("sw_channel *")
+    fill_table(cell, table)
+    return [library.sw_table_value(cell, float(t)) for t in times]
+
+
 def compiler() -> list[str]:
     """The C compiler's command: $CC, else the interpreter's, else cc."""
     text = os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc"
@@ -142,8 +172,6 @@ def load(root: Path | None = None):
         _note(f"using the Python ngspice callbacks: their C build failed ({reason})")
     else:
         try:
-            from ._callbacks_ffi import ffi
-
             library = ffi.dlopen(str(path))
         except OSError as err:  # a file that does not load (another machine's, a damaged file)
             _note(f"using the Python ngspice callbacks: {path} does not load ({err})")
