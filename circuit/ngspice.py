@@ -181,6 +181,8 @@ class NgspiceSession:
       other channels' Python functions through one trampoline (``_on_c_evaluate``); without
       the library (a failed build, or SWITCHSIM_PYTHON_CALLBACKS=1) the Python callback
       ``_on_vsrc`` does it all. The route is chosen at each ``load``; both give the same bits;
+    - the EXTERNAL current sources (the arcs' states, arc.py) read their ArcState's
+      ``value``: in C from its ``cell`` (the compiled callback), else ``_on_isrc``;
     - a transient is one ``run`` in its own greenlet: ``transient`` switches into it, and the
       SendData callback (after each accepted point is stored) switches back at the pause's
       target, with ngspice suspended inside its time loop (no command per pause).
@@ -214,6 +216,7 @@ class NgspiceSession:
         self._cstate = None
         self._c_cells = None
         self._c_channels: list[CompiledChannel] = []  # by their index in the cells
+        self._c_arc_cells: list = []  # the arcs' value cells the compiled isrc callback reads
         self._failure_value: BaseException | None = None
         self._failure = None
         # The loaded circuit's transient runs in its own greenlet ("run", one ngspice
@@ -360,13 +363,14 @@ class NgspiceSession:
         library = compiled_callbacks.load()
         if library is self._compiled:
             return
-        vsrc = self._vsrc_c
+        vsrc, isrc = self._vsrc_c, self._isrc_c
         if library is not None:
             if self._cstate is None or library is not self._clib:
                 self._start_compiled(library)
             vsrc = ffi.cast("GetVSRCData *", int(cffi_callbacks.cast("uintptr_t", library.sw_vsrc)))
+            isrc = ffi.cast("GetISRCData *", int(cffi_callbacks.cast("uintptr_t", library.sw_isrc)))
         # (ngspice keeps the last callbacks given; a NULL user pointer leaves its own unchanged)
-        rc = self._ngspice_shared.ngSpice_Init_Sync(vsrc, self._isrc_c, self._sync_c, self._ident_c, ffi.NULL)
+        rc = self._ngspice_shared.ngSpice_Init_Sync(vsrc, isrc, self._sync_c, self._ident_c, ffi.NULL)
         if rc:
             raise NgspiceError(f"ngSpice_Init_Sync returned {rc}")
         self._compiled = library
@@ -379,8 +383,13 @@ class NgspiceSession:
                                                    onerror=self._on_callback_error)
         self._c_learn = cffi_callbacks.callback("sw_learn_fn", self._on_c_learn, error=-1,
                                                 onerror=self._on_callback_error)
+        self._c_learn_arc = cffi_callbacks.callback("sw_learn_fn", self._on_c_learn_arc, error=0,
+                                                    onerror=self._on_callback_error)
         state.evaluate = self._c_evaluate
         state.learn = self._c_learn
+        state.learn_arc = self._c_learn_arc
+        self._c_arcs = cffi_callbacks.new("sw_arc[]", 4)
+        state.arcs, state.arcs_size = self._c_arcs, 4
         self._c_cells = cffi_callbacks.new("sw_channel[]", 8)
         state.channels = self._c_cells
         state.failed = self._failure is not None
@@ -424,6 +433,12 @@ class NgspiceSession:
             cell.kind = compiled_callbacks.PYTHON
             channel.function, channel.keep = function, None
 
+    def _forget_c_arcs(self) -> None:
+        """The compiled isrc callback learns the arcs afresh (a new circuit or new arcs)."""
+        if self._cstate is not None:
+            self._cstate.arcs_used = 0
+        self._c_arc_cells = []
+
     def _on_c_evaluate(self, index, t, out):
         # The compiled vsrc callback's trampoline: a Python channel's new time (the repeats
         # and the checks before it are in C), or a C channel's value that is not finite and
@@ -450,6 +465,25 @@ class NgspiceSession:
                 self._failure = NgspiceError(f"EXTERNAL source {text!r} has no input channel")
         channel.cell.name = name
         return channel.index
+
+    def _on_c_learn_arc(self, name):
+        # The compiled isrc callback meets a source for the first time: 1 and its arc's value
+        # cell bound to the name pointer, or 0 (not an arc's: 0 A, asked again next time).
+        arc = self._arcs.get(cffi_callbacks.string(name).decode("ascii", "replace").lower())
+        if arc is None:
+            return 0
+        state = self._cstate
+        used = state.arcs_used
+        if used == state.arcs_size:  # more room: the slots move (C scans them afresh)
+            arcs = cffi_callbacks.new("sw_arc[]", 2 * used)
+            cffi_callbacks.memmove(arcs, self._c_arcs, used * cffi_callbacks.sizeof("sw_arc"))
+            self._c_arcs, state.arcs, state.arcs_size = arcs, arcs, 2 * used
+        cell = cffi_callbacks.from_buffer("double[]", arc.cell)
+        self._c_arc_cells.append(cell)  # (held while C reads through it)
+        state.arcs[used].name = name
+        state.arcs[used].value = cell
+        state.arcs_used = used + 1
+        return 1
 
     def _learn(self, name) -> "Channel":
         """The channel of an EXTERNAL voltage source seen for the first time (by its name)."""
@@ -584,6 +618,7 @@ class NgspiceSession:
         self._c_channels = []
         if self._cstate is not None:
             self._cstate.channels_used = 0
+        self._forget_c_arcs()
         self._target = math.inf
         self._deadline = math.inf
         self._failure = None
@@ -641,6 +676,7 @@ class NgspiceSession:
         that carries its state (empty: no arc)."""
         self._arcs = {name.lower(): arc for name, arc in arcs.items()}
         self._arc_by_pointer = {}
+        self._forget_c_arcs()
         self._arc_from = math.nan
         self._arc_step = math.inf
         self._arc_land = math.inf
