@@ -8,7 +8,7 @@ C callbacks answer those without Python and call Python only for the other chann
 (circuit/ngspice.py installs them; what runs where is described in callbacks.c).
 
 Where: ``<NUMBA_CACHE_DIR or circuit/__pycache__>/callbacks-<key>/libswitchsim_callbacks.so``,
-the key a hash of callbacks.c, the compiler command and the machine. Built at first use
+the key a hash of callbacks.c, the flags and the machine. Built at first use
 by running the C compiler (``$CC``, else the interpreter's, else ``cc``) with
 ``-O2 -fPIC -shared -ffp-contract=off`` (no -ffast-math: the arithmetic stays IEEE
 double, operation for operation as written, which is what makes both routes agree to the
@@ -24,14 +24,13 @@ The library is loaded through cffi's out-of-line ABI module circuit/_callbacks_f
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
-import platform
 import shlex
 import shutil
 import subprocess
 import sys
-import sysconfig
 import tempfile
 from pathlib import Path
 
@@ -129,6 +128,8 @@ def table_values(library, table, times) -> list[float]:
 
 def compiler() -> list[str]:
     """The C compiler's command: $CC, else the interpreter's, else cc."""
+    import sysconfig  # (only to build)
+
     text = os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc"
     return shlex.split(text) or ["cc"]
 
@@ -137,9 +138,13 @@ def cache_root() -> Path:
     return Path(os.environ.get("NUMBA_CACHE_DIR") or PACKAGE / "__pycache__")
 
 
+@functools.lru_cache(maxsize=None)
 def build_key() -> str:
+    """The source's and flags' hash with the machine (once per process: asked at each load;
+    the compiler is not in it, as sysconfig is not imported at a start)."""
+    machine = os.uname().machine if hasattr(os, "uname") else os.environ.get("PROCESSOR_ARCHITECTURE", "")
     digest = hashlib.sha256(SOURCE.read_bytes())
-    digest.update(repr((compiler(), FLAGS, platform.machine(), sys.platform)).encode())
+    digest.update(repr((FLAGS, machine, sys.platform)).encode())
     return digest.hexdigest()[:16]
 
 
