@@ -25,9 +25,7 @@ The library is loaded through cffi's out-of-line ABI module circuit/_callbacks_f
 from __future__ import annotations
 
 import functools
-import hashlib
 import os
-import shlex
 import shutil
 import subprocess
 import sys
@@ -128,6 +126,7 @@ def table_values(library, table, times) -> list[float]:
 
 def compiler() -> list[str]:
     """The C compiler's command: $CC, else the interpreter's, else cc."""
+    import shlex
     import sysconfig  # (only to build)
 
     text = os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc"
@@ -143,7 +142,14 @@ def build_key() -> str:
     """The source's and flags' hash with the machine (once per process: asked at each load;
     the compiler is not in it, as sysconfig is not imported at a start)."""
     machine = os.uname().machine if hasattr(os, "uname") else os.environ.get("PROCESSOR_ARCHITECTURE", "")
-    digest = hashlib.sha256(SOURCE.read_bytes())
+    try:  # (hashlib loads OpenSSL, ~4 ms of a start that needs no other hash)
+        from _sha2 import sha256  # Python 3.12 and later
+    except ImportError:
+        try:
+            from _sha256 import sha256
+        except ImportError:
+            from hashlib import sha256
+    digest = sha256(SOURCE.read_bytes())
     digest.update(repr((FLAGS, machine, sys.platform)).encode())
     return digest.hexdigest()[:16]
 
