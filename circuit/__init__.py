@@ -16,6 +16,7 @@ channels (``<label>.conductance`` S, ``<label>.gap`` m) and result columns.
 
 from .arc import ArcModel, add_arc
 from .blocks import ContactBlock
+from .channels import ConstantChannel, TableChannel
 from .contact import add_contact, left_limited
 from .errors import (
     ConductanceError,
@@ -59,6 +60,7 @@ __all__ = [
     "ChangeoverCircuit",
     "COLUMNS",
     "CapacitiveLoad",
+    "ConstantChannel",
     "CurrentSource",
     "ConductanceError",
     "ContactBlock",
@@ -85,6 +87,7 @@ __all__ = [
     "Stepper",
     "ShortCircuit",
     "SwitchCircuit",
+    "TableChannel",
     "TimestepTooSmallError",
     "Wiring",
     "add_arc",

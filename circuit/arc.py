@@ -93,6 +93,7 @@ from __future__ import annotations
 
 import math
 import re
+from array import array
 from bisect import bisect_left, insort
 from dataclasses import dataclass
 from typing import Callable, ClassVar, Sequence
@@ -324,7 +325,19 @@ class ArcState:
         self._sign_b = node_b.lower() not in GROUND  # v = V(a) - V(b); a grounded node reads 0
         self._sign_a = node_a.lower() not in GROUND
         self._ayrton = arc.characteristic == "ayrton"
+        self.cell = array("d", [0.0])  # (never resized: its address is read once per load)
         self.start(False)
+
+    @property
+    def value(self) -> float:
+        """The arc's EXTERNAL current source's value (0: out, else 1 + 1/I_f, see ``_follow``),
+        held in ``cell`` too, a C double that ngspice's compiled callbacks read."""
+        return self._value
+
+    @value.setter
+    def value(self, value: float) -> None:
+        self._value = value
+        self.cell[0] = value
 
     def start(self, closed: bool) -> None:
         """Before the run: the state at the operating point (burning/armed iff closed at t = 0)."""

@@ -39,6 +39,7 @@ from typing import Callable, Iterable, Sequence
 
 from PySpice.Spice.Netlist import Circuit
 
+from .channels import ConstantChannel, TableChannel
 from .names import check_block_name, named
 
 CONDUCTANCE_SOURCE = "Vcontact_g"
@@ -152,20 +153,24 @@ def left_limited(conductance: Conductance, breakpoints: Sequence[float], span: f
         at = snapped((b,), t_stop, span, merge)[0] if t_stop is not None else b
         before = b - max(1e-9 * span, 64.0 * math.ulp(b))
         befores[at] = min(before, befores.get(at, math.inf))
-    if not befores:
+    if not befores or isinstance(conductance, ConstantChannel):  # (a constant's left limit is itself)
         return conductance
     points = sorted(befores)
     # Nearest breakpoint by bisection: one comparison per call whatever their number.
     lows = [b - _same_instant(b) for b in points]
     highs = [b + _same_instant(b) for b in points]
     values = [befores[b] for b in points]
+    function = conductance.function if isinstance(conductance, TableChannel) else conductance
 
     def source(t: float) -> float:
         i = bisect_right(lows, t) - 1
         if i >= 0 and t <= highs[i]:
-            return conductance(values[i])
-        return conductance(t)
+            return function(values[i])
+        return function(t)
 
+    if isinstance(conductance, TableChannel) and conductance.windows is None:
+        # the same windows, evaluated by the compiled callbacks (this comparison, this bisection)
+        return conductance.with_windows(source, lows, highs, values)
     return source
 
 

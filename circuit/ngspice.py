@@ -26,7 +26,10 @@ from typing import Callable, Mapping
 import numpy as np
 from greenlet import getcurrent, greenlet
 
+from . import compiled_callbacks
+from ._callbacks_ffi import ffi as cffi_callbacks
 from ._ngspice_ffi import ffi
+from .channels import ConstantChannel, TableChannel
 from .contact import LANDING_TOLERANCE
 from .netlist_check import check_deck
 from .errors import (
@@ -168,10 +171,18 @@ class NgspiceSession:
     - stdout/stderr lines are captured per command instead of being printed or logged
       (ngspice prints "condition met", "Note: ..." and warnings on success);
     - the background-thread and status callbacks return an int, as ngspice expects;
-    - the EXTERNAL voltage source gets its value from a Python function of time set
-      with ``set_channels`` (by source name); the GetSyncData callback (installed once: ngspice cannot
+    - the EXTERNAL voltage source gets its value from a function of time set with
+      ``set_channels`` (by source name); the GetSyncData callback (installed once: ngspice cannot
       uninstall it) shortens steps to land exactly on the next macro time, and aborts
       the run on a callback failure or a wall-clock timeout;
+    - the EXTERNAL voltage sources' callback is compiled C (circuit/callbacks.c, built at
+      first use by circuit/compiled_callbacks.py) when its library is there: it answers a
+      repeated time, a ConstantChannel and a TableChannel without Python and calls the
+      other channels' Python functions through one trampoline (``_on_c_evaluate``); without
+      the library (a failed build, or SWITCHSIM_PYTHON_CALLBACKS=1) the Python callback
+      ``_on_vsrc`` does it all. The route is chosen at each ``load``; both give the same bits;
+    - the EXTERNAL current sources (the arcs' states, arc.py) read their ArcState's
+      ``value``: in C from its ``cell`` (the compiled callback), else ``_on_isrc``;
     - a transient is one ``run`` in its own greenlet: ``transient`` switches into it, and the
       SendData callback (after each accepted point is stored) switches back at the pause's
       target, with ngspice suspended inside its time loop (no command per pause).
@@ -198,7 +209,16 @@ class NgspiceSession:
         self._target = math.inf
         self._max_step = math.inf  # s: the step bound of the current pause (transient's max_step)
         self._deadline = math.inf
-        self._failure: BaseException | None = None
+        # The compiled callbacks (circuit/callbacks.c) when the loaded circuit uses them
+        # (compiled_callbacks.load(), chosen at each load), their state and channel cells
+        self._compiled = None
+        self._clib = None
+        self._cstate = None
+        self._c_cells = None
+        self._c_channels: list[CompiledChannel] = []  # by their index in the cells
+        self._c_arc_cells: list = []  # the arcs' value cells the compiled isrc callback reads
+        self._failure_value: BaseException | None = None
+        self._failure = None
         # The loaded circuit's transient runs in its own greenlet ("run", one ngspice
         # command for the whole analysis); at a pause it switches back to the caller of
         # transient() from ngspice's per-point data callback and is resumed from there.
@@ -261,6 +281,18 @@ class NgspiceSession:
         # no pager: a long listing would wait for a key press that never comes
         self.command("set nomoremode")
 
+    @property
+    def _failure(self) -> BaseException | None:
+        """The exception a callback met (re-raised after ngspice stopped), or None; the
+        compiled callbacks see whether there is one."""
+        return self._failure_value
+
+    @_failure.setter
+    def _failure(self, failure: BaseException | None) -> None:
+        self._failure_value = failure
+        if self._cstate is not None:
+            self._cstate.failed = failure is not None
+
     # -- ngspice's output and status callbacks --
 
     def _send_char(self, message_c, ngspice_id, user_data):
@@ -321,6 +353,137 @@ class NgspiceSession:
         channel.last_value = value
         out[0] = value
         return 0
+
+    # -- the compiled callbacks (circuit/callbacks.c) --
+
+    def _choose_callbacks(self) -> None:
+        """The source callbacks of the next circuit: the compiled ones when their library
+        is there (built at first use), else (a failed build, or FORCE_PYTHON in the
+        environment) the Python ones. Chosen at each load, with no circuit loaded."""
+        library = compiled_callbacks.load()
+        if library is self._compiled:
+            return
+        vsrc, isrc = self._vsrc_c, self._isrc_c
+        if library is not None:
+            if self._cstate is None or library is not self._clib:
+                self._start_compiled(library)
+            vsrc = ffi.cast("GetVSRCData *", int(cffi_callbacks.cast("uintptr_t", library.sw_vsrc)))
+            isrc = ffi.cast("GetISRCData *", int(cffi_callbacks.cast("uintptr_t", library.sw_isrc)))
+        # (ngspice keeps the last callbacks given; a NULL user pointer leaves its own unchanged)
+        rc = self._ngspice_shared.ngSpice_Init_Sync(vsrc, isrc, self._sync_c, self._ident_c, ffi.NULL)
+        if rc:
+            raise NgspiceError(f"ngSpice_Init_Sync returned {rc}")
+        self._compiled = library
+
+    def _start_compiled(self, library) -> None:
+        """The compiled callbacks' state: Python's trampolines and the channel cells."""
+        state = cffi_callbacks.new("sw_state *")
+        # kept as long as the session (the library holds their addresses)
+        self._c_evaluate = cffi_callbacks.callback("sw_evaluate_fn", self._on_c_evaluate, error=1,
+                                                   onerror=self._on_callback_error)
+        self._c_learn = cffi_callbacks.callback("sw_learn_fn", self._on_c_learn, error=-1,
+                                                onerror=self._on_callback_error)
+        self._c_learn_arc = cffi_callbacks.callback("sw_learn_fn", self._on_c_learn_arc, error=0,
+                                                    onerror=self._on_callback_error)
+        state.evaluate = self._c_evaluate
+        state.learn = self._c_learn
+        state.learn_arc = self._c_learn_arc
+        self._c_arcs = cffi_callbacks.new("sw_arc[]", 4)
+        state.arcs, state.arcs_size = self._c_arcs, 4
+        self._c_cells = cffi_callbacks.new("sw_channel[]", 8)
+        state.channels = self._c_cells
+        state.failed = self._failure is not None
+        library.sw_install(state)
+        self._cstate, self._clib = state, library
+
+    def _new_channel(self, name: str, function, make_error=None) -> "Channel":
+        """A channel of the loaded circuit: a C cell of its own with the compiled callbacks."""
+        if self._compiled is None:
+            return Channel(name, function, make_error)
+        index = len(self._c_channels)
+        if index == len(self._c_cells):  # more room: the cells move (C finds them by index)
+            cells = cffi_callbacks.new("sw_channel[]", 2 * index)
+            cffi_callbacks.memmove(cells, self._c_cells, index * cffi_callbacks.sizeof("sw_channel"))
+            for k, channel in enumerate(self._c_channels):
+                channel.cell = cells + k
+            self._c_cells = self._cstate.channels = cells
+        cell = self._c_cells + index
+        cell.name = cffi_callbacks.NULL
+        cell.kind = compiled_callbacks.PYTHON
+        channel = CompiledChannel(name, function, make_error, cell, index)
+        self._c_channels.append(channel)
+        self._cstate.channels_used = index + 1
+        return channel
+
+    def _set_function(self, channel: "Channel", function) -> None:
+        """The function behind ``channel`` for the next macro step: evaluated in C if it is a
+        ConstantChannel or a TableChannel and the compiled callbacks are in use."""
+        if self._compiled is None:
+            channel.function = function.function if isinstance(function, (ConstantChannel, TableChannel)) else function
+            return
+        cell = channel.cell
+        if isinstance(function, ConstantChannel):
+            cell.kind = compiled_callbacks.CONSTANT
+            cell.constant = function.value
+            channel.function, channel.keep = function.function, None
+        elif isinstance(function, TableChannel):
+            compiled_callbacks.fill_table(cell, function)
+            channel.function, channel.keep = function.function, function  # (its arrays live while C reads them)
+        else:
+            cell.kind = compiled_callbacks.PYTHON
+            channel.function, channel.keep = function, None
+
+    def _forget_c_arcs(self) -> None:
+        """The compiled isrc callback learns the arcs afresh (a new circuit or new arcs)."""
+        if self._cstate is not None:
+            self._cstate.arcs_used = 0
+        self._c_arc_cells = []
+
+    def _on_c_evaluate(self, index, t, out):
+        # The compiled vsrc callback's trampoline: a Python channel's new time (the repeats
+        # and the checks before it are in C), or a C channel's value that is not finite and
+        # >= 0 (its Python function gives the same value and the error). 1: failed.
+        channel = self._c_channels[index]
+        try:
+            value = float(channel.function(t))
+        except BaseException as exc:  # re-raised after ngspice has stopped
+            self._failure = exc
+            return 1
+        if not (0.0 <= value < math.inf):
+            self._failure = channel.error(t, value)
+            return 1
+        out[0] = value
+        return 0
+
+    def _on_c_learn(self, name):
+        # The compiled vsrc callback meets a source for the first time: its channel's index.
+        text = cffi_callbacks.string(name).decode("ascii", "replace").lower()
+        channel = self._channels.get(text)
+        if channel is None:  # not one of ours (the deck admits none): an error, reported after the run
+            channel = self._new_channel(text, _zero)
+            if self._failure is None:
+                self._failure = NgspiceError(f"EXTERNAL source {text!r} has no input channel")
+        channel.cell.name = name
+        return channel.index
+
+    def _on_c_learn_arc(self, name):
+        # The compiled isrc callback meets a source for the first time: 1 and its arc's value
+        # cell bound to the name pointer, or 0 (not an arc's: 0 A, asked again next time).
+        arc = self._arcs.get(cffi_callbacks.string(name).decode("ascii", "replace").lower())
+        if arc is None:
+            return 0
+        state = self._cstate
+        used = state.arcs_used
+        if used == state.arcs_size:  # more room: the slots move (C scans them afresh)
+            arcs = cffi_callbacks.new("sw_arc[]", 2 * used)
+            cffi_callbacks.memmove(arcs, self._c_arcs, used * cffi_callbacks.sizeof("sw_arc"))
+            self._c_arcs, state.arcs, state.arcs_size = arcs, arcs, 2 * used
+        cell = cffi_callbacks.from_buffer("double[]", arc.cell)
+        self._c_arc_cells.append(cell)  # (held while C reads through it)
+        state.arcs[used].name = name
+        state.arcs[used].value = cell
+        state.arcs_used = used + 1
+        return 1
 
     def _learn(self, name) -> "Channel":
         """The channel of an EXTERNAL voltage source seen for the first time (by its name)."""
@@ -452,6 +615,10 @@ class NgspiceSession:
         self.rejections = []
         self._channels = {}
         self._by_pointer = {}
+        self._c_channels = []
+        if self._cstate is not None:
+            self._cstate.channels_used = 0
+        self._forget_c_arcs()
         self._target = math.inf
         self._deadline = math.inf
         self._failure = None
@@ -474,6 +641,7 @@ class NgspiceSession:
                 "callbacks (one ngspice per process): run PySpice's simulations in a separate process")
         self.clear()
         self._check_alive()
+        self._choose_callbacks()
         keep = [ffi.new("char[]", line.encode("utf-8")) for line in lines] + [ffi.NULL]
         self._lines = []
         rc = self._ngspice_shared.ngSpice_Circ(ffi.new("char *[]", keep))
@@ -494,8 +662,8 @@ class NgspiceSession:
             key = source.lower()
             channel = self._channels.get(key)
             if channel is None:
-                channel = self._channels[key] = Channel(key, function, errors.get(source))
-            channel.function = function
+                channel = self._channels[key] = self._new_channel(key, function, errors.get(source))
+            self._set_function(channel, function)
             channel.last_t = math.nan
 
     @property
@@ -508,6 +676,7 @@ class NgspiceSession:
         that carries its state (empty: no arc)."""
         self._arcs = {name.lower(): arc for name, arc in arcs.items()}
         self._arc_by_pointer = {}
+        self._forget_c_arcs()
         self._arc_from = math.nan
         self._arc_step = math.inf
         self._arc_land = math.inf
@@ -753,6 +922,43 @@ class Channel:
         if self.make_error is not None:
             return self.make_error(t, value)
         return ValueError(f"input {self.name} at t = {t!r} s is {value!r}; it must be finite and >= 0")
+
+
+class CompiledChannel(Channel):
+    """An input channel of the compiled callbacks: its last time, value and calls live in
+    its C cell (``cell``, index ``index`` of the session's cells), where the C callback
+    keeps them; ``keep`` holds what the cell points to (a TableChannel's arrays)."""
+
+    __slots__ = ("cell", "index", "keep")
+
+    def __init__(self, name: str, function: Callable[[float], float],
+                 make_error: Callable[[float, float], Exception] | None, cell, index: int):
+        self.cell, self.index, self.keep = cell, index, None
+        super().__init__(name, function, make_error)
+
+    @property
+    def last_t(self) -> float:
+        return self.cell.last_t
+
+    @last_t.setter
+    def last_t(self, t: float) -> None:
+        self.cell.last_t = t
+
+    @property
+    def last_value(self) -> float:
+        return self.cell.last_value
+
+    @last_value.setter
+    def last_value(self, value: float) -> None:
+        self.cell.last_value = value
+
+    @property
+    def calls(self) -> int:
+        return int(self.cell.calls)
+
+    @calls.setter
+    def calls(self, calls: int) -> None:
+        self.cell.calls = calls
 
 
 def _message(printed: list[str]) -> str:

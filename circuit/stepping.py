@@ -34,6 +34,7 @@ from typing import Callable, Iterable, Mapping, NamedTuple
 
 import numpy as np
 
+from .channels import ConstantChannel
 from .contact import Conductance, checked_breakpoints, left_limited, snapped
 from .deck import CircuitLike, arc_states, build_deck, input_sources
 from .errors import ConductanceError, GapError, SessionBusyError
@@ -161,7 +162,8 @@ class Stepper:
 
         inputs: every input channel (``self.inputs``) -> its value over [t_current, t_next]:
             a function of time only (ngspice calls it at Newton iterations and rejected
-            trial points too), or a constant. A conductance (S) is exactly 0 for an open
+            trial points too), a ``TableChannel`` (a piecewise polynomial that the compiled
+            callbacks evaluate without Python), or a constant. A conductance (S) is exactly 0 for an open
             contact; a gap (m) is the distance d(t) >= 0. A circuit with one contact may
             give ``conductance`` and ``gap`` instead.
         max_step: s, ngspice's steps within this macro step at most this long (besides the
@@ -502,6 +504,6 @@ def _as_function(value: Conductance | float, what: str = "conductance", unit: st
         number = float(value)
         if not (0.0 <= number < math.inf):
             raise ValueError(f"{what} = {value!r} {unit}: must be finite and >= 0")
-        return lambda t: number
+        return ConstantChannel(number)
     raise TypeError(f"{what} must be a function of time or a number ({unit}), got {type(value).__name__}")
 

@@ -193,6 +193,23 @@ class Segment:
         self._arm_t, self._arm_last = t, out
         return out
 
+    def armature_pieces(self) -> tuple | None:
+        """The armature's travel q over the segment as the dense output's pieces, for a caller
+        that evaluates ``armature(t)[0]`` elsewhere with the same arithmetic: (q at t_start,
+        ends, t0, h, coefficients), float64 C arrays, ends, t0 and h (n,), the coefficients
+        (n, 5). For t in [t_start, t_end]: q at t_start if n = 0 or t <= t_start, else with
+        k = min(bisect_left(ends, t), n - 1), th = (t - t0[k]) / h[k] and t1 = 1 - th,
+        q = c0 + th * (c1 + t1 * (c2 + th * (c3 + t1 * c4))) with c = coefficients[k] (the
+        operations of ``armature``, in its order). None without an armature, or when the
+        dense output is not kept."""
+        a = self._model.armature_index
+        n = len(self._t_valid)
+        if a < 0 or (n and not len(self._coef)):
+            return None
+        return (float(self._start_state[a]), np.ascontiguousarray(self._t_valid, dtype=np.float64),
+                np.ascontiguousarray(self._t0[:n], dtype=np.float64), np.ascontiguousarray(self._h[:n], dtype=np.float64),
+                np.ascontiguousarray(self._coef[:n, :, a], dtype=np.float64))
+
     def pair_forces(self, t: float) -> np.ndarray:
         """(rows, 3) at t (s): each contact row's (pair's, ImpactSolver.pairs) normal force
         (N), penetration (m) and gap to its fixed contact (m, 0 when touching), by a compiled

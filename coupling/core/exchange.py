@@ -501,7 +501,16 @@ class CoilLink:
             s = lo if s < lo else (hi if s > hi else s)
             return max(working_gap(armature(s)[0]), 0.0)
 
-        return {f"{self.label}.gap": gap}
+        pieces = seg.armature_pieces()
+        if pieces is None:
+            return {f"{self.label}.gap": gap}
+        # the same gap as a table of the dense output's pieces, which ngspice's compiled
+        # callbacks evaluate with gap's own operations (rest_gap - lever * q, then max(., 0))
+        from circuit.channels import TableChannel  # (circuit is imported when a run starts)
+
+        start, ends, t0, h, coefficients = pieces
+        return {f"{self.label}.gap": TableChannel(gap, lo, hi, start, ends, t0, h, coefficients,
+                                                  offset=self.rest_gap, scale=self.lever)}
 
     def flux(self, step) -> float:
         """Wb: the coil's flux linkage at the step's end."""

@@ -1,0 +1,204 @@
+"""Runs through ngspice's compiled source callbacks (circuit/callbacks.c) against runs
+through its Python callbacks: the same waveforms to the bit, the same errors, the same
+channel calls; a TableChannel's C values against its Python function at random times;
+a session without the compiled library runs on the Python route.
+
+The route is chosen when a Stepper loads its circuit: SWITCHSIM_PYTHON_CALLBACKS=1 forces
+the Python callbacks (compiled_callbacks.FORCE_PYTHON).
+"""
+
+from __future__ import annotations
+
+import math
+import random
+import struct
+from bisect import bisect_left
+
+import numpy as np
+import pytest
+
+from circuit import (
+    ArcModel,
+    ConductanceError,
+    ContactSchedule,
+    DCSource,
+    GapError,
+    InductiveLoad,
+    SimulationOptions,
+    Stepper,
+    SwitchCircuit,
+    TableChannel,
+    Wiring,
+    compiled_callbacks,
+    get_session,
+)
+
+V_S, R_S = 24.0, 0.05
+SPEED, T_BREAK, T_END = 2.0, 0.1e-3, 0.6e-3
+ARC = ArcModel(min_voltage=12.0, min_current=0.4, resistance=0.05, column_gradient=2e3)
+BREAK = ContactSchedule(((0.0, T_BREAK),), closed_resistance=0.01)
+OPTIONS = SimulationOptions(max_step=1e-6)
+MACRO = 0.05e-3
+
+
+def circuit() -> SwitchCircuit:
+    return SwitchCircuit(DCSource(V_S, R_S), InductiveLoad(12.0, 1e-3), wiring=Wiring(0.0, 0.0),
+                         contact_capacitance=100e-12, arc=ARC)
+
+
+def bits(x: float) -> bytes:
+    return struct.pack("<d", x)
+
+
+def python_twin(lo, hi, start, ends, t0, h, coefficients, offset, scale):
+    """A TableChannel's value written as plain Python float arithmetic (its definition)."""
+    ends, t0, h, rows = ends.tolist(), t0.tolist(), h.tolist(), coefficients.tolist()
+    n = len(ends)
+
+    def value(s: float) -> float:
+        s = lo if s < lo else (hi if s > hi else s)
+        if not ends or s <= lo:
+            q = start
+        else:
+            k = min(bisect_left(ends, s), n - 1)
+            c0, c1, c2, c3, c4 = rows[k]
+            th = (s - t0[k]) / h[k]
+            t1 = 1.0 - th
+            q = c0 + th * (c1 + t1 * (c2 + th * (c3 + t1 * c4)))
+        return max(offset - scale * q, 0.0)
+
+    return value
+
+
+def gap_table(lo: float, hi: float, pieces: int = 3, seed: int = 0, bad: float | None = None) -> TableChannel:
+    """The gap SPEED (t - T_BREAK), 0 before the break, as quartic pieces over [lo, hi] with
+    small curvature terms (so that every coefficient counts); ``bad``: a value put in."""
+    rng = random.Random(seed)
+    edges = np.linspace(lo, hi, pieces + 1)
+    t0, h, ends = edges[:-1], np.diff(edges), edges[1:]
+    y = SPEED * (edges - T_BREAK)
+    coefficients = np.array([[y[k], y[k + 1] - y[k]] + [rng.uniform(-1e-7, 1e-7) for _ in range(3)]
+                             for k in range(pieces)])
+    if bad is not None:
+        coefficients[-1, 0] = bad
+    start = float(y[0])
+    twin = python_twin(lo, hi, start, ends, t0, h, coefficients, 0.0, -1.0)
+    return TableChannel(twin, lo, hi, start, ends, t0, h, coefficients, offset=0.0, scale=-1.0)
+
+
+@pytest.fixture(params=["compiled", "python"])
+def route(request, monkeypatch):
+    if request.param == "python":
+        monkeypatch.setenv(compiled_callbacks.FORCE_PYTHON, "1")
+    else:
+        monkeypatch.delenv(compiled_callbacks.FORCE_PYTHON, raising=False)
+    return request.param
+
+
+def stepped(table: bool, constant_after: float | None = None) -> tuple[dict, dict, bool]:
+    """A break with an arc, the gap a TableChannel (or its Python function), the contact's
+    conductance a function, then (``constant_after``) a constant: columns, stats, route."""
+    with Stepper(circuit(), T_END, OPTIONS) as stepper:
+        compiled = get_session()._compiled is not None
+        t = 0.0
+        while not stepper.finished:
+            t_next = min(t + MACRO, T_END)
+            gap = gap_table(t, t_next, seed=int(t / MACRO))
+            conductance = BREAK if constant_after is None or t < constant_after else 0.0
+            stepper.advance(t_next, conductance, BREAK.breakpoints(t, t_next), gap=gap if table else gap.function)
+            t = t_next
+        return stepper.result_columns(), stepper.stats, compiled
+
+
+def same(a: dict, b: dict) -> bool:
+    return a.keys() == b.keys() and all(np.asarray(a[k]).tobytes() == np.asarray(b[k]).tobytes() for k in a)
+
+
+def test_both_routes_give_the_same_waveforms_to_the_bit(monkeypatch):
+    results = {}
+    for name in ("compiled", "python"):
+        if name == "python":
+            monkeypatch.setenv(compiled_callbacks.FORCE_PYTHON, "1")
+        else:
+            monkeypatch.delenv(compiled_callbacks.FORCE_PYTHON, raising=False)
+        results[name] = stepped(table=True, constant_after=0.3e-3)
+    (columns_c, stats_c, compiled), (columns_p, stats_p, python) = results["compiled"], results["python"]
+    assert compiled and not python
+    assert same(columns_c, columns_p)
+    assert stats_c["gap_calls"] == stats_p["gap_calls"] > 0
+    assert stats_c["conductance_calls"] == stats_p["conductance_calls"] > 0
+    assert np.any(columns_c["arc_current"] != 0.0)  # the arc burned: its source was read
+
+
+def test_a_table_channel_runs_as_its_python_function(route):
+    with_table, _, _ = stepped(table=True)
+    with_function, _, _ = stepped(table=False)
+    assert same(with_table, with_function)
+
+
+def test_without_the_compiled_library_the_session_runs_the_python_callbacks(monkeypatch):
+    monkeypatch.delenv(compiled_callbacks.FORCE_PYTHON, raising=False)
+    compiled, _, on_c = stepped(table=True)
+    monkeypatch.setattr(compiled_callbacks, "load", lambda root=None: None)  # (a failed build)
+    python, _, on_c_after = stepped(table=True)
+    assert on_c and not on_c_after
+    assert same(compiled, python)
+
+
+def _error(run) -> tuple[type, str]:
+    with pytest.raises(Exception) as caught:
+        run()
+    return type(caught.value), str(caught.value)
+
+
+def test_a_bad_value_raises_the_same_one_line_error_on_both_routes(monkeypatch):
+    def bad_conductance():
+        with Stepper(circuit(), T_END, OPTIONS) as stepper:
+            stepper.advance(0.2e-3, lambda t: -1.0 if t > 0.05e-3 else 1.0, gap=0.0)
+
+    def bad_table():
+        with Stepper(circuit(), T_END, OPTIONS) as stepper:
+            stepper.advance(0.2e-3, BREAK, BREAK.breakpoints(0.0, 0.2e-3), gap=gap_table(0.0, 0.2e-3, bad=math.nan))
+
+    def infinite_table():  # (a table's value is clipped at zero: only NaN or inf can be bad)
+        with Stepper(circuit(), T_END, OPTIONS) as stepper:
+            stepper.advance(0.2e-3, BREAK, BREAK.breakpoints(0.0, 0.2e-3), gap=gap_table(0.0, 0.2e-3, bad=math.inf))
+
+    for run, kind, pattern in ((bad_conductance, ConductanceError, "conductance at t = "),
+                               (bad_table, GapError, " is nan m; it must be finite and >= 0"),
+                               (infinite_table, GapError, " is inf m; it must be finite and >= 0")):
+        errors = []
+        for python in (False, True):
+            if python:
+                monkeypatch.setenv(compiled_callbacks.FORCE_PYTHON, "1")
+            else:
+                monkeypatch.delenv(compiled_callbacks.FORCE_PYTHON, raising=False)
+            errors.append(_error(run))
+        assert errors[0] == errors[1]
+        assert errors[0][0] is kind and pattern in errors[0][1] and "\n" not in errors[0][1], errors[0]
+
+
+def test_the_c_table_equals_its_python_definition_at_random_times_bit_for_bit(monkeypatch):
+    monkeypatch.delenv(compiled_callbacks.FORCE_PYTHON, raising=False)
+    library = compiled_callbacks.load()
+    assert library is not None
+    rng = random.Random(7)
+    for seed in range(20):
+        lo = rng.uniform(0.0, 1e-3)
+        hi = lo + rng.uniform(1e-9, 1e-4)
+        table = gap_table(lo, hi, pieces=rng.randint(1, 6), seed=seed)
+        times = [rng.uniform(lo - 0.1 * (hi - lo), hi + 0.1 * (hi - lo)) for _ in range(200)]
+        times += [lo, hi, *table.ends.tolist(), *table.t0.tolist(), math.nextafter(lo, -1.0), math.nextafter(hi, 2.0)]
+        assert [bits(v) for v in compiled_callbacks.table_values(library, table, times)] == \
+            [bits(table.function(t)) for t in times]
+        # read as left limits at breakpoints (circuit.contact.left_limited's windows)
+        from circuit.contact import left_limited
+
+        breaks = sorted(rng.uniform(lo, hi) for _ in range(2))
+        limited = left_limited(table, breaks, hi - lo, hi)
+        assert isinstance(limited, TableChannel) and limited.windows is not None
+        times += [b + d for b in breaks for d in (-1e-12 * b, 0.0, 1e-13 * b, 2e-12 * b)]
+        assert [bits(v) for v in compiled_callbacks.table_values(library, limited, times)] == \
+            [bits(limited.function(t)) for t in times]
+    empty = TableChannel(lambda s: 0.5, 0.0, 1.0, 0.5, [], [], [], np.empty((0, 5)))
+    assert compiled_callbacks.table_values(library, empty, [0.0, 0.5, 2.0]) == [0.5, 0.5, 0.5]
