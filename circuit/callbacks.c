@@ -1,4 +1,4 @@
-/* ngspice's per-point source callbacks answered in C where they need no Python.
+/* ngspice's per-point source and step callbacks answered in C where they need no Python.
 
    Compiled once into a shared library by circuit/compiled_callbacks.py (the flags keep
    IEEE double arithmetic as Python does it: -O2 -ffp-contract=off, no -ffast-math) and
@@ -12,6 +12,8 @@
      a value that is not finite and >= 0 (a table channel's bad value goes there too:
      the Python function behind it gives the same value and raises its error).
    - An arc's EXTERNAL current source reads the double that its ArcState writes.
+   - GetSyncData (sw_sync) applies NgspiceSession._on_sync's rules, calling it for the
+     cases that need Python (below).
    A source met for the first time is learned through Python (by name), by its name
    pointer after that. The arithmetic of the table channel is that of its Python twin
    (coupling's CoilLink.inputs over mech's Segment.armature), operation for operation,
@@ -19,6 +21,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <time.h>
 
 #define SW_PYTHON 0
 #define SW_CONSTANT 1
@@ -26,6 +29,8 @@
 
 typedef int (*sw_evaluate_fn)(int index, double t, double *out);
 typedef int (*sw_learn_fn)(char *name);
+typedef int (*sw_sync_fn)(double ckttime, double *pdelta, double olddelta, int redostep, int ident,
+                          int location, void *user);
 
 typedef struct sw_channel {
     char *name;           /* ngspice's name string of the source (its pointer), NULL: not seen yet */
@@ -61,6 +66,13 @@ typedef struct sw_state {
     sw_channel *channels;
     int arcs_used, arcs_size;
     sw_arc *arcs;
+    /* the step control (sw_sync): NgspiceSession's fields of the same names, written by
+       Python (accepting by both); landings[head:used] its _landings, popped here or there */
+    sw_sync_fn sync_python;     /* Python's _on_sync, for the calls sw_sync does not answer */
+    int has_arcs;
+    double accepting, target, max_step, deadline, arc_from, arc_step, arc_land, landing_tolerance;
+    int landings_head, landings_used, landings_size;
+    double *landings;
 } sw_state;
 
 static sw_state *state = NULL;
@@ -199,6 +211,66 @@ int sw_layout(long *out, int size)
     SW_PUT(offsetof(sw_state, learn)); SW_PUT(offsetof(sw_state, learn_arc));
     SW_PUT(offsetof(sw_state, channels_used)); SW_PUT(offsetof(sw_state, channels));
     SW_PUT(offsetof(sw_state, arcs_used)); SW_PUT(offsetof(sw_state, arcs_size));
-    SW_PUT(offsetof(sw_state, arcs));
+    SW_PUT(offsetof(sw_state, arcs)); SW_PUT(offsetof(sw_state, sync_python));
+    SW_PUT(offsetof(sw_state, has_arcs)); SW_PUT(offsetof(sw_state, accepting));
+    SW_PUT(offsetof(sw_state, target)); SW_PUT(offsetof(sw_state, max_step));
+    SW_PUT(offsetof(sw_state, deadline)); SW_PUT(offsetof(sw_state, arc_from));
+    SW_PUT(offsetof(sw_state, arc_step)); SW_PUT(offsetof(sw_state, arc_land));
+    SW_PUT(offsetof(sw_state, landing_tolerance)); SW_PUT(offsetof(sw_state, landings_head));
+    SW_PUT(offsetof(sw_state, landings_used)); SW_PUT(offsetof(sw_state, landings_size));
+    SW_PUT(offsetof(sw_state, landings));
     return k;
+}
+
+/* circuit.ngspice.stop_margin: max(1e-12 |target|, 1e-300) (Python's max: the first unless
+   the second is greater) */
+static double stop_margin(double target)
+{
+    double a = 1e-12 * fabs(target);
+    return 1e-300 > a ? 1e-300 : a;
+}
+
+static double monotonic(void)  /* Python's time.monotonic() on POSIX: CLOCK_MONOTONIC */
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+/* GetSyncData: NgspiceSession._on_sync's common path, rule for rule. Python's own
+   _on_sync answers a rejected step's redo (the rejections log), a run with a failure, a
+   wall-clock deadline passed, and the point after an accepted one when there are arcs
+   (their ArcState.accepted). The landings are one list: Python drops from its _landings
+   what this copy popped before it answers, and sets landings_head after. */
+int sw_sync(double ckttime, double *pdelta, double olddelta, int redostep, int ident, int location, void *user)
+{
+    sw_state *s = state;
+    if (redostep || s->failed || (s->has_arcs && location == 0) ||
+            (s->deadline < INFINITY && monotonic() > s->deadline))
+        return s->sync_python(ckttime, pdelta, olddelta, redostep, ident, location, user);
+    if (location)
+        s->accepting = ckttime;
+    double target = s->target;
+    if (*pdelta > s->max_step)
+        *pdelta = s->max_step;
+    if (s->has_arcs && ckttime == s->arc_from) {  /* the step (or its retry) from that accepted point */
+        if (*pdelta > s->arc_step)
+            *pdelta = s->arc_step;
+        if (s->arc_land < target)
+            target = s->arc_land;
+    }
+    while (s->landings_head < s->landings_used &&
+           s->landings[s->landings_head] <= ckttime + stop_margin(s->landings[s->landings_head]))
+        s->landings_head++;
+    if (s->landings_head < s->landings_used && s->landings[s->landings_head] < target)
+        target = s->landings[s->landings_head];
+    double remaining = target - ckttime;
+    if (remaining > stop_margin(target)) {
+        double delta = *pdelta;
+        if (delta >= remaining * (1.0 - s->landing_tolerance))
+            *pdelta = remaining;
+        else if (remaining < 2.0 * delta)
+            *pdelta = 0.5 * remaining;
+    }
+    return 0;
 }

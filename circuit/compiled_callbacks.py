@@ -1,11 +1,13 @@
-"""ngspice's source callbacks compiled from C (circuit/callbacks.c): building, caching, loading.
+"""ngspice's source and step-control callbacks compiled from C (circuit/callbacks.c):
+building, caching, loading.
 
 Why: ngspice calls the EXTERNAL sources' callbacks some 60 000 times in a relay run, most
 of them at a time already asked (Newton iterations), for a constant, for the coil's gap (a
 polynomial of the mechanics' dense output) or for an arc's state (a constant between
-accepted points); cffi's dispatch into Python and the Python body cost ~1 us a call. The
-C callbacks answer those without Python and call Python only for the other channels
-(circuit/ngspice.py installs them; what runs where is described in callbacks.c).
+accepted points), and GetSyncData 12 000 times; cffi's dispatch into Python and the Python
+body cost ~1 us a call. The C callbacks answer those without Python and call Python only
+for the other channels and the step control's rarer cases (circuit/ngspice.py installs
+them; what runs where is described in callbacks.c).
 
 Where: ``<NUMBA_CACHE_DIR or circuit/__pycache__>/callbacks-<key>/libswitchsim_callbacks.so``,
 the key a hash of callbacks.c, the flags and the machine. Built at first use
@@ -46,6 +48,8 @@ BUILD_TIMEOUT = 120.0  # s
 DECLARATIONS = """
 typedef int (*sw_evaluate_fn)(int index, double t, double *out);
 typedef int (*sw_learn_fn)(char *name);
+typedef int (*sw_sync_fn)(double ckttime, double *pdelta, double olddelta, int redostep, int ident,
+                          int location, void *user);
 
 typedef struct sw_channel {
     char *name;
@@ -75,11 +79,17 @@ typedef struct sw_state {
     sw_channel *channels;
     int arcs_used, arcs_size;
     sw_arc *arcs;
+    sw_sync_fn sync_python;
+    int has_arcs;
+    double accepting, target, max_step, deadline, arc_from, arc_step, arc_land, landing_tolerance;
+    int landings_head, landings_used, landings_size;
+    double *landings;
 } sw_state;
 
 void sw_install(sw_state *s);
 int sw_vsrc(double *out, double t, char *name, int ident, void *user);
 int sw_isrc(double *out, double t, char *name, int ident, void *user);
+int sw_sync(double ckttime, double *pdelta, double olddelta, int redostep, int ident, int location, void *user);
 double sw_table_value(const sw_channel *ch, double t);
 int sw_layout(long *out, int size);
 """
@@ -93,7 +103,10 @@ LAYOUT = tuple(("sw_channel", f) for f in ("name", "kind", "last_t", "last_value
                                            "coefficients", "windows", "lows", "highs", "befores")) + \
     (("sw_arc", "name"), ("sw_arc", "value")) + \
     tuple(("sw_state", f) for f in ("failed", "evaluate", "learn", "learn_arc", "channels_used", "channels",
-                                    "arcs_used", "arcs_size", "arcs"))
+                                    "arcs_used", "arcs_size", "arcs", "sync_python", "has_arcs", "accepting",
+                                    "target", "max_step", "deadline", "arc_from", "arc_step", "arc_land",
+                                    "landing_tolerance", "landings_head", "landings_used", "landings_size",
+                                    "landings"))
 
 
 def fill_table(cell, table) -> None:

@@ -183,6 +183,10 @@ class NgspiceSession:
       ``_on_vsrc`` does it all. The route is chosen at each ``load``; both give the same bits;
     - the EXTERNAL current sources (the arcs' states, arc.py) read their ArcState's
       ``value``: in C from its ``cell`` (the compiled callback), else ``_on_isrc``;
+    - GetSyncData is compiled too (``sw_sync``, ``_on_sync``'s rules), calling ``_on_sync``
+      (through ``_on_sync_from_c``) for a redo, a failure, a deadline passed and, with arcs,
+      the point after an accepted one; the fields it reads are mirrored into its state
+      when Python changes them (``_mirror_steps``), the landings kept one list;
     - a transient is one ``run`` in its own greenlet: ``transient`` switches into it, and the
       SendData callback (after each accepted point is stored) switches back at the pause's
       target, with ngspice suspended inside its time loop (no command per pause).
@@ -217,6 +221,7 @@ class NgspiceSession:
         self._c_cells = None
         self._c_channels: list[CompiledChannel] = []  # by their index in the cells
         self._c_arc_cells: list = []  # the arcs' value cells the compiled isrc callback reads
+        self._c_landings_seen = 0  # the compiled landings' head when _landings last followed it
         self._failure_value: BaseException | None = None
         self._failure = None
         # The loaded circuit's transient runs in its own greenlet ("run", one ngspice
@@ -324,7 +329,8 @@ class NgspiceSession:
 
     def _on_data(self, values, count, ngspice_id, user_data):
         # Each accepted point, after ngspice stored it: the pause (back to transient()'s caller).
-        if self._accepting >= self._pause_at and self._failure is None:
+        accepting = self._accepting if self._compiled is None else self._cstate.accepting
+        if accepting >= self._pause_at and self._failure is None:
             self._pause_at = math.inf
             self._caller.switch()
         return 0
@@ -363,14 +369,15 @@ class NgspiceSession:
         library = compiled_callbacks.load()
         if library is self._compiled:
             return
-        vsrc, isrc = self._vsrc_c, self._isrc_c
+        vsrc, isrc, sync = self._vsrc_c, self._isrc_c, self._sync_c
         if library is not None:
             if self._cstate is None or library is not self._clib:
                 self._start_compiled(library)
             vsrc = ffi.cast("GetVSRCData *", int(cffi_callbacks.cast("uintptr_t", library.sw_vsrc)))
             isrc = ffi.cast("GetISRCData *", int(cffi_callbacks.cast("uintptr_t", library.sw_isrc)))
+            sync = ffi.cast("GetSyncData *", int(cffi_callbacks.cast("uintptr_t", library.sw_sync)))
         # (ngspice keeps the last callbacks given; a NULL user pointer leaves its own unchanged)
-        rc = self._ngspice_shared.ngSpice_Init_Sync(vsrc, isrc, self._sync_c, self._ident_c, ffi.NULL)
+        rc = self._ngspice_shared.ngSpice_Init_Sync(vsrc, isrc, sync, self._ident_c, ffi.NULL)
         if rc:
             raise NgspiceError(f"ngSpice_Init_Sync returned {rc}")
         self._compiled = library
@@ -385,9 +392,14 @@ class NgspiceSession:
                                                 onerror=self._on_callback_error)
         self._c_learn_arc = cffi_callbacks.callback("sw_learn_fn", self._on_c_learn_arc, error=0,
                                                     onerror=self._on_callback_error)
+        self._c_sync = cffi_callbacks.callback("sw_sync_fn", self._on_sync_from_c, onerror=self._on_callback_error)
         state.evaluate = self._c_evaluate
         state.learn = self._c_learn
         state.learn_arc = self._c_learn_arc
+        state.sync_python = self._c_sync
+        state.landing_tolerance = LANDING_TOLERANCE
+        self._c_landings = cffi_callbacks.new("double[]", 16)
+        state.landings, state.landings_size = self._c_landings, 16
         self._c_arcs = cffi_callbacks.new("sw_arc[]", 4)
         state.arcs, state.arcs_size = self._c_arcs, 4
         self._c_cells = cffi_callbacks.new("sw_channel[]", 8)
@@ -395,6 +407,51 @@ class NgspiceSession:
         state.failed = self._failure is not None
         library.sw_install(state)
         self._cstate, self._clib = state, library
+        state.accepting = self._accepting
+        self._mirror_steps()
+
+    def _mirror_steps(self) -> None:
+        """The step control's fields that only Python writes into the compiled sync callback's
+        state (after Python changed any: a pause's start and end, the arcs, a breakpoint);
+        the accepting time, which both write, is copied where Python sets it."""
+        state = self._cstate
+        if state is None:
+            return
+        self._landings_from_c()
+        state.target, state.max_step, state.deadline = self._target, self._max_step, self._deadline
+        state.has_arcs = bool(self._arcs)
+        state.arc_from, state.arc_step, state.arc_land = self._arc_from, self._arc_step, self._arc_land
+        landings = self._landings
+        if len(landings) > state.landings_size:
+            self._c_landings = cffi_callbacks.new("double[]", 2 * len(landings))
+            state.landings, state.landings_size = self._c_landings, 2 * len(landings)
+        for k, t in enumerate(landings):
+            state.landings[k] = t
+        state.landings_head, state.landings_used = 0, len(landings)
+        self._c_landings_seen = 0
+
+    def _landings_from_c(self) -> None:
+        """The landings the compiled sync callback passed, dropped from ``_landings`` too: one
+        list, popped in order by whichever callback answers (as the Python callback alone would)."""
+        state = self._cstate
+        if state is not None and self._compiled is not None:
+            passed = state.landings_head - self._c_landings_seen
+            if passed:
+                del self._landings[:passed]
+                self._c_landings_seen = state.landings_head
+
+    def _on_sync_from_c(self, ckttime, pdelta, olddelta, redostep, ident, loc, user):
+        # The compiled sync callback's calls that need Python (a redo, a failure, a deadline
+        # passed, the point after an accepted one with arcs): Python's own rules, then what
+        # they changed back into the compiled state (the accepting time, the arcs' bounds).
+        self._landings_from_c()
+        result = self._on_sync(ckttime, pdelta, olddelta, redostep, ident, loc, user)
+        state = self._cstate
+        state.accepting = self._accepting
+        state.arc_from, state.arc_step, state.arc_land = self._arc_from, self._arc_step, self._arc_land
+        # (Python pops only from the front of the same list)
+        state.landings_head = self._c_landings_seen = state.landings_used - len(self._landings)
+        return result
 
     def _new_channel(self, name: str, function, make_error=None) -> "Channel":
         """A channel of the loaded circuit: a C cell of its own with the compiled callbacks."""
@@ -619,6 +676,7 @@ class NgspiceSession:
         if self._cstate is not None:
             self._cstate.channels_used = 0
         self._forget_c_arcs()
+        self._mirror_steps()
         self._target = math.inf
         self._deadline = math.inf
         self._failure = None
@@ -680,6 +738,7 @@ class NgspiceSession:
         self._arc_from = math.nan
         self._arc_step = math.inf
         self._arc_land = math.inf
+        self._mirror_steps()
 
     def set_breakpoint(self, t: float) -> None:
         """A transient breakpoint: ngspice lands on t and restarts with a small first-order step."""
@@ -689,7 +748,9 @@ class NgspiceSession:
         self._lines = []
         if not ok:
             raise NgspiceError(f"ngspice refused a breakpoint at t = {t!r} s", _message(printed))
+        self._landings_from_c()
         bisect.insort(self._landings, float(t))
+        self._mirror_steps()
 
     def transient(self, target: float | None, first: bool, wall_timeout: float | None, t_end: float,
                   end_tolerance: float = 0.0, max_step: float = math.inf) -> None:
@@ -714,6 +775,8 @@ class NgspiceSession:
                 self._run = greenlet(self._run_body)
                 self._run_thread = threading.current_thread()
                 self._accepting = -math.inf  # (the last run's last point)
+                if self._cstate is not None:
+                    self._cstate.accepting = -math.inf
             elif self._run is not None and not self._resumable():
                 self._run = None
                 raise SimulationAborted("the thread that started this transient has ended: it cannot be resumed")
@@ -725,6 +788,7 @@ class NgspiceSession:
                 raise SimulationAborted(f"ngspice's transient ended at t = {self.last_time()!r} s, "
                                         f"before {threshold!r} s")
             self._pause_at = math.inf if target is None else threshold
+            self._mirror_steps()
             self._caller = getcurrent()
             printed = self._run.switch()
             if not self._run.dead:
@@ -740,6 +804,7 @@ class NgspiceSession:
             self._max_step = math.inf
             self._deadline = math.inf
             self._landings = []
+            self._mirror_steps()
 
     def _run_body(self) -> list[str]:
         """The whole transient of the loaded circuit: one "run" (its greenlet pauses inside)."""

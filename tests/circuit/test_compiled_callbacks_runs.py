@@ -1,7 +1,8 @@
-"""Runs through ngspice's compiled source callbacks (circuit/callbacks.c) against runs
-through its Python callbacks: the same waveforms to the bit, the same errors, the same
-channel calls; a TableChannel's C values against its Python function at random times;
-a session without the compiled library runs on the Python route.
+"""Runs through ngspice's compiled callbacks (circuit/callbacks.c: the sources and the step
+control) against runs through its Python callbacks: the same waveforms to the bit, the
+same errors and wall-clock aborts, the same channel calls; a TableChannel's C values
+against its Python function at random times; a session without the compiled library runs
+on the Python route.
 
 The route is chosen when a Stepper loads its circuit: SWITCHSIM_PYTHON_CALLBACKS=1 forces
 the Python callbacks (compiled_callbacks.FORCE_PYTHON).
@@ -12,6 +13,7 @@ from __future__ import annotations
 import math
 import random
 import struct
+import time
 from bisect import bisect_left
 
 import numpy as np
@@ -25,6 +27,7 @@ from circuit import (
     GapError,
     InductiveLoad,
     SimulationOptions,
+    SimulationTimeout,
     Stepper,
     SwitchCircuit,
     TableChannel,
@@ -105,9 +108,12 @@ def stepped(table: bool, constant_after: float | None = None) -> tuple[dict, dic
             t_next = min(t + MACRO, T_END)
             gap = gap_table(t, t_next, seed=int(t / MACRO))
             conductance = BREAK if constant_after is None or t < constant_after else 0.0
-            stepper.advance(t_next, conductance, BREAK.breakpoints(t, t_next), gap=gap if table else gap.function)
+            stepper.advance(t_next, conductance, BREAK.breakpoints(t, t_next), gap=gap if table else gap.function,
+                            max_step=3e-7 if 0.1e-3 <= t < 0.2e-3 else math.inf)  # (the pause's own bound)
             t = t_next
-        return stepper.result_columns(), stepper.stats, compiled
+        columns = stepper.result_columns()
+        columns["rejected_from"], columns["rejected_newton"] = stepper.rejections  # (the sync callback's log)
+        return columns, stepper.stats, compiled
 
 
 def same(a: dict, b: dict) -> bool:
@@ -176,6 +182,23 @@ def test_a_bad_value_raises_the_same_one_line_error_on_both_routes(monkeypatch):
             errors.append(_error(run))
         assert errors[0] == errors[1]
         assert errors[0][0] is kind and pattern in errors[0][1] and "\n" not in errors[0][1], errors[0]
+
+
+def test_the_wall_clock_limit_aborts_a_run_with_no_python_channel_on_both_routes(monkeypatch):
+    """Constant inputs and no arc: on the compiled route no step of the run enters Python
+    until the deadline has passed."""
+    plain = SwitchCircuit(DCSource(V_S, R_S), InductiveLoad(12.0, 1e-3), wiring=Wiring(0.0, 0.0))
+    for python in (False, True):
+        if python:
+            monkeypatch.setenv(compiled_callbacks.FORCE_PYTHON, "1")
+        else:
+            monkeypatch.delenv(compiled_callbacks.FORCE_PYTHON, raising=False)
+        started = time.monotonic()
+        with Stepper(plain, 10.0, SimulationOptions(max_step=1e-7, wall_timeout=0.1)) as stepper:
+            assert (get_session()._compiled is None) == python
+            with pytest.raises(SimulationTimeout, match="wall-clock limit"):
+                stepper.advance(10.0, 1.0)
+        assert time.monotonic() - started < 5.0
 
 
 def test_the_c_table_equals_its_python_definition_at_random_times_bit_for_bit(monkeypatch):
