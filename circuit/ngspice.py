@@ -345,20 +345,28 @@ class NgspiceSession:
             out[0] = channel.last_value
             return 0
         channel.calls += 1
-        try:
-            value = float(channel.function(t))
-        except BaseException as exc:  # re-raised after ngspice has stopped
-            self._failure = exc
-            out[0] = channel.last_value
-            return 0
-        if not (0.0 <= value < math.inf):
-            self._failure = channel.error(t, value)
+        value = self._value(channel, t)
+        if value is None:
             out[0] = channel.last_value
             return 0
         channel.last_t = t
         channel.last_value = value
         out[0] = value
         return 0
+
+    def _value(self, channel: "Channel", t: float) -> float | None:
+        """The value of ``channel``'s function at t (s), checked finite and >= 0; None with
+        the failure kept (re-raised after ngspice has stopped) otherwise. Both source
+        callbacks' route: the Python one and the compiled one's trampoline."""
+        try:
+            value = float(channel.function(t))
+        except BaseException as exc:  # re-raised after ngspice has stopped
+            self._failure = exc
+            return None
+        if not (0.0 <= value < math.inf):
+            self._failure = channel.error(t, value)
+            return None
+        return value
 
     # -- the compiled callbacks (circuit/callbacks.c) --
 
@@ -500,26 +508,15 @@ class NgspiceSession:
         # The compiled vsrc callback's trampoline: a Python channel's new time (the repeats
         # and the checks before it are in C), or a C channel's value that is not finite and
         # >= 0 (its Python function gives the same value and the error). 1: failed.
-        channel = self._c_channels[index]
-        try:
-            value = float(channel.function(t))
-        except BaseException as exc:  # re-raised after ngspice has stopped
-            self._failure = exc
-            return 1
-        if not (0.0 <= value < math.inf):
-            self._failure = channel.error(t, value)
+        value = self._value(self._c_channels[index], t)
+        if value is None:
             return 1
         out[0] = value
         return 0
 
     def _on_c_learn(self, name):
         # The compiled vsrc callback meets a source for the first time: its channel's index.
-        text = cffi_callbacks.string(name).decode("ascii", "replace").lower()
-        channel = self._channels.get(text)
-        if channel is None:  # not one of ours (the deck admits none): an error, reported after the run
-            channel = self._new_channel(text, _zero)
-            if self._failure is None:
-                self._failure = NgspiceError(f"EXTERNAL source {text!r} has no input channel")
+        channel = self._channel_named(cffi_callbacks.string(name).decode("ascii", "replace").lower())
         channel.cell.name = name
         return channel.index
 
@@ -544,13 +541,18 @@ class NgspiceSession:
 
     def _learn(self, name) -> "Channel":
         """The channel of an EXTERNAL voltage source seen for the first time (by its name)."""
-        text = ffi.string(name).decode("ascii", "replace").lower()
+        channel = self._by_pointer[name] = self._channel_named(ffi.string(name).decode("ascii", "replace").lower())
+        return channel
+
+    def _channel_named(self, text: str) -> "Channel":
+        """The input channel of the EXTERNAL source named ``text`` (lower case), for both
+        source callbacks' routes; for a source that has none (the deck admits none), a
+        channel of 0 and an error, reported after the run."""
         channel = self._channels.get(text)
-        if channel is None:  # not one of ours (the deck admits none): an error, reported after the run
-            channel = Channel(text, _zero)
+        if channel is None:
+            channel = self._new_channel(text, _zero)
             if self._failure is None:
                 self._failure = NgspiceError(f"EXTERNAL source {text!r} has no input channel")
-        self._by_pointer[name] = channel
         return channel
 
     def _on_callback_error(self, exc_type, exc_value, traceback):
