@@ -580,11 +580,14 @@ class ImpactSolver:
         kept = np.asarray(kept, dtype=np.int64)
         if len(kept) and not (0 <= kept[0] and kept[-1] < rec.n and np.all(np.diff(kept) > 0)):
             raise ValueError(f"records: indices must ascend within the {rec.n} records so far")
-        m = self.model
-        origin = energy_table(rec.y[:1], m.arrays, m.armature_arrays)[0]
-        return ImpactResult(model=m, t=rec.t[kept], states=rec.y[kept], aux=rec.aux[kept],
+        return ImpactResult(model=self.model, t=rec.t[kept], states=rec.y[kept], aux=rec.aux[kept],
                             peak_force=rec.fmax[kept], regimes=rec.regime[kept], events=list(self.events),
-                            stats={}, extra_states=rec.ext[kept], energy_origin=origin)
+                            stats={}, extra_states=rec.ext[kept], energy_origin=self._first_energies())
+
+    def _first_energies(self) -> np.ndarray:
+        """(5,) J: ``energies`` of the run's first record, the energy audit's origin."""
+        m = self.model
+        return energy_table(self.recorder.y[:1], m.arrays, m.armature_arrays)[0]
 
     # --- memory: the history in proportion to what is kept ------------------------------
 
@@ -662,7 +665,7 @@ class ImpactSolver:
         # as the result computes its own rows' energies: the armature's included, and the
         # ringing its seats removed credited (seat_credit, as ImpactResult's residual)
         E = energy_table(Y, m.arrays, m.armature_arrays)
-        first = energy_table(rec.y[:1], m.arrays, m.armature_arrays)[0]
+        first = self._first_energies()
         qd = Y[:, m.slices()["quad"]]
         terms = audit_terms(E, qd, first)
         residual = audit_residual(E, qd, first) + seat_credit(rec.t[:len(drop)][drop], self.events)
