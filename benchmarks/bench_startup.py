@@ -138,9 +138,8 @@ PHASES = textwrap.dedent("""
         timed(TableWriter, "collect", "waiting for the table writer")
         if scene.output.history:  # as run_command: history.csv's rows sent while the run goes on
             from coupling.app.history_stream import HistoryStream
-            from coupling.app.output import history_codes
             timed(HistoryStream, "__call__", "history.csv's pieces (during the run: rows decided, computed, sent)")
-            watch = writer.history = HistoryStream(writer, scene, history_codes())
+            watch = writer.history = HistoryStream(writer, scene)
     result = run(scene, progress=False, watch=watch)
     mark("run (model build, ngspice start, co-simulation)")
     soundness = assess(result)

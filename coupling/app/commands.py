@@ -71,9 +71,8 @@ def _run(scene_path, out_dir, quiet, overwrite, check, plots, one_shot) -> int:
             writer = TableWriter.start()
             if writer is not None and scene.output.history and not check:
                 from coupling.app.history_stream import HistoryStream
-                from coupling.app.output import history_codes
 
-                writer.history = HistoryStream(writer, scene, history_codes())
+                writer.history = HistoryStream(writer, scene)
     try:
         return _run_and_write(scene, folder, extra, writer, quiet, check)
     finally:

@@ -30,7 +30,7 @@ import numpy as np
 
 from mech.results import seat_credit
 
-from coupling.app.output import kept_records
+from coupling.app.output import history_codes, kept_records
 
 # records a piece: ~500 rows of a relay's 75 columns (37 500 cells, Arrow's route in the
 # helper); the last piece, sent after the run, is at most about this long
@@ -47,9 +47,9 @@ class HistoryStream:
     goes on: call it with the mechanics solver after every macro step (``CoSimulation``'s
     ``watch``); ``finish`` says which records are left for the last piece."""
 
-    def __init__(self, writer, scene, codes: dict):
+    def __init__(self, writer, scene):
         self.writer = writer
-        self.codes = codes  # the regime columns' names, as write_files writes them
+        self.codes = history_codes()  # the regime columns' names, as write_files writes them
         # s: the resolution of a run that reaches its end (a shorter one's is checked again)
         self.interval = scene.output.history_interval(scene.t_end)
         self.stream = 0
@@ -62,7 +62,11 @@ class HistoryStream:
         self.sending = solver is not None
         self.decided = 0  # records [0, decided) are decided: kept and sent, or left out
         self.pieces: list[tuple] = []  # each piece's (kept indices, t, states, aux, regimes, events)
-        self.rows = 0  # rows sent
+
+    @property
+    def rows(self) -> int:
+        """Rows sent in pieces."""
+        return sum(len(piece[0]) for piece in self.pieces)
 
     def __call__(self, solver) -> None:
         try:
@@ -82,9 +86,8 @@ class HistoryStream:
         stop = rec.n - 1  # the last record's row depends on what comes after it
         if stop - self.decided < PIECE_ROWS:
             return
-        kept = (np.arange(self.decided, stop) if self.interval <= 0.0 else
-                kept_records(rec.t[:rec.n], rec.regime[:rec.n], np.array([e["time"] for e in solver.events], float),
-                             self.interval, self.decided, stop))
+        kept = kept_records(rec.t[:rec.n], rec.regime[:rec.n], np.array([e["time"] for e in solver.events], float),
+                            self.interval, self.decided, stop)
         if self.rows + len(kept) > STREAM_ROWS_MAX:  # (the rest goes in the last piece)
             self.sending = False
             return
@@ -93,7 +96,6 @@ class HistoryStream:
             self.sending = False
             return
         self.pieces.append((kept, piece.t, piece.states, piece.aux, piece.regimes, piece.events))
-        self.rows += len(kept)
         self.decided = stop
 
     def finish(self, mres, kept: np.ndarray, interval: float) -> np.ndarray | None:

@@ -398,10 +398,10 @@ def write_files(result, folder: Path, summary_extra: dict | None = None, writer=
             stream = writer.history if writer is not None else None  # its rows sent during the run
             rest = stream.finish(m, kept, interval) if stream is not None else None
             if rest is not None and writer.submit("write_csv_pieces", path, stream.stream,
-                                                  thin_result(m, rest).history_columns, codes, len(stream.pieces)):
-                sent.append((lambda where: write_csv(where, thin_result(m, kept).history_columns, codes), path, ()))
+                                                  m.select(rest).history_columns, codes, len(stream.pieces)):
+                sent.append((lambda where: write_csv(where, m.select(kept).history_columns, codes), path, ()))
             else:
-                large("write_csv", path, thin_result(m, kept).history_columns, codes)
+                large("write_csv", path, m.select(kept).history_columns, codes)
             history = {"file": "history.csv", "resolution": interval,
                        "rows": int(len(kept)), "solver_records": int(len(t))}
         if waves is not None:
@@ -451,7 +451,7 @@ def thin_history(mres, resolution: float) -> np.ndarray:
     regime changes) + 2 rows, however many steps the solver took."""
     t = np.asarray(mres.t)
     n = len(t)
-    if n <= 2 or resolution <= 0.0:
+    if n <= 2:
         return np.arange(n)
     times = np.array([e["time"] for e in mres.events], dtype=float)
     return kept_records(t, np.asarray(mres.regimes), times, resolution, 0, n)
@@ -465,7 +465,9 @@ def kept_records(t: np.ndarray, regimes: np.ndarray, event_times: np.ndarray, re
     run that goes on (coupling.app.history_stream), whose decisions for [start, stop) the
     records and events after them cannot change: a record's bin follows from the record
     before, a change of regime from the record after, and an event after the records so far
-    keeps none of them."""
+    keeps none of them. A resolution of 0 keeps every record."""
+    if resolution <= 0.0:
+        return np.arange(start, stop)
     n = len(t)
     whole = stop == n
     keep = np.zeros(stop - start, bool)
@@ -489,11 +491,6 @@ def kept_records(t: np.ndarray, regimes: np.ndarray, event_times: np.ndarray, re
         k = k[(k >= start) & (k < stop)]
         keep[k - start] = True
     return np.flatnonzero(keep) + start
-
-
-def thin_result(mres, kept: np.ndarray):
-    """The mechanics result restricted to the records ``kept`` (for its history table)."""
-    return mres.select(kept)
 
 
 def write_csv(path: Path, columns: dict, codes: dict | None = None) -> None:

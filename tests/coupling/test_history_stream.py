@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from coupling.app import arrow_text, history_stream
-from coupling.app.output import csv_rows, history_codes, thin_history, thin_result, write_csv, write_csv_pieces
+from coupling.app.output import csv_rows, history_codes, thin_history, write_csv, write_csv_pieces
 from coupling.core.master import CoSimulation
 from coupling.core.scene import builtin_scene
 
@@ -62,7 +62,7 @@ def streamed_run(scene, writer, monkeypatch, rows: int = 100):
     """A coupled run of ``scene`` watched by a HistoryStream sending pieces of ``rows``
     records to ``writer``; (stream, the run's result)."""
     monkeypatch.setattr(history_stream, "PIECE_ROWS", rows)
-    stream = history_stream.HistoryStream(writer, scene, history_codes())
+    stream = history_stream.HistoryStream(writer, scene)
     result = CoSimulation(scene, watch=stream).run()
     return stream, result
 
@@ -71,12 +71,12 @@ def whole_and_streamed(tmp_path, stream, writer, result) -> tuple[bytes, bytes |
     m = result.mechanics
     interval = result.scene.output.history_interval(float(m.t[-1] - m.t[0]))
     kept = thin_history(m, interval)
-    write_csv(tmp_path / "whole.csv", thin_result(m, kept).history_columns, history_codes())
+    write_csv(tmp_path / "whole.csv", m.select(kept).history_columns, history_codes())
     rest = stream.finish(m, kept, interval)
     if rest is None:
         return (tmp_path / "whole.csv").read_bytes(), None
     assert len(writer.pieces[stream.stream]) == len(stream.pieces)
-    write_csv_pieces(tmp_path / "pieces.csv", thin_result(m, rest).history_columns, history_codes(),
+    write_csv_pieces(tmp_path / "pieces.csv", m.select(rest).history_columns, history_codes(),
                      writer.pieces[stream.stream])
     return (tmp_path / "whole.csv").read_bytes(), (tmp_path / "pieces.csv").read_bytes()
 
