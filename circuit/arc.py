@@ -117,6 +117,10 @@ RESTART = 1e-3  # the first step after the arc switches, as a fraction of the st
 # at ~100 us opens the gap at 40-75 um/ms in turn over 20-40 us steps)
 _RATE_MEMORY = 3
 _LEVEL_TOLERANCE = 1e-9  # of the armed filter's level, when landing on its crossing of 1/2
+#: ArcState.cells: the arc's state as doubles, where ngspice's compiled step callback reads
+#: and moves it too (circuit/callbacks.c's SW_ARC_*, held together by a test)
+ARC_CELLS = ("t", "level", "closed", "burning", "plain", "tau", "tolerance")
+_T, _LEVEL, _CLOSED, _BURNING, _PLAIN, _TAU, _TOLERANCE = range(len(ARC_CELLS))
 _ATTRIBUTE = "_switchsim_arc"  # where add_arc records the model on a PySpice Circuit
 CHARACTERISTICS = ("linear", "ayrton")
 AYRTON_RESISTANCE = 1e-4  # ohm: the Ayrton arc's own slope (what stays of R_arc; 0.04 V at 400 A)
@@ -326,7 +330,54 @@ class ArcState:
         self._sign_a = node_a.lower() not in GROUND
         self._ayrton = arc.characteristic == "ayrton"
         self.cell = array("d", [0.0])  # (never resized: its address is read once per load)
+        # the state below as doubles (ARC_CELLS; never resized either): ngspice's compiled
+        # step callback answers ``accepted`` itself where only the filter's level moves
+        # (the arc stays lit and closed, or out and unarmed), which "plain" allows
+        self.cells = array("d", [-math.inf, 0.0, 0.0, 0.0, 0.0, self._tau, _LEVEL_TOLERANCE])
         self.start(False)
+
+    # the state the compiled step callback shares (``cells``)
+    @property
+    def level(self) -> float:
+        """The filtered closed indicator (0 .. 1)."""
+        return self.cells[_LEVEL]
+
+    @level.setter
+    def level(self, level: float) -> None:
+        self.cells[_LEVEL] = level
+
+    @property
+    def burning(self) -> bool:
+        return self.cells[_BURNING] != 0.0
+
+    @burning.setter
+    def burning(self, burning: bool) -> None:
+        self.cells[_BURNING] = 1.0 if burning else 0.0
+
+    @property
+    def _t(self) -> float:
+        return self.cells[_T]
+
+    @_t.setter
+    def _t(self, t: float) -> None:
+        self.cells[_T] = t
+
+    @property
+    def _closed(self) -> float:
+        return self.cells[_CLOSED]
+
+    @_closed.setter
+    def _closed(self, closed: float) -> None:
+        self.cells[_CLOSED] = closed
+
+    def _publish(self) -> None:
+        """Whether the compiled step callback may answer the next accepted point (its
+        "plain" cell): not for the Ayrton arc (its current followed at each point), a
+        breakdown to test (an arc out with a breakdown voltage), an approach under way
+        (``_previous``: its rates are kept point by point) or before the first point."""
+        plain = not self._ayrton and self._previous is None and self._t > -math.inf and \
+            (self.arc.breakdown_voltage is None or self.burning)
+        self.cells[_PLAIN] = 1.0 if plain else 0.0
 
     @property
     def value(self) -> float:
@@ -354,6 +405,7 @@ class ArcState:
         self._rates: list[float] = []  # the approach's last _RATE_MEMORY rates (per s)
         self.filtered_current = 0.0  # I_f of the Ayrton characteristic, A (0: not yet carrying I_min)
         self._taking_over = (-math.inf, 0.0)  # (t, |i|) at the last point before I_f is set
+        self._publish()
 
     def add_breakpoints(self, times: Sequence[float]) -> None:
         """Instants (s) where G may change (make/break, ramp corners, PWL vertices)."""
@@ -367,6 +419,11 @@ class ArcState:
 
         conductance: G at ``t`` (S) if the caller knows it, else None (read from ngspice).
         """
+        answer = self._accepted(t, conductance, read)
+        self._publish()
+        return answer
+
+    def _accepted(self, t: float, conductance: float | None, read: Reader) -> tuple[float, float]:
         arc = self.arc
         if not t > self._t:
             return math.inf, math.inf  # the same point again (a resume after a pause)

@@ -13,7 +13,9 @@
      the Python function behind it gives the same value and raises its error).
    - An arc's EXTERNAL current source reads the double that its ArcState writes.
    - GetSyncData (sw_sync) applies NgspiceSession._on_sync's rules, calling it for the
-     cases that need Python (below).
+     cases that need Python (below): it logs a rejected step's redo in a buffer Python
+     reads, and answers an arc's ArcState.accepted where only the arc's filtered closed
+     indicator moves (sw_arc_plain).
    A source met for the first time is learned through Python (by name), by its name
    pointer after that. The arithmetic of the table channel is that of its Python twin
    (coupling's CoilLink.inputs over mech's Segment.armature), operation for operation,
@@ -57,6 +59,21 @@ typedef struct sw_arc {
     const double *value;
 } sw_arc;
 
+/* An ArcState's cells (ArcState.cells, shared with Python, which keeps the arc's state in
+   them on both routes), by index */
+#define SW_ARC_T 0          /* s: the last accepted point (-inf: none yet) */
+#define SW_ARC_LEVEL 1      /* the filtered closed indicator */
+#define SW_ARC_CLOSED 2     /* 1.0 or 0.0: the contact at that point */
+#define SW_ARC_BURNING 3    /* 1.0 or 0.0 */
+#define SW_ARC_PLAIN 4      /* 1.0: sw_arc_plain may answer (set by Python after each of its answers) */
+#define SW_ARC_TAU 5        /* s: the filter's time constant */
+#define SW_ARC_TOLERANCE 6  /* of the level, at its crossing of 1/2 */
+
+typedef struct sw_arc_rule {
+    double *cells;      /* the ArcState's cells (above) */
+    int conductance;    /* the input channel whose last value is G at an accepted point, -1: none */
+} sw_arc_rule;
+
 typedef struct sw_state {
     int failed;                 /* the session holds a failure: answer last values, call nothing */
     sw_evaluate_fn evaluate;    /* Python: channel index, t -> value (0) or failure (1) */
@@ -73,6 +90,12 @@ typedef struct sw_state {
     double accepting, target, max_step, deadline, arc_from, arc_step, arc_land, landing_tolerance;
     int landings_head, landings_used, landings_size;
     double *landings;
+    int arc_rules_used;         /* the session's arcs (all of them: Python's _arcs), for sw_sync */
+    sw_arc_rule *arc_rules;
+    /* rejected steps logged here, (t, 1.0 if Newton failed else 0.0) pairs, until Python
+       moves them into its rejections list (a full buffer: Python's _on_sync logs it) */
+    int rejections_used, rejections_size;
+    double *rejections;
 } sw_state;
 
 static sw_state *state = NULL;
@@ -190,12 +213,13 @@ int sw_isrc(double *out, double t, char *name, int ident, void *user)
 }
 
 /* The structures' layout as this compiler lays them out, for the test that holds
-   compiled_callbacks.DECLARATIONS to it: sizes, then the offset of each field in order. */
+   compiled_callbacks.DECLARATIONS to it: sizes, then the offset of each field in order,
+   then the ArcState cells' indices (circuit.arc's ARC_CELLS). */
 #define SW_PUT(x) do { if (k < size) out[k] = (long)(x); k++; } while (0)
 int sw_layout(long *out, int size)
 {
     int k = 0;
-    SW_PUT(sizeof(sw_channel)); SW_PUT(sizeof(sw_arc)); SW_PUT(sizeof(sw_state));
+    SW_PUT(sizeof(sw_channel)); SW_PUT(sizeof(sw_arc)); SW_PUT(sizeof(sw_arc_rule)); SW_PUT(sizeof(sw_state));
     SW_PUT(offsetof(sw_channel, name)); SW_PUT(offsetof(sw_channel, kind));
     SW_PUT(offsetof(sw_channel, last_t)); SW_PUT(offsetof(sw_channel, last_value));
     SW_PUT(offsetof(sw_channel, calls)); SW_PUT(offsetof(sw_channel, constant));
@@ -207,6 +231,7 @@ int sw_layout(long *out, int size)
     SW_PUT(offsetof(sw_channel, windows)); SW_PUT(offsetof(sw_channel, lows));
     SW_PUT(offsetof(sw_channel, highs)); SW_PUT(offsetof(sw_channel, befores));
     SW_PUT(offsetof(sw_arc, name)); SW_PUT(offsetof(sw_arc, value));
+    SW_PUT(offsetof(sw_arc_rule, cells)); SW_PUT(offsetof(sw_arc_rule, conductance));
     SW_PUT(offsetof(sw_state, failed)); SW_PUT(offsetof(sw_state, evaluate));
     SW_PUT(offsetof(sw_state, learn)); SW_PUT(offsetof(sw_state, learn_arc));
     SW_PUT(offsetof(sw_state, channels_used)); SW_PUT(offsetof(sw_state, channels));
@@ -218,7 +243,11 @@ int sw_layout(long *out, int size)
     SW_PUT(offsetof(sw_state, arc_step)); SW_PUT(offsetof(sw_state, arc_land));
     SW_PUT(offsetof(sw_state, landing_tolerance)); SW_PUT(offsetof(sw_state, landings_head));
     SW_PUT(offsetof(sw_state, landings_used)); SW_PUT(offsetof(sw_state, landings_size));
-    SW_PUT(offsetof(sw_state, landings));
+    SW_PUT(offsetof(sw_state, landings)); SW_PUT(offsetof(sw_state, arc_rules_used));
+    SW_PUT(offsetof(sw_state, arc_rules)); SW_PUT(offsetof(sw_state, rejections_used));
+    SW_PUT(offsetof(sw_state, rejections_size)); SW_PUT(offsetof(sw_state, rejections));
+    SW_PUT(SW_ARC_T); SW_PUT(SW_ARC_LEVEL); SW_PUT(SW_ARC_CLOSED); SW_PUT(SW_ARC_BURNING);
+    SW_PUT(SW_ARC_PLAIN); SW_PUT(SW_ARC_TAU); SW_PUT(SW_ARC_TOLERANCE);
     return k;
 }
 
@@ -237,22 +266,89 @@ static double monotonic(void)  /* Python's time.monotonic() on POSIX: CLOCK_MONO
     return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
 
-/* GetSyncData: NgspiceSession._on_sync's common path, rule for rule. Python's own
-   _on_sync answers a rejected step's redo (the rejections log), a run with a failure, a
-   wall-clock deadline passed, and the point after an accepted one when there are arcs
-   (their ArcState.accepted). The landings are one list: Python drops from its _landings
-   what this copy popped before it answers, and sets landings_head after. */
+/* ArcState.accepted at the accepted point t, where nothing but the arc's filtered closed
+   indicator moves: the arc keeps burning (armed and closed) or stays out without arming,
+   the contact's conductance at t known from its input channel and the contact as it was
+   at the arc's last point, no breakdown to test, no current to follow (SW_ARC_PLAIN: Python
+   sets it after each of its own answers). 1 with (step, land) and, if *moved, the new
+   level (nothing written); 0: Python's rules answer. ArcState.accepted's operations. */
+static int sw_arc_plain(const sw_arc_rule *rule, double t, double *step, double *land, double *level, int *moved)
+{
+    const double *c = rule->cells;
+    *moved = 0;
+    if (!(t > c[SW_ARC_T])) {  /* the same point again (a resume after a pause) */
+        *step = *land = INFINITY;
+        return 1;
+    }
+    if (c[SW_ARC_PLAIN] == 0.0 || rule->conductance < 0)
+        return 0;
+    const sw_channel *ch = state->channels + rule->conductance;
+    if (!(ch->last_t == t))
+        return 0;
+    double closed = ch->last_value > 0.0 ? 1.0 : 0.0;
+    if (closed != c[SW_ARC_CLOSED])
+        return 0;  /* made or broken since: the switch instant is among Python's breakpoints */
+    double tau = c[SW_ARC_TAU];
+    double value = closed + (c[SW_ARC_LEVEL] - closed) * exp(-(t - c[SW_ARC_T]) / tau);
+    int armed = closed != 0.0 ? value > 0.5 - c[SW_ARC_TOLERANCE] : value > 0.5 + c[SW_ARC_TOLERANCE];
+    int burning = c[SW_ARC_BURNING] != 0.0;
+    if (armed != burning || (burning && closed == 0.0))
+        return 0;  /* ignites, goes out or needs the arc's current */
+    *step = INFINITY;
+    *land = closed != 0.0 && !armed ? t + tau * log(2.0 * (1.0 - value)) : INFINITY;
+    *level = value;
+    *moved = 1;
+    return 1;
+}
+
+#define SW_ARCS_MAX 16  /* arcs sw_sync answers for at once (more: Python) */
+
+/* GetSyncData: NgspiceSession._on_sync's rules, rule for rule. Python's own _on_sync
+   answers a run with a failure, a wall-clock deadline passed, a redo when the rejections'
+   buffer is full, and the point after an accepted one when an arc needs more than
+   sw_arc_plain (ArcState.accepted); which it is is decided before anything is written.
+   The landings are one list: Python drops from its _landings what this copy popped
+   before it answers, and sets landings_head after; the rejections logged here are moved
+   into its list first. */
 int sw_sync(double ckttime, double *pdelta, double olddelta, int redostep, int ident, int location, void *user)
 {
     sw_state *s = state;
-    if (redostep || s->failed || (s->has_arcs && location == 0) ||
+    if (s->failed || (redostep && s->rejections_used >= s->rejections_size) ||
             (s->deadline < INFINITY && monotonic() > s->deadline))
         return s->sync_python(ckttime, pdelta, olddelta, redostep, ident, location, user);
-    if (location)
+    int arcs = s->has_arcs && location == 0 ? s->arc_rules_used : 0;
+    double steps[SW_ARCS_MAX], lands[SW_ARCS_MAX], levels[SW_ARCS_MAX];
+    int moved[SW_ARCS_MAX];
+    if (arcs > SW_ARCS_MAX)
+        return s->sync_python(ckttime, pdelta, olddelta, redostep, ident, location, user);
+    for (int i = 0; i < arcs; i++)
+        if (!sw_arc_plain(s->arc_rules + i, ckttime, steps + i, lands + i, levels + i, moved + i))
+            return s->sync_python(ckttime, pdelta, olddelta, redostep, ident, location, user);
+    if (redostep) {
+        int k = 2 * s->rejections_used++;
+        s->rejections[k] = ckttime;
+        s->rejections[k + 1] = *pdelta == 0.125 * olddelta ? 1.0 : 0.0;
+    } else if (location) {
         s->accepting = ckttime;
-    double target = s->target;
+    }
     if (*pdelta > s->max_step)
         *pdelta = s->max_step;
+    if (s->has_arcs && location == 0) {
+        double step = INFINITY, land = INFINITY;
+        for (int i = 0; i < arcs; i++) {
+            if (moved[i]) {
+                double *c = s->arc_rules[i].cells;
+                c[SW_ARC_T] = ckttime;
+                c[SW_ARC_LEVEL] = levels[i];
+            }
+            if (steps[i] < step) step = steps[i];  /* Python's min(step, arc_step) */
+            if (lands[i] < land) land = lands[i];
+        }
+        s->arc_step = step;
+        s->arc_land = land;
+        s->arc_from = ckttime;
+    }
+    double target = s->target;
     if (s->has_arcs && ckttime == s->arc_from) {  /* the step (or its retry) from that accepted point */
         if (*pdelta > s->arc_step)
             *pdelta = s->arc_step;

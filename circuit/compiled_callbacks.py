@@ -42,6 +42,7 @@ LIBRARY = "libswitchsim_callbacks.so"
 MODULE = "circuit._callbacks_ffi"
 FORCE_PYTHON = "SWITCHSIM_PYTHON_CALLBACKS"  # "1": the Python callbacks, no compiled library
 FLAGS = ("-O2", "-fPIC", "-shared", "-ffp-contract=off")
+LIBRARIES = ("-lm",)  # (after the source: exp and log of the arcs' rules)
 BUILD_TIMEOUT = 120.0  # s
 
 #: The part of callbacks.c that Python uses (must match the C source's definitions).
@@ -70,6 +71,11 @@ typedef struct sw_arc {
     const double *value;
 } sw_arc;
 
+typedef struct sw_arc_rule {
+    double *cells;
+    int conductance;
+} sw_arc_rule;
+
 typedef struct sw_state {
     int failed;
     sw_evaluate_fn evaluate;
@@ -84,6 +90,10 @@ typedef struct sw_state {
     double accepting, target, max_step, deadline, arc_from, arc_step, arc_land, landing_tolerance;
     int landings_head, landings_used, landings_size;
     double *landings;
+    int arc_rules_used;
+    sw_arc_rule *arc_rules;
+    int rejections_used, rejections_size;
+    double *rejections;
 } sw_state;
 
 void sw_install(sw_state *s);
@@ -97,16 +107,21 @@ int sw_layout(long *out, int size);
 #: The channel kinds of callbacks.c.
 PYTHON, CONSTANT, TABLE = 0, 1, 2
 
-#: (struct, field) in the order of callbacks.c's sw_layout, after the three structures' sizes.
+#: The structures, in the order of callbacks.c's sw_layout (their sizes first).
+STRUCTS = ("sw_channel", "sw_arc", "sw_arc_rule", "sw_state")
+
+#: (struct, field) in the order of callbacks.c's sw_layout, after the structures' sizes
+#: (then come the ArcState cells' indices, circuit.arc.ARC_CELLS).
 LAYOUT = tuple(("sw_channel", f) for f in ("name", "kind", "last_t", "last_value", "calls", "constant", "lo",
                                            "hi", "start", "offset", "scale", "n", "ends", "t0", "h",
                                            "coefficients", "windows", "lows", "highs", "befores")) + \
-    (("sw_arc", "name"), ("sw_arc", "value")) + \
+    (("sw_arc", "name"), ("sw_arc", "value"), ("sw_arc_rule", "cells"), ("sw_arc_rule", "conductance")) + \
     tuple(("sw_state", f) for f in ("failed", "evaluate", "learn", "learn_arc", "channels_used", "channels",
                                     "arcs_used", "arcs_size", "arcs", "sync_python", "has_arcs", "accepting",
                                     "target", "max_step", "deadline", "arc_from", "arc_step", "arc_land",
                                     "landing_tolerance", "landings_head", "landings_used", "landings_size",
-                                    "landings"))
+                                    "landings", "arc_rules_used", "arc_rules", "rejections_used",
+                                    "rejections_size", "rejections"))
 
 
 def fill_table(cell, table) -> None:
@@ -163,7 +178,7 @@ def build_key() -> str:
         except ImportError:
             from hashlib import sha256
     digest = sha256(SOURCE.read_bytes())
-    digest.update(repr((FLAGS, machine, sys.platform)).encode())
+    digest.update(repr((FLAGS, LIBRARIES, machine, sys.platform)).encode())
     return digest.hexdigest()[:16]
 
 
@@ -235,7 +250,7 @@ def _build(folder: Path) -> str | None:
         return f"no C compiler ({command[0]!r} not found)"
     staging = Path(tempfile.mkdtemp(prefix=folder.name + ".build-", dir=folder.parent))
     try:
-        done = subprocess.run([*command, *FLAGS, "-o", str(staging / LIBRARY), str(SOURCE)],
+        done = subprocess.run([*command, *FLAGS, "-o", str(staging / LIBRARY), str(SOURCE), *LIBRARIES],
                               capture_output=True, text=True, timeout=BUILD_TIMEOUT)
         if done.returncode != 0:
             return " ".join((done.stderr or done.stdout).strip().splitlines()[-1:]) or \

@@ -62,6 +62,9 @@ _FALLBACK_PATHS = (
 # ngSpice_Command keeps every command in ngspice's history; a stepping run
 # sends three per macro step, so the history is released periodically (a NULL command).
 _COMMANDS_BEFORE_HISTORY_RELEASE = 5000
+# Rejected steps the compiled sync callback logs before Python moves them into its list
+# (a full log: that redo goes to Python, which empties it)
+REJECTIONS_LOGGED = 1024
 
 
 def find_library() -> str:
@@ -238,11 +241,13 @@ class NgspiceSession:
         self._arc_from = math.nan  # accepted time the arc's step bounds below apply from
         self._arc_step = math.inf
         self._arc_land = math.inf
-        # Every step ngspice rejected since the circuit was loaded: (the accepted time it retries
-        # from, s; True if Newton failed, else its truncation-error test), from the sync
-        # callback's redo flag. ngspice cuts a step that failed to converge to exactly 1/8
-        # (dctran.c); a truncation-error rejection proposes its own estimate instead.
-        self.rejections: list[tuple[float, bool]] = []
+        self._rejections: list[tuple[float, bool]] = []  # (``rejections``)
+        # the compiled sync callback's arc rules (sw_arc_rule[]) and its rejections' log
+        self._c_rules = None
+        self._c_rules_size = 0
+        self._c_rule_cells: list = []
+        self._c_rules_stale = True  # the arcs or the channels changed since the rules were written
+        self._c_rejections = None
         self._commands_sent = 0
         self._encoded: dict[str, bytes] = {}
         self.owner: weakref.ref | None = None
@@ -412,23 +417,28 @@ class NgspiceSession:
         state.arcs, state.arcs_size = self._c_arcs, 4
         self._c_cells = cffi_callbacks.new("sw_channel[]", 8)
         state.channels = self._c_cells
+        self._c_rejections = cffi_callbacks.new("double[]", 2 * REJECTIONS_LOGGED)
+        state.rejections, state.rejections_size = self._c_rejections, REJECTIONS_LOGGED
         state.failed = self._failure is not None
         library.sw_install(state)
         self._cstate, self._clib = state, library
+        self._c_rules, self._c_rules_size, self._c_rules_stale = None, 0, True
         state.accepting = self._accepting
+        self._set_arc_bounds(self._arc_from, self._arc_step, self._arc_land)
         self._mirror_steps()
 
     def _mirror_steps(self) -> None:
         """The step control's fields that only Python writes into the compiled sync callback's
         state (after Python changed any: a pause's start and end, the arcs, a breakpoint);
-        the accepting time, which both write, is copied where Python sets it."""
+        the accepting time and the arcs' step bounds, which both write, are copied where
+        Python sets them (``_set_arc_bounds``, ``_on_sync_from_c``)."""
         state = self._cstate
         if state is None:
             return
         self._landings_from_c()
         state.target, state.max_step, state.deadline = self._target, self._max_step, self._deadline
-        state.has_arcs = bool(self._arcs)
-        state.arc_from, state.arc_step, state.arc_land = self._arc_from, self._arc_step, self._arc_land
+        if self._c_rules_stale:
+            self._c_arc_rules()
         landings = self._landings
         if len(landings) > state.landings_size:
             self._c_landings = cffi_callbacks.new("double[]", 2 * len(landings))
@@ -448,13 +458,62 @@ class NgspiceSession:
                 del self._landings[:passed]
                 self._c_landings_seen = state.landings_head
 
-    def _on_sync_from_c(self, ckttime, pdelta, olddelta, redostep, ident, loc, user):
-        # The compiled sync callback's calls that need Python (a redo, a failure, a deadline
-        # passed, the point after an accepted one with arcs): Python's own rules, then what
-        # they changed back into the compiled state (the accepting time, the arcs' bounds).
-        self._landings_from_c()
-        result = self._on_sync(ckttime, pdelta, olddelta, redostep, ident, loc, user)
+    def _rejections_from_c(self) -> None:
+        """The rejected steps the compiled sync callback logged, appended to ``_rejections``
+        (in order: Python logs only after this)."""
         state = self._cstate
+        if state is not None and state.rejections_used:
+            log = self._c_rejections
+            self._rejections.extend((log[2 * k], log[2 * k + 1] != 0.0) for k in range(state.rejections_used))
+            state.rejections_used = 0
+
+    @property
+    def rejections(self) -> list[tuple[float, bool]]:
+        """Every step ngspice rejected since the circuit was loaded: (the accepted time it
+        retries from, s; True if Newton failed, else its truncation-error test), from the
+        sync callback's redo flag. ngspice cuts a step that failed to converge to exactly
+        1/8 (dctran.c); a truncation-error rejection proposes its own estimate instead."""
+        self._rejections_from_c()
+        return self._rejections
+
+    def _set_arc_bounds(self, start: float, step: float, land: float) -> None:
+        """The arcs' step bounds (from the accepted time ``start``: the next step at most
+        ``step``, landing on ``land``), in the compiled state too."""
+        self._arc_from, self._arc_step, self._arc_land = start, step, land
+        if self._cstate is not None:
+            self._cstate.arc_from, self._cstate.arc_step, self._cstate.arc_land = start, step, land
+
+    def _c_arc_rules(self) -> None:
+        """The compiled sync callback's view of the arcs: each ArcState's cells and the
+        input channel whose last value is its contact's conductance (-1: none, Python reads
+        it from ngspice)."""
+        state = self._cstate
+        arcs = list(self._arcs.values())
+        if len(arcs) > self._c_rules_size:
+            self._c_rules_size = 2 * len(arcs)
+            self._c_rules = cffi_callbacks.new("sw_arc_rule[]", self._c_rules_size)
+            state.arc_rules = self._c_rules
+        self._c_rule_cells = []
+        for k, arc in enumerate(arcs):
+            cells = cffi_callbacks.from_buffer("double[]", arc.cells)
+            self._c_rule_cells.append(cells)  # (held while C reads through it)
+            channel = self._channels.get(arc.conductance_source.lower()) if arc.conductance_source else None
+            self._c_rules[k].cells = cells
+            self._c_rules[k].conductance = channel.index if isinstance(channel, CompiledChannel) else -1
+        state.arc_rules_used = len(arcs)
+        state.has_arcs = bool(arcs)
+        self._c_rules_stale = False
+
+    def _on_sync_from_c(self, ckttime, pdelta, olddelta, redostep, ident, loc, user):
+        # The compiled sync callback's calls that need Python (a failure, a deadline passed,
+        # a full rejections' buffer, an arc's point that is not plain): Python's own rules on
+        # the compiled state's arc bounds and rejections, then what they changed back into it
+        # (the accepting time, the arcs' bounds).
+        self._landings_from_c()
+        self._rejections_from_c()
+        state = self._cstate
+        self._arc_from, self._arc_step, self._arc_land = state.arc_from, state.arc_step, state.arc_land
+        result = self._on_sync(ckttime, pdelta, olddelta, redostep, ident, loc, user)
         state.accepting = self._accepting
         state.arc_from, state.arc_step, state.arc_land = self._arc_from, self._arc_step, self._arc_land
         # (Python pops only from the front of the same list)
@@ -575,7 +634,7 @@ class NgspiceSession:
 
     def _on_sync(self, ckttime, pdelta, olddelta, redostep, ident, loc, user):
         if redostep:
-            self.rejections.append((ckttime, pdelta[0] == 0.125 * olddelta))
+            self._rejections.append((ckttime, pdelta[0] == 0.125 * olddelta))
         elif loc:
             self._accepting = ckttime
         if self._failure is None and time.monotonic() > self._deadline:
@@ -671,7 +730,9 @@ class NgspiceSession:
         self._reset_callback_state()
 
     def _reset_callback_state(self) -> None:
-        self.rejections = []
+        self._rejections = []
+        if self._cstate is not None:
+            self._cstate.rejections_used = 0
         self._channels = {}
         self._by_pointer = {}
         self._c_channels = []
@@ -684,9 +745,8 @@ class NgspiceSession:
         self._failure = None
         self._arcs = {}
         self._arc_by_pointer = {}
-        self._arc_from = math.nan
-        self._arc_step = math.inf
-        self._arc_land = math.inf
+        self._set_arc_bounds(math.nan, math.inf, math.inf)
+        self._c_rules_stale = True
 
     def load(self, lines: list[str]) -> None:
         """Load a deck (title line first, ``.end`` last); raises NetlistError with ngspice's message.
@@ -723,6 +783,7 @@ class NgspiceSession:
             channel = self._channels.get(key)
             if channel is None:
                 channel = self._channels[key] = self._new_channel(key, function, errors.get(source))
+                self._c_rules_stale = True  # (an arc's conductance channel may be this one)
             self._set_function(channel, function)
             channel.last_t = math.nan
 
@@ -737,9 +798,8 @@ class NgspiceSession:
         self._arcs = {name.lower(): arc for name, arc in arcs.items()}
         self._arc_by_pointer = {}
         self._forget_c_arcs()
-        self._arc_from = math.nan
-        self._arc_step = math.inf
-        self._arc_land = math.inf
+        self._set_arc_bounds(math.nan, math.inf, math.inf)
+        self._c_rules_stale = True
         self._mirror_steps()
 
     def set_breakpoint(self, t: float) -> None:

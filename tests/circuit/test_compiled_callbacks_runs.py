@@ -34,6 +34,7 @@ from circuit import (
     Wiring,
     compiled_callbacks,
     get_session,
+    ngspice,
 )
 
 V_S, R_S = 24.0, 0.05
@@ -44,9 +45,21 @@ OPTIONS = SimulationOptions(max_step=1e-6)
 MACRO = 0.05e-3
 
 
-def circuit() -> SwitchCircuit:
+# arcs whose accepted points the compiled step callback answers where only the arc's filter
+# moves (lit and closed, out and unarmed), and arcs it leaves to ArcState.accepted at
+# every point: one out after the break with a breakdown to test, the Ayrton arc
+ARCS = {
+    "linear": ARC,
+    "breakdown": ArcModel(min_voltage=12.0, min_current=0.4, resistance=0.05, column_gradient=2e3,
+                          breakdown_voltage=30.0, breakdown_gradient=1e5),
+    "ayrton": ArcModel(min_voltage=12.0, min_current=0.4, column_gradient=2e3, characteristic="ayrton",
+                       ayrton_c=2.0, ayrton_d=1e3),
+}
+
+
+def circuit(arc: ArcModel = ARC) -> SwitchCircuit:
     return SwitchCircuit(DCSource(V_S, R_S), InductiveLoad(12.0, 1e-3), wiring=Wiring(0.0, 0.0),
-                         contact_capacitance=100e-12, arc=ARC)
+                         contact_capacitance=100e-12, arc=arc)
 
 
 def bits(x: float) -> bytes:
@@ -98,10 +111,10 @@ def route(request, monkeypatch):
     return request.param
 
 
-def stepped(table: bool, constant_after: float | None = None) -> tuple[dict, dict, bool]:
+def stepped(table: bool, constant_after: float | None = None, arc: ArcModel = ARC) -> tuple[dict, dict, bool]:
     """A break with an arc, the gap a TableChannel (or its Python function), the contact's
     conductance a function, then (``constant_after``) a constant: columns, stats, route."""
-    with Stepper(circuit(), T_END, OPTIONS) as stepper:
+    with Stepper(circuit(arc), T_END, OPTIONS) as stepper:
         compiled = get_session()._compiled is not None
         t = 0.0
         while not stepper.finished:
@@ -134,6 +147,37 @@ def test_both_routes_give_the_same_waveforms_to_the_bit(monkeypatch):
     assert stats_c["gap_calls"] == stats_p["gap_calls"] > 0
     assert stats_c["conductance_calls"] == stats_p["conductance_calls"] > 0
     assert np.any(columns_c["arc_current"] != 0.0)  # the arc burned: its source was read
+
+
+@pytest.mark.parametrize("kind", sorted(ARCS))
+def test_every_arc_kind_runs_to_the_same_bits_on_both_routes(kind, monkeypatch):
+    """The arc's state at every accepted point, whichever callback decided it, is Python's
+    (the waveforms and the rejected steps' log, to the bit)."""
+    results = []
+    for python in (False, True):
+        if python:
+            monkeypatch.setenv(compiled_callbacks.FORCE_PYTHON, "1")
+        else:
+            monkeypatch.delenv(compiled_callbacks.FORCE_PYTHON, raising=False)
+        results.append(stepped(table=True, arc=ARCS[kind]))
+    (compiled, _, on_c), (python, _, on_python) = results
+    assert on_c and not on_python
+    assert same(compiled, python)
+    assert np.any(compiled["arc_current"] != 0.0)
+
+
+def test_rejected_steps_beyond_the_compiled_log_are_kept_in_order(monkeypatch, tmp_path):
+    """The compiled step callback logs rejected steps in a buffer that Python empties into its
+    list; a full buffer hands that redo to Python, which empties it first. With room for two,
+    the log is the Python route's, entry for entry."""
+    monkeypatch.setattr(ngspice, "REJECTIONS_LOGGED", 2)
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))  # (a library of its own: its state made afresh)
+    monkeypatch.delenv(compiled_callbacks.FORCE_PYTHON, raising=False)
+    compiled, _, on_c = stepped(table=True)
+    monkeypatch.setenv(compiled_callbacks.FORCE_PYTHON, "1")
+    python, _, _ = stepped(table=True)
+    assert on_c and len(compiled["rejected_from"]) > 2 * 2
+    assert same(compiled, python)
 
 
 def test_a_table_channel_runs_as_its_python_function(route):
