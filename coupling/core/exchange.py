@@ -307,7 +307,10 @@ class ContactLink:
 
         out = {}
         if gap_wanted:
-            out[f"{self.label}.gap"] = gap
+            # a point that touches throughout makes the gap 0 throughout: a constant, which
+            # ngspice's compiled callbacks answer without Python (a closed contact's steps)
+            closed = any(a <= lo and hi <= b for a, b in spans)
+            out[f"{self.label}.gap"] = 0.0 if closed else gap
         if not touching:
             out[f"{self.label}.conductance"] = 0.0  # open throughout: no conductance callback needed
             return out
