@@ -62,6 +62,37 @@ def test_page_is_self_contained_and_holds_the_data(tmp_path):
                             "contact resistance"}
 
 
+def test_the_page_is_the_same_bytes_whether_the_kernel_or_python_copies_plotly_js(tmp_path, monkeypatch):
+    """plotly.min.js goes into the page by os.sendfile; where that is missing or fails part
+    way (a part already sent), the bytes are written from Python instead: the same page."""
+    import os
+
+    from coupling.app import waveview
+
+    t = np.linspace(0.0, 1e-3, 101)
+    res = types.SimpleNamespace(waveform_columns=dict(time=t, contact_voltage=24.0 * t), closed_intervals=[],
+                                scene=types.SimpleNamespace(name="t"))
+    pages = []
+    real = os.sendfile
+
+    def partly(out, src, offset, count):  # a first piece, then a failure
+        if offset == 0:
+            return real(out, src, offset, min(count, 65536))
+        raise OSError("sendfile failed")
+
+    for send in (real, None, partly):
+        with monkeypatch.context() as patch:
+            if send is None:
+                patch.delattr(os, "sendfile")
+            else:
+                patch.setattr(os, "sendfile", send)
+            path = tmp_path / f"page{len(pages)}.html"
+            assert waveview.write_waveform_html(res, path) == "written"
+            pages.append(path.read_bytes())
+    script = waveview.plotly_js().read_bytes()
+    assert pages[0] == pages[1] == pages[2] and pages[0].count(script) == 1
+
+
 # --- the page of a real run: the default relay to 2 ms (one rivet: contact point 1 does not exist) ---
 
 _PAGE = {}
