@@ -12,6 +12,9 @@
      a value that is not finite and >= 0 (a table channel's bad value goes there too:
      the Python function behind it gives the same value and raises its error).
    - An arc's EXTERNAL current source reads the double that its ArcState writes.
+   - SendData (sw_data, given to ngspice once, at its init, when the library is there)
+     calls Python's only for the accepted point that pauses the run, or for every point on
+     the Python route.
    - GetSyncData (sw_sync) applies NgspiceSession._on_sync's rules, calling it for the
      cases that need Python (below): it logs a rejected step's redo in a buffer Python
      reads, and answers an arc's ArcState.accepted where only the arc's filtered closed
@@ -33,6 +36,7 @@ typedef int (*sw_evaluate_fn)(int index, double t, double *out);
 typedef int (*sw_learn_fn)(char *name);
 typedef int (*sw_sync_fn)(double ckttime, double *pdelta, double olddelta, int redostep, int ident,
                           int location, void *user);
+typedef int (*sw_data_fn)(void *values, int count, int ident, void *user);
 
 typedef struct sw_channel {
     char *name;           /* ngspice's name string of the source (its pointer), NULL: not seen yet */
@@ -96,11 +100,27 @@ typedef struct sw_state {
        moves them into its rejections list (a full buffer: Python's _on_sync logs it) */
     int rejections_used, rejections_size;
     double *rejections;
+    double pause_at;            /* s: the accepted point at or after this time pauses the run (sw_data) */
+    int python_data;            /* 1: the Python callbacks' route, every SendData to Python */
 } sw_state;
 
 static sw_state *state = NULL;
+static sw_data_fn data_python = NULL;  /* Python's SendData (NgspiceSession._on_data) */
 
 void sw_install(sw_state *s) { state = s; }
+void sw_install_data(sw_data_fn fn) { data_python = fn; }
+
+/* SendData, after each accepted point is stored: Python's _on_data pauses the run at the
+   first accepted point at or after pause_at (it switches back to transient()'s caller);
+   with a failure it does nothing. Before a compiled state is installed, and on the
+   Python route, every call is Python's. */
+int sw_data(void *values, int count, int ident, void *user)
+{
+    sw_state *s = state;
+    if (s == NULL || s->python_data || (s->accepting >= s->pause_at && !s->failed))
+        return data_python(values, count, ident, user);
+    return 0;
+}
 
 static long bisect_left(const double *a, long n, double x)
 {
@@ -246,6 +266,7 @@ int sw_layout(long *out, int size)
     SW_PUT(offsetof(sw_state, landings)); SW_PUT(offsetof(sw_state, arc_rules_used));
     SW_PUT(offsetof(sw_state, arc_rules)); SW_PUT(offsetof(sw_state, rejections_used));
     SW_PUT(offsetof(sw_state, rejections_size)); SW_PUT(offsetof(sw_state, rejections));
+    SW_PUT(offsetof(sw_state, pause_at)); SW_PUT(offsetof(sw_state, python_data));
     SW_PUT(SW_ARC_T); SW_PUT(SW_ARC_LEVEL); SW_PUT(SW_ARC_CLOSED); SW_PUT(SW_ARC_BURNING);
     SW_PUT(SW_ARC_PLAIN); SW_PUT(SW_ARC_TAU); SW_PUT(SW_ARC_TOLERANCE);
     return k;

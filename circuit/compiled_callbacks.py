@@ -51,6 +51,7 @@ typedef int (*sw_evaluate_fn)(int index, double t, double *out);
 typedef int (*sw_learn_fn)(char *name);
 typedef int (*sw_sync_fn)(double ckttime, double *pdelta, double olddelta, int redostep, int ident,
                           int location, void *user);
+typedef int (*sw_data_fn)(void *values, int count, int ident, void *user);
 
 typedef struct sw_channel {
     char *name;
@@ -94,9 +95,13 @@ typedef struct sw_state {
     sw_arc_rule *arc_rules;
     int rejections_used, rejections_size;
     double *rejections;
+    double pause_at;
+    int python_data;
 } sw_state;
 
 void sw_install(sw_state *s);
+void sw_install_data(sw_data_fn fn);
+int sw_data(void *values, int count, int ident, void *user);
 int sw_vsrc(double *out, double t, char *name, int ident, void *user);
 int sw_isrc(double *out, double t, char *name, int ident, void *user);
 int sw_sync(double ckttime, double *pdelta, double olddelta, int redostep, int ident, int location, void *user);
@@ -121,7 +126,7 @@ LAYOUT = tuple(("sw_channel", f) for f in ("name", "kind", "last_t", "last_value
                                     "target", "max_step", "deadline", "arc_from", "arc_step", "arc_land",
                                     "landing_tolerance", "landings_head", "landings_used", "landings_size",
                                     "landings", "arc_rules_used", "arc_rules", "rejections_used",
-                                    "rejections_size", "rejections"))
+                                    "rejections_size", "rejections", "pause_at", "python_data"))
 
 
 def fill_table(cell, table) -> None:

@@ -187,12 +187,17 @@ class NgspiceSession:
     - the EXTERNAL current sources (the arcs' states, arc.py) read their ArcState's
       ``value``: in C from its ``cell`` (the compiled callback), else ``_on_isrc``;
     - GetSyncData is compiled too (``sw_sync``, ``_on_sync``'s rules), calling ``_on_sync``
-      (through ``_on_sync_from_c``) for a redo, a failure, a deadline passed and, with arcs,
-      the point after an accepted one; the fields it reads are mirrored into its state
-      when Python changes them (``_mirror_steps``), the landings kept one list;
+      (through ``_on_sync_from_c``) for a failure, a deadline passed, a full log of
+      rejected steps and, with arcs, a point after an accepted one that is not the arcs'
+      plain case (``ArcState.cells``); the fields it reads are mirrored into its state
+      when Python changes them (``_mirror_steps``), the landings kept one list, the
+      rejections moved into ``rejections`` before Python reads or adds to it;
     - a transient is one ``run`` in its own greenlet: ``transient`` switches into it, and the
       SendData callback (after each accepted point is stored) switches back at the pause's
-      target, with ngspice suspended inside its time loop (no command per pause).
+      target, with ngspice suspended inside its time loop (no command per pause). SendData
+      is given once, at ngspice's init: the compiled ``sw_data`` when the library is there
+      then, which calls ``_on_data`` only for the point that pauses (every point on the
+      Python route).
 
     The library is reached through cffi's out-of-line ABI module (no C parser at a
     start), not through PySpice's NgSpiceShared, which parses its header at each start;
@@ -232,7 +237,7 @@ class NgspiceSession:
         # transient() from ngspice's per-point data callback and is resumed from there.
         self._run: greenlet | None = None
         self._caller: greenlet | None = None
-        self._pause_at = math.inf  # s: the accepted point at or after this time pauses the run
+        self._pause_value = math.inf  # (``_pause_at``)
         self._accepting = -math.inf  # s: time of the point ngspice is accepting (sync callback, loc 1)
         self._run_thread: threading.Thread | None = None  # the thread whose greenlet self._run is
         self._landings: list[float] = []  # s: the breakpoints set for the current pause, ascending
@@ -276,9 +281,17 @@ class NgspiceSession:
         self._data_c = ffi.callback("int(void *, int, int, void *)", self._on_data, onerror=self._on_callback_error)
         self._init_data_c = ffi.callback("int(void *, int, void *)", self._on_init_data)
         self._ident_c = ffi.new("int *", 0)
+        # SendData is given once, here: the compiled one (callbacks.c's sw_data) when the
+        # library is there, which calls _on_data only at a pause (or on the Python route)
+        data = ffi.cast("void *", self._data_c)
+        self._data_library = compiled_callbacks.load()
+        if self._data_library is not None:
+            self._c_data = cffi_callbacks.callback("sw_data_fn", self._on_data, onerror=self._on_callback_error)
+            self._data_library.sw_install_data(self._c_data)
+            data = ffi.cast("void *", int(cffi_callbacks.cast("uintptr_t", self._data_library.sw_data)))
         with isolated_start():
             rc = self._ngspice_shared.ngSpice_Init(
-                self._send_char_c, self._send_stat_c, self._exit_c, ffi.cast("void *", self._data_c),
+                self._send_char_c, self._send_stat_c, self._exit_c, data,
                 ffi.cast("void *", self._init_data_c), self._background_c, self._self_c)
         if rc:
             raise NgspiceError(f"ngSpice_Init returned {rc}", _message(self._lines))
@@ -290,6 +303,18 @@ class NgspiceSession:
         self.library = library_path
         # no pager: a long listing would wait for a key press that never comes
         self.command("set nomoremode")
+
+    @property
+    def _pause_at(self) -> float:
+        """s: the accepted point at or after this time pauses the run (the compiled SendData
+        sees it too)."""
+        return self._pause_value
+
+    @_pause_at.setter
+    def _pause_at(self, t: float) -> None:
+        self._pause_value = t
+        if self._cstate is not None:
+            self._cstate.pause_at = t
 
     @property
     def _failure(self) -> BaseException | None:
@@ -382,6 +407,8 @@ class NgspiceSession:
         library = compiled_callbacks.load()
         if library is self._compiled:
             return
+        if self._cstate is not None:  # (the compiled SendData calls Python at every point then)
+            self._cstate.python_data = library is None
         vsrc, isrc, sync = self._vsrc_c, self._isrc_c, self._sync_c
         if library is not None:
             if self._cstate is None or library is not self._clib:
@@ -397,6 +424,9 @@ class NgspiceSession:
 
     def _start_compiled(self, library) -> None:
         """The compiled callbacks' state: Python's trampolines and the channel cells."""
+        if self._clib is not None and self._clib is not library:
+            # (another library's: its SendData, if ngspice has it, must not read the state freed below)
+            self._clib.sw_install(cffi_callbacks.NULL)
         state = cffi_callbacks.new("sw_state *")
         # kept as long as the session (the library holds their addresses)
         self._c_evaluate = cffi_callbacks.callback("sw_evaluate_fn", self._on_c_evaluate, error=1,
@@ -420,6 +450,8 @@ class NgspiceSession:
         self._c_rejections = cffi_callbacks.new("double[]", 2 * REJECTIONS_LOGGED)
         state.rejections, state.rejections_size = self._c_rejections, REJECTIONS_LOGGED
         state.failed = self._failure is not None
+        state.pause_at = self._pause_at
+        state.python_data = False
         library.sw_install(state)
         self._cstate, self._clib = state, library
         self._c_rules, self._c_rules_size, self._c_rules_stale = None, 0, True

@@ -178,3 +178,26 @@ def test_the_compiled_step_callback_logs_rejected_steps_and_hands_a_full_log_to_
     assert control.state.accepting == -math.inf  # a redo accepts nothing
     control.sync(4e-6, location=1)
     assert control.state.accepting == 4e-6 and control.state.rejections_used == 2
+
+
+def test_the_compiled_senddata_hands_python_only_the_point_that_pauses(tmp_path, fresh):
+    """SendData (sw_data): Python's _on_data pauses the run at the first accepted point at or
+    after the pause time, and does nothing once the run failed; the compiled one calls it
+    exactly there, and at every point before a state is installed or on the Python route."""
+    library = compiled_callbacks.load(tmp_path)
+    called = []
+    data = ffi.callback("sw_data_fn", lambda values, count, ident, user: called.append(count) or 0)
+    library.sw_install_data(data)
+    library.sw_install(ffi.NULL)
+    library.sw_data(ffi.NULL, 1, 0, ffi.NULL)  # no state yet: Python's
+    state = ffi.new("sw_state *")
+    state.pause_at, state.accepting = 2e-6, 1e-6
+    library.sw_install(state)
+    library.sw_data(ffi.NULL, 2, 0, ffi.NULL)  # before the pause: nothing to do
+    state.accepting = 2e-6
+    library.sw_data(ffi.NULL, 3, 0, ffi.NULL)  # the point that pauses
+    state.failed = 1
+    library.sw_data(ffi.NULL, 4, 0, ffi.NULL)  # failed: no pause
+    state.failed, state.python_data, state.accepting = 0, 1, 1e-6
+    library.sw_data(ffi.NULL, 5, 0, ffi.NULL)  # the Python route: every point
+    assert called == [1, 3, 5]
