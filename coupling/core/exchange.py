@@ -178,8 +178,13 @@ class Tail:
         self.v: list[float] = []
 
     def observe(self, t: np.ndarray, v: np.ndarray, jumped: bool) -> None:
-        times = (self.t + t.tolist())[-TAIL_POINTS:]
-        values = (self.v + v.tolist())[-TAIL_POINTS:]
+        self.observe_floats(t.tolist(), v.tolist(), jumped)
+
+    def observe_floats(self, t: list[float], v: list[float], jumped: bool) -> None:
+        """``observe`` on the step's points as lists of floats (a caller that has them as
+        lists already: the coil's two tails share the step's times)."""
+        times = (self.t + t)[-TAIL_POINTS:]
+        values = (self.v + v)[-TAIL_POINTS:]
         # a point no later than the one before it is dropped (a step's first point is the
         # previous step's last)
         keep = [k for k in range(1, len(times)) if times[k] - times[k - 1] > 0.0]
@@ -434,7 +439,9 @@ class CoilLink:
         # (``receive``), against which the magnet's work as the circuit sees it is audited
         self.received = 0.0
         self._gain_integral = None  # GainIntegral of the mechanics' gain table, built at the first step,
-        self._drive_row = -1  # ... and the mechanics' drive row of "armature.force"
+        self._drive_row = -1  # ... and the mechanics' drive row of "armature.force" ...
+        self._drive_columns = (0, 0, 0)  # ... and the drive's value, slope and t0 columns (kernel_layout D_*)
+        self._table_channel = None  # circuit.channels.TableChannel, once the first step asks (``inputs``)
 
     def next_switch(self, t: float) -> float:
         """s: the coil drive's next switching instant after t (its driver's PWL vertices: on,
@@ -506,8 +513,11 @@ class CoilLink:
             return {f"{self.label}.gap": gap}
         # the same gap as a table of the dense output's pieces, which ngspice's compiled
         # callbacks evaluate with gap's own operations (rest_gap - lever * q, then max(., 0))
-        from circuit.channels import TableChannel  # (circuit is imported when a run starts)
+        TableChannel = self._table_channel
+        if TableChannel is None:  # (looked up once a run, not by an import statement per macro step)
+            from circuit.channels import TableChannel  # (circuit is imported when a run starts)
 
+            self._table_channel = TableChannel
         start, ends, t0, h, coefficients = pieces
         return {f"{self.label}.gap": TableChannel(gap, lo, hi, start, ends, t0, h, coefficients,
                                                   offset=self.rest_gap, scale=self.lever)}
@@ -525,9 +535,10 @@ class CoilLink:
         the same without that floor), and the armature's travel at the step's circuit points
         (for the result's columns)."""
         times = step.reader("time")
-        psi = step.reader(self._flux_column)
-        self.tail.observe(times, self.signal(psi), False)
-        self.flux_tail.observe(times, psi, False)
+        # (as floats once for both tails: psi * psi is the same double product as numpy's)
+        t_list, psi_list = times.tolist(), step.reader(self._flux_column).tolist()
+        self.tail.observe_floats(t_list, [p * p for p in psi_list] if self.separable else psi_list, False)
+        self.flux_tail.observe_floats(t_list, psi_list, False)
         self.flux_rate = self.flux_tail.derivatives(policy.macro_step)[0]
         self.value = self.signal(self.flux(step))
         self.rate, curvature = self.tail.derivatives(policy.macro_step)
@@ -565,11 +576,11 @@ class CoilLink:
             scales.append((self.gap_scale, "gap"))
         self.scale, self.bound_by = min(scales)
         self.horizon = min([plain, *(scale for scale, _ in scales[1:])])  # (the curvature's without its floor)
-        new = times[1:] if self._sampled else times
+        new = t_list[1:] if self._sampled else t_list
         self._sampled = True
         lo, hi = seg.t_start, seg.t_end
         armature = seg.armature
-        for s in new.tolist():  # (a point or two a step: kept as floats, joined into arrays at the end)
+        for s in new:  # (a point or two a step: kept as floats, joined into arrays at the end)
             self.q_times.append(s)
             self.q.append(armature(lo if s < lo else (hi if s > hi else s))[0])
 
@@ -578,15 +589,19 @@ class CoilLink:
         mechanics' own solution (``received_work`` on its dense output), with the drive as the
         mechanics held it (``mech.drive``'s armature row, linear over the step, read at the
         segment's ends) and the antiderivative of its gain table (``GainIntegral``)."""
-        from mech.kernel_layout import D_SLOPE, D_T0, D_VALUE
-
         t0, t1 = seg.t_start, seg.t_end
         if self._gain_integral is None:
+            from mech.kernel_layout import D_SLOPE, D_T0, D_VALUE
+
             self._gain_integral = GainIntegral(mech.model.again)
             self._drive_row = mech.model.armature_drive_row
+            # (the drive's columns looked up once a run: an import statement per macro step
+            # cost ~0.6 us even with the module loaded)
+            self._drive_columns = (D_VALUE, D_SLOPE, D_T0)
         # the kernel's drive_at, on the row's three floats (mech.drives.values_at does every row)
         row = mech.drive[self._drive_row].tolist()
-        value, slope, t_ref = row[D_VALUE], row[D_SLOPE], row[D_T0]
+        c_value, c_slope, c_t0 = self._drive_columns
+        value, slope, t_ref = row[c_value], row[c_slope], row[c_t0]
         self.received += received_work(seg.armature, t0, t1, value + slope * (t0 - t_ref),
                                        value + slope * (t1 - t_ref), self._gain_integral,
                                        [e["time"] for e in seg.events] if seg.events else ())
