@@ -114,10 +114,9 @@ class GainIntegral:
         if q <= x[0]:
             d = q - x[0]
             return d * (y[0] + 0.5 * m[0] * d)
-        last = self.count - 1
-        if q >= x[last]:
-            d = q - x[last]
-            return self.at_knot[last] + d * (y[last] + 0.5 * m[last] * d)
+        if q >= x[-1]:  # (the last knot: count - 1)
+            d = q - x[-1]
+            return self.at_knot[-1] + d * (y[-1] + 0.5 * m[-1] * d)
         lo = bisect_right(x, q) - 1
         h = x[lo + 1] - x[lo]
         s = (q - x[lo]) / h
