@@ -106,6 +106,11 @@ class GainIntegral:
             h = self.x[k + 1] - self.x[k]
             self.at_knot.append(self.at_knot[-1] + h * (0.5 * (self.y[k] + self.y[k + 1])
                                                          + h * (self.m[k] - self.m[k + 1]) / 12.0))
+        # per interval what __call__ takes from it, the products h m as __call__ formed them
+        # (the same doubles): one lookup instead of a dozen, six calls a macro step
+        self._intervals = [(self.x[k], self.x[k + 1] - self.x[k], self.at_knot[k], self.y[k],
+                            (self.x[k + 1] - self.x[k]) * self.m[k], self.y[k + 1],
+                            (self.x[k + 1] - self.x[k]) * self.m[k + 1]) for k in range(self.count - 1)]
 
     def __call__(self, q: float) -> float:
         if self.count == 0:
@@ -117,18 +122,18 @@ class GainIntegral:
         if q >= x[-1]:  # (the last knot: count - 1)
             d = q - x[-1]
             return self.at_knot[-1] + d * (y[-1] + 0.5 * m[-1] * d)
-        lo = bisect_right(x, q) - 1
-        h = x[lo + 1] - x[lo]
-        s = (q - x[lo]) / h
+        x_lo, h, g_lo, y_lo, hm_lo, y_hi, hm_hi = self._intervals[bisect_right(x, q) - 1]
+        s = (q - x_lo) / h
         s2 = s * s
         s3 = s2 * s
         s4 = s3 * s
-        # the integrals from 0 to s of the Hermite basis h00, h10, h01, h11
-        return self.at_knot[lo] + h * (y[lo] * (s - s3 + 0.5 * s4) + h * m[lo] * (0.5 * s2 - 2.0 * s3 / 3.0 + 0.25 * s4)
-                                       + y[lo + 1] * (s3 - 0.5 * s4) + h * m[lo + 1] * (0.25 * s4 - s3 / 3.0))
+        # the integrals from 0 to s of the Hermite basis h00, h10, h01, h11 (hm: h m at the ends)
+        return g_lo + h * (y_lo * (s - s3 + 0.5 * s4) + hm_lo * (0.5 * s2 - 2.0 * s3 / 3.0 + 0.25 * s4)
+                           + y_hi * (s3 - 0.5 * s4) + hm_hi * (0.25 * s4 - s3 / 3.0))
 
 
-def received_work(armature, t0: float, t1: float, drive0: float, drive1: float, gain_integral, cuts=()) -> float:
+def received_work(armature, t0: float, t1: float, drive0: float, drive1: float, gain_integral, cuts=(),
+                  travel=None) -> float:
     """J: the work a drive did on the armature over [t0, t1] (s), the integral of
     F(t) dq/dt dt with F = drive(t) gain(q(t)): the drive linear in time from drive0 at t0 to
     drive1 at t1 (N, or Wb^2: what mech's "armature.force" channel holds), gain the
@@ -140,7 +145,9 @@ def received_work(armature, t0: float, t1: float, drive0: float, drive1: float, 
     it, which the bar's vibration carries through the card (a 4-point Gauss-Legendre of
     F dq/dt per macro step left the default relay's received work 1.4e-4 off the mechanics'
     own quadrature). Gauss-Legendre of RECEIVED_NODES points on each piece between the
-    ``cuts`` (s: the mechanics' events, where dq/dt has a kink: a stop or the card)."""
+    ``cuts`` (s: the mechanics' events, where dq/dt has a kink: a stop or the card).
+    ``travel``: optionally, times -> [q] at once, the same q as ``armature``'s (mech's
+    Segment.travel: one call for a piece's nodes instead of one each)."""
     span = t1 - t0
     if span <= 0.0:
         return 0.0
@@ -157,8 +164,8 @@ def received_work(armature, t0: float, t1: float, drive0: float, drive1: float, 
     for k in range(len(edges) - 1):
         a, h = edges[k], edges[k + 1] - edges[k]
         piece = 0.0
-        for x, w in zip(GAUSS_NODES, GAUSS_WEIGHTS):
-            q = armature(a + x * h)[0]
+        nodes = [a + x * h for x in GAUSS_NODES]
+        for q, w in zip(travel(nodes) if travel is not None else [armature(s)[0] for s in nodes], GAUSS_WEIGHTS):
             if q != q0:  # (an armature that has not moved adds nothing)
                 piece += w * (gain_integral(q) - g0)
         total += h * piece
@@ -559,11 +566,13 @@ class CoilLink:
             # not beyond the time it takes to change by its own size (plus the floor): a signal
             # falling linearly to zero (a clamped coil's release) has no curvature
             scales.append(((abs(self.value) + self.floor) / abs(self.rate), "size"))
+        # (the start first: the armature's cache then holds the end, which ``receive`` asks for first)
+        q_dot_start = seg.armature(seg.t_start)[1]
         q, q_dot = seg.armature(seg.t_end)[:2]
         span = seg.t_end - seg.t_start
         speed = self.lever * abs(float(q_dot))  # m/s of the working gap
         # m/s^2: the armature's acceleration over the step (its velocity change)
-        accel = self.lever * abs(float(q_dot) - float(seg.armature(seg.t_start)[1])) / span if span > 0.0 else 0.0
+        accel = self.lever * abs(float(q_dot) - float(q_dot_start)) / span if span > 0.0 else 0.0
         self.gap_scale = math.inf
         if speed > 0.0 or accel > 0.0:
             # nor beyond the time the gap takes to change by its own size: the coil's flux
@@ -578,10 +587,11 @@ class CoilLink:
         new = t_list[1:] if self._sampled else t_list
         self._sampled = True
         lo, hi = seg.t_start, seg.t_end
-        armature = seg.armature
-        for s in new:  # (a point or two a step: kept as floats, joined into arrays at the end)
-            self.q_times.append(s)
-            self.q.append(armature(lo if s < lo else (hi if s > hi else s))[0])
+        # (a point or two a step: kept as floats, joined into arrays at the end)
+        self.q_times.extend(new)
+        clamped = [lo if s < lo else (hi if s > hi else s) for s in new]
+        travel = getattr(seg, "travel", None)  # (mech's Segment: at once; a stand-in may give armature alone)
+        self.q.extend(travel(clamped) if travel is not None else [seg.armature(s)[0] for s in clamped])
 
     def receive(self, seg, mech) -> None:
         """After a step: add the work the drive did on the armature over the segment, along the
@@ -603,7 +613,7 @@ class CoilLink:
         value, slope, t_ref = row[c_value], row[c_slope], row[c_t0]
         self.received += received_work(seg.armature, t0, t1, value + slope * (t0 - t_ref),
                                        value + slope * (t1 - t_ref), self._gain_integral,
-                                       [e["time"] for e in seg.events] if seg.events else ())
+                                       [e["time"] for e in seg.events] if seg.events else (), seg.travel)
 
     def columns(self, waves: dict) -> dict:
         """The result's coil columns beside the circuit's (coil_current, coil_voltage,
