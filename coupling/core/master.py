@@ -389,9 +389,11 @@ class CoSimulation:
         # (a make/break within the policy's guard after the step's start is at the start, where
         # ngspice restarts: the mechanics find one a few femtoseconds after the step cut at
         # it, and a sliver step towards it failed against an inductive load)
-        guard = policy.guard
-        restart = any(t < s <= t + guard for s in switching)
-        breakpoints = sorted({s for s in switching if t + guard < s <= t_next})
+        restart, breakpoints = False, []
+        if switching:  # (most steps make or break nothing: no generator, set and sort for none)
+            guard = policy.guard
+            restart = any(t < s <= t + guard for s in switching)
+            breakpoints = sorted({s for s in switching if t + guard < s <= t_next})
         inputs = {}
         for link in links:
             inputs.update(link.inputs(seg, touching, stepper.uses_gap))
