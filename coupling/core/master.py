@@ -467,13 +467,17 @@ class CoSimulation:
         output, sample their contact (penetration, rate, normal force per tip) at the points
         noted, from that dense output, and release it: the mechanics keep a few macro steps'
         dense output, not the run's (docs/mechanics.md, "Memory")."""
+        if not self._contact_links:
+            # an armature alone: no contact is sampled, so no point is noted (a read of the
+            # step's times and a slice a macro step); the coil link samples the armature
+            # step by step, and the dense output is released all the same
+            if mech.dense_rows >= DENSE_FLUSH_ROWS:
+                mech.release_dense()
+            return
         times = step.reader("time")
         self._pending.append(times[1:] if self._started else times)
         self._started = True
-        if mech.dense_rows >= DENSE_FLUSH_ROWS and not self._contact_links:
-            self._pending = []
-            mech.release_dense()  # (an armature alone: the coil link samples the armature step by step)
-        elif mech.dense_rows >= DENSE_FLUSH_ROWS:
+        if mech.dense_rows >= DENSE_FLUSH_ROWS:
             pending = np.concatenate(self._pending)
             # a point beyond the last record (ngspice may land a hair past the step's end)
             # lies in the next step's first record: sampled later, from that record
