@@ -64,9 +64,14 @@ def kind_of(name: str) -> DriveKind:
     return KINDS[name.split(".", 1)[0]]
 
 
-def _pair(kind: DriveKind, value, label: str) -> tuple[float, float]:
+def _label(name: str | None) -> str:
+    """How an error names a step's value of channel ``name`` (None: the ``mu`` argument)."""
+    return "mu" if name is None else f"drives[{name!r}]"
+
+
+def _pair(kind: DriveKind, value, name: str | None) -> tuple[float, float]:
     """(start, end) of one channel's value over a step (a number is constant), checked
-    against its kind; ``label`` names the value in an error."""
+    against its kind; ``name``: the channel's, for an error (None: the ``mu`` argument's)."""
     try:
         if type(value) is tuple and len(value) == 2 and type(value[0]) is float and type(value[1]) is float:
             start, end = value  # (what a co-simulation passes at every macro step: np.shape is ~2 us)
@@ -77,11 +82,11 @@ def _pair(kind: DriveKind, value, label: str) -> tuple[float, float]:
         else:
             raise TypeError
     except (TypeError, ValueError):
-        raise ValueError(f"{label} = {value!r}: expected a number or a (start, end) pair") from None
+        raise ValueError(f"{_label(name)} = {value!r}: expected a number or a (start, end) pair") from None
     for v in (start, end):
         if not (v >= kind.minimum and math.isfinite(v)):
             allowed = "a finite number" + (f" >= {kind.minimum:g}" if kind.minimum > -math.inf else "")
-            raise ValueError(f"{label} = {value!r}: must be {allowed} ({kind.unit})")
+            raise ValueError(f"{_label(name)} = {value!r}: must be {allowed} ({kind.unit})")
     return start, end
 
 
@@ -90,7 +95,7 @@ def step_targets(names: tuple, drives, mu) -> dict[int, tuple[float, float]]:
     channel names of ``names`` to a number or a (start, end) pair; ``mu`` sets every "mu.<i>"."""
     out: dict[int, tuple[float, float]] = {}
     if mu is not None:
-        pair = _pair(KINDS["mu"], mu, "mu")
+        pair = _pair(KINDS["mu"], mu, None)
         out.update({row: pair for row, name in enumerate(names) if name.startswith("mu.")})
     if drives is None:
         return out
@@ -102,7 +107,8 @@ def step_targets(names: tuple, drives, mu) -> dict[int, tuple[float, float]]:
             raise ValueError(f"drives: unknown channel {name!r}; this model's channels are {', '.join(names)}")
         if mu is not None and name.startswith("mu."):
             raise ValueError(f"drives[{name!r}] and mu = {mu!r} both given: mu sets every mu.<i>; give one")
-        out[names.index(name)] = _pair(kind_of(name), value, f"drives[{name!r}]")
+        # (the channel's name, not its message: built only for an error, not once a macro step)
+        out[names.index(name)] = _pair(kind_of(name), value, name)
     return out
 
 

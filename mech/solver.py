@@ -215,6 +215,7 @@ class Segment:
             steps = self._arm_steps = (self._t_valid.tolist(), [None] * len(self._t_valid))
         ends, pieces = steps
         lo, hi, last = self.t_start, self.t_end, len(ends) - 1
+        dense = len(self._coef) > 0
         out = []
         for t in times:
             if not (lo - 1e-15 <= t <= hi + 1e-15):
@@ -222,7 +223,7 @@ class Segment:
             if last < 0 or t <= lo:
                 out.append(float(self._start_state[a]))
                 continue
-            if not len(self._coef):
+            if not dense:
                 raise ValueError("Segment.travel: the dense output is kept only with "
                                  "ImpactSolver(scene, keep_dense=True)")
             k = min(bisect_left(ends, t), last)
@@ -332,6 +333,8 @@ class ImpactSolver:
         self.model = build_model(scene, input_work=input_work)
         self.keep_dense = keep_dense
         m = self.model
+        # (of the frozen model: read at every step's drives, where a numpy scalar's test cost ~0.2 us)
+        self._friction_exact = bool(m.ipar[I_FRICTION] == FRICTION_EXACT)
         self.t = 0.0
         self.y = m.initial_state()
         self.h = 0.0
@@ -911,14 +914,16 @@ class ImpactSolver:
             return
         if self.armature_closed[EA_SEAT] and self._seat_state()[2] <= 0.0:
             self._unseat()  # the new drive no longer presses the seated armature on its stop
-        if m.ipar[I_FRICTION] == FRICTION_EXACT and any(kinds[row].friction for row in changed):
+        if self._friction_exact and any(kinds[row].friction for row in changed):
             self._resolve(triggered=None)  # a new mu may change what can stick
         self._step_end = t_end
-        if any(kinds[row].moves_equilibrium and not self._seated_through(row) for row in changed):
-            if self._hold_until > self.t:
-                self._release_hold()
-            else:
-                self._restart_rest_window()
+        for row in changed:  # (a loop, not any() over a generator: once a macro step)
+            if kinds[row].moves_equilibrium and not self._seated_through(row):
+                if self._hold_until > self.t:
+                    self._release_hold()
+                else:
+                    self._restart_rest_window()
+                break
 
     def _drives_ramping(self) -> bool:
         """True if a channel that moves the static equilibrium changes during this step."""
