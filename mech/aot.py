@@ -218,9 +218,11 @@ def argument_checks(folder: Path) -> dict:
             def ok(a):
                 if a is last_tuple[0]:
                     return True
-                if not (isinstance(a, tuple) and len(a) == len(parts)
-                        and all(part is None or part(item) for part, item in zip(parts, a))):
+                if not (isinstance(a, tuple) and len(a) == len(parts)):
                     return False
+                for part, item in zip(parts, a):  # (a loop: all() over a generator cost more)
+                    if part is not None and not part(item):
+                        return False
                 last_tuple[0] = a
                 return True
             return ok

@@ -64,9 +64,14 @@ def kind_of(name: str) -> DriveKind:
     return KINDS[name.split(".", 1)[0]]
 
 
-def _pair(kind: DriveKind, value, label: str) -> tuple[float, float]:
+def _label(name: str | None) -> str:
+    """How an error names a step's value of channel ``name`` (None: the ``mu`` argument)."""
+    return "mu" if name is None else f"drives[{name!r}]"
+
+
+def _pair(kind: DriveKind, value, name: str | None) -> tuple[float, float]:
     """(start, end) of one channel's value over a step (a number is constant), checked
-    against its kind; ``label`` names the value in an error."""
+    against its kind; ``name``: the channel's, for an error (None: the ``mu`` argument's)."""
     try:
         if type(value) is tuple and len(value) == 2 and type(value[0]) is float and type(value[1]) is float:
             start, end = value  # (what a co-simulation passes at every macro step: np.shape is ~2 us)
@@ -77,11 +82,11 @@ def _pair(kind: DriveKind, value, label: str) -> tuple[float, float]:
         else:
             raise TypeError
     except (TypeError, ValueError):
-        raise ValueError(f"{label} = {value!r}: expected a number or a (start, end) pair") from None
+        raise ValueError(f"{_label(name)} = {value!r}: expected a number or a (start, end) pair") from None
     for v in (start, end):
         if not (v >= kind.minimum and math.isfinite(v)):
             allowed = "a finite number" + (f" >= {kind.minimum:g}" if kind.minimum > -math.inf else "")
-            raise ValueError(f"{label} = {value!r}: must be {allowed} ({kind.unit})")
+            raise ValueError(f"{_label(name)} = {value!r}: must be {allowed} ({kind.unit})")
     return start, end
 
 
@@ -90,11 +95,11 @@ def step_targets(names: tuple, drives, mu) -> dict[int, tuple[float, float]]:
     channel names of ``names`` to a number or a (start, end) pair; ``mu`` sets every "mu.<i>"."""
     out: dict[int, tuple[float, float]] = {}
     if mu is not None:
-        pair = _pair(KINDS["mu"], mu, "mu")
+        pair = _pair(KINDS["mu"], mu, None)
         out.update({row: pair for row, name in enumerate(names) if name.startswith("mu.")})
     if drives is None:
         return out
-    if not isinstance(drives, Mapping):
+    if type(drives) is not dict and not isinstance(drives, Mapping):  # (the ABC's check skipped for a dict)
         raise ValueError(f"drives = {drives!r}: expected a mapping of channel names to values "
                          f"(channels: {', '.join(names)})")
     for name, value in drives.items():
@@ -102,7 +107,8 @@ def step_targets(names: tuple, drives, mu) -> dict[int, tuple[float, float]]:
             raise ValueError(f"drives: unknown channel {name!r}; this model's channels are {', '.join(names)}")
         if mu is not None and name.startswith("mu."):
             raise ValueError(f"drives[{name!r}] and mu = {mu!r} both given: mu sets every mu.<i>; give one")
-        out[names.index(name)] = _pair(kind_of(name), value, f"drives[{name!r}]")
+        # (the channel's name, not its message: built only for an error, not once a macro step)
+        out[names.index(name)] = _pair(kind_of(name), value, name)
     return out
 
 
@@ -118,16 +124,18 @@ def set_step(drive: np.ndarray, kinds: tuple, targets: dict, t: float, t_end: fl
     t (as the kernel reads it: clipped kinds compared after clipping), and those of kinds
     that move the equilibrium that now ramp."""
     changed = []
-    for row in range(drive.shape[0]):
+    # (each row read as floats once: numpy's scalar indexing cost ~1 us a macro step; the
+    # arithmetic is the same double arithmetic)
+    for row, now in enumerate(drive.tolist()):
         target = targets.get(row)
         if target is None:
-            if drive[row, D_SLOPE] != 0.0:  # a ramp of an earlier step ends where that step ended
-                drive[row, D_VALUE] = drive[row, D_VALUE] + drive[row, D_SLOPE] * (t - drive[row, D_T0])
+            if now[D_SLOPE] != 0.0:  # a ramp of an earlier step ends where that step ended
+                drive[row, D_VALUE] = now[D_VALUE] + now[D_SLOPE] * (t - now[D_T0])
                 drive[row, D_SLOPE] = 0.0
                 drive[row, D_T0] = t
             continue
         kind = kinds[row]
-        old = drive[row, D_VALUE] + drive[row, D_SLOPE] * (t - drive[row, D_T0])
+        old = now[D_VALUE] + now[D_SLOPE] * (t - now[D_T0])
         start, end = target
         value = max(start, 0.0) if kind.clipped else start
         slope = (end - start) / (t_end - t) if t_end > t else 0.0

@@ -748,7 +748,7 @@ class BarModel:
     def _slice_map(self) -> dict:
         return state_slices(self.n, self.planar, self.nq, self.has_armature, self.has_bar, self.hysteresis_count)
 
-    @property
+    @functools.cached_property
     def armature_drive_row(self) -> int:
         """The drive row of "armature.force" (-1: no armature)."""
         return int(self.ipar[I_ARM_DRIVE]) if self.has_armature else -1

@@ -184,9 +184,16 @@ class Recorder:
         Both views are equally long, so a stepper that fills one never overruns the other."""
         n = self.n
         room = min(self.capacity - n, self.room_end - self.recorded)
-        records = (self.t[n:n + room], self.y[n:n + room], self.aux[n:n + room], self.fmax[n:n + room])
         if self.keep_dense:
             d = n - self.dense_base
+            dense_room = min(room, len(self.dense_t0) - d)
+            if dense_room >= 0:  # (always, after reserve: the records cut once, not cut and cut again)
+                end = n + dense_room
+                return ((self.t[n:end], self.y[n:end], self.aux[n:end], self.fmax[n:end]),
+                        (self.dense_t0[d:d + dense_room], self.dense_h[d:d + dense_room],
+                         self.dense_coef[d:d + dense_room]))
+        records = (self.t[n:n + room], self.y[n:n + room], self.aux[n:n + room], self.fmax[n:n + room])
+        if self.keep_dense:
             room = min(room, len(self.dense_t0) - d)
             records = tuple(a[:room] for a in records)
             return records, (self.dense_t0[d:d + room], self.dense_h[d:d + room], self.dense_coef[d:d + room])

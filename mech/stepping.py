@@ -45,13 +45,23 @@ class Stepper(Protocol):
 class CompiledStepper:
     """The compiled DOPRI5 loop with event location (mech.integrator)."""
 
+    def __init__(self):
+        # (model, solver settings, their tolerance tuple): both frozen, so one tuple serves
+        # every segment, and the compiled call's argument check (mech.aot) passes it by
+        # identity instead of checking a new tuple's arrays each time
+        self._tolerances = (None, None, None)
+
     def segment(self, state, t_goal: float) -> Outcome:
         m = state.model
         solver = state.scene.solver
         rec = state.recorder
         rows, dense = rec.free_rows()
+        model, settings, tolerances = self._tolerances
+        if model is not m or settings is not solver:
+            tolerances = (m.max_step, solver.rtol, m.atol, m.relmask)
+            self._tolerances = (m, solver, tolerances)
         return Outcome(*integrate(
-            state.t, state.y, t_goal, state.h, (m.max_step, solver.rtol, m.atol, m.relmask), state.arrays,
+            state.t, state.y, t_goal, state.h, tolerances, state.arrays,
             state.regime, state.eref, state.ev_sign, rows, dense, rec.keep_dense, solver.max_steps,
             state.work, state.stats, state.arm,
         ))

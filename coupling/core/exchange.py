@@ -106,6 +106,11 @@ class GainIntegral:
             h = self.x[k + 1] - self.x[k]
             self.at_knot.append(self.at_knot[-1] + h * (0.5 * (self.y[k] + self.y[k + 1])
                                                          + h * (self.m[k] - self.m[k + 1]) / 12.0))
+        # per interval what __call__ takes from it, the products h m as __call__ formed them
+        # (the same doubles): one lookup instead of a dozen, six calls a macro step
+        self._intervals = [(self.x[k], self.x[k + 1] - self.x[k], self.at_knot[k], self.y[k],
+                            (self.x[k + 1] - self.x[k]) * self.m[k], self.y[k + 1],
+                            (self.x[k + 1] - self.x[k]) * self.m[k + 1]) for k in range(self.count - 1)]
 
     def __call__(self, q: float) -> float:
         if self.count == 0:
@@ -114,22 +119,21 @@ class GainIntegral:
         if q <= x[0]:
             d = q - x[0]
             return d * (y[0] + 0.5 * m[0] * d)
-        last = self.count - 1
-        if q >= x[last]:
-            d = q - x[last]
-            return self.at_knot[last] + d * (y[last] + 0.5 * m[last] * d)
-        lo = bisect_right(x, q) - 1
-        h = x[lo + 1] - x[lo]
-        s = (q - x[lo]) / h
+        if q >= x[-1]:  # (the last knot: count - 1)
+            d = q - x[-1]
+            return self.at_knot[-1] + d * (y[-1] + 0.5 * m[-1] * d)
+        x_lo, h, g_lo, y_lo, hm_lo, y_hi, hm_hi = self._intervals[bisect_right(x, q) - 1]
+        s = (q - x_lo) / h
         s2 = s * s
         s3 = s2 * s
         s4 = s3 * s
-        # the integrals from 0 to s of the Hermite basis h00, h10, h01, h11
-        return self.at_knot[lo] + h * (y[lo] * (s - s3 + 0.5 * s4) + h * m[lo] * (0.5 * s2 - 2.0 * s3 / 3.0 + 0.25 * s4)
-                                       + y[lo + 1] * (s3 - 0.5 * s4) + h * m[lo + 1] * (0.25 * s4 - s3 / 3.0))
+        # the integrals from 0 to s of the Hermite basis h00, h10, h01, h11 (hm: h m at the ends)
+        return g_lo + h * (y_lo * (s - s3 + 0.5 * s4) + hm_lo * (0.5 * s2 - 2.0 * s3 / 3.0 + 0.25 * s4)
+                           + y_hi * (s3 - 0.5 * s4) + hm_hi * (0.25 * s4 - s3 / 3.0))
 
 
-def received_work(armature, t0: float, t1: float, drive0: float, drive1: float, gain_integral, cuts=()) -> float:
+def received_work(armature, t0: float, t1: float, drive0: float, drive1: float, gain_integral, cuts=(),
+                  travel=None) -> float:
     """J: the work a drive did on the armature over [t0, t1] (s), the integral of
     F(t) dq/dt dt with F = drive(t) gain(q(t)): the drive linear in time from drive0 at t0 to
     drive1 at t1 (N, or Wb^2: what mech's "armature.force" channel holds), gain the
@@ -141,7 +145,9 @@ def received_work(armature, t0: float, t1: float, drive0: float, drive1: float, 
     it, which the bar's vibration carries through the card (a 4-point Gauss-Legendre of
     F dq/dt per macro step left the default relay's received work 1.4e-4 off the mechanics'
     own quadrature). Gauss-Legendre of RECEIVED_NODES points on each piece between the
-    ``cuts`` (s: the mechanics' events, where dq/dt has a kink: a stop or the card)."""
+    ``cuts`` (s: the mechanics' events, where dq/dt has a kink: a stop or the card).
+    ``travel``: optionally, times -> [q] at once, the same q as ``armature``'s (mech's
+    Segment.travel: one call for a piece's nodes instead of one each)."""
     span = t1 - t0
     if span <= 0.0:
         return 0.0
@@ -158,8 +164,8 @@ def received_work(armature, t0: float, t1: float, drive0: float, drive1: float, 
     for k in range(len(edges) - 1):
         a, h = edges[k], edges[k + 1] - edges[k]
         piece = 0.0
-        for x, w in zip(GAUSS_NODES, GAUSS_WEIGHTS):
-            q = armature(a + x * h)[0]
+        nodes = [a + x * h for x in GAUSS_NODES]
+        for q, w in zip(travel(nodes) if travel is not None else [armature(s)[0] for s in nodes], GAUSS_WEIGHTS):
             if q != q0:  # (an armature that has not moved adds nothing)
                 piece += w * (gain_integral(q) - g0)
         total += h * piece
@@ -178,8 +184,13 @@ class Tail:
         self.v: list[float] = []
 
     def observe(self, t: np.ndarray, v: np.ndarray, jumped: bool) -> None:
-        times = (self.t + t.tolist())[-TAIL_POINTS:]
-        values = (self.v + v.tolist())[-TAIL_POINTS:]
+        self.observe_floats(t.tolist(), v.tolist(), jumped)
+
+    def observe_floats(self, t: list[float], v: list[float], jumped: bool) -> None:
+        """``observe`` on the step's points as lists of floats (a caller that has them as
+        lists already: the coil's two tails share the step's times)."""
+        times = (self.t + t)[-TAIL_POINTS:]
+        values = (self.v + v)[-TAIL_POINTS:]
         # a point no later than the one before it is dropped (a step's first point is the
         # previous step's last)
         keep = [k for k in range(1, len(times)) if times[k] - times[k - 1] > 0.0]
@@ -437,7 +448,9 @@ class CoilLink:
         # (``receive``), against which the magnet's work as the circuit sees it is audited
         self.received = 0.0
         self._gain_integral = None  # GainIntegral of the mechanics' gain table, built at the first step,
-        self._drive_row = -1  # ... and the mechanics' drive row of "armature.force"
+        self._drive_row = -1  # ... and the mechanics' drive row of "armature.force" ...
+        self._drive_columns = (0, 0, 0)  # ... and the drive's value, slope and t0 columns (kernel_layout D_*)
+        self._table_channel = None  # circuit.channels.TableChannel, once the first step asks (``inputs``)
 
     def next_switch(self, t: float) -> float:
         """s: the coil drive's next switching instant after t (its driver's PWL vertices: on,
@@ -509,8 +522,11 @@ class CoilLink:
             return {f"{self.label}.gap": gap}
         # the same gap as a table of the dense output's pieces, which ngspice's compiled
         # callbacks evaluate with gap's own operations (rest_gap - lever * q, then max(., 0))
-        from circuit.channels import TableChannel  # (circuit is imported when a run starts)
+        TableChannel = self._table_channel
+        if TableChannel is None:  # (looked up once a run, not by an import statement per macro step)
+            from circuit.channels import TableChannel  # (circuit is imported when a run starts)
 
+            self._table_channel = TableChannel
         start, ends, t0, h, coefficients = pieces
         return {f"{self.label}.gap": TableChannel(gap, lo, hi, start, ends, t0, h, coefficients,
                                                   offset=self.rest_gap, scale=self.lever)}
@@ -528,9 +544,10 @@ class CoilLink:
         the same without that floor), and the armature's travel at the step's circuit points
         (for the result's columns)."""
         times = step.reader("time")
-        psi = step.reader(self._flux_column)
-        self.tail.observe(times, self.signal(psi), False)
-        self.flux_tail.observe(times, psi, False)
+        # (as floats once for both tails: psi * psi is the same double product as numpy's)
+        t_list, psi_list = times.tolist(), step.reader(self._flux_column).tolist()
+        self.tail.observe_floats(t_list, [p * p for p in psi_list] if self.separable else psi_list, False)
+        self.flux_tail.observe_floats(t_list, psi_list, False)
         self.flux_rate = self.flux_tail.derivatives(policy.macro_step)[0]
         self.value = self.signal(self.flux(step))
         self.rate, curvature = self.tail.derivatives(policy.macro_step)
@@ -552,11 +569,13 @@ class CoilLink:
             # not beyond the time it takes to change by its own size (plus the floor): a signal
             # falling linearly to zero (a clamped coil's release) has no curvature
             scales.append(((abs(self.value) + self.floor) / abs(self.rate), "size"))
+        # (the start first: the armature's cache then holds the end, which ``receive`` asks for first)
+        q_dot_start = seg.armature(seg.t_start)[1]
         q, q_dot = seg.armature(seg.t_end)[:2]
         span = seg.t_end - seg.t_start
         speed = self.lever * abs(float(q_dot))  # m/s of the working gap
         # m/s^2: the armature's acceleration over the step (its velocity change)
-        accel = self.lever * abs(float(q_dot) - float(seg.armature(seg.t_start)[1])) / span if span > 0.0 else 0.0
+        accel = self.lever * abs(float(q_dot) - float(q_dot_start)) / span if span > 0.0 else 0.0
         self.gap_scale = math.inf
         if speed > 0.0 or accel > 0.0:
             # nor beyond the time the gap takes to change by its own size: the coil's flux
@@ -568,31 +587,36 @@ class CoilLink:
             scales.append((self.gap_scale, "gap"))
         self.scale, self.bound_by = min(scales)
         self.horizon = min([plain, *(scale for scale, _ in scales[1:])])  # (the curvature's without its floor)
-        new = times[1:] if self._sampled else times
+        new = t_list[1:] if self._sampled else t_list
         self._sampled = True
         lo, hi = seg.t_start, seg.t_end
-        armature = seg.armature
-        for s in new.tolist():  # (a point or two a step: kept as floats, joined into arrays at the end)
-            self.q_times.append(s)
-            self.q.append(armature(lo if s < lo else (hi if s > hi else s))[0])
+        # (a point or two a step: kept as floats, joined into arrays at the end)
+        self.q_times.extend(new)
+        clamped = [lo if s < lo else (hi if s > hi else s) for s in new]
+        travel = getattr(seg, "travel", None)  # (mech's Segment: at once; a stand-in may give armature alone)
+        self.q.extend(travel(clamped) if travel is not None else [seg.armature(s)[0] for s in clamped])
 
     def receive(self, seg, mech) -> None:
         """After a step: add the work the drive did on the armature over the segment, along the
         mechanics' own solution (``received_work`` on its dense output), with the drive as the
         mechanics held it (``mech.drive``'s armature row, linear over the step, read at the
         segment's ends) and the antiderivative of its gain table (``GainIntegral``)."""
-        from mech.kernel_layout import D_SLOPE, D_T0, D_VALUE
-
         t0, t1 = seg.t_start, seg.t_end
         if self._gain_integral is None:
+            from mech.kernel_layout import D_SLOPE, D_T0, D_VALUE
+
             self._gain_integral = GainIntegral(mech.model.again)
             self._drive_row = mech.model.armature_drive_row
+            # (the drive's columns looked up once a run: an import statement per macro step
+            # cost ~0.6 us even with the module loaded)
+            self._drive_columns = (D_VALUE, D_SLOPE, D_T0)
         # the kernel's drive_at, on the row's three floats (mech.drives.values_at does every row)
         row = mech.drive[self._drive_row].tolist()
-        value, slope, t_ref = row[D_VALUE], row[D_SLOPE], row[D_T0]
+        c_value, c_slope, c_t0 = self._drive_columns
+        value, slope, t_ref = row[c_value], row[c_slope], row[c_t0]
         self.received += received_work(seg.armature, t0, t1, value + slope * (t0 - t_ref),
                                        value + slope * (t1 - t_ref), self._gain_integral,
-                                       [e["time"] for e in seg.events] if seg.events else ())
+                                       [e["time"] for e in seg.events] if seg.events else (), seg.travel)
 
     def columns(self, waves: dict) -> dict:
         """The result's coil columns beside the circuit's (coil_current, coil_voltage,

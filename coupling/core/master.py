@@ -359,7 +359,8 @@ class CoSimulation:
         # In free flight no friction acts, so a step may end where it meets a make without
         # being redone there with the current extrapolated to that end: the mechanics stop
         # at it (instead of integrating the bounces beyond and returning to it).
-        in_flight = align and not touching.any()
+        # (any() of the few rows as Python bools: ndarray.any's wrapper cost ~1 us a step)
+        in_flight = align and not any(touching.tolist())
         seated = coil is not None and mech.armature_seated
         start = cp if cp is not None or not seated else mech.checkpoint()
         seg = mech.advance(t_next, drives(t_next), stop_at_switch=in_flight)
@@ -388,9 +389,11 @@ class CoSimulation:
         # (a make/break within the policy's guard after the step's start is at the start, where
         # ngspice restarts: the mechanics find one a few femtoseconds after the step cut at
         # it, and a sliver step towards it failed against an inductive load)
-        guard = policy.guard
-        restart = any(t < s <= t + guard for s in switching)
-        breakpoints = sorted({s for s in switching if t + guard < s <= t_next})
+        restart, breakpoints = False, []
+        if switching:  # (most steps make or break nothing: no generator, set and sort for none)
+            guard = policy.guard
+            restart = any(t < s <= t + guard for s in switching)
+            breakpoints = sorted({s for s in switching if t + guard < s <= t_next})
         inputs = {}
         for link in links:
             inputs.update(link.inputs(seg, touching, stepper.uses_gap))
@@ -464,13 +467,17 @@ class CoSimulation:
         output, sample their contact (penetration, rate, normal force per tip) at the points
         noted, from that dense output, and release it: the mechanics keep a few macro steps'
         dense output, not the run's (docs/mechanics.md, "Memory")."""
+        if not self._contact_links:
+            # an armature alone: no contact is sampled, so no point is noted (a read of the
+            # step's times and a slice a macro step); the coil link samples the armature
+            # step by step, and the dense output is released all the same
+            if mech.dense_rows >= DENSE_FLUSH_ROWS:
+                mech.release_dense()
+            return
         times = step.reader("time")
         self._pending.append(times[1:] if self._started else times)
         self._started = True
-        if mech.dense_rows >= DENSE_FLUSH_ROWS and not self._contact_links:
-            self._pending = []
-            mech.release_dense()  # (an armature alone: the coil link samples the armature step by step)
-        elif mech.dense_rows >= DENSE_FLUSH_ROWS:
+        if mech.dense_rows >= DENSE_FLUSH_ROWS:
             pending = np.concatenate(self._pending)
             # a point beyond the last record (ngspice may land a hair past the step's end)
             # lies in the next step's first record: sampled later, from that record
