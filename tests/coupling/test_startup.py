@@ -10,6 +10,7 @@ Python side never (waveforms.html is written directly); PySpice only with a circ
 never cffi's C parser (pycparser: ngspice's declarations come pre-parsed,
 circuit/ngspice_api.py); Dask never; numpy.ma never (np.unique and np.quantile import it, ~10 ms of a start: the magnet's
 points and the waveform page's axes use their own, tests/coupling/test_sorted_values.py).
+A circuit that is a coil's drive alone imports none of circuit's other circuits or one-shot runs.
 """
 
 from __future__ import annotations
@@ -59,6 +60,11 @@ load_resistance = 12.0
 
 def _loaded(tmp_path: Path, scene_text: str | None, *args: str) -> set[str]:
     """The heavy packages `switchsim run` imported (scene_text None: the built-in default scene)."""
+    return {name for name in HEAVY if name in _imported(tmp_path, scene_text, *args)}
+
+
+def _imported(tmp_path: Path, scene_text: str | None, *args: str) -> set[str]:
+    """Every module `switchsim run` imported (scene_text None: the built-in default scene)."""
     scene = []
     if scene_text is not None:
         (tmp_path / "scene.toml").write_text(scene_text)
@@ -74,7 +80,7 @@ def _loaded(tmp_path: Path, scene_text: str | None, *args: str) -> set[str]:
     assert done.returncode == 0, done.stderr[-2000:]
     rc, modules = json.loads(done.stdout.strip().splitlines()[-1])
     assert rc == 0
-    return {name for name in HEAVY if name in modules}
+    return set(modules)
 
 
 def _requires_aot():
@@ -119,6 +125,16 @@ def test_default_scene_imports_pyspice_and_pyarrow_only_and_writes_its_documente
                        "history.csv", "contacts.csv", "phases.csv", "events.csv"}
     readme = (ROOT / "README.md").read_text()
     assert all(f"`{name}`" in readme for name in written)
+
+
+def test_a_coil_drive_alone_imports_no_templates_netlist_circuit_or_one_shot_runs(tmp_path):
+    """examples/plunger_solenoid.toml, whose circuit is its coil's drive: circuit's templates
+    (twelve dataclasses, ~8 ms), the netlist circuit, the schedule and the one-shot runs are
+    imported on first use (circuit/__init__.py) and never by this run."""
+    _requires_aot()
+    modules = _imported(tmp_path, (ROOT / "examples" / "plunger_solenoid.toml").read_text())
+    assert modules.isdisjoint({"circuit.templates", "circuit.netlist", "circuit.schedule", "circuit.transient"})
+    assert "circuit.coil_drive" in modules
 
 
 def test_the_stored_default_fit_is_current_and_equals_a_fresh_fit():
