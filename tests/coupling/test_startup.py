@@ -10,7 +10,8 @@ Python side never (waveforms.html is written directly); PySpice only with a circ
 never cffi's C parser (pycparser: ngspice's declarations come pre-parsed,
 circuit/ngspice_api.py); Dask never; numpy.ma never (np.unique and np.quantile import it, ~10 ms of a start: the magnet's
 points and the waveform page's axes use their own, tests/coupling/test_sorted_values.py).
-A circuit that is a coil's drive alone imports none of circuit's other circuits or one-shot runs.
+Nor the standard modules of UNREACHED (an AOT build's) where the run does not use them, and
+a circuit that is a coil's drive alone none of circuit's other circuits or one-shot runs.
 """
 
 from __future__ import annotations
@@ -29,6 +30,9 @@ from fit_compare import assert_same_fit
 ROOT = Path(__file__).resolve().parents[2]
 HEAVY = ("numba", "scipy", "pandas", "pyarrow", "matplotlib", "plotly", "PySpice", "pycparser", "dask",
          "distributed", "numpy.ma")
+# standard modules imported where they are used, which a run does not reach: the AOT
+# module's build (subprocess, sysconfig)
+UNREACHED = ("subprocess", "sysconfig")
 
 MECH = """
 [bar]
@@ -91,9 +95,12 @@ def _requires_aot():
 
 
 def test_mechanics_only_scene_with_its_default_outputs_imports_nothing_heavy(tmp_path):
-    """restitution given: the damping is calibrated (compiled), without scipy."""
+    """restitution given: the damping is calibrated (compiled), without scipy; nor the
+    modules of UNREACHED."""
     _requires_aot()
-    assert _loaded(tmp_path, MECH.format(plots="false")) == set()
+    modules = _imported(tmp_path, MECH.format(plots="false"))
+    assert {name for name in HEAVY if name in modules} == set()
+    assert modules.isdisjoint(UNREACHED)
     out = tmp_path / "out"
     assert {p.name for p in out.iterdir()} == {"summary.json", "history.csv", "contacts.csv", "phases.csv",
                                                "events.csv"}
@@ -119,7 +126,10 @@ def test_default_scene_imports_pyspice_and_pyarrow_only_and_writes_its_documente
     """The built-in default scene (the coil-driven relay, inline laws) with its default outputs; the
     files are the ones README.md lists for it."""
     _requires_aot()
-    assert _loaded(tmp_path, None) == {"PySpice", "pyarrow"}
+    modules = _imported(tmp_path, None)
+    assert {name for name in HEAVY if name in modules} == {"PySpice", "pyarrow"}
+    # (subprocess: ngspice's library is looked up with ldconfig -p)
+    assert modules.isdisjoint(set(UNREACHED) - {"subprocess"})
     written = {p.name for p in (tmp_path / "out").iterdir()}
     assert written == {"summary.json", "waveforms.csv", "waveforms.parquet", "waveforms.html", "openings.csv",
                        "history.csv", "contacts.csv", "phases.csv", "events.csv"}
@@ -135,6 +145,7 @@ def test_a_coil_drive_alone_imports_no_templates_netlist_circuit_or_one_shot_run
     modules = _imported(tmp_path, (ROOT / "examples" / "plunger_solenoid.toml").read_text())
     assert modules.isdisjoint({"circuit.templates", "circuit.netlist", "circuit.schedule", "circuit.transient"})
     assert "circuit.coil_drive" in modules
+    assert modules.isdisjoint(set(UNREACHED) - {"subprocess"})  # (ldconfig -p, as above)
 
 
 def test_the_stored_default_fit_is_current_and_equals_a_fresh_fit():
