@@ -10,8 +10,9 @@ Python side never (waveforms.html is written directly); PySpice only with a circ
 never cffi's C parser (pycparser: ngspice's declarations come pre-parsed,
 circuit/ngspice_api.py); Dask never; numpy.ma never (np.unique and np.quantile import it, ~10 ms of a start: the magnet's
 points and the waveform page's axes use their own, tests/coupling/test_sorted_values.py).
-Nor the standard modules of UNREACHED (an AOT build's) where the run does not use them, and
-a circuit that is a coil's drive alone none of circuit's other circuits or one-shot runs.
+Nor the standard modules of UNREACHED (an AOT build's, an error's did-you-mean) where the
+run does not use them, and a circuit that is a coil's drive alone none of circuit's other
+circuits or one-shot runs.
 """
 
 from __future__ import annotations
@@ -31,8 +32,8 @@ ROOT = Path(__file__).resolve().parents[2]
 HEAVY = ("numba", "scipy", "pandas", "pyarrow", "matplotlib", "plotly", "PySpice", "pycparser", "dask",
          "distributed", "numpy.ma")
 # standard modules imported where they are used, which a run does not reach: the AOT
-# module's build (subprocess, sysconfig)
-UNREACHED = ("subprocess", "sysconfig")
+# module's build (subprocess, sysconfig), an error's did-you-mean (difflib)
+UNREACHED = ("subprocess", "sysconfig", "difflib")
 
 MECH = """
 [bar]
