@@ -10,9 +10,9 @@ Python side never (waveforms.html is written directly); PySpice only with a circ
 never cffi's C parser (pycparser: ngspice's declarations come pre-parsed,
 circuit/ngspice_api.py); Dask never; numpy.ma never (np.unique and np.quantile import it, ~10 ms of a start: the magnet's
 points and the waveform page's axes use their own, tests/coupling/test_sorted_values.py).
-Nor the standard modules of UNREACHED (an AOT build's, an error's did-you-mean) where the
-run does not use them, and a circuit that is a coil's drive alone none of circuit's other
-circuits or one-shot runs.
+Nor the standard modules of UNREACHED (an AOT build's, an error's did-you-mean, a built-in
+scene's file) where the run does not use them, and a circuit that is a coil's drive alone
+none of circuit's other circuits or one-shot runs.
 """
 
 from __future__ import annotations
@@ -32,8 +32,9 @@ ROOT = Path(__file__).resolve().parents[2]
 HEAVY = ("numba", "scipy", "pandas", "pyarrow", "matplotlib", "plotly", "PySpice", "pycparser", "dask",
          "distributed", "numpy.ma")
 # standard modules imported where they are used, which a run does not reach: the AOT
-# module's build (subprocess, sysconfig), an error's did-you-mean (difflib)
-UNREACHED = ("subprocess", "sysconfig", "difflib")
+# module's build (subprocess, sysconfig), an error's did-you-mean (difflib), a built-in
+# scene's file (importlib.resources)
+UNREACHED = ("subprocess", "sysconfig", "difflib", "importlib.resources")
 
 MECH = """
 [bar]
@@ -129,8 +130,8 @@ def test_default_scene_imports_pyspice_and_pyarrow_only_and_writes_its_documente
     _requires_aot()
     modules = _imported(tmp_path, None)
     assert {name for name in HEAVY if name in modules} == {"PySpice", "pyarrow"}
-    # (subprocess: ngspice's library is looked up with ldconfig -p)
-    assert modules.isdisjoint(set(UNREACHED) - {"subprocess"})
+    # (subprocess: ngspice's library is looked up with ldconfig -p; importlib.resources: the scene's file)
+    assert modules.isdisjoint(set(UNREACHED) - {"subprocess", "importlib.resources"})
     written = {p.name for p in (tmp_path / "out").iterdir()}
     assert written == {"summary.json", "waveforms.csv", "waveforms.parquet", "waveforms.html", "openings.csv",
                        "history.csv", "contacts.csv", "phases.csv", "events.csv"}
