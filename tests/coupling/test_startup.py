@@ -11,8 +11,8 @@ never cffi's C parser (pycparser: ngspice's declarations come pre-parsed,
 circuit/ngspice_api.py); Dask never; numpy.ma never (np.unique and np.quantile import it, ~10 ms of a start: the magnet's
 points and the waveform page's axes use their own, tests/coupling/test_sorted_values.py).
 Nor the standard modules of UNREACHED (an AOT build's, an error's did-you-mean, a built-in
-scene's file) where the run does not use them, and a circuit that is a coil's drive alone
-none of circuit's other circuits or one-shot runs.
+scene's file, a quoted table's) where the run does not use them, and a circuit that is a
+coil's drive alone none of circuit's other circuits or one-shot runs.
 """
 
 from __future__ import annotations
@@ -33,8 +33,8 @@ HEAVY = ("numba", "scipy", "pandas", "pyarrow", "matplotlib", "plotly", "PySpice
          "distributed", "numpy.ma")
 # standard modules imported where they are used, which a run does not reach: the AOT
 # module's build (subprocess, sysconfig), an error's did-you-mean (difflib), a built-in
-# scene's file (importlib.resources)
-UNREACHED = ("subprocess", "sysconfig", "difflib", "importlib.resources")
+# scene's file (importlib.resources), a table whose cells need quoting (csv)
+UNREACHED = ("subprocess", "sysconfig", "difflib", "importlib.resources", "csv")
 
 MECH = """
 [bar]
