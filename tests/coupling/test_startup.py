@@ -10,8 +10,8 @@ Python side never (waveforms.html is written directly); PySpice only with a circ
 never cffi's C parser (pycparser: ngspice's declarations come pre-parsed,
 circuit/ngspice_api.py); Dask never; numpy.ma never (np.unique and np.quantile import it, ~10 ms of a start: the magnet's
 points and the waveform page's axes use their own, tests/coupling/test_sorted_values.py).
-Nor the standard modules of UNREACHED (an AOT build's, an error's did-you-mean, a built-in
-scene's file, a quoted table's) where the run does not use them, and a circuit that is a
+Nor the standard modules of UNREACHED (an AOT build's, an error's did-you-mean, a quoted
+table's, importlib.resources) where the run does not use them, and a circuit that is a
 coil's drive alone none of circuit's other circuits or one-shot runs.
 """
 
@@ -32,8 +32,9 @@ ROOT = Path(__file__).resolve().parents[2]
 HEAVY = ("numba", "scipy", "pandas", "pyarrow", "matplotlib", "plotly", "PySpice", "pycparser", "dask",
          "distributed", "numpy.ma")
 # standard modules imported where they are used, which a run does not reach: the AOT
-# module's build (subprocess, sysconfig), an error's did-you-mean (difflib), a built-in
-# scene's file (importlib.resources), a table whose cells need quoting (csv)
+# module's build (subprocess, sysconfig), an error's did-you-mean (difflib), a table whose
+# cells need quoting (csv); and importlib.resources, which no run uses (the built-in
+# scenes and the contact materials are read by path)
 UNREACHED = ("subprocess", "sysconfig", "difflib", "importlib.resources", "csv")
 
 MECH = """
@@ -130,8 +131,8 @@ def test_default_scene_imports_pyspice_and_pyarrow_only_and_writes_its_documente
     _requires_aot()
     modules = _imported(tmp_path, None)
     assert {name for name in HEAVY if name in modules} == {"PySpice", "pyarrow"}
-    # (subprocess: ngspice's library is looked up with ldconfig -p; importlib.resources: the scene's file)
-    assert modules.isdisjoint(set(UNREACHED) - {"subprocess", "importlib.resources"})
+    # (subprocess: ngspice's library is looked up with ldconfig -p)
+    assert modules.isdisjoint(set(UNREACHED) - {"subprocess"})
     written = {p.name for p in (tmp_path / "out").iterdir()}
     assert written == {"summary.json", "waveforms.csv", "waveforms.parquet", "waveforms.html", "openings.csv",
                        "history.csv", "contacts.csv", "phases.csv", "events.csv"}
