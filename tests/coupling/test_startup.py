@@ -12,7 +12,8 @@ circuit/ngspice_api.py); Dask never; numpy.ma never (np.unique and np.quantile i
 points and the waveform page's axes use their own, tests/coupling/test_sorted_values.py).
 Nor the standard modules of UNREACHED (an AOT build's, an error's did-you-mean, a quoted
 table's, importlib.resources) where the run does not use them, and a circuit that is a
-coil's drive alone none of circuit's other circuits or one-shot runs.
+coil's drive alone none of circuit's other circuits or one-shot runs; a free bar or an
+armature alone not the finite-element beam (BEAM).
 """
 
 from __future__ import annotations
@@ -36,6 +37,8 @@ HEAVY = ("numba", "scipy", "pandas", "pyarrow", "matplotlib", "plotly", "PySpice
 # cells need quoting (csv); and importlib.resources, which no run uses (the built-in
 # scenes and the contact materials are read by path)
 UNREACHED = ("subprocess", "sysconfig", "difflib", "importlib.resources", "csv")
+# the finite-element beam, which only a held bar (a mechanism) builds
+BEAM = ("mech.beam_fe",)
 
 MECH = """
 [bar]
@@ -99,11 +102,12 @@ def _requires_aot():
 
 def test_mechanics_only_scene_with_its_default_outputs_imports_nothing_heavy(tmp_path):
     """restitution given: the damping is calibrated (compiled), without scipy; nor the
-    modules of UNREACHED."""
+    modules of UNREACHED, nor the beam's (a free bar)."""
     _requires_aot()
     modules = _imported(tmp_path, MECH.format(plots="false"))
     assert {name for name in HEAVY if name in modules} == set()
     assert modules.isdisjoint(UNREACHED)
+    assert modules.isdisjoint(BEAM)
     out = tmp_path / "out"
     assert {p.name for p in out.iterdir()} == {"summary.json", "history.csv", "contacts.csv", "phases.csv",
                                                "events.csv"}
@@ -149,6 +153,7 @@ def test_a_coil_drive_alone_imports_no_templates_netlist_circuit_or_one_shot_run
     assert modules.isdisjoint({"circuit.templates", "circuit.netlist", "circuit.schedule", "circuit.transient"})
     assert "circuit.coil_drive" in modules
     assert modules.isdisjoint(set(UNREACHED) - {"subprocess"})  # (ldconfig -p, as above)
+    assert modules.isdisjoint(BEAM)  # (an armature on no bar)
 
 
 def test_the_stored_default_fit_is_current_and_equals_a_fresh_fit():
