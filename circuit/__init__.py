@@ -31,28 +31,39 @@ from .errors import (
     SimulationTimeout,
     TimestepTooSmallError,
 )
-from .netlist import NetlistCircuit
 from .ngspice import find_library, get_session
 from .options import SimulationOptions
 from .probes import COLUMNS, Probes
-from .schedule import ContactSchedule
 from .stepping import StepResult, Stepper
-from .templates import (
-    BridgeCircuit,
-    ChangeoverCircuit,
-    CapacitiveLoad,
-    CurrentSource,
-    DCSource,
-    FlybackDiode,
-    InductiveLoad,
-    McuInput,
-    ResistiveLoad,
-    Snubber,
-    ShortCircuit,
-    SwitchCircuit,
-    Wiring,
-)
-from .transient import run_pwl_reference, run_transient
+
+# Imported on first use (PEP 562): the circuits' dataclasses besides the coil drive (the
+# templates, a netlist file's circuit) and the one-shot runs with their schedule. A run
+# whose circuit is a coil drive alone (examples/plunger_solenoid.toml) uses none of them,
+# and their classes cost ~10 ms of its start (dataclasses writes and compiles each
+# generated method: templates.py's twelve classes ~8 ms).
+_LAZY = {
+    "NetlistCircuit": "netlist",
+    "ContactSchedule": "schedule",
+    "run_pwl_reference": "transient", "run_transient": "transient",
+    **dict.fromkeys(("BridgeCircuit", "ChangeoverCircuit", "CapacitiveLoad", "CurrentSource", "DCSource",
+                     "FlybackDiode", "InductiveLoad", "McuInput", "ResistiveLoad", "Snubber", "ShortCircuit",
+                     "SwitchCircuit", "Wiring"), "templates"),
+}
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+        globals()[name] = value  # (kept: the next use does not come here)
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))
+
 
 __all__ = [
     "ArcModel",

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Mapping, Union
+from typing import TYPE_CHECKING, Mapping, Union
 
 import numpy as np
 from PySpice.Spice.Netlist import Circuit
@@ -11,13 +11,16 @@ from .arc import ArcState, recorded_arc
 from .blocks import COILS_PLACED, ContactBlock
 from .coil_drive import CoilDrive
 from .contact import placed_contacts
-from .netlist import NetlistCircuit
 from .options import SimulationOptions
 from .probes import Probes
-from .templates import LOAD_PROBE, McuInput, SwitchCircuit
 from .validation import check_range
 
-CircuitLike = Union[SwitchCircuit, CoilDrive, McuInput, NetlistCircuit, Circuit]
+if TYPE_CHECKING:
+    from .netlist import NetlistCircuit
+    from .templates import McuInput, SwitchCircuit
+
+# (named, not imported: a run whose circuit is a coil drive never loads them, circuit/__init__.py)
+CircuitLike = Union["SwitchCircuit", CoilDrive, "McuInput", "NetlistCircuit", Circuit]
 
 #: Drive of an input channel's source: "external" (a Python function of time, through
 #: ngspice's callback) or PWL vertices (times s, values in the channel's unit, >= 0).
@@ -26,7 +29,14 @@ Drive = Union[str, tuple[np.ndarray, np.ndarray]]
 
 def circuit_netlist(circuit: CircuitLike) -> tuple[str, Probes]:
     """Netlist text (title line first, no analysis, no .end) and its probes."""
-    if isinstance(circuit, (SwitchCircuit, McuInput, CoilDrive)):
+    if isinstance(circuit, CoilDrive):
+        return str(circuit.build()), circuit.probes
+    # (imported here, not at the top: a coil drive's run never loads them, circuit/__init__.py;
+    # a circuit of theirs has imported its module already)
+    from .netlist import NetlistCircuit
+    from .templates import LOAD_PROBE, McuInput, SwitchCircuit
+
+    if isinstance(circuit, (SwitchCircuit, McuInput)):
         return str(circuit.build()), circuit.probes
     if isinstance(circuit, NetlistCircuit):
         return circuit.netlist(), circuit.probes

@@ -33,12 +33,7 @@ import importlib.machinery
 import importlib.util
 import json
 import os
-import shutil
-import subprocess
 import sys
-import sysconfig
-import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -129,6 +124,14 @@ def _build_locked(folder: Path) -> str | None:
 
 def _build(folder: Path) -> str | None:
     """Compile in a child process into a temporary folder beside ``folder``, then rename it."""
+    # (imported here: a run that loads the built module needs none of them; subprocess
+    # alone is ~3 ms of a mechanics-only run's start)
+    import shutil
+    import subprocess
+    import sysconfig
+    import tempfile
+    import time
+
     compiler = (sysconfig.get_config_var("CC") or "cc").split()[0]
     if shutil.which(compiler) is None:
         return f"no C compiler ({compiler!r} not found)"
@@ -169,6 +172,8 @@ def _build(folder: Path) -> str | None:
 def remove_stale(folder: Path) -> None:
     """Delete the builds of earlier sources beside ``folder`` (a loaded one stays mapped),
     with their lock files and failure notes; keep ``folder``'s own and builds under way."""
+    import shutil  # (after a build only: see _build)
+
     for stale in folder.parent.glob("aot-*"):
         if stale.name.startswith(folder.name) or ".build-" in stale.name:
             continue

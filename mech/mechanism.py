@@ -22,10 +22,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .beam_fe import FEBeam, PointMass, beam_basis, beam_invariants, point_shapes
 from .contact_laws import hertz_stiffness
 from .kernel_layout import (
     C_C, C_K, C_N, C_ON, C_R, C_Z, CONTACT_ROWS, L_AX, L_AY, L_AZ, L_BODY, L_C, L_DX, L_DY, L_DZ, L_FLOOR, L_K,
@@ -35,6 +35,9 @@ from .kernel_layout import (
 from .modal_basis import ModalBasis
 from .parameters import MechScene
 from .frozen import frozen
+
+if TYPE_CHECKING:
+    from .beam_fe import FEBeam
 
 
 @frozen
@@ -123,6 +126,8 @@ def fe_beam(scene: MechScene) -> FEBeam:
     A rivet's rotary inertia about the section's bending axis: a sphere's 2/5 m r^2 plus
     m h^2 for its offset h from the axis (it is carried on the axis point it sits above).
     """
+    from .beam_fe import FEBeam, PointMass  # (here: see build_arrays)
+
     bar = scene.bar
     i22, i33 = bar.second_moments
     masses = tuple(PointMass(rv.position, rv.mass, rv.mass * (0.4 * rv.radius**2 + rv.offset**2))
@@ -156,6 +161,11 @@ class MechanismArrays:
 
 def build_arrays(scene: MechScene, planar: bool) -> MechanismArrays:
     """Modes, invariants and point arrays of a mechanism scene."""
+    # (imported here, not at the top: a free bar's scene or an armature's alone never
+    # builds a beam, and the module's start, its classes and reference matrices, cost
+    # the plunger example ~1.5 ms)
+    from .beam_fe import beam_basis, beam_invariants, point_shapes
+
     bar = scene.bar
     if bar.bending != "euler_bernoulli":
         raise ValueError(f"bar.bending = {bar.bending!r}: switch mechanisms (mount, rivets, forces, springs) "

@@ -15,7 +15,6 @@ from dataclasses import field, replace
 import numpy as np
 
 from .armature import gain_table
-from .beam_fe import beam_frequencies
 from .contact_laws import damping_formula, hertz_impact, hertz_stiffness
 from .damping_calibration import calibrate_damping
 from .drives import ARMATURE_DRIVE, DriveKind, kind_of
@@ -1198,6 +1197,8 @@ def frequencies_below(beam, family: str, cutoff: float, cap: int, first: int = 8
     (beam_fe.beam_frequencies: no shapes, a third of the cost), which the shapes' Rayleigh
     quotients of beam_modes match to their round-off.
     """
+    from .beam_fe import beam_frequencies  # (here: a held bar's alone, mech.mechanism.build_arrays)
+
     count = max(1, min(first, cap))
     while True:
         f = beam_frequencies(beam, family, count)

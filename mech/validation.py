@@ -12,7 +12,6 @@ values are checked"). coupling's own section dataclasses use these checks too, a
 from __future__ import annotations
 
 import dataclasses
-import difflib
 import math
 import re
 from pathlib import Path
@@ -206,6 +205,8 @@ def check_file(name: str, path) -> Path:
 def suggest(word: str, allowed) -> str:
     """The did-you-mean of every scene section, key and CSV column: ' (did you mean 'x'?)'
     for the closest allowed name, or '' when none is close."""
+    import difflib  # (here: only an error asks for it; ~1 ms of every run's start otherwise)
+
     close = difflib.get_close_matches(str(word), [str(a) for a in allowed], n=1)
     return f" (did you mean {close[0]!r}?)" if close else ""
 

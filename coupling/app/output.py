@@ -24,7 +24,6 @@
 
 from __future__ import annotations
 
-import csv
 import dataclasses
 import errno
 import fcntl
@@ -549,6 +548,8 @@ def _write_table(fh, columns: dict, codes: dict | None, header: bool) -> None:
     text = io.TextIOWrapper(fh, newline="", write_through=True)
     try:
         if not plain:
+            import csv  # (here: the default scene's and the plunger's tables never come this way)
+
             writer = csv.writer(text, lineterminator="\n")
             if header:
                 writer.writerow(names)

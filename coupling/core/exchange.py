@@ -82,11 +82,13 @@ def contact_intervals(seg, touching_at_start) -> list[list[tuple[float, float]]]
 
 
 # Gauss-Legendre on [0, 1] (nodes, weights) of RECEIVED_NODES points: the quadrature of the
-# armature's drive work (``received_work``), exact for polynomials of degree 7 in time
+# armature's drive work (``received_work``), exact for polynomials of degree 7 in time.
+# Written out: numpy.polynomial.legendre.leggauss(4)'s, mapped to [0, 1] (x -> (x + 1) / 2,
+# w -> w / 2), bit for bit (tests/coupling/test_relay_interface.py); importing
+# numpy.polynomial for them cost ~2.2 ms of every coupled run's start
 RECEIVED_NODES = 4
-_LEGENDRE = np.polynomial.legendre.leggauss(RECEIVED_NODES)
-GAUSS_NODES = tuple(0.5 * (float(x) + 1.0) for x in _LEGENDRE[0])
-GAUSS_WEIGHTS = tuple(0.5 * float(w) for w in _LEGENDRE[1])
+GAUSS_NODES = (0.06943184420297371, 0.33000947820757187, 0.6699905217924281, 0.9305681557970262)
+GAUSS_WEIGHTS = (0.17392742256872679, 0.3260725774312732, 0.3260725774312732, 0.17392742256872679)
 
 
 class GainIntegral:

@@ -36,7 +36,7 @@ from __future__ import annotations
 import math
 import tomllib
 from dataclasses import field
-from importlib import resources
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -168,7 +168,8 @@ def _datum(name: str, prop: str, item) -> tuple[float, tuple[float, float], str,
 def load_materials(text: str | None = None) -> dict[str, Material]:
     """The contact-material library (coupling/laws/data/contact_materials.toml, or TOML ``text``)."""
     if text is None:
-        text = resources.files("coupling.laws").joinpath("data/contact_materials.toml").read_text()
+        # (a path beside this module, as builtin_scene_text's: no importlib.resources at a run's start)
+        text = (Path(__file__).parent / "data" / "contact_materials.toml").read_text(encoding="utf-8")
     doc = tomllib.loads(text)
     out = {}
     for name, entry in doc.items():

@@ -26,6 +26,19 @@ from circuit import (
 )
 
 
+def test_the_package_gives_every_name_it_lists_those_imported_on_first_use_too():
+    """circuit/__init__.py imports the templates, the netlist circuit, the schedule and the
+    one-shot runs on first use (PEP 562): each listed name is still there, and in dir()."""
+    import circuit
+    import circuit.templates
+
+    assert all(getattr(circuit, name) is not None for name in circuit.__all__)
+    assert set(circuit.__all__) <= set(dir(circuit))
+    assert circuit.SwitchCircuit is circuit.templates.SwitchCircuit
+    with pytest.raises(AttributeError, match="module 'circuit' has no attribute 'Nothing'"):
+        circuit.Nothing  # noqa: B018
+
+
 def test_full_template_netlist_has_contact_and_named_nodes():
     circuit = SwitchCircuit(
         DCSource(24.0, 0.1),

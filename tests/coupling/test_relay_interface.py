@@ -14,7 +14,7 @@ from scipy.integrate import quad
 
 from coupling import builtin_scene, load_scene, run
 from coupling.app.accuracy import refined_steps
-from coupling.core.exchange import GAUSS_NODES, GAUSS_WEIGHTS, CoilLink, GainIntegral, received_work
+from coupling.core.exchange import GAUSS_NODES, GAUSS_WEIGHTS, RECEIVED_NODES, CoilLink, GainIntegral, received_work
 from coupling.laws.magnet import FluxTubeMagnet
 from mech.armature import gain_at, gain_table
 
@@ -50,6 +50,14 @@ def test_the_gain_integral_is_the_antiderivative_of_the_mechanics_gain_table():
         ref = ref if q >= x0 else -ref
         assert G(q) == pytest.approx(ref, rel=1e-10, abs=1e-12 * abs(G(x1))), q
     assert GainIntegral(np.zeros((3, 0)))(0.3) == 0.3  # no table: gain 1
+
+
+def test_the_written_out_gauss_rule_is_numpys_leggauss_bit_for_bit():
+    """coupling.core.exchange writes the 4-point rule out (no numpy.polynomial at a run's
+    start): the same floats as leggauss(4) mapped to [0, 1]."""
+    x, w = np.polynomial.legendre.leggauss(RECEIVED_NODES)
+    assert GAUSS_NODES == tuple(0.5 * (float(v) + 1.0) for v in x)
+    assert GAUSS_WEIGHTS == tuple(0.5 * float(v) for v in w)
 
 
 def test_received_work_meets_the_direct_quadrature_of_force_times_speed():

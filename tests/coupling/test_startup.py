@@ -10,6 +10,10 @@ Python side never (waveforms.html is written directly); PySpice only with a circ
 never cffi's C parser (pycparser: ngspice's declarations come pre-parsed,
 circuit/ngspice_api.py); Dask never; numpy.ma never (np.unique and np.quantile import it, ~10 ms of a start: the magnet's
 points and the waveform page's axes use their own, tests/coupling/test_sorted_values.py).
+Nor the standard modules of UNREACHED (an AOT build's, an error's did-you-mean, a quoted
+table's, importlib.resources) where the run does not use them, and a circuit that is a
+coil's drive alone none of circuit's other circuits or one-shot runs; a free bar or an
+armature alone not the finite-element beam (BEAM).
 """
 
 from __future__ import annotations
@@ -28,6 +32,14 @@ from fit_compare import assert_same_fit
 ROOT = Path(__file__).resolve().parents[2]
 HEAVY = ("numba", "scipy", "pandas", "pyarrow", "matplotlib", "plotly", "PySpice", "pycparser", "dask",
          "distributed", "numpy.ma")
+# standard modules imported where they are used, which a run does not reach: the AOT
+# module's build (subprocess, sysconfig), an error's did-you-mean (difflib), a table whose
+# cells need quoting (csv); and importlib.resources, which no run uses (the built-in
+# scenes and the contact materials are read by path)
+UNREACHED = ("subprocess", "sysconfig", "difflib", "importlib.resources", "csv")
+# the finite-element beam, which only a held bar (a mechanism) builds, with numpy.polynomial
+# (its Gauss rules; coupling.core.exchange writes its own out)
+BEAM = ("mech.beam_fe", "numpy.polynomial")
 
 MECH = """
 [bar]
@@ -59,6 +71,11 @@ load_resistance = 12.0
 
 def _loaded(tmp_path: Path, scene_text: str | None, *args: str) -> set[str]:
     """The heavy packages `switchsim run` imported (scene_text None: the built-in default scene)."""
+    return {name for name in HEAVY if name in _imported(tmp_path, scene_text, *args)}
+
+
+def _imported(tmp_path: Path, scene_text: str | None, *args: str) -> set[str]:
+    """Every module `switchsim run` imported (scene_text None: the built-in default scene)."""
     scene = []
     if scene_text is not None:
         (tmp_path / "scene.toml").write_text(scene_text)
@@ -74,7 +91,7 @@ def _loaded(tmp_path: Path, scene_text: str | None, *args: str) -> set[str]:
     assert done.returncode == 0, done.stderr[-2000:]
     rc, modules = json.loads(done.stdout.strip().splitlines()[-1])
     assert rc == 0
-    return {name for name in HEAVY if name in modules}
+    return set(modules)
 
 
 def _requires_aot():
@@ -85,9 +102,13 @@ def _requires_aot():
 
 
 def test_mechanics_only_scene_with_its_default_outputs_imports_nothing_heavy(tmp_path):
-    """restitution given: the damping is calibrated (compiled), without scipy."""
+    """restitution given: the damping is calibrated (compiled), without scipy; nor the
+    modules of UNREACHED, nor the beam's (a free bar)."""
     _requires_aot()
-    assert _loaded(tmp_path, MECH.format(plots="false")) == set()
+    modules = _imported(tmp_path, MECH.format(plots="false"))
+    assert {name for name in HEAVY if name in modules} == set()
+    assert modules.isdisjoint(UNREACHED)
+    assert modules.isdisjoint(BEAM)
     out = tmp_path / "out"
     assert {p.name for p in out.iterdir()} == {"summary.json", "history.csv", "contacts.csv", "phases.csv",
                                                "events.csv"}
@@ -113,12 +134,27 @@ def test_default_scene_imports_pyspice_and_pyarrow_only_and_writes_its_documente
     """The built-in default scene (the coil-driven relay, inline laws) with its default outputs; the
     files are the ones README.md lists for it."""
     _requires_aot()
-    assert _loaded(tmp_path, None) == {"PySpice", "pyarrow"}
+    modules = _imported(tmp_path, None)
+    assert {name for name in HEAVY if name in modules} == {"PySpice", "pyarrow"}
+    # (subprocess: ngspice's library is looked up with ldconfig -p)
+    assert modules.isdisjoint(set(UNREACHED) - {"subprocess"})
     written = {p.name for p in (tmp_path / "out").iterdir()}
     assert written == {"summary.json", "waveforms.csv", "waveforms.parquet", "waveforms.html", "openings.csv",
                        "history.csv", "contacts.csv", "phases.csv", "events.csv"}
     readme = (ROOT / "README.md").read_text()
     assert all(f"`{name}`" in readme for name in written)
+
+
+def test_a_coil_drive_alone_imports_no_templates_netlist_circuit_or_one_shot_runs(tmp_path):
+    """examples/plunger_solenoid.toml, whose circuit is its coil's drive: circuit's templates
+    (twelve dataclasses, ~8 ms), the netlist circuit, the schedule and the one-shot runs are
+    imported on first use (circuit/__init__.py) and never by this run."""
+    _requires_aot()
+    modules = _imported(tmp_path, (ROOT / "examples" / "plunger_solenoid.toml").read_text())
+    assert modules.isdisjoint({"circuit.templates", "circuit.netlist", "circuit.schedule", "circuit.transient"})
+    assert "circuit.coil_drive" in modules
+    assert modules.isdisjoint(set(UNREACHED) - {"subprocess"})  # (ldconfig -p, as above)
+    assert modules.isdisjoint(BEAM)  # (an armature on no bar)
 
 
 def test_the_stored_default_fit_is_current_and_equals_a_fresh_fit():

@@ -13,6 +13,7 @@ import json
 import os
 import subprocess
 import sys
+import sysconfig
 import textwrap
 import threading
 from pathlib import Path
@@ -237,7 +238,8 @@ def test_concurrent_callers_build_once(tmp_path, monkeypatch):
 def test_a_failed_build_is_remembered_said_once_and_the_jit_route_taken(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
     monkeypatch.delenv(aot.FORCE_JIT, raising=False)
-    monkeypatch.setattr(aot.sysconfig, "get_config_var", lambda name: "no-such-compiler-here" if name == "CC" else None)
+    # (the sysconfig the build imports when it starts: mech.aot's own import of it is inside _build)
+    monkeypatch.setattr(sysconfig, "get_config_var", lambda name: "no-such-compiler-here" if name == "CC" else None)
     assert aot.load() is None
     err = capsys.readouterr().err
     assert err.count("switchsim:") == 1 and "no C compiler" in err and "just-in-time" in err

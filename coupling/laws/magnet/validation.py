@@ -4,7 +4,6 @@ its checked form. (The magnet imports nothing of mech, whose own checks these mi
 
 from __future__ import annotations
 
-import difflib
 import math
 
 import numpy as np
@@ -58,6 +57,8 @@ def check_instance(name: str, value, classes, what: str):
 
 def unknown(where: str, name: str, allowed, kind: str) -> ValueError:
     """The error for an unknown name: a did-you-mean and the allowed names."""
+    import difflib  # (here: only an error asks for it; ~1 ms of every run's start otherwise)
+
     close = difflib.get_close_matches(str(name), [str(a) for a in allowed], n=1)
     hint = f" (did you mean {close[0]!r}?)" if close else ""
     return ValueError(f"{where}: unknown {kind} {name!r}{hint}; allowed: {', '.join(sorted(allowed))}")
