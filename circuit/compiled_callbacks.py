@@ -28,10 +28,7 @@ from __future__ import annotations
 
 import functools
 import os
-import shutil
-import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 from ._callbacks_ffi import ffi
@@ -250,6 +247,10 @@ def _build_locked(folder: Path) -> str | None:
 
 def _build(folder: Path) -> str | None:
     """Run the compiler into a temporary folder beside ``folder``, then rename it."""
+    import shutil  # (these three only to build: a run that loads the library imports none)
+    import subprocess
+    import tempfile
+
     command = compiler()
     if shutil.which(command[0]) is None:
         return f"no C compiler ({command[0]!r} not found)"
@@ -278,6 +279,8 @@ def _build(folder: Path) -> str | None:
 def _remove_stale(folder: Path) -> None:
     """Delete the builds of earlier sources beside ``folder`` (a loaded one stays mapped),
     with their lock files and failure notes; keep ``folder``'s own and builds under way."""
+    import shutil
+
     for stale in folder.parent.glob("callbacks-*"):
         if stale.name.startswith(folder.name) or ".build-" in stale.name:
             continue

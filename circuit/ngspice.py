@@ -14,7 +14,6 @@ import math
 import os
 import re
 import shutil
-import subprocess
 import sys
 import tempfile
 import threading
@@ -70,15 +69,22 @@ REJECTIONS_LOGGED = 1024
 def find_library() -> str:
     """Path of the ngspice shared library.
 
-    Order: the environment variable ``NGSPICE_LIBRARY_PATH``; ``ldconfig -p`` for
-    ``libngspice.so.0`` (what Debian's ``libngspice0`` installs, without the -dev
-    symlink ``libngspice.so``) or ``libngspice.so``; a few usual install paths.
+    Order: the environment variable ``NGSPICE_LIBRARY_PATH``; ``libngspice.so.0`` (what
+    Debian's ``libngspice0`` installs, without the -dev symlink ``libngspice.so``) or
+    ``libngspice.so`` as the dynamic loader finds it (its own search: LD_LIBRARY_PATH,
+    the ld.so cache, the system's folders), the file it mapped read back from
+    /proc/self/maps; where that finds none (or there is no /proc), ``ldconfig -p`` for
+    the same names; a few usual install paths.
     """
     override = os.environ.get(LIBRARY_ENV)
     if override:
         if not Path(override).is_file():
             raise LibraryNotFoundError(f"{LIBRARY_ENV}={override!r} does not name an existing file")
         return override
+    for name in ("libngspice.so.0", "libngspice.so"):
+        found = _loader_lookup(name)
+        if found:
+            return found
     for name in ("libngspice.so.0", "libngspice.so"):
         found = _ldconfig_lookup(name)
         if found:
@@ -92,7 +98,48 @@ def find_library() -> str:
     )
 
 
+_LOADED_BY_NAME: list = []  # the library the loader opened by its name (held: the session opens the same)
+
+
+def _loader_lookup(name: str) -> str | None:
+    """The file the dynamic loader opens for the library ``name``, or None (not found, or
+    no /proc/self/maps to say which file it is). Cheaper than running ``ldconfig -p``
+    (its fork and exec, ~4-10 ms of a coupled run's start, and subprocess's import)."""
+    before = _mapped_ngspice()
+    if before is None:
+        return None
+    try:
+        library = ffi.dlopen(name)
+    except OSError:
+        return None
+    after = _mapped_ngspice()
+    if not after:
+        return None
+    new = after - before or after
+    if len(new) != 1:  # (two ngspice libraries in one process: which is which is not known here)
+        return None
+    _LOADED_BY_NAME.append(library)
+    path = next(iter(new))
+    return path if Path(path).is_file() else None
+
+
+def _mapped_ngspice() -> set[str] | None:
+    """The files named libngspice* mapped into this process (/proc/self/maps), None without it."""
+    try:
+        with open("/proc/self/maps", encoding="utf-8", errors="replace") as maps:
+            found = set()
+            for line in maps:
+                fields = line.rstrip("\n").split(maxsplit=5)
+                if len(fields) == 6 and os.path.basename(fields[5]).startswith("libngspice"):
+                    found.add(fields[5])
+            return found
+    except OSError:
+        return None
+
+
 def _ldconfig_lookup(name: str) -> str | None:
+    import subprocess  # (only here: a run finds its library through the loader)
+
     exe = shutil.which("ldconfig") or next(
         (p for p in ("/sbin/ldconfig", "/usr/sbin/ldconfig") if Path(p).is_file()), None
     )

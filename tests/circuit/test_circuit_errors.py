@@ -137,6 +137,26 @@ def test_library_lookup(monkeypatch, tmp_path):
     assert find_library() == found
 
 
+def test_the_library_found_is_the_one_ldconfig_lists(monkeypatch):
+    """find_library asks the dynamic loader (its own search, then the file it mapped); on a
+    system whose ld.so cache lists libngspice.so.0, that is the same file as ldconfig's."""
+    import os
+    import shutil
+    import subprocess
+
+    monkeypatch.delenv("NGSPICE_LIBRARY_PATH", raising=False)
+    exe = shutil.which("ldconfig") or next((p for p in ("/sbin/ldconfig", "/usr/sbin/ldconfig") if os.path.isfile(p)),
+                                           None)
+    if exe is None:
+        pytest.skip("no ldconfig here")
+    listed = [line.split("=>", 1)[1].strip() for line in subprocess.run([exe, "-p"], capture_output=True,
+                                                                           text=True).stdout.splitlines()
+              if line.strip().startswith("libngspice.so.0 ") and "=>" in line]
+    if not listed:
+        pytest.skip("ldconfig lists no libngspice.so.0")
+    assert os.path.realpath(find_library()) == os.path.realpath(listed[0])
+
+
 def test_a_fresh_process_prints_nothing():
     """No 'Unsupported Ngspice version', no spinit note, no PySpice error logging."""
     code = textwrap.dedent(
