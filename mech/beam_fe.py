@@ -58,10 +58,18 @@ FAMILY_DIRECTION = {"axial": 0, "bend2": 1, "bend3": 2}
 _BETA_H = 0.5
 _MIN_ELEMENTS = 8
 _COINCIDENT = 1e-9  # relative to L: a support this close to an end is at the end
-_QUAD_XI, _QUAD_W = np.polynomial.legendre.leggauss(4)  # exact for degree 7 per element
+# Gauss-Legendre nodes and weights on [-1, 1]: numpy.polynomial.legendre.leggauss(n)'s,
+# written out bit for bit (tests/mech/test_beam_fe.py); importing numpy.polynomial for
+# them cost ~2 ms of every held bar's run
+LEGGAUSS = {
+    3: ((-0.7745966692414834, 0.0, 0.7745966692414834), (0.5555555555555557, 0.8888888888888888, 0.5555555555555557)),
+    4: ((-0.8611363115940526, -0.33998104358485626, 0.33998104358485626, 0.8611363115940526),
+        (0.34785484513745357, 0.6521451548625464, 0.6521451548625464, 0.34785484513745357)),
+}
+_QUAD_XI, _QUAD_W = (np.array(v) for v in LEGGAUSS[4])  # exact for degree 7 per element
 _QUAD_XI = 0.5 * (_QUAD_XI + 1.0)
 _QUAD_W = 0.5 * _QUAD_W
-_G3_XI, _G3_W = np.polynomial.legendre.leggauss(3)
+_G3_XI, _G3_W = (np.array(v) for v in LEGGAUSS[3])
 _GAUSS3 = (0.5 * (_G3_XI + 1.0), 0.5 * _G3_W)  # on [0, 1], exact for degree 5
 
 
@@ -318,7 +326,7 @@ def _lagrange(xi: np.ndarray, h: np.ndarray, derivative: int) -> np.ndarray:
 
 def _reference_axial_matrices():
     """int N'_i N'_j dxi and int N_i N_j dxi on [0, 1] (Gauss, exact): scaled by 1/h and h."""
-    xi, w = np.polynomial.legendre.leggauss(_AXIAL_P + 1)
+    xi, w = (np.array(v) for v in LEGGAUSS[_AXIAL_P + 1])
     xi, w = 0.5 * (xi + 1.0), 0.5 * w
     one = np.ones_like(xi)
     n0, n1 = _lagrange(xi, one, 0), _lagrange(xi, one, 1)

@@ -38,8 +38,8 @@ HEAVY = ("numba", "scipy", "pandas", "pyarrow", "matplotlib", "plotly", "PySpice
 # cells need quoting (csv); and importlib.resources, which no run uses (the built-in
 # scenes and the contact materials are read by path)
 UNREACHED = ("subprocess", "sysconfig", "difflib", "importlib.resources", "csv")
-# the finite-element beam, which only a held bar (a mechanism) builds, with numpy.polynomial
-# (its Gauss rules; coupling.core.exchange writes its own out)
+# the finite-element beam, which only a held bar (a mechanism) builds, and numpy.polynomial,
+# which no run imports (beam_fe and coupling.core.exchange write their Gauss rules out)
 BEAM = ("mech.beam_fe", "numpy.polynomial")
 
 MECH = """
@@ -138,6 +138,7 @@ def test_default_scene_imports_pyspice_and_pyarrow_only_and_writes_its_documente
     modules = _imported(tmp_path, None)
     assert {name for name in HEAVY if name in modules} == {"PySpice", "pyarrow"}
     assert modules.isdisjoint(UNREACHED)  # (ngspice's library found through the loader, no ldconfig -p)
+    assert "mech.beam_fe" in modules and "numpy.polynomial" not in modules  # (its Gauss rules written out)
     written = {p.name for p in (tmp_path / "out").iterdir()}
     assert written == {"summary.json", "waveforms.csv", "waveforms.parquet", "waveforms.html", "openings.csv",
                        "history.csv", "contacts.csv", "phases.csv", "events.csv"}

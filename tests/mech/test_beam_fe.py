@@ -67,6 +67,16 @@ def pinned_free_roots(count):  # tan b = tanh b, as sin b - cos b tanh b = 0 (b 
 
 # ----------------------------------------------------------------------------- frequencies
 
+def test_the_written_out_gauss_rules_are_numpys_bit_for_bit():
+    """beam_fe's quadratures are numpy.polynomial.legendre.leggauss's nodes and weights,
+    written out (its import cost a held bar's run ~2 ms)."""
+    from mech.beam_fe import LEGGAUSS
+
+    for n, (nodes, weights) in LEGGAUSS.items():
+        x, w = np.polynomial.legendre.leggauss(n)
+        assert np.array(nodes).tobytes() == x.tobytes() and np.array(weights).tobytes() == w.tobytes(), n
+
+
 def test_clamped_free_bending_matches_the_published_roots_in_both_planes():
     beam = strip(support="clamp", support_position=L)  # held at the tip-1 end
     bend2, bend3 = beam_basis(beam, 0, 4, elements=80)
