@@ -42,6 +42,7 @@ from typing import Sequence
 
 import numpy as np
 
+from .eigen_cache import cached
 from .validation import check_choice, check_finite, check_nonnegative, check_positive, check_whole
 from .frozen import frozen
 
@@ -521,7 +522,13 @@ def _generalized_eigh(a: np.ndarray, b: np.ndarray, vectors: bool = True):
     """Eigenpairs of a v = mu b v (a symmetric, b symmetric positive definite), mu ascending,
     v^T b v = 1: with b = L L^T, the standard problem of L^-1 a L^-T (numpy alone: scipy's
     eigh would cost scipy.linalg's import, ~0.13 s, on every held bar's first build).
-    vectors=False: (mu, None), the eigenvalues alone (eigvalsh, a third of the cost)."""
+    vectors=False: (mu, None), the eigenvalues alone (eigvalsh, a third of the cost).
+    Solved once per machine and problem (mech.eigen_cache: the same arrays, bit for bit)."""
+    return cached(a, b, vectors, _solve_generalized_eigh)
+
+
+def _solve_generalized_eigh(a: np.ndarray, b: np.ndarray, vectors: bool):
+    """``_generalized_eigh``'s solution, computed."""
     with _one_blas_thread():
         low = np.linalg.cholesky(b)
         inv = np.linalg.solve(low, np.eye(len(b)))

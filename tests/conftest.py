@@ -2,9 +2,15 @@
 
 from __future__ import annotations
 
+import os
 import signal
 
 import pytest
+
+# The suite solves the finite-element eigenproblems every time (mech.eigen_cache keeps their
+# solutions between runs): its tests of the modes test the solver, not a stored answer; the
+# cache's own tests turn it on
+os.environ["SWITCHSIM_EIGEN_CACHE"] = "0"
 
 
 @pytest.fixture
