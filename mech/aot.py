@@ -39,16 +39,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .compiled_cache import PACKAGE, source_key
+from .compiled_cache import PACKAGE, cache_root, source_key
 
 FORCE_JIT = "SWITCHSIM_JIT"  # "1": numba's just-in-time route, no extension module
 MODULE = "_mech_aot"  # the extension's module name (its init symbol is PyInit__mech_aot)
 SIGNATURES = "signatures.json"  # beside the module: what each exported argument must be
 BUILD_TIMEOUT = 1800.0  # s: a build that hangs is abandoned, the JIT route taken
-
-
-def cache_root() -> Path:
-    return Path(os.environ.get("NUMBA_CACHE_DIR") or PACKAGE / "__pycache__")
 
 
 def build_key() -> str:

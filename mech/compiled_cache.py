@@ -30,11 +30,16 @@ def source_key(folder: Path = PACKAGE) -> str:
     return digest.hexdigest()[:12]
 
 
+def cache_root() -> Path:
+    """Where mech keeps what it compiles or solves once: NUMBA_CACHE_DIR, else mech/__pycache__
+    (numba's cache, the ahead-of-time module, mech.eigen_cache's solutions)."""
+    return Path(os.environ.get("NUMBA_CACHE_DIR") or PACKAGE / "__pycache__")
+
+
 def configure() -> Path:
     """Point numba's cache at <NUMBA_CACHE_DIR or mech/__pycache__>/numba-<source key>."""
     import numba  # here, not at the top: mech.aot takes source_key from this module without numba
 
-    root = Path(os.environ.get("NUMBA_CACHE_DIR") or PACKAGE / "__pycache__")
-    folder = root / f"numba-{source_key()}"
+    folder = cache_root() / f"numba-{source_key()}"
     numba.config.CACHE_DIR = str(folder)
     return folder

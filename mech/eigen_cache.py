@@ -30,10 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-try:  # CPython's own SHA-1 (as mech.compiled_cache): no OpenSSL load at a start
-    from _sha1 import sha1
-except ImportError:
-    from hashlib import sha1
+from .compiled_cache import cache_root, sha1
 
 ENV = "SWITCHSIM_EIGEN_CACHE"  # "0": solve every time, nothing read or written
 FILES_MAX = 256
@@ -45,7 +42,7 @@ def enabled() -> bool:
 
 
 def folder() -> Path:
-    return Path(os.environ.get("NUMBA_CACHE_DIR") or Path(__file__).resolve().parent / "__pycache__") / FOLDER
+    return cache_root() / FOLDER
 
 
 @lru_cache(maxsize=1)
