@@ -43,6 +43,7 @@ from typing import Sequence
 import numpy as np
 
 from .eigen_cache import cached
+from .gauss import LEGGAUSS
 from .validation import check_choice, check_finite, check_nonnegative, check_positive, check_whole
 from .frozen import frozen
 
@@ -59,14 +60,6 @@ FAMILY_DIRECTION = {"axial": 0, "bend2": 1, "bend3": 2}
 _BETA_H = 0.5
 _MIN_ELEMENTS = 8
 _COINCIDENT = 1e-9  # relative to L: a support this close to an end is at the end
-# Gauss-Legendre nodes and weights on [-1, 1]: numpy.polynomial.legendre.leggauss(n)'s,
-# written out bit for bit (tests/mech/test_beam_fe.py); importing numpy.polynomial for
-# them cost ~2 ms of every held bar's run
-LEGGAUSS = {
-    3: ((-0.7745966692414834, 0.0, 0.7745966692414834), (0.5555555555555557, 0.8888888888888888, 0.5555555555555557)),
-    4: ((-0.8611363115940526, -0.33998104358485626, 0.33998104358485626, 0.8611363115940526),
-        (0.34785484513745357, 0.6521451548625464, 0.6521451548625464, 0.34785484513745357)),
-}
 _QUAD_XI, _QUAD_W = (np.array(v) for v in LEGGAUSS[4])  # exact for degree 7 per element
 _QUAD_XI = 0.5 * (_QUAD_XI + 1.0)
 _QUAD_W = 0.5 * _QUAD_W

@@ -23,6 +23,7 @@ import math
 from bisect import bisect_right
 
 import numpy as np
+from mech.gauss import LEGGAUSS
 
 from coupling.core.policy import BEND_FRACTION, TAIL_POINTS, end_derivatives, end_rate, time_scale
 
@@ -82,13 +83,12 @@ def contact_intervals(seg, touching_at_start) -> list[list[tuple[float, float]]]
 
 
 # Gauss-Legendre on [0, 1] (nodes, weights) of RECEIVED_NODES points: the quadrature of the
-# armature's drive work (``received_work``), exact for polynomials of degree 7 in time.
-# Written out: numpy.polynomial.legendre.leggauss(4)'s, mapped to [0, 1] (x -> (x + 1) / 2,
-# w -> w / 2), bit for bit (tests/coupling/test_relay_interface.py); importing
-# numpy.polynomial for them cost ~2.2 ms of every coupled run's start
+# armature's drive work (``received_work``), exact for polynomials of degree 7 in time;
+# mech.gauss's rule on [-1, 1] mapped (x -> (x + 1) / 2, w -> w / 2: numpy.polynomial is
+# not imported at a run's start)
 RECEIVED_NODES = 4
-GAUSS_NODES = (0.06943184420297371, 0.33000947820757187, 0.6699905217924281, 0.9305681557970262)
-GAUSS_WEIGHTS = (0.17392742256872679, 0.3260725774312732, 0.3260725774312732, 0.17392742256872679)
+GAUSS_NODES = tuple(0.5 * (x + 1.0) for x in LEGGAUSS[RECEIVED_NODES][0])
+GAUSS_WEIGHTS = tuple(0.5 * w for w in LEGGAUSS[RECEIVED_NODES][1])
 
 
 class GainIntegral:

@@ -52,12 +52,15 @@ def test_the_gain_integral_is_the_antiderivative_of_the_mechanics_gain_table():
     assert GainIntegral(np.zeros((3, 0)))(0.3) == 0.3  # no table: gain 1
 
 
-def test_the_written_out_gauss_rule_is_numpys_leggauss_bit_for_bit():
-    """coupling.core.exchange writes the 4-point rule out (no numpy.polynomial at a run's
-    start): the same floats as leggauss(4) mapped to [0, 1]."""
-    x, w = np.polynomial.legendre.leggauss(RECEIVED_NODES)
-    assert GAUSS_NODES == tuple(0.5 * (float(v) + 1.0) for v in x)
-    assert GAUSS_WEIGHTS == tuple(0.5 * float(v) for v in w)
+def test_the_received_works_gauss_rule_is_exact_on_the_unit_interval_to_degree_seven():
+    """received_work's 4-point rule on [0, 1] (mech.gauss's, mapped): the integral of t^k is
+    1 / (k + 1) for k <= 2 RECEIVED_NODES - 1 to round-off, and not for the degree above."""
+    assert len(GAUSS_NODES) == len(GAUSS_WEIGHTS) == RECEIVED_NODES and all(0.0 < t < 1.0 for t in GAUSS_NODES)
+    for k in range(2 * RECEIVED_NODES):
+        assert sum(w * t**k for t, w in zip(GAUSS_NODES, GAUSS_WEIGHTS)) == pytest.approx(1.0 / (k + 1), rel=0,
+                                                                                          abs=1e-15)
+    k = 2 * RECEIVED_NODES
+    assert abs(sum(w * t**k for t, w in zip(GAUSS_NODES, GAUSS_WEIGHTS)) - 1.0 / (k + 1)) > 1e-6
 
 
 def test_received_work_meets_the_direct_quadrature_of_force_times_speed():

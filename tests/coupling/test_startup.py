@@ -39,7 +39,7 @@ HEAVY = ("numba", "scipy", "pandas", "pyarrow", "matplotlib", "plotly", "PySpice
 # scenes and the contact materials are read by path)
 UNREACHED = ("subprocess", "sysconfig", "difflib", "importlib.resources", "csv")
 # the finite-element beam, which only a held bar (a mechanism) builds, and numpy.polynomial,
-# which no run imports (beam_fe and coupling.core.exchange write their Gauss rules out)
+# which no run imports (beam_fe and coupling.core.exchange take their Gauss rules from mech.gauss)
 BEAM = ("mech.beam_fe", "numpy.polynomial")
 
 MECH = """

@@ -67,14 +67,27 @@ def pinned_free_roots(count):  # tan b = tanh b, as sin b - cos b tanh b = 0 (b 
 
 # ----------------------------------------------------------------------------- frequencies
 
-def test_the_written_out_gauss_rules_are_numpys_bit_for_bit():
-    """beam_fe's quadratures are numpy.polynomial.legendre.leggauss's nodes and weights,
-    written out (its import cost a held bar's run ~2 ms)."""
-    from mech.beam_fe import LEGGAUSS
+def test_the_written_out_gauss_rules_are_the_closed_form_ones():
+    """mech.gauss's rules (numpy's leggauss floats written out: no numpy.polynomial import at a
+    run's start): the closed-form nodes and weights and numpy's to round-off, exact for
+    polynomials of degree 2n - 1 and not of degree 2n."""
+    from mech.gauss import LEGGAUSS
 
+    inner, outer = math.sqrt(3 / 7 - 2 / 7 * math.sqrt(6 / 5)), math.sqrt(3 / 7 + 2 / 7 * math.sqrt(6 / 5))
+    w_inner, w_outer = (18 + math.sqrt(30)) / 36, (18 - math.sqrt(30)) / 36
+    closed = {3: ((-math.sqrt(0.6), 0.0, math.sqrt(0.6)), (5 / 9, 8 / 9, 5 / 9)),
+              4: ((-outer, -inner, inner, outer), (w_outer, w_inner, w_inner, w_outer))}
+    assert LEGGAUSS.keys() == closed.keys()
     for n, (nodes, weights) in LEGGAUSS.items():
+        np.testing.assert_allclose(nodes, closed[n][0], rtol=0, atol=1e-15)
+        np.testing.assert_allclose(weights, closed[n][1], rtol=0, atol=1e-15)
         x, w = np.polynomial.legendre.leggauss(n)
-        assert np.array(nodes).tobytes() == x.tobytes() and np.array(weights).tobytes() == w.tobytes(), n
+        np.testing.assert_allclose(nodes, x, rtol=0, atol=1e-15)
+        np.testing.assert_allclose(weights, w, rtol=0, atol=1e-15)
+        for k in range(2 * n):  # the integral of x^k over [-1, 1]: 2 / (k + 1), k even
+            exact = 2.0 / (k + 1) if k % 2 == 0 else 0.0
+            assert sum(wj * xj**k for xj, wj in zip(nodes, weights)) == pytest.approx(exact, rel=0, abs=1e-15)
+        assert abs(sum(wj * xj ** (2 * n) for xj, wj in zip(nodes, weights)) - 2.0 / (2 * n + 1)) > 1e-3
 
 
 def test_clamped_free_bending_matches_the_published_roots_in_both_planes():
