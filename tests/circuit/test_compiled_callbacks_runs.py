@@ -102,12 +102,17 @@ def gap_table(lo: float, hi: float, pieces: int = 3, seed: int = 0, bad: float |
     return TableChannel(twin, lo, hi, start, ends, t0, h, coefficients, offset=0.0, scale=-1.0)
 
 
-@pytest.fixture(params=["compiled", "python"])
-def route(request, monkeypatch):
-    if request.param == "python":
+def use_route(monkeypatch, python: bool) -> None:
+    """The next circuit load runs on the Python callbacks (``python``) or the compiled ones."""
+    if python:
         monkeypatch.setenv(compiled_callbacks.FORCE_PYTHON, "1")
     else:
         monkeypatch.delenv(compiled_callbacks.FORCE_PYTHON, raising=False)
+
+
+@pytest.fixture(params=["compiled", "python"])
+def route(request, monkeypatch):
+    use_route(monkeypatch, request.param == "python")
     return request.param
 
 
@@ -136,10 +141,7 @@ def same(a: dict, b: dict) -> bool:
 def test_both_routes_give_the_same_waveforms_to_the_bit(monkeypatch):
     results = {}
     for name in ("compiled", "python"):
-        if name == "python":
-            monkeypatch.setenv(compiled_callbacks.FORCE_PYTHON, "1")
-        else:
-            monkeypatch.delenv(compiled_callbacks.FORCE_PYTHON, raising=False)
+        use_route(monkeypatch, name == "python")
         results[name] = stepped(table=True, constant_after=0.3e-3)
     (columns_c, stats_c, compiled), (columns_p, stats_p, python) = results["compiled"], results["python"]
     assert compiled and not python
@@ -155,10 +157,7 @@ def test_every_arc_kind_runs_to_the_same_bits_on_both_routes(kind, monkeypatch):
     (the waveforms and the rejected steps' log, to the bit)."""
     results = []
     for python in (False, True):
-        if python:
-            monkeypatch.setenv(compiled_callbacks.FORCE_PYTHON, "1")
-        else:
-            monkeypatch.delenv(compiled_callbacks.FORCE_PYTHON, raising=False)
+        use_route(monkeypatch, python)
         results.append(stepped(table=True, arc=ARCS[kind]))
     (compiled, _, on_c), (python, _, on_python) = results
     assert on_c and not on_python
@@ -172,9 +171,9 @@ def test_rejected_steps_beyond_the_compiled_log_are_kept_in_order(monkeypatch, t
     the log is the Python route's, entry for entry."""
     monkeypatch.setattr(ngspice, "REJECTIONS_LOGGED", 2)
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))  # (a library of its own: its state made afresh)
-    monkeypatch.delenv(compiled_callbacks.FORCE_PYTHON, raising=False)
+    use_route(monkeypatch, False)
     compiled, _, on_c = stepped(table=True)
-    monkeypatch.setenv(compiled_callbacks.FORCE_PYTHON, "1")
+    use_route(monkeypatch, True)
     python, _, _ = stepped(table=True)
     assert on_c and len(compiled["rejected_from"]) > 2 * 2
     assert same(compiled, python)
@@ -187,7 +186,7 @@ def test_a_table_channel_runs_as_its_python_function(route):
 
 
 def test_without_the_compiled_library_the_session_runs_the_python_callbacks(monkeypatch):
-    monkeypatch.delenv(compiled_callbacks.FORCE_PYTHON, raising=False)
+    use_route(monkeypatch, False)
     compiled, _, on_c = stepped(table=True)
     monkeypatch.setattr(compiled_callbacks, "load", lambda root=None: None)  # (a failed build)
     python, _, on_c_after = stepped(table=True)
@@ -219,10 +218,7 @@ def test_a_bad_value_raises_the_same_one_line_error_on_both_routes(monkeypatch):
                                (infinite_table, GapError, " is inf m; it must be finite and >= 0")):
         errors = []
         for python in (False, True):
-            if python:
-                monkeypatch.setenv(compiled_callbacks.FORCE_PYTHON, "1")
-            else:
-                monkeypatch.delenv(compiled_callbacks.FORCE_PYTHON, raising=False)
+            use_route(monkeypatch, python)
             errors.append(_error(run))
         assert errors[0] == errors[1]
         assert errors[0][0] is kind and pattern in errors[0][1] and "\n" not in errors[0][1], errors[0]
@@ -233,10 +229,7 @@ def test_the_wall_clock_limit_aborts_a_run_with_no_python_channel_on_both_routes
     until the deadline has passed."""
     plain = SwitchCircuit(DCSource(V_S, R_S), InductiveLoad(12.0, 1e-3), wiring=Wiring(0.0, 0.0))
     for python in (False, True):
-        if python:
-            monkeypatch.setenv(compiled_callbacks.FORCE_PYTHON, "1")
-        else:
-            monkeypatch.delenv(compiled_callbacks.FORCE_PYTHON, raising=False)
+        use_route(monkeypatch, python)
         started = time.monotonic()
         with Stepper(plain, 10.0, SimulationOptions(max_step=1e-7, wall_timeout=0.1)) as stepper:
             assert (get_session()._compiled is None) == python
@@ -246,7 +239,7 @@ def test_the_wall_clock_limit_aborts_a_run_with_no_python_channel_on_both_routes
 
 
 def test_the_c_table_equals_its_python_definition_at_random_times_bit_for_bit(monkeypatch):
-    monkeypatch.delenv(compiled_callbacks.FORCE_PYTHON, raising=False)
+    use_route(monkeypatch, False)
     library = compiled_callbacks.load()
     assert library is not None
     rng = random.Random(7)

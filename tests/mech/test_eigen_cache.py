@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from mech import eigen_cache
-from mech.beam_fe import FEBeam, beam_basis, beam_frequencies
+from mech.beam_fe import FEBeam, _solve_generalized_eigh, beam_basis, beam_frequencies
 
 
 @pytest.fixture
@@ -28,17 +28,12 @@ def problem(n: int = 12, seed: int = 0):
 
 
 def solver():
+    """beam_fe's own solver, its calls counted (a call the cache answers is not one)."""
     calls = []
 
     def solve(a, b, vectors):
         calls.append(vectors)
-        low = np.linalg.cholesky(b)
-        inv = np.linalg.solve(low, np.eye(len(b)))
-        c = inv @ a @ inv.T
-        if not vectors:
-            return np.linalg.eigvalsh(0.5 * (c + c.T)), None
-        mu, w = np.linalg.eigh(0.5 * (c + c.T))
-        return mu, inv.T @ w
+        return _solve_generalized_eigh(a, b, vectors)
 
     return solve, calls
 
