@@ -238,8 +238,7 @@ def _send_file(fh, source: Path, size: int) -> bool:
                 done += sent
     except OSError:
         pass
-    if done == size:
-        os.lseek(out, start + size, os.SEEK_SET)
+    if done == size:  # (sendfile moved the page's offset past what it wrote)
         return True
     os.lseek(out, start, os.SEEK_SET)  # (a part sent is written over)
     os.ftruncate(out, start)
