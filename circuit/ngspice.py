@@ -1055,6 +1055,19 @@ class NgspiceSession:
         pairs = np.frombuffer(ffi.buffer(info.v_compdata, n * 16), dtype=np.float64)
         return pairs[2 * start : 2 * stop : 2].copy()
 
+    def floats(self, name: str, start: int = 0, stop: int | None = None) -> list[float]:
+        """``vector(name, start, stop)`` as a list of floats (the same doubles), read by cffi
+        without a numpy array between."""
+        info = self.vector_info(name)
+        if info is None:
+            raise KeyError(f"ngspice has no vector {name!r} in the current plot")
+        n = info.v_length
+        stop = n if stop is None else min(stop, n)
+        start = max(0, min(start, stop))
+        if info.v_realdata != ffi.NULL:
+            return ffi.unpack(info.v_realdata + start, stop - start)
+        return self.vector(name, start, stop).tolist()
+
     def length(self) -> int:
         info = self.vector_info("time")
         return 0 if info is None else int(info.v_length)

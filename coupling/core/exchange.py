@@ -376,7 +376,7 @@ class ContactLink:
     def observe(self, step, jumped: bool) -> None:
         """Keep the circuit's last points of the current (for its rate and time scale), and
         the contact's share of it at the step's end (``load_column``)."""
-        self.tail.observe(step.reader("time"), step.reader("load_current"), jumped)
+        self.tail.observe_floats(step.floats("time"), step.floats("load_current"), jumped)
         if self.load_column is not None:
             own, supply = float(step.values[self.load_column]), float(step.values["load_current"])
             # (both open, the supply's current is leakage: the share is then of no consequence)
@@ -545,9 +545,8 @@ class CoilLink:
         (``policy.gap_change_fraction``; ``bound_by`` names the rule that set it; ``horizon``:
         the same without that floor), and the armature's travel at the step's circuit points
         (for the result's columns)."""
-        times = step.reader("time")
         # (as floats once for both tails: psi * psi is the same double product as numpy's)
-        t_list, psi_list = times.tolist(), step.reader(self._flux_column).tolist()
+        t_list, psi_list = step.floats("time"), step.floats(self._flux_column)
         self.tail.observe_floats(t_list, [p * p for p in psi_list] if self.separable else psi_list, False)
         self.flux_tail.observe_floats(t_list, psi_list, False)
         self.flux_rate = self.flux_tail.derivatives(policy.macro_step)[0]

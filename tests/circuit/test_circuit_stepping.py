@@ -104,9 +104,15 @@ def test_step_results_cover_the_step(ringing_circuit, bounce_schedule, bounce_op
         assert second.contact_voltage == pytest.approx(24.0, rel=1e-4)
         whole = stepper.results()
         assert np.array_equal(whole.time.to_numpy()[-len(frame):], frame.time.to_numpy())
+        # the step's columns as floats: the same doubles as its arrays, each call its own list
+        for name, values in second.arrays().items():
+            floats = second.floats(name)
+            assert floats == values.tolist() and floats is not second.floats(name)
+            assert all(type(x) is float for x in floats)
     # After close the results stay readable.
     assert stepper.results().time.iloc[-1] == pytest.approx(0.3e-3, rel=1e-12)
     assert second.frame().time.iloc[-1] == pytest.approx(0.3e-3, rel=1e-12)
+    assert first.floats("load_current") == first.reader("load_current").tolist()
 
 
 def test_macro_landing_does_not_reset_the_integration(ringing_circuit, bounce_options):
