@@ -199,22 +199,36 @@ def write_waveform_html(result, path, max_points: int = MAX_POINTS) -> str:
     traces, layout = waveform_page(result, max_points)
     config = {"scrollZoom": True, "displaylogo": False, "responsive": True}
     div = "switchsim-waveforms"
-    script = js.read_bytes()  # copied as bytes: decoding 4.8 MB of JavaScript and encoding it again cost ~10 ms
-    plain = b"\r" not in script  # (so in plotly's file) else as text mode reads it: universal newlines
-    if not plain:
-        script = js.read_text(encoding="utf-8").encode("utf-8")
+    # copied as bytes (decoding 4.8 MB of JavaScript and encoding it again cost ~10 ms) where the
+    # file has no carriage return (plotly's has none), else as text mode reads it: universal newlines
+    size, plain = _plain_size(js)
     with open(Path(path), "wb") as fh:
         fh.write(b'<html>\n<head><meta charset="utf-8" /></head>\n<body>\n<div>\n'
                  b'<script type="text/javascript">window.PlotlyConfig = {MathJaxConfig: \'local\'};</script>\n'
                  b'<script charset="utf-8" type="text/javascript">')
-        if not (plain and _send_file(fh, js, len(script))):
-            fh.write(script)
+        if not (plain and _send_file(fh, js, size)):
+            fh.write(js.read_bytes() if plain else js.read_text(encoding="utf-8").encode("utf-8"))
         tail = (f'</script>\n<div id="{div}" class="plotly-graph-div" style="height:{layout["height"]}px; '
                 'width:100%;"></div>\n<script type="text/javascript">\n'
                 f'Plotly.newPlot("{div}", {json.dumps(traces)}, {json.dumps(layout)}, {json.dumps(config)});\n'
                 '</script>\n</div>\n</body>\n</html>\n')
         fh.write(tail.encode("utf-8"))
     return "written"
+
+
+def _plain_size(source: Path) -> tuple[int, bool]:
+    """(bytes, True if the file has no carriage return) of ``source``, searched in a read-only
+    mapping of it: reading plotly's 4.8 MB into a bytes object to search it cost ~3.5 ms of
+    every page, the mapping ~0.8 ms (both measured warm). Where it cannot be mapped (an
+    empty file, no mmap): read."""
+    try:
+        import mmap
+
+        with open(source, "rb") as src, mmap.mmap(src.fileno(), 0, access=mmap.ACCESS_READ) as view:
+            return len(view), view.find(b"\r") < 0
+    except (ImportError, OSError, ValueError):
+        data = source.read_bytes()
+        return len(data), b"\r" not in data
 
 
 def _send_file(fh, source: Path, size: int) -> bool:

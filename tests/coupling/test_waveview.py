@@ -93,6 +93,28 @@ def test_the_page_is_the_same_bytes_whether_the_kernel_or_python_copies_plotly_j
     assert pages[0] == pages[1] == pages[2] and pages[0].count(script) == 1
 
 
+def test_a_script_with_carriage_returns_goes_in_as_text_mode_reads_it(tmp_path, monkeypatch):
+    """A plotly.min.js with Windows line ends (plotly's own has none) is put into the page with
+    universal newlines, as Python's text mode reads it, not copied byte for byte; an empty one
+    adds nothing."""
+    from coupling.app import waveview
+
+    t = np.linspace(0.0, 1e-3, 11)
+    res = types.SimpleNamespace(waveform_columns=dict(time=t, contact_voltage=24.0 * t), closed_intervals=[],
+                                scene=types.SimpleNamespace(name="t"))
+    for name, body, inserted in (("crlf.js", b"var a = 1;\r\nvar b = 2;\rvar c = 3;\n", b"var a = 1;\nvar b = 2;\nvar c = 3;\n"),
+                                 ("empty.js", b"", b"")):
+        script = tmp_path / name
+        script.write_bytes(body)
+        monkeypatch.setattr(waveview, "plotly_js", lambda script=script: script)
+        page = tmp_path / f"{name}.html"
+        assert waveview.write_waveform_html(res, page) == "written"
+        html = page.read_bytes()
+        head = b'<script charset="utf-8" type="text/javascript">'
+        start = html.index(head) + len(head)
+        assert html[start:start + len(inserted) + len(b"</script>")] == inserted + b"</script>"
+
+
 # --- the page of a real run: the default relay to 2 ms (one rivet: contact point 1 does not exist) ---
 
 _PAGE = {}
