@@ -33,7 +33,10 @@ datum and the model when one is missing.
 
 from __future__ import annotations
 
+import marshal
 import math
+import os
+import sys
 import tomllib
 from dataclasses import field
 from pathlib import Path
@@ -44,6 +47,7 @@ import numpy as np
 from mech.validation import (
     check_choice, check_finite, check_keys, check_nonnegative, check_positive, check_whole, unknown,
 )
+from mech.compiled_cache import sha1
 from mech.frozen import frozen
 
 MIN_SPOT_RADIUS = 0.1e-6  # m: a >> the electron mean free path (Holm's diffusive constriction)
@@ -165,12 +169,56 @@ def _datum(name: str, prop: str, item) -> tuple[float, tuple[float, float], str,
     return value, (lo, hi), source, str(item.get("note", ""))
 
 
+LIBRARY = Path(__file__).parent / "data" / "contact_materials.toml"
+# the parsed library, kept per version of its file (``library_document``)
+DOCUMENT_CACHE = "contact_materials"
+
+
+def library_document(path: Path = LIBRARY, cache: Path | None = None) -> dict:
+    """The library file's TOML document (the data; ``load_materials`` checks it).
+
+    tomllib took 3-4 ms of every run that reads the library (the default relay's start), so
+    the document is kept, as marshal's bytes (read back in ~0.07 ms), in ``cache``
+    (default: NUMBA_CACHE_DIR, else this package's __pycache__: where the project's other
+    caches go), named by the SHA-1 of the file's bytes and the interpreter's tag: an edited
+    file is parsed again, and the entries of earlier versions are removed. A cache that
+    cannot be read is parsed again; one that cannot be written is left out."""
+    data = path.read_bytes()
+    folder = cache if cache is not None else Path(os.environ.get("NUMBA_CACHE_DIR") or Path(__file__).parent / "__pycache__")
+    entry = folder / f"{DOCUMENT_CACHE}-{sha1(data).hexdigest()[:20]}.{sys.implementation.cache_tag}.marshal"
+    try:
+        doc = marshal.loads(entry.read_bytes())
+        if type(doc) is dict:
+            return doc
+    except (OSError, EOFError, ValueError, TypeError):
+        pass
+    doc = tomllib.loads(data.decode("utf-8"))
+    _keep_document(entry, doc)
+    return doc
+
+
+def _keep_document(entry: Path, doc: dict) -> None:
+    """Write the cache entry whole (a reader sees it complete or not at all) and remove the
+    other versions' entries; quietly nothing where the folder cannot be written."""
+    tmp = entry.with_name(f".{entry.name}.{os.getpid()}.tmp")
+    try:
+        entry.parent.mkdir(parents=True, exist_ok=True)
+        tmp.write_bytes(marshal.dumps(doc))
+        os.replace(tmp, entry)
+        for old in entry.parent.glob(f"{DOCUMENT_CACHE}-*.marshal"):
+            if old.name != entry.name:
+                old.unlink(missing_ok=True)
+    except (OSError, ValueError):  # (ValueError: a value marshal cannot write, none in a TOML document)
+        try:
+            tmp.unlink(missing_ok=True)
+        except OSError:
+            pass
+
+
 def load_materials(text: str | None = None) -> dict[str, Material]:
     """The contact-material library (coupling/laws/data/contact_materials.toml, or TOML ``text``)."""
-    if text is None:
-        # (a path beside this module, as builtin_scene_text's: no importlib.resources at a run's start)
-        text = (Path(__file__).parent / "data" / "contact_materials.toml").read_text(encoding="utf-8")
-    doc = tomllib.loads(text)
+    # (a path beside this module, as builtin_scene_text's: no importlib.resources at a run's start)
+    doc = library_document() if text is None else tomllib.loads(text)
     out = {}
     for name, entry in doc.items():
         if not isinstance(entry, dict):

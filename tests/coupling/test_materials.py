@@ -182,3 +182,41 @@ def test_coupled_run_warns_when_hertz_is_used_beyond_yield():
     np.testing.assert_allclose(w.contact_conductance[closed].iloc[-1],
                                sc.tribology.laws.resistance_law.force_conductance(w.normal_force[closed].iloc[-1]),
                                rtol=1e-6)
+
+
+def test_the_library_document_is_parsed_once_per_version_of_its_file(tmp_path, monkeypatch):
+    """library_document keeps the parsed TOML by the file's bytes: read back without tomllib,
+    the same document (bit for bit: marshal keeps the floats); a damaged entry is parsed
+    again; an edited file is parsed again and the old entry removed; an unwritable cache
+    folder only parses."""
+    import tomllib
+
+    from coupling.laws import materials
+
+    source = tmp_path / "library.toml"
+    source.write_bytes(materials.LIBRARY.read_bytes())
+    cache = tmp_path / "cache"
+    parsed = tomllib.loads(source.read_text(encoding="utf-8"))
+    assert materials.library_document(source, cache) == parsed
+    (entry,) = cache.glob("*.marshal")
+
+    def refuse(text):
+        raise AssertionError("parsed again")
+
+    with monkeypatch.context() as patch:
+        patch.setattr(materials.tomllib, "loads", refuse)
+        again = materials.library_document(source, cache)
+    assert again == parsed and repr(again) == repr(parsed)
+
+    entry.write_bytes(b"\x00 damaged")
+    assert materials.library_document(source, cache) == parsed
+    assert list(cache.glob("*.marshal")) == [entry] and entry.read_bytes() != b"\x00 damaged"
+
+    source.write_bytes(source.read_bytes().replace(b"8960", b"8961", 1))  # an edit (a density)
+    edited = materials.library_document(source, cache)
+    assert edited != parsed and edited == tomllib.loads(source.read_text(encoding="utf-8"))
+    assert [p.name for p in cache.glob("*.marshal")] != [entry.name] and len(list(cache.glob("*.marshal"))) == 1
+
+    blocked = tmp_path / "file"
+    blocked.write_text("not a folder")
+    assert materials.library_document(source, blocked / "cache") == edited
