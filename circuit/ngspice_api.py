@@ -38,6 +38,20 @@ typedef struct vector_info {
     int v_length;
 } vector_info, *pvector_info;
 
+typedef struct vecvalues {
+    char *name;
+    double creal;
+    double cimag;
+    bool is_scale;
+    bool is_complex;
+} vecvalues, *pvecvalues;
+
+typedef struct vecvaluesall {
+    int veccount;
+    int vecindex;
+    pvecvalues *vecsa;
+} vecvaluesall, *pvecvaluesall;
+
 typedef int (SendChar) (char *, int, void *);
 typedef int (SendStat) (char *, int, void *);
 typedef int (ControlledExit) (int, bool, bool, int, void *);
@@ -54,9 +68,10 @@ int ngSpice_Circ(char **);
 bool ngSpice_SetBkpt(double);
 """
 # (ngSpice_Init's fourth and fifth arguments, the SendData and SendInitData callbacks, are
-# declared as void *: switchsim passes its callbacks cast to void * and reads neither
-# structure. SendData only marks where a pause falls, after each accepted point is stored;
-# the vectors are read through ngGet_Vec_Info. So their structures need no copy here.)
+# declared as void *: switchsim passes its callbacks cast to void *. SendData marks where a
+# pause falls, after each accepted point is stored; at the pause its vecvaluesall, the last
+# point of every vector, gives a macro step's last values (NgspiceSession.last_values);
+# the vectors themselves are read through ngGet_Vec_Info. SendInitData's structure is not read.)
 
 #: Functions of ``DECLARATIONS`` (the test compares each with PySpice's header).
 FUNCTIONS = ("ngSpice_Init", "ngSpice_Init_Sync", "ngSpice_Command", "ngGet_Vec_Info", "ngSpice_Circ",

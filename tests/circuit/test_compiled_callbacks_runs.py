@@ -262,3 +262,28 @@ def test_the_c_table_equals_its_python_definition_at_random_times_bit_for_bit(mo
             [bits(limited.function(t)) for t in times]
     empty = TableChannel(lambda s: 0.5, 0.0, 1.0, 0.5, [], [], [], np.empty((0, 5)))
     assert compiled_callbacks.table_values(library, empty, [0.0, 0.5, 2.0]) == [0.5, 0.5, 0.5]
+
+
+def test_a_macro_steps_last_values_are_the_stored_points_on_both_routes(monkeypatch):
+    """At each pause the step's last values (``StepResult``'s scalars) are read from the point
+    SendData gave, not looked up vector by vector: the same doubles as the stored vectors'
+    last points, and the step's length theirs, on either callback route."""
+    for python in (False, True):
+        use_route(monkeypatch, python)
+        with Stepper(circuit(), T_END, OPTIONS) as stepper:
+            session = get_session()
+            t, steps = 0.0, 0
+            while not stepper.finished:
+                t_next = min(t + MACRO, T_END)
+                gap = gap_table(t, t_next, seed=int(t / MACRO))
+                step = stepper.advance(t_next, BREAK, BREAK.breakpoints(t, t_next), gap=gap)
+                for name in ("contact_current", "load_current", "arc_current"):  # (vectors of ngspice's)
+                    assert bits(step.values[name]) == bits(float(step.reader(name)[-1])), (python, t, name)
+                # (the column is I/G while the contact conducts: the scalar is the nodes' difference)
+                contact = stepper.probes.contacts[0]
+                across = float(stepper.vector(contact.node_a)[-1]) - float(stepper.vector(contact.node_b)[-1])
+                assert bits(step.values["contact_voltage"]) == bits(across)
+                assert step.points == len(step.reader("time")) - 1 and step.t_end == step.reader("time")[-1]
+                t, steps = t_next, steps + 1
+            assert session._point_plans and all(plan is not None for plan in session._point_plans.values())
+        assert steps == round(T_END / MACRO)
