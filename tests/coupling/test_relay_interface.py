@@ -52,6 +52,38 @@ def test_the_gain_integral_is_the_antiderivative_of_the_mechanics_gain_table():
     assert GainIntegral(np.zeros((3, 0)))(0.3) == 0.3  # no table: gain 1
 
 
+def test_the_gain_integral_of_many_is_the_gain_integral_of_each_to_the_bit():
+    """GainIntegral.many (a batch of samples at once) against __call__ one by one: the same
+    doubles, before, inside, at the knots of and beyond the table, and without one."""
+    table = plunger_table()
+    G = GainIntegral(table)
+    x = table[0]
+    rng = np.random.default_rng(7)
+    q = np.concatenate([x, rng.uniform(x[0] - 1e-4, x[-1] + 1e-4, 500), [x[0] - 1e-9, x[-1] + 1e-9]])
+    assert G.many(q).tobytes() == np.array([G(float(v)) for v in q]).tobytes()
+    assert GainIntegral(np.zeros((3, 0))).many(q).tobytes() == q.tobytes()
+    one = GainIntegral(table[:, :1])
+    assert one.many(q).tobytes() == np.array([one(float(v)) for v in q]).tobytes()
+
+
+@pytest.mark.parametrize("batch", [1, 7])
+def test_the_batched_samples_and_received_work_are_those_of_each_step(batch, monkeypatch):
+    """CoilLink evaluates the armature's travel at the circuit's points and the received work
+    for BATCH_STEPS macro steps at once; against the same run sampled step by step
+    (Segment.travel and received_work on each segment, the route of a segment ``inputs`` did
+    not see): the same travel column and received work, to the bit."""
+    from coupling.core import exchange
+
+    scene = load_scene(PLUNGER).set("solver.t_end", 0.014)  # (the first arrival and bounces at the pole)
+    monkeypatch.setattr(exchange, "BATCH_STEPS", batch)
+    batched = run(scene)
+    monkeypatch.setattr(CoilLink, "_segment_index", lambda self, seg: None)
+    stepwise = run(scene)
+    assert batched.armature_received == stepwise.armature_received != 0.0
+    a, b = batched.waveform_columns["armature_position"], stepwise.waveform_columns["armature_position"]
+    assert a.tobytes() == b.tobytes() and np.ptp(a) > 4e-3
+
+
 def test_the_received_works_gauss_rule_is_exact_on_the_unit_interval_to_degree_seven():
     """received_work's 4-point rule on [0, 1] (mech.gauss's, mapped): the integral of t^k is
     1 / (k + 1) for k <= 2 RECEIVED_NODES - 1 to round-off, and not for the degree above."""
