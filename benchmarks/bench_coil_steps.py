@@ -1,6 +1,7 @@
 """The coil's step rules, error against run time: the plunger solenoid (and the default relay's
-operate time) at the coil's time-scale fraction and gap rule of the master against a refined
-reference, beside the results' sensitivity to 1 % changes of the scene's inputs.
+operate time, make bounces and openings) at the coil's time-scale fraction and gap rule of the
+master against a refined reference, beside the results' sensitivity to 1 % changes of the
+scene's inputs.
 
     .venv/bin/python benchmarks/bench_coil_steps.py [--repeat 5] [--no-write]
 
@@ -88,7 +89,10 @@ def run(scene, fraction: float, gap: float, points=POINTS, repeat: int = 1) -> d
     arrivals = [e["time"] for e in result.mechanics.events
                 if e["kind"] == "armature_stop_start" and relay["armature_arrival"] is not None
                 and e["time"] > relay["armature_arrival"]]
+    bounce = result.summary.get("bounce") or {}
     return dict(arrival=relay["armature_arrival"], operate=relay["operate_time"],
+                make_bounces=bounce.get("bounces"),
+                openings=[o["start"] for o in bounce.get("openings", [])],
                 current=float(result.waveform_columns["coil_current"][-1]), bounces=arrivals,
                 residual=relay["energy"]["relative_residual"], steps=result.stats["macro_steps"],
                 points=result.stats["circuit"]["points"],
@@ -213,21 +217,29 @@ def main() -> None:
                                          "coupling.max_macro_step": ropts.max_macro_step / REFINE}),
                            reltol=relay.circuit.options.reltol / RELTOL_REFINE), 0.1 / REFINE, 1.0 / REFINE, fine)
     parts = []
-    relay_configs = {"the current rules": (0.1, POINTS), "fraction 0.2": (0.2, POINTS),
-                     "coil_point_fraction 1 (no bound from L/R)": (0.1, (POINTS, 1.0)),
-                     "coil_step_points 1, coil_point_fraction 1 (before them)": (0.1, (1, 1.0))}
-    relay_rows = {label: run(relay, fraction, 1.0, points) for label, (fraction, points) in relay_configs.items()}
+    # (label: coil_time_scale_fraction, gap_change_fraction, coil_step_points or (points, point fraction))
+    relay_configs = {"the current rules": (0.1, 1.0, POINTS), "fraction 0.2": (0.2, 1.0, POINTS),
+                     "fraction 0.3": (0.3, 1.0, POINTS), "gap rule x2": (0.1, 2.0, POINTS),
+                     "gap rule x4": (0.1, 4.0, POINTS),
+                     "coil_point_fraction 1 (no bound from L/R)": (0.1, 1.0, (POINTS, 1.0)),
+                     "coil_step_points 1, coil_point_fraction 1 (before them)": (0.1, 1.0, (1, 1.0))}
+    relay_rows = {label: run(relay, *config) for label, config in relay_configs.items()}
     relay_walls = {label: [] for label in relay_rows}
     for _ in range(max(1, args.repeat // 2)):
-        for label, (fraction, points) in relay_configs.items():
-            relay_walls[label].append(run(relay, fraction, 1.0, points)["wall"])
+        for label, config in relay_configs.items():
+            relay_walls[label].append(run(relay, *config)["wall"])
+    lines += ["", f"The default relay against its reference (the same rule: operate time {rref['operate'] * 1e3:.4f} ms, "
+                  f"{rref['make_bounces']} make bounces, {rref['residual']:.1e} coil energy residual):", "",
+              "| rules | macro steps | ngspice points | run time | operate time | make bounces | openings the "
+              "reference lacks | coil energy residual |", "|---|---|---|---|---|---|---|---|"]
     for label, m in relay_rows.items():
         m["wall"] = statistics.median(relay_walls[label])
-        parts.append(f"{label}: {m['steps']} macro steps, {m['points']} ngspice points, {m['wall'] * 1e3:.0f} ms, "
-                     f"operate time {abs(m['operate'] - rref['operate']) * 1e6:.1f} us from the reference's "
-                     f"{rref['operate'] * 1e3:.4f} ms, coil energy residual {m['residual']:.1e}")
-    lines += ["", "- The default relay (same reference rule): " + "; ".join(parts) + ".",
-              load_line()]
+        # an opening more than 5 us from every one of the reference's
+        extra = [t for t in m["openings"] if min((abs(t - r) for r in rref["openings"]), default=1.0) > 5e-6]
+        lines.append(f"| {label} | {m['steps']} | {m['points']} | {m['wall'] * 1e3:.0f} ms | "
+                     f"{abs(m['operate'] - rref['operate']) * 1e6:.1f} us | {m['make_bounces']} | "
+                     f"{', '.join(f'{t * 1e3:.4f} ms' for t in extra) or '-'} | {m['residual']:.1e} |")
+    lines += ["", load_line()]
     publish(DOC, BEGIN, END, lines, write=not args.no_write)
 
 
