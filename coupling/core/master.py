@@ -206,7 +206,7 @@ class CoSimulation:
             self.stats["approach_steps"] = 0  # macro steps redone to approach an armature's unseat
         self._contact_times: list[np.ndarray] = []  # the circuit's points sampled so far ...
         self._contacts: list[np.ndarray] = []  # ... and the mechanics' contact there (_sample_contact)
-        self._pending: list[np.ndarray] = []  # the circuit's points not sampled yet
+        self._pending: list[float] = []  # s: the circuit's points not sampled yet
         self._started = False
 
     @property
@@ -474,17 +474,18 @@ class CoSimulation:
             if mech.dense_rows >= DENSE_FLUSH_ROWS:
                 mech.release_dense()
             return
-        times = step.reader("time")
-        self._pending.append(times[1:] if self._started else times)
+        # (as floats: a step's few points appended to a list, an array made at the flush)
+        times = step.floats("time")
+        self._pending.extend(times[1:] if self._started else times)
         self._started = True
         if mech.dense_rows >= DENSE_FLUSH_ROWS:
-            pending = np.concatenate(self._pending)
+            pending = np.array(self._pending, dtype=np.float64)
             # a point beyond the last record (ngspice may land a hair past the step's end)
             # lies in the next step's first record: sampled later, from that record
             k = int(np.searchsorted(pending, mech.last_record_time, side="right"))
             self._contact_times.append(pending[:k])
             self._contacts.append(mech.contact_series(pending[:k]))
-            self._pending = [pending[k:]]
+            self._pending = pending[k:].tolist()
             mech.release_dense()
 
 
