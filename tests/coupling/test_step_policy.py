@@ -419,3 +419,22 @@ def test_the_coils_time_scale_at_a_zero_of_its_flux_is_the_curvatures_not_zero()
     assert link.scale == pytest.approx(BEND_FRACTION * bend, rel=0.05)
     assert link.horizon == pytest.approx(abs(link.rate / link.curvature), rel=1e-9)
     assert link.horizon < 1e-2 * link.scale  # (what the step rules took before: the steps fell to the probe)
+
+
+def test_a_pair_of_tails_keeps_what_each_would_keep_alone():
+    """Tail.observe_pair (the coil's psi^2 and psi, over the same times) keeps the points that
+    observe_floats keeps on each tail alone: steps whose first point repeats the last one,
+    a point no later than the one before it, more points than the tail holds."""
+    from coupling.core.exchange import Tail
+
+    steps = [[0.0, 1e-6], [1e-6, 2e-6, 3e-6], [3e-6, 3e-6, 5e-6], [5e-6, 4.5e-6, 6e-6, 7e-6],
+             [7e-6] + [7e-6 + 1e-7 * k for k in range(1, 11)]]
+    alone, psi_alone, first, second = Tail(), Tail(), Tail(), Tail()
+    for k, t in enumerate(steps):
+        v = [math.sin(1e5 * s) + k for s in t]
+        w = [x * x for x in v]
+        alone.observe_floats(t, w, False)
+        psi_alone.observe_floats(t, v, False)
+        first.observe_pair(second, t, w, v)
+        assert (first.t, first.v, second.t, second.v) == (alone.t, alone.v, psi_alone.t, psi_alone.v)
+        assert first.derivatives(1e-6) == alone.derivatives(1e-6)
