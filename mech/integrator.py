@@ -528,15 +528,22 @@ def dense_force_scratch_size(n_state, n_modes, rows):
 
 
 @njit_borrowing
-def _dense_forces_into(t, args, out):
-    """``pair_forces`` at time t (s) from the dense output into out (rows, 2), args as
-    dense_tip_forces'; every intermediate array is cut from its scratch vector (compiled
-    without reference counts, so cutting it costs nothing)."""
-    t_valid, dense_t0, dense_h, dense_coef, psi, xc, cpar, n, planar, mount, beta, scratch = args
-    N = dense_coef.shape[2]
-    if scratch.shape[0] < dense_force_scratch_size(N, n, cpar.shape[0]):
+def _check_scratch(args):
+    """Refuse a scratch vector of dense_tip_forces' args shorter than dense_force_scratch_size
+    (its cuts would be short: written past, or a reshape refused with numba's own words)."""
+    if args[11].shape[0] < dense_force_scratch_size(args[3].shape[2], args[7], args[6].shape[0]):
         raise ValueError("dense_tip_forces, dense_pair_forces: the scratch vector is shorter than "
                          "dense_force_scratch_size")
+
+
+@njit_borrowing
+def _dense_forces_into(t, args, out):
+    """``pair_forces`` at time t (s) from the dense output into out (rows, 2), args as
+    dense_tip_forces' (its scratch's length checked: _check_scratch); every intermediate
+    array is cut from its scratch vector (compiled without reference counts, so cutting it
+    costs nothing)."""
+    t_valid, dense_t0, dense_h, dense_coef, psi, xc, cpar, n, planar, mount, beta, scratch = args
+    N = dense_coef.shape[2]
     n_steps = t_valid.shape[0]
     lo = 0
     hi = n_steps - 1
@@ -563,6 +570,7 @@ def _dense_forces_into(t, args, out):
 @njit_borrowing
 def _dense_tip_forces(t, args):
     """dense_tip_forces without reference counts (see there)."""
+    _check_scratch(args)
     dense_coef, cpar, n, scratch = args[3], args[6], args[7], args[11]
     rows = cpar.shape[0]
     b = dense_coef.shape[2] + 24 + 2 * n  # (the forces' place in the scratch: after _dense_forces_into's)
@@ -599,6 +607,7 @@ def dense_tip_forces(t, args):
 def dense_pair_forces(t, args, out):
     """``pair_forces`` at time t (s) from the dense output: out (rows, 2), each contact row's
     normal force (N) and penetration (m); args as ``dense_tip_forces``'."""
+    _check_scratch(args)
     _dense_forces_into(t, args, out)
 
 
