@@ -517,9 +517,33 @@ def dense_contact(times, t_valid, dense_t0, dense_h, dense_coef, regimes, mdl,
             out[m, i, 2] = aux[i, A_FN]
 
 
-@njit(cache=True)
-def _dense_state(t, t_valid, dense_t0, dense_h, dense_coef):
-    """The state at time t (s) from the dense output of steps ending at t_valid."""
+@njit_borrowing
+def dense_force_scratch_size(n_state, n_modes, rows):
+    """Length of the float64 scratch vector of dense_tip_forces and dense_pair_forces for a
+    state of n_state components, n_modes modes and ``rows`` contact rows: the state, each
+    row's (force, penetration), and kernel.unpack's r, R, q, V, w, eta and a contact point's
+    position and velocity (pair_forces_into's x, v). (mech.compiled.dense_force_arguments
+    makes it by the same formula, on the Python side; a test compares the two.)"""
+    return n_state + 2 * rows + 2 * n_modes + 24
+
+
+@njit_borrowing
+def _check_scratch(args):
+    """Refuse a scratch vector of dense_tip_forces' args shorter than dense_force_scratch_size
+    (its cuts would be short: written past, or a reshape refused with numba's own words)."""
+    if args[11].shape[0] < dense_force_scratch_size(args[3].shape[2], args[7], args[6].shape[0]):
+        raise ValueError("dense_tip_forces, dense_pair_forces: the scratch vector is shorter than "
+                         "dense_force_scratch_size")
+
+
+@njit_borrowing
+def _dense_forces_into(t, args, out):
+    """``pair_forces`` at time t (s) from the dense output into out (rows, 2), args as
+    dense_tip_forces' (its scratch's length checked: _check_scratch); every intermediate
+    array is cut from its scratch vector (compiled without reference counts, so cutting it
+    costs nothing)."""
+    t_valid, dense_t0, dense_h, dense_coef, psi, xc, cpar, n, planar, mount, beta, scratch = args
+    N = dense_coef.shape[2]
     n_steps = t_valid.shape[0]
     lo = 0
     hi = n_steps - 1
@@ -530,26 +554,61 @@ def _dense_state(t, t_valid, dense_t0, dense_h, dense_coef):
         else:
             hi = mid
     k = lo
-    N = dense_coef.shape[2]
-    y = np.empty(N)
+    y = scratch[0:N]
     dense_eval(dense_coef[k], (t - dense_t0[k]) / dense_h[k], y)
-    return y
+    r = scratch[N:N + 3]
+    R = scratch[N + 3:N + 12].reshape((3, 3))
+    V = scratch[N + 12:N + 15]
+    w = scratch[N + 15:N + 18]
+    x = scratch[N + 18:N + 21]
+    v = scratch[N + 21:N + 24]
+    q = scratch[N + 24:N + 24 + n]
+    eta = scratch[N + 24 + n:N + 24 + 2 * n]
+    pair_forces_of(y, n, planar, mount, beta, psi, xc, cpar, out, r, R, q, V, w, eta, x, v)
+
+
+@njit_borrowing
+def _dense_tip_forces(t, args):
+    """dense_tip_forces without reference counts (see there)."""
+    _check_scratch(args)
+    dense_coef, cpar, n, scratch = args[3], args[6], args[7], args[11]
+    rows = cpar.shape[0]
+    b = dense_coef.shape[2] + 24 + 2 * n  # (the forces' place in the scratch: after _dense_forces_into's)
+    pf = scratch[b:b + 2 * rows].reshape((rows, 2))
+    _dense_forces_into(t, args, pf)
+    gap = 1e300
+    for i in range(rows):
+        if cpar[i, C_ON] != 0.0 and -pf[i, 1] < gap:
+            gap = -pf[i, 1]
+    return pf[0, 0], pf[1, 0], gap if gap > 0.0 else 0.0, pf[0, 1], pf[1, 1]
 
 
 @njit(cache=True)
-def dense_tip_forces(t, t_valid, dense_t0, dense_h, dense_coef, mdl, out):
-    """Normal force (N) of the first two contact rows, the gap (m) of the nearest and the
-    first two's penetration (m) at time t from the dense output, into out = (F_0, F_1, gap,
-    y_0, y_1): only what a circuit needs, without the full right-hand side (the ngspice
-    callbacks ask for it thousands of times per run)."""
-    tip_forces(_dense_state(t, t_valid, dense_t0, dense_h, dense_coef), mdl, out)
+def dense_tip_forces(t, args):
+    """(F_0, F_1, gap, y_0, y_1) at time t (s) from the dense output: the first two contact
+    rows' normal force (N), the nearest row's gap (m, 0 when touching; 1e300 without a
+    contact point) and the first two's penetration (m) (``tip_forces``): only what a circuit
+    needs, without the full right-hand side (the ngspice callbacks ask for it thousands of
+    times per run).
+
+    args (mech.compiled.dense_force_arguments, made once per segment): the dense output
+    (t_valid, t0, h, coef: s, s, s, the coefficients), what it reads of the model (psi, xc,
+    cpar, n, planar, mount, beta: model.BarModel.kernel_arrays' arrays and ipar's and fpar's
+    values) and a float64 scratch vector of at least dense_force_scratch_size. (One tuple
+    of only those, the same object at every call of a segment, not the 15-array model tuple
+    and arrays made per call: the ahead-of-time wrapper converts every array argument at
+    every call, ~70 ns each, every array made is an allocation, and each argument is
+    checked on the Python side unless it is the previous call's object: of a 2.2 us call,
+    ~1.1 us went to those.)"""
+    return _dense_tip_forces(t, args)
 
 
 @njit(cache=True)
-def dense_pair_forces(t, t_valid, dense_t0, dense_h, dense_coef, mdl, out):
+def dense_pair_forces(t, args, out):
     """``pair_forces`` at time t (s) from the dense output: out (rows, 2), each contact row's
-    normal force (N) and penetration (m)."""
-    pair_forces(_dense_state(t, t_valid, dense_t0, dense_h, dense_coef), mdl, out)
+    normal force (N) and penetration (m); args as ``dense_tip_forces``'."""
+    _check_scratch(args)
+    _dense_forces_into(t, args, out)
 
 
 @njit(cache=True)
@@ -588,15 +647,23 @@ def pair_forces_into(y, mdl, out, r, R, q, V, w, eta, x, v):
     """``pair_forces`` with the bar's state unpacked into r, R, q, V, w, eta (kernel.unpack's
     arrays) and each contact point's world position and velocity into x, v (3,): scratch
     its caller holds (the step's record samples three interior points without allocating)."""
-    fpar, ipar, psi, xc, cpar = mdl[0], mdl[1], mdl[6], mdl[8], mdl[9]
+    ipar = mdl[1]
+    pair_forces_of(y, ipar[I_N], ipar[I_PLANAR], ipar[I_MOUNT], mdl[0][F_BETA], mdl[6], mdl[8], mdl[9], out,
+                   r, R, q, V, w, eta, x, v)
+
+
+@njit_borrowing
+def pair_forces_of(y, n, planar, mount, beta, psi, xc, cpar, out, r, R, q, V, w, eta, x, v):
+    """``pair_forces_into`` given only what it reads of the model: its mode count n,
+    planar flag and mount kind (ipar's), the Hertz exponent's beta (fpar's) and the arrays
+    psi, xc, cpar (mdl[6], [8], [9])."""
     rows = cpar.shape[0]
-    if ipar[I_MOUNT] == MOUNT_NONE:  # no bar: no contact point
+    if mount == MOUNT_NONE:  # no bar: no contact point
         for i in range(rows):
             out[i, 0] = 0.0
             out[i, 1] = -1e3
         return
-    n = ipar[I_N]
-    unpack(y, n, ipar[I_PLANAR], r, R, q, V, w, eta)
+    unpack(y, n, planar, r, R, q, V, w, eta)
     for i in range(rows):
         if cpar[i, C_ON] == 0.0:
             out[i, 0] = 0.0
@@ -606,5 +673,5 @@ def pair_forces_into(y, mdl, out, r, R, q, V, w, eta, x, v):
         load_point_motion(i, xc, psi, r, R, q, V, w, eta, n, x, v)
         sg = cpar[i, C_N]
         pen = cpar[i, C_R] - sg * (x[2] - cpar[i, C_Z])
-        out[i, 0] = normal_force(pen, -sg * v[2], cpar[i, C_K], cpar[i, C_C], fpar[F_BETA])
+        out[i, 0] = normal_force(pen, -sg * v[2], cpar[i, C_K], cpar[i, C_C], beta)
         out[i, 1] = pen

@@ -344,7 +344,7 @@ def test_normal_forces_from_the_kinematics_equal_the_right_hand_sides(name):
     import tomllib
 
     from mech import ImpactSolver
-    from mech.compiled import dense_tip_forces, dynamics, make_work
+    from mech.compiled import dense_force_arguments, dense_tip_forces, dynamics, make_work
     from mech.kernel_layout import A_FN, A_Y, C_ON, NAUX
     from mech.scene import SCENE_SECTIONS, scene_from_dict
 
@@ -358,16 +358,44 @@ def test_normal_forces_from_the_kinematics_equal_the_right_hand_sides(name):
     solver = ImpactSolver(mech_scene)
     res = solver.run()
     arrays, work = solver.arrays, make_work(solver.model.n)
-    aux, dy, out = np.empty((2, NAUX)), np.empty(res.states.shape[1]), np.empty(5)
+    aux, dy = np.empty((2, NAUX)), np.empty(res.states.shape[1])
     touched = 0
     for k in np.linspace(0, len(res.t) - 1, 300).astype(int):
         y = np.ascontiguousarray(res.states[k])
         dynamics(res.t[k], y, arrays, res.regimes[k], solver.eref, dy, aux, work)
         coef = np.zeros((1, 5, len(y)))
         coef[0, 0] = y  # a one-point dense output: the state itself
-        dense_tip_forces(res.t[k], np.array([res.t[k]]), np.array([res.t[k]]), np.ones(1), coef, arrays, out)
+        args = dense_force_arguments(np.array([res.t[k]]), np.array([res.t[k]]), np.ones(1), coef, arrays)
+        out = np.array(dense_tip_forces(res.t[k], args))
         np.testing.assert_allclose(out[:2], aux[:, A_FN], rtol=1e-12, atol=1e-12 * max(1.0, aux[:, A_FN].max()))
         on = solver.model.cpar[:, C_ON] > 0.0
         np.testing.assert_allclose(out[3:][on], aux[on, A_Y], rtol=1e-12, atol=1e-15)
         touched += int(aux[:, A_FN].max() > 0.0)
     assert touched > 10  # the check saw contacts carrying force
+
+
+def test_the_dense_forces_scratch_is_sized_alike_and_checked():
+    """mech.compiled.dense_force_arguments sizes the scratch vector of dense_tip_forces by
+    the formula of mech.integrator.dense_force_scratch_size (the compiled side's check), and
+    a scratch vector too short is refused, not written past."""
+    from mech import ImpactSolver
+    from mech.compiled import dense_force_arguments, dense_pair_forces, dense_tip_forces
+    from mech.integrator import dense_force_scratch_size
+    from mech.scene import scene_from_dict
+
+    solver = ImpactSolver(scene_from_dict({"bar": dict(length=0.1, diameter=0.006, tip_radius=0.003, modes=2,
+                                                       youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0),
+                                           "initial": dict(height=1e-4, velocity=[0.0, 0.0, -1.0]),
+                                           "solver": dict(t_end=3e-4)}), keep_dense=True)
+    seg = solver.advance(3e-4)
+    coef = np.ascontiguousarray(seg._coef)
+    args = dense_force_arguments(seg._t_valid, seg._t0, seg._h, coef, solver.arrays)
+    m = solver.model
+    assert len(args[-1]) == dense_force_scratch_size(coef.shape[2], m.n, m.rows)
+    t = 0.5 * (seg.t_start + seg.t_end)
+    assert dense_tip_forces(t, args) == seg.tip_forces(t)
+    short = args[:-1] + (np.zeros(len(args[-1]) - 1),)
+    with pytest.raises(ValueError, match="scratch"):
+        dense_tip_forces(t, short)
+    with pytest.raises(ValueError, match="scratch"):
+        dense_pair_forces(t, short, np.empty((m.rows, 2)))
