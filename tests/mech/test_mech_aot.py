@@ -143,6 +143,32 @@ def test_a_wrong_array_inside_a_tuple_argument_is_named_and_goes_to_the_jit_func
     assert expected[0] > 0.0  # the bar moves down at its initial speed: kinetic energy
 
 
+def test_a_new_tuple_is_checked_where_its_items_are_new():
+    """A tuple argument that is a new tuple of the items the last one held (a segment's model
+    tuple: the same arrays and a new drive) is checked at its new items only, and a wrong
+    new item is still named; the items it shares passed before."""
+    import mech.compiled as compiled
+    from mech.model import build_model
+    from mech.scene import scene_from_dict
+
+    if compiled.ROUTE != "aot":
+        pytest.skip("the ahead-of-time module is not in use here")
+    check = aot.argument_checks(aot.module_folder())["energies"]
+    model = build_model(scene_from_dict({"bar": {"length": 0.1, "diameter": 0.006, "tip_radius": 0.003,
+                                                 "modes": 2}}))
+    y, out = model.initial_state(), np.empty(5)
+    work = compiled.make_work(model.n)
+    check((y, model.arrays, work, out, None))
+    fresh = model.kernel_arrays(model.arrays[-1].copy())
+    check((y, fresh, work, out, None))  # a new drive: passed
+    bad = model.kernel_arrays(model.arrays[-1].astype(np.float32))
+    with pytest.raises(TypeError, match=r"energies argument 1\[14\]"):
+        check((y, bad, work, out, None))
+    wrong_first = (model.arrays[0].astype(np.float32),) + fresh[1:]
+    with pytest.raises(TypeError, match=r"energies argument 1\[0\]"):
+        check((y, wrong_first, work, out, None))
+
+
 def test_the_drive_channels_take_the_ahead_of_time_route():
     """The drive (a float64 row per named channel) and the model's contact-drive index
     array (int64, one row per contact point) are arguments the module was built for (the
