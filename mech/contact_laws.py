@@ -10,7 +10,8 @@ calibration of a damping to a restitution, which root-finds on the compiled
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+
+from .frozen import frozen
 
 
 # t_c = 2.943275 delta_max / v0 for an undamped Hertz impact: 2 int_0^1 (1 - x^2.5)^-1/2 dx
@@ -40,7 +41,7 @@ def normal_force(y: float, ydot: float, k: float, c: float, beta: float) -> floa
     return f if f > 0.0 else 0.0
 
 
-@dataclass(frozen=True)
+@frozen
 class HertzImpact:
     """Closed-form undamped Hertz impact of a rigid mass: penetration m, force N, time s."""
 

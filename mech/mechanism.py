@@ -21,7 +21,6 @@ points follow.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -34,7 +33,7 @@ from .kernel_layout import (
 )
 from .modal_basis import ModalBasis
 from .parameters import MechScene
-from .frozen import frozen
+from .frozen import frozen, record
 
 if TYPE_CHECKING:
     from .beam_fe import FEBeam
@@ -138,7 +137,7 @@ def fe_beam(scene: MechScene) -> FEBeam:
                   support_position=mnt.position if mnt.held else 0.0, point_masses=masses)
 
 
-@dataclass
+@record
 class MechanismArrays:
     """Everything the kernel needs beyond the free bar (SI units, body frame)."""
 

@@ -16,12 +16,13 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 
 import numpy as np
 
 from .compiled import armature_table, energy_table
+from .frozen import record
 from .kernel_layout import (
     A_FN, A_FTX, A_FTY, A_VTX, A_VTY, A_Y, A_YDOT, Q_DFRICTION, Q_DMODAL, Q_DNORMAL,
     Q_DLOAD, Q_WIN, C_ON, quadrature_rows,
@@ -55,7 +56,7 @@ def seat_credit(t: np.ndarray, events: list[dict]) -> np.ndarray:
     return out
 
 
-@dataclass
+@record
 class ImpactResult:
     """Outcome of ``ImpactSolver.run``. Build tables with the properties; ``save`` writes them."""
 

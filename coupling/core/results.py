@@ -12,11 +12,12 @@ from __future__ import annotations
 
 import enum
 import math
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 
 import numpy as np
 
+from mech.frozen import record
 from mech.results import REGIME_NAMES
 
 from coupling.core.metrics import MetricSettings, merge_intervals
@@ -76,7 +77,7 @@ class RunStatus(str, enum.Enum):
         return self.value
 
 
-@dataclass
+@record
 class CoupledResult:
     """What a run produced. mechanics: mech.ImpactResult or None; waveform_columns: name ->
     numpy array (time, contact_voltage, contact_current, load_current, contact_resistance,

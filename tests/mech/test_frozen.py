@@ -1,4 +1,5 @@
-"""mech.frozen against the standard library's frozen dataclass, class for class.
+"""mech.frozen against the standard library's frozen dataclass, class for class (and
+mech.frozen.record against the standard mutable dataclass).
 
 Each case is declared twice, once with ``dataclasses.dataclass(frozen=True)`` and once with
 ``mech.frozen.frozen``, and the two must behave the same: construction (positional,
@@ -16,7 +17,7 @@ from dataclasses import field
 
 import pytest
 
-from mech.frozen import frozen
+from mech.frozen import frozen, record
 
 
 def _declare(decorate, name):
@@ -163,3 +164,49 @@ def test_keyword_only_and_own_methods():
 def test_field_order_is_checked():
     with pytest.raises(TypeError):
         frozen(type("Order", (), {"__annotations__": {"a": "int", "b": "int"}, "a": 1}))
+
+
+StdRecord = _declare(dataclasses.dataclass, "StdRecord")
+OurRecord = _declare(record, "OurRecord")
+StdRecordOwn = _own_methods(dataclasses.dataclass, "StdRecordOwn")
+OurRecordOwn = _own_methods(record, "OurRecordOwn")
+
+
+@record
+class OurRecordChild(OurRecord):
+    z: tuple = (1, 2)
+
+
+@pytest.mark.parametrize("args, kwargs", CALLS)
+def test_a_record_is_constructed_as_the_standard_mutable_dataclass(args, kwargs):
+    assert _outcome(lambda: OurRecord(*args, **kwargs)) == _outcome(lambda: StdRecord(*args, **kwargs))
+    try:
+        std = StdRecord(*args, **kwargs)
+    except Exception:  # noqa: BLE001
+        return
+    ours = OurRecord(*args, **kwargs)
+    assert dataclasses.asdict(ours) == dataclasses.asdict(std)
+    assert repr(ours).replace("OurRecord", "StdRecord") == repr(std)
+
+
+def test_a_record_may_be_assigned_and_is_unhashable_as_the_standard_one():
+    a, std = OurRecord(1.0, 2, [1]), StdRecord(1.0, 2, [1])
+    a.x, std.x = 3.0, 3.0
+    a.extra = "kept"
+    assert a.x == 3.0 and a.extra == "kept" and dataclasses.asdict(a) == dataclasses.asdict(std)
+    del a.extra
+    b = OurRecord(1.0, 2, [5])
+    b.x = 3.0
+    assert a == b and (a == std) is False  # tags do not compare; another class
+    assert OurRecord.__hash__ is StdRecord.__hash__ is None
+    with pytest.raises(TypeError):
+        hash(a)
+    assert [f.name for f in dataclasses.fields(OurRecord)] == [f.name for f in dataclasses.fields(StdRecord)]
+    assert OurRecord.__match_args__ == StdRecord.__match_args__
+    assert dataclasses.replace(a, x=4.0).derived == 8.0
+    child = OurRecordChild(1.0, 3, [1], "m", (5,))
+    child.z = ()
+    assert pickle.loads(pickle.dumps(child)) == child and copy.deepcopy(child) == child
+    # a class's own __eq__ and __repr__ stay; it is unhashable, as the standard one
+    assert OurRecordOwn(1) == OurRecordOwn(2) and repr(OurRecordOwn(1)) == "own"
+    assert OurRecordOwn.__hash__ is StdRecordOwn.__hash__ is None
