@@ -29,8 +29,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .compiled import (
-    armature_force, armature_table, dense_contact, dense_eval, dense_pair_forces, dense_tip_forces, dynamics,
-    energies, energy_table, event_values, make_work, project_to_stick,
+    armature_force, armature_table, dense_contact, dense_eval, dense_force_arguments, dense_pair_forces,
+    dense_tip_forces, dynamics, energies, energy_table, event_values, make_work, project_to_stick,
 )
 from .kernel_layout import (
     A_FN, A_FTX, A_FTY, A_MARGIN, A_VTX, A_VTY, A_Y, A_YDOT, BAR_HELD, BUFFER_FULL, C_N, C_ON, C_R, DONE, EV_CLIP,
@@ -111,7 +111,9 @@ class Segment:
     _arrays: tuple = field(repr=False)  # the kernel's arguments with the drive of the segment
     _arm: tuple = field(repr=False, default=None)  # and its armature's (kernel.dynamics), or None
     _work: tuple = field(repr=False, default=None)
-    _out: np.ndarray = field(repr=False, default=None)  # tip_forces' output, made at its first call
+    # the dense force evaluations' arguments after t (mech.compiled.dense_force_arguments),
+    # made at the first tip_forces or pair_forces call
+    _out: tuple = field(repr=False, default=None)
     _last_t: float = field(repr=False, default=float("nan"))
     _last_forces: tuple = field(repr=False, default=(0.0, 0.0, 0.0, 0.0, 0.0))
     _pairs_t: float = field(repr=False, default=float("nan"))
@@ -271,8 +273,6 @@ class Segment:
         else:
             args = self._out
             if args is None:  # (as tip_forces': one tuple of arguments a segment, made once)
-                from .compiled import dense_force_arguments
-
                 args = self._out = dense_force_arguments(self._t_valid, self._t0, self._h, self._coef,
                                                          self._arrays)
             dense_pair_forces(t, args, out[:, :2])
@@ -310,8 +310,6 @@ class Segment:
             # call, and the arrays the call made cost ~1.1 us of its 2.2 us)
             args = self._out
             if args is None:
-                from .compiled import dense_force_arguments  # (once a segment)
-
                 args = self._out = dense_force_arguments(self._t_valid, self._t0, self._h, self._coef,
                                                          self._arrays)
             forces = dense_tip_forces(t, args)
