@@ -10,8 +10,7 @@ calibration of a damping to a restitution, which root-finds on the compiled
 from __future__ import annotations
 
 import math
-
-from .frozen import frozen
+from dataclasses import dataclass
 
 
 # t_c = 2.943275 delta_max / v0 for an undamped Hertz impact: 2 int_0^1 (1 - x^2.5)^-1/2 dx
@@ -41,7 +40,7 @@ def normal_force(y: float, ydot: float, k: float, c: float, beta: float) -> floa
     return f if f > 0.0 else 0.0
 
 
-@frozen
+@dataclass(frozen=True)
 class HertzImpact:
     """Closed-form undamped Hertz impact of a rigid mass: penetration m, force N, time s."""
 
