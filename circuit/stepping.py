@@ -119,6 +119,10 @@ class Stepper:
         self.uses_gap = any(c.gap_source is not None for c in self.probes.contacts)
         self.t_end = float(t_end)
         self.deck = tuple(lines)
+        # s: the run's fixed lengths, from the options and t_end (asked at every macro step)
+        self._sliver = self.options.sliver(self.t_end)
+        self._min_break = self.options.min_break(self.t_end)
+        self._end_tolerance = self.options.end_tolerance(self.t_end)
         self._session: NgspiceSession | None = None
         self._t = 0.0
         self._started = False
@@ -212,12 +216,12 @@ class Stepper:
                 for arc in self._arcs.values():
                     arc.start(float(functions[arc.conductance_source](0.0)) > 0.0)
             span = t_next - t0
-            merge = self.options.sliver(self.t_end)  # (no sliver step after a breakpoint)
+            merge = self._sliver  # (no sliver step after a breakpoint)
             # (without breakpoints left_limited returns each function as it is)
             session.set_channels({source: left_limited(f, points, span, t_next, merge)
                                   for source, f in functions.items()} if points else functions, self._errors)
             landings = snapped(points, t_next, t_next - t0, merge) if points else []
-            if self._started and (restart or (landings and landings[0] - t0 <= self.options.min_break(self.t_end))):
+            if self._started and (restart or (landings and landings[0] - t0 <= self._min_break)):
                 # ngspice drops a breakpoint within CKTminBreak after its current time
                 # (measured at TMAX 1 us: 4e-11 s after it dropped, 1e-10 s landed), so a make
                 # 2.6e-17 s after a macro time accumulated as t + H had its 10 ns ramp taken in
@@ -232,7 +236,7 @@ class Stepper:
             clock = _time.perf_counter()
             try:
                 session.transient(None if final else t_next, not self._started, self.options.wall_timeout, self.t_end,
-                                  self.options.end_tolerance(self.t_end), max_step)
+                                  self._end_tolerance, max_step)
             except BaseException as exc:
                 self._failure = exc
                 raise
