@@ -1075,14 +1075,20 @@ class NgspiceSession:
         plan = [where.get(name.lower()) for name in names]
         return None if None in plan else plan
 
-    def vector(self, name: str, start: int = 0, stop: int | None = None) -> np.ndarray:
-        """Copy of a real vector of the current plot (node name, 'xxx#branch', 'time')."""
+    def _span(self, name: str, start: int, stop: int | None):
+        """(vector_info, start, stop) of the points [start, stop) of a vector of the current
+        plot, the bounds clipped to its length; KeyError naming a vector it does not hold."""
         info = self.vector_info(name)
         if info is None:
             raise KeyError(f"ngspice has no vector {name!r} in the current plot")
         n = info.v_length
         stop = n if stop is None else min(stop, n)
-        start = max(0, min(start, stop))
+        return info, max(0, min(start, stop)), stop
+
+    def vector(self, name: str, start: int = 0, stop: int | None = None) -> np.ndarray:
+        """Copy of a real vector of the current plot (node name, 'xxx#branch', 'time')."""
+        info, start, stop = self._span(name, start, stop)
+        n = info.v_length
         if info.v_realdata != ffi.NULL:
             data = np.frombuffer(ffi.buffer(info.v_realdata, n * 8), dtype=np.float64)
             return data[start:stop].copy()
@@ -1092,12 +1098,7 @@ class NgspiceSession:
     def floats(self, name: str, start: int = 0, stop: int | None = None) -> list[float]:
         """``vector(name, start, stop)`` as a list of floats (the same doubles), read by cffi
         without a numpy array between."""
-        info = self.vector_info(name)
-        if info is None:
-            raise KeyError(f"ngspice has no vector {name!r} in the current plot")
-        n = info.v_length
-        stop = n if stop is None else min(stop, n)
-        start = max(0, min(start, stop))
+        info, start, stop = self._span(name, start, stop)
         if info.v_realdata != ffi.NULL:
             return ffi.unpack(info.v_realdata + start, stop - start)
         return self.vector(name, start, stop).tolist()

@@ -236,6 +236,15 @@ def pieces_travel(segments: list[tuple], which: np.ndarray, times: np.ndarray) -
     return np.where((count == 0) | (times <= starts), at_start, q)
 
 
+def _kept(times: list[float], *series: list[float]) -> tuple[list[float], ...]:
+    """(times, *series) without the points no later than the one before them (a step's first
+    point is the previous step's last): a Tail's filter."""
+    keep = [k for k in range(1, len(times)) if times[k] - times[k - 1] > 0.0]
+    if len(keep) >= len(times) - 1:  # (every point kept; none or one point)
+        return (times, *series)
+    return tuple([values[0]] + [values[k] for k in keep] for values in (times, *series))
+
+
 class Tail:
     """The last points of a circuit signal, kept across macro steps for its rate and time
     scale (``end_rate``); points before a jump say nothing of the signal after it.
@@ -253,14 +262,7 @@ class Tail:
     def observe_floats(self, t: list[float], v: list[float], jumped: bool) -> None:
         """``observe`` on the step's points as lists of floats (a caller that has them as
         lists already: the coil's two tails share the step's times)."""
-        times = (self.t + t)[-TAIL_POINTS:]
-        values = (self.v + v)[-TAIL_POINTS:]
-        # a point no later than the one before it is dropped (a step's first point is the
-        # previous step's last)
-        keep = [k for k in range(1, len(times)) if times[k] - times[k - 1] > 0.0]
-        if len(keep) < len(times) - 1:
-            times = [times[0]] + [times[k] for k in keep]
-            values = [values[0]] + [values[k] for k in keep]
+        times, values = _kept((self.t + t)[-TAIL_POINTS:], (self.v + v)[-TAIL_POINTS:])
         if jumped:
             times, values = times[-1:], values[-1:]
         self.t, self.v = times, values
@@ -269,14 +271,8 @@ class Tail:
         """``observe_floats(t, v, False)`` on this tail and ``other.observe_floats(t, w, False)``
         on a tail that has seen the same times (the coil's psi^2 and psi): which points are
         kept depends on the times alone, so it is worked out once (~3 us of a coil macro step)."""
-        times = (self.t + t)[-TAIL_POINTS:]
-        values = (self.v + v)[-TAIL_POINTS:]
-        others = (other.v + w)[-TAIL_POINTS:]
-        keep = [k for k in range(1, len(times)) if times[k] - times[k - 1] > 0.0]
-        if len(keep) < len(times) - 1:
-            times = [times[0]] + [times[k] for k in keep]
-            values = [values[0]] + [values[k] for k in keep]
-            others = [others[0]] + [others[k] for k in keep]
+        times, values, others = _kept((self.t + t)[-TAIL_POINTS:], (self.v + v)[-TAIL_POINTS:],
+                                      (other.v + w)[-TAIL_POINTS:])
         # (one list for both tails' times: a tail replaces its lists, never changes them)
         self.t, self.v = times, values
         other.t, other.v = times, others
