@@ -82,8 +82,11 @@ def contact_intervals(seg, touching_at_start) -> list[list[tuple[float, float]]]
     return intervals
 
 
-# macro steps whose armature samples and received work ``CoilLink`` evaluates at once
+# macro steps whose armature samples and received work ``CoilLink`` evaluates at once, and
+# dense steps of the armature's travel it holds for them at most (a bar at nanosecond steps
+# can have a million in one macro step: 64 B each, the memory stays a few MB)
 BATCH_STEPS = 256
+BATCH_PIECES = 1 << 16
 
 # Gauss-Legendre on [0, 1] (nodes, weights) of RECEIVED_NODES points: the quadrature of the
 # armature's drive work (``received_work``), exact for polynomials of degree 7 in time;
@@ -528,6 +531,7 @@ class CoilLink:
         # pieces (``inputs``: (t_start, *Segment.armature_pieces())), its points and its work's
         # inputs. The same doubles as step by step; ~11 us less a plunger macro step.
         self._segments: list[tuple] = []
+        self._pieces = 0  # dense steps the pending segments hold
         self._step_segment: tuple | None = None  # (the step's Segment, its index in _segments)
         self._pending_q: list[tuple[int, list[float]]] = []
         self._pending_work: list[tuple] = []
@@ -613,6 +617,7 @@ class CoilLink:
             self._table_channel = TableChannel
         start, ends, t0, h, coefficients = pieces
         self._segments.append((lo, start, ends, t0, h, coefficients))
+        self._pieces += len(ends)
         self._step_segment = (seg, len(self._segments) - 1)
         return {f"{self.label}.gap": TableChannel(gap, lo, hi, start, ends, t0, h, coefficients,
                                                   offset=self.rest_gap, scale=self.lever)}
@@ -723,7 +728,7 @@ class CoilLink:
                                             seg.travel)
             return
         self._pending_work.append((index, t0, t1, drive0, drive1, cuts))
-        if len(self._pending_work) >= BATCH_STEPS:
+        if len(self._pending_work) >= BATCH_STEPS or self._pieces >= BATCH_PIECES:
             self._flush()
 
     @property
@@ -744,6 +749,7 @@ class CoilLink:
         each step's work added in step order."""
         segments, pending_q, pending_work = self._segments, self._pending_q, self._pending_work
         self._segments, self._pending_q, self._pending_work, self._step_segment = [], [], [], None
+        self._pieces = 0
         if pending_q:
             which = np.repeat([index for index, _ in pending_q], [len(times) for _, times in pending_q])
             times = [t for _, step_times in pending_q for t in step_times]

@@ -66,16 +66,18 @@ def test_the_gain_integral_of_many_is_the_gain_integral_of_each_to_the_bit():
     assert one.many(q).tobytes() == np.array([one(float(v)) for v in q]).tobytes()
 
 
-@pytest.mark.parametrize("batch", [1, 7])
-def test_the_batched_samples_and_received_work_are_those_of_each_step(batch, monkeypatch):
+@pytest.mark.parametrize("batch, pieces", [(1, 1 << 16), (7, 1 << 16), (256, 5)])
+def test_the_batched_samples_and_received_work_are_those_of_each_step(batch, pieces, monkeypatch):
     """CoilLink evaluates the armature's travel at the circuit's points and the received work
-    for BATCH_STEPS macro steps at once; against the same run sampled step by step
-    (Segment.travel and received_work on each segment, the route of a segment ``inputs`` did
-    not see): the same travel column and received work, to the bit."""
+    for BATCH_STEPS macro steps at once (or fewer, once they hold BATCH_PIECES dense steps);
+    against the same run sampled step by step (Segment.travel and received_work on each
+    segment, the route of a segment ``inputs`` did not see): the same travel column and
+    received work, to the bit."""
     from coupling.core import exchange
 
     scene = load_scene(PLUNGER).set("solver.t_end", 0.014)  # (the first arrival and bounces at the pole)
     monkeypatch.setattr(exchange, "BATCH_STEPS", batch)
+    monkeypatch.setattr(exchange, "BATCH_PIECES", pieces)
     batched = run(scene)
     monkeypatch.setattr(CoilLink, "_segment_index", lambda self, seg: None)
     stepwise = run(scene)
