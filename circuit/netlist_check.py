@@ -22,8 +22,8 @@ XSPICE ``A`` devices (some read files), element names that are ngspice commands.
 Error messages name the file, the line and what is wrong; they never repeat text from
 the file (an included file may not be a netlist at all, e.g. ``/etc/passwd``).
 
-``check_deck`` is a second, independent guard run on every deck right before it is
-handed to ngspice (``NgspiceSession.load``), whatever built it.
+``check_deck`` (circuit/deck_guard.py) is a second, independent guard run on every deck
+right before it is handed to ngspice (``NgspiceSession.load``), whatever built it.
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from .deck_guard import COMMAND_NAMES, DECK_TITLE, check_deck  # noqa: F401 (check_deck: this module's name for it)
 from .errors import NetlistInputError
 
 #: Largest include depth (the netlist itself is depth 0).
@@ -97,16 +98,6 @@ _REFUSED_PREFIXES = (
     (".width", "output cards are not allowed"),
     (".csparam", "'.csparam' passes values to ngspice commands: not allowed"),
 )
-#: ngspice commands that run programs, read or write files, or load code; an element
-#: line whose name is one of these is refused (it would be a command in a script).
-COMMAND_NAMES = frozenset({
-    "shell", "source", "write", "wrdata", "wrs2p", "wrnodev", "codemodel", "osdi", "load", "save", "set", "setcs",
-    "unset", "exec", "echo", "run", "listing", "edit", "rusage", "sysinfo", "quit", "exit", "cd", "aspice",
-    "jobs", "rspice", "hardcopy", "print", "plot", "destroy", "remcirc", "reset", "alter", "altermod", "let",
-    "define", "alias", "eprint", "eprvcd", "snsave", "snload", "inventory", "option", "options", "circbyline",
-    "mc_source", "bg_run", "stop", "resume", "step", "trace", "iplot", "version", "history", "meas", "gnuplot",
-    "fourier", "spec", "linearize", "compose", "setplot", "settype", "strcmp", "wrpd", "psd",
-})
 
 
 @dataclass(frozen=True)
@@ -567,31 +558,3 @@ def _check_card(head: str, tokens: list[str], where: str) -> None:
             raise NetlistInputError(f"{where}: {reason}")
     raise NetlistInputError(f"{where}: dot-card not allowed; allowed: {', '.join(ALLOWED_CARDS)} "
                             "(and .include/.lib in a netlist file)")
-
-
-# ------------------------------------------------------------------------------------
-# The last guard before ngspice
-
-#: Title line of every deck handed to ngspice.
-DECK_TITLE = "* switchsim deck"
-_DECK_REFUSED = re.compile(r"^\s*(\.control|\.endc|\.exec|\.inc|\.lib|\.title|\.csparam|\*#|pre_|@)", re.I)
-
-
-def check_deck(lines: list[str]) -> list[str]:
-    """The deck with switchsim's own title; raises NetlistInputError if any line could make
-    ngspice run a command or read a file (whoever built the deck)."""
-    if not lines:
-        raise NetlistInputError("empty deck")
-    out = [DECK_TITLE]
-    for k, line in enumerate(lines[1:], start=2):
-        if "\n" in line or "\r" in line or "\x00" in line:
-            raise NetlistInputError(f"deck line {k}: embedded line break or NUL")
-        stripped = line.strip()
-        low = stripped.lower()
-        if _DECK_REFUSED.match(low) or "ng_script" in low or low.rstrip().endswith("\\"):
-            raise NetlistInputError(f"deck line {k}: refused before ngspice (command, script or include card)")
-        head = low.split(None, 1)[0] if low else ""
-        if head in COMMAND_NAMES:
-            raise NetlistInputError(f"deck line {k}: refused before ngspice (an ngspice command name)")
-        out.append(line)
-    return out

@@ -30,7 +30,7 @@ from ._callbacks_ffi import ffi as cffi_callbacks
 from ._ngspice_ffi import ffi
 from .channels import ConstantChannel, TableChannel
 from .contact import LANDING_TOLERANCE
-from .netlist_check import check_deck
+from .deck_guard import check_deck
 from .errors import (
     ConvergenceError,
     LibraryNotFoundError,
@@ -839,7 +839,7 @@ class NgspiceSession:
     def load(self, lines: list[str]) -> None:
         """Load a deck (title line first, ``.end`` last); raises NetlistError with ngspice's message.
 
-        The deck passes ``netlist_check.check_deck`` first (its title is replaced by
+        The deck passes ``deck_guard.check_deck`` first (its title is replaced by
         switchsim's own): no line that could run an ngspice command or read a file gets
         through, whoever built the deck (NetlistInputError)."""
         lines = check_deck(list(lines))
