@@ -32,12 +32,14 @@ def circuit_netlist(circuit: CircuitLike) -> tuple[str, Probes]:
     if isinstance(circuit, CoilDrive):
         return str(circuit.build()), circuit.probes
     # (imported here, not at the top: a coil drive's run never loads them, circuit/__init__.py;
-    # a circuit of theirs has imported its module already)
-    from .netlist import NetlistCircuit
+    # a circuit of theirs has imported its module already, and a template's run does not
+    # load the netlist reader)
     from .templates import LOAD_PROBE, McuInput, SwitchCircuit
 
     if isinstance(circuit, (SwitchCircuit, McuInput)):
         return str(circuit.build()), circuit.probes
+    from .netlist import NetlistCircuit
+
     if isinstance(circuit, NetlistCircuit):
         return circuit.netlist(), circuit.probes
     if isinstance(circuit, Circuit):

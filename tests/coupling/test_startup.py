@@ -139,6 +139,8 @@ def test_default_scene_imports_pyspice_and_pyarrow_only_and_writes_its_documente
     assert {name for name in HEAVY if name in modules} == {"PySpice", "pyarrow"}
     assert modules.isdisjoint(UNREACHED)  # (ngspice's library found through the loader, no ldconfig -p)
     assert "mech.beam_fe" in modules and "numpy.polynomial" not in modules  # (its Gauss rules written out)
+    # a template's deck passes the last guard alone, not the netlist-file reader
+    assert "circuit.deck_guard" in modules and "circuit.netlist_check" not in modules
     written = {p.name for p in (tmp_path / "out").iterdir()}
     assert written == {"summary.json", "waveforms.csv", "waveforms.parquet", "waveforms.html", "openings.csv",
                        "history.csv", "contacts.csv", "phases.csv", "events.csv"}
@@ -152,7 +154,8 @@ def test_a_coil_drive_alone_imports_no_templates_netlist_circuit_or_one_shot_run
     imported on first use (circuit/__init__.py) and never by this run."""
     _requires_aot()
     modules = _imported(tmp_path, (ROOT / "examples" / "plunger_solenoid.toml").read_text())
-    assert modules.isdisjoint({"circuit.templates", "circuit.netlist", "circuit.schedule", "circuit.transient"})
+    assert modules.isdisjoint({"circuit.templates", "circuit.netlist", "circuit.schedule", "circuit.transient",
+                               "circuit.netlist_check"})
     assert "circuit.coil_drive" in modules
     assert modules.isdisjoint(UNREACHED)
     assert modules.isdisjoint(BEAM)  # (an armature on no bar)
