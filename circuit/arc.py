@@ -288,6 +288,23 @@ def recorded_arc(circuit: Circuit, name: str = "") -> ArcModel | None:
 Reader = Callable[[Sequence[str]], Sequence[float]]
 
 
+class _Cell:
+    """An ArcState attribute kept in its ``cells`` (the doubles the compiled step callback
+    shares) at ``index``: a float, or with ``flag`` a bool kept as 1.0 or 0.0."""
+
+    def __init__(self, index: int, doc: str, flag: bool = False):
+        self.index, self.flag, self.__doc__ = index, flag, doc
+
+    def __get__(self, state, owner=None):
+        if state is None:
+            return self
+        value = state.cells[self.index]
+        return value != 0.0 if self.flag else value
+
+    def __set__(self, state, value) -> None:
+        state.cells[self.index] = (1.0 if value else 0.0) if self.flag else value
+
+
 class ArcState:
     """The arc's on/off state, decided at ngspice's accepted time points.
 
@@ -337,38 +354,10 @@ class ArcState:
         self.start(False)
 
     # the state the compiled step callback shares (``cells``)
-    @property
-    def level(self) -> float:
-        """The filtered closed indicator (0 .. 1)."""
-        return self.cells[_LEVEL]
-
-    @level.setter
-    def level(self, level: float) -> None:
-        self.cells[_LEVEL] = level
-
-    @property
-    def burning(self) -> bool:
-        return self.cells[_BURNING] != 0.0
-
-    @burning.setter
-    def burning(self, burning: bool) -> None:
-        self.cells[_BURNING] = 1.0 if burning else 0.0
-
-    @property
-    def _t(self) -> float:
-        return self.cells[_T]
-
-    @_t.setter
-    def _t(self, t: float) -> None:
-        self.cells[_T] = t
-
-    @property
-    def _closed(self) -> float:
-        return self.cells[_CLOSED]
-
-    @_closed.setter
-    def _closed(self, closed: float) -> None:
-        self.cells[_CLOSED] = closed
+    level = _Cell(_LEVEL, "The filtered closed indicator (0 .. 1).")
+    burning = _Cell(_BURNING, "The arc burns (or is armed).", flag=True)
+    _t = _Cell(_T, "s: the last accepted point (-inf: none yet).")
+    _closed = _Cell(_CLOSED, "1.0 or 0.0: the contact at that point.")
 
     def _publish(self) -> None:
         """Whether the compiled step callback may answer the next accepted point (its
