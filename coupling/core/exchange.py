@@ -750,19 +750,18 @@ class CoilLink:
         segments, pending_q, pending_work = self._segments, self._pending_q, self._pending_work
         self._segments, self._pending_q, self._pending_work, self._step_segment = [], [], [], None
         self._pieces = 0
-        if pending_q:
-            which = np.repeat([index for index, _ in pending_q], [len(times) for _, times in pending_q])
-            times = [t for _, step_times in pending_q for t in step_times]
-            self._q.extend(pieces_travel(segments, which, times).tolist())
-        if not pending_work:
+        if not pending_q and not pending_work:
             return
-        gain = self._gain_integral
-        # per step: its end's travel; per quadrature piece (between the step's events): its
-        # RECEIVED_NODES nodes' travel, the piece's start and length, and its step
-        ends_which, ends_times, piece_step, piece_start, piece_length = [], [], [], [], []
+        # every travel the pending steps ask for, in one evaluation: at the circuit's points,
+        # and for the received work at each step's end and its quadrature nodes (per piece
+        # between the step's events: its start, length and step)
+        which = [index for index, step_times in pending_q for _ in step_times]
+        times = [t for _, step_times in pending_q for t in step_times]
+        samples = len(times)
+        piece_step, piece_start, piece_length = [], [], []
         for k, (index, t0, t1, drive0, drive1, cuts) in enumerate(pending_work):
-            ends_which.append(index)
-            ends_times.append(t1)
+            which.append(index)
+            times.append(t1)
             if t1 - t0 > 0.0 and drive1 != drive0 and (drive1 - drive0) / (t1 - t0) != 0.0:
                 inner = sorted(c for c in cuts if t0 < c < t1) if cuts else ()
                 edges = [t0, *inner, t1]
@@ -770,20 +769,25 @@ class CoilLink:
                     piece_step.append(k)
                     piece_start.append(edges[j])
                     piece_length.append(edges[j + 1] - edges[j])
+        a, h = np.array(piece_start), np.array(piece_length)
+        nodes = a[:, None] + np.array(GAUSS_NODES)[None, :] * h[:, None]
+        which += [pending_work[k][0] for k in piece_step for _ in range(RECEIVED_NODES)]
+        q = pieces_travel(segments, which, np.concatenate([times, nodes.ravel()]))
+        self._q.extend(q[:samples].tolist())
+        if not pending_work:
+            return
+        steps = len(pending_work)
         starts = np.array([segments[index][1] for index, *_ in pending_work])  # q at each step's start
-        g_end = gain.many(pieces_travel(segments, ends_which, ends_times)).tolist()
-        g_start = gain.many(starts)
+        g = self._gain_integral.many(np.concatenate([q[samples:], starts]))
+        g_end, g_nodes, g_start = g[:steps].tolist(), g[steps:-steps].reshape(nodes.shape), g[-steps:]
         sums = []
         if piece_step:
-            steps = np.array(piece_step, dtype=np.intp)
-            a, h = np.array(piece_start), np.array(piece_length)
-            nodes = a[:, None] + np.array(GAUSS_NODES)[None, :] * h[:, None]
-            which = np.repeat(np.array([pending_work[k][0] for k in piece_step], dtype=np.intp), RECEIVED_NODES)
-            q = pieces_travel(segments, which, nodes.ravel()).reshape(nodes.shape)
-            q0, g0 = starts[steps][:, None], g_start[steps][:, None]
+            at = np.array(piece_step, dtype=np.intp)
+            q0, g0 = starts[at][:, None], g_start[at][:, None]
             # (received_work skips a node where the armature has not moved: its term, +0.0
             # here, leaves the piece's sum as it was)
-            terms = np.where(q != q0, np.array(GAUSS_WEIGHTS)[None, :] * (gain.many(q) - g0), 0.0)
+            terms = np.where(q[samples + steps:].reshape(nodes.shape) != q0,
+                             np.array(GAUSS_WEIGHTS)[None, :] * (g_nodes - g0), 0.0)
             piece = 0.0 + terms[:, 0]
             for j in range(1, RECEIVED_NODES):
                 piece = piece + terms[:, j]
