@@ -505,16 +505,16 @@ def _circuit(table: dict, base_dir: Path, current_factor: str | None, device=Non
 
     table = _table("[circuit]", table)
     named = table.get("template", "resistive")
+    usable = template_keys(named) | common_keys() if named in TEMPLATES else set()  # (else refused below)
     # (a table whose keys all belong to its own template passes the check against every
     # template's keys: those, which import the netlist reader, ~3 ms, are looked at only
     # when a key is not its template's, for the same error as before)
-    if not (isinstance(named, str) and named in TEMPLATES and set(table) <= template_keys(named) | common_keys()):
+    if not set(table) <= usable:
         table = check_keys("[circuit]", table, circuit_keys())
-    template = check_choice("circuit.template", table.get("template", "resistive"), TEMPLATES)
+    template = check_choice("circuit.template", named, TEMPLATES)
     if "voltage" in table and "current" in table:
         raise ValueError("circuit.voltage and circuit.current both name a source: give one, current "
                          "(A) with template = \"current_source\", or voltage (V) with a voltage-source template")
-    usable = template_keys(template) | common_keys()
     stray = sorted(set(table) - usable)
     if stray:
         hint = {"netlist": " (put it in the netlist)",
