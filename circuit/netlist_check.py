@@ -32,7 +32,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from .deck_guard import COMMAND_NAMES, DECK_TITLE, check_deck  # noqa: F401 (check_deck: this module's name for it)
+from .deck_guard import COMMAND_NAMES, DECK_TITLE
 from .errors import NetlistInputError
 
 #: Largest include depth (the netlist itself is depth 0).

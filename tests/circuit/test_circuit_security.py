@@ -17,7 +17,8 @@ from PySpice.Spice.Netlist import Circuit
 
 from circuit import NetlistCircuit, SimulationOptions, add_contact, run_transient
 from circuit.errors import NetlistInputError
-from circuit.netlist_check import MAX_INCLUDE_DEPTH, check_deck
+from circuit.deck_guard import check_deck
+from circuit.netlist_check import MAX_INCLUDE_DEPTH
 
 REPO = Path(__file__).resolve().parents[2]
 OPTIONS = SimulationOptions(max_step=1e-6)
