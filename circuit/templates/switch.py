@@ -30,13 +30,13 @@ from typing import ClassVar, Union
 
 from PySpice.Spice.Netlist import Circuit
 
-from .arc import ArcModel, add_arc
-from .blocks import CoilBlock, ContactBlock
-from .coil_drive import CoilDrive
-from .contact import DEFAULT_LEAKAGE, add_contact, check_current_factor
-from .names import check_block_name
-from .probes import Probes
-from .validation import check_range, internal, scene_key
+from ..arc import ArcModel, add_arc
+from ..blocks import CoilBlock, ContactBlock
+from ..coil_drive import CoilDrive
+from ..contact import DEFAULT_LEAKAGE, add_contact, check_current_factor
+from ..names import check_block_name
+from ..probes import Probes
+from ..validation import check_range, internal, scene_key
 
 BOLTZMANN_OVER_CHARGE = 8.617333262e-5  # V/K
 CLAMP_TEMPERATURE = 27.0  # degC: the clamp diode's instance temperature (fixed, whatever TEMP)
