@@ -40,7 +40,8 @@ from .stepping import StepResult, Stepper
 # templates, a netlist file's circuit) and the one-shot runs with their schedule. A run
 # whose circuit is a coil drive alone (examples/plunger_solenoid.toml) uses none of them,
 # and their classes cost ~10 ms of its start (dataclasses writes and compiles each
-# generated method: templates.py's twelve classes ~8 ms).
+# generated method: the templates' thirteen classes ~11 ms). circuit/templates/ in turn
+# imports each family of templates on first use: a run creates only its template's classes.
 _LAZY = {
     "NetlistCircuit": "netlist",
     "ContactSchedule": "schedule",
