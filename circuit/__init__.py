@@ -52,18 +52,28 @@ _LAZY = {
 }
 
 
-def __getattr__(name: str):
-    if name in _LAZY:
-        import importlib
+def _lazy_attributes(package: str, table: dict[str, str]):
+    """A package's ``__getattr__`` and ``__dir__`` (PEP 562): a name of ``table`` is taken from
+    the submodule ``table[name]``, imported on first use, and kept in the package (the next use
+    does not come here). circuit/templates/ uses them too."""
+    import sys
 
-        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
-        globals()[name] = value  # (kept: the next use does not come here)
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    def getattr_(name: str):
+        if name in table:
+            import importlib
+
+            value = getattr(importlib.import_module(f".{table[name]}", package), name)
+            setattr(sys.modules[package], name, value)
+            return value
+        raise AttributeError(f"module {package!r} has no attribute {name!r}")
+
+    def dir_():
+        return sorted(set(vars(sys.modules[package])) | set(table))
+
+    return getattr_, dir_
 
 
-def __dir__():
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = _lazy_attributes(__name__, _LAZY)
 
 
 __all__ = [

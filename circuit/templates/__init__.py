@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import sys
 
+from .. import _lazy_attributes
+
 # module -> its public names (classes, aliases, constants)
 _FAMILIES = {
     "sources": ("DCSource", "CurrentSource", "Source", "BOLTZMANN_OVER_CHARGE", "CLAMP_TEMPERATURE",
@@ -37,18 +39,7 @@ _LAZY = {name: module for module, names in _FAMILIES.items() for name in names}
 __all__ = list(_LAZY)  # (a star import loads every family)
 
 
-def __getattr__(name: str):
-    if name in _LAZY:
-        import importlib
-
-        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
-        globals()[name] = value  # (kept: the next use does not come here)
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = _lazy_attributes(__name__, _LAZY)
 
 
 def loaded(*names: str) -> tuple[type, ...]:
