@@ -27,7 +27,7 @@ puzzling list of earlier sessions: arc off, 24 V, RELTOL 1e-5, leakage 1e-6 S pa
 CHGTOL, method, capacitance, wiring, U_min, the arc's off-conductance did not help; so did
 ngspice's `.options pivrel=1` (0.5 did not), and moving the probe.
 
-The fix (circuit/templates.py, ChangeoverCircuit.build): the probe at the source (src -Vload-
+The fix (circuit/templates/changeover.py, ChangeoverCircuit.build): the probe at the source (src -Vload-
 supply -R- wire -Lwire- contact_a), the wiring ending on the common as in the one-contact
 template; the same circuit in series order, the 0 V probes now exact. Part 2 below runs the
 old arrangement (the deck rewritten by text) and the new on the small make of

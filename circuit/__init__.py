@@ -40,7 +40,8 @@ from .stepping import StepResult, Stepper
 # templates, a netlist file's circuit) and the one-shot runs with their schedule. A run
 # whose circuit is a coil drive alone (examples/plunger_solenoid.toml) uses none of them,
 # and their classes cost ~10 ms of its start (dataclasses writes and compiles each
-# generated method: templates.py's twelve classes ~8 ms).
+# generated method: the templates' thirteen classes ~11 ms). circuit/templates/ in turn
+# imports each family of templates on first use: a run creates only its template's classes.
 _LAZY = {
     "NetlistCircuit": "netlist",
     "ContactSchedule": "schedule",
@@ -51,18 +52,28 @@ _LAZY = {
 }
 
 
-def __getattr__(name: str):
-    if name in _LAZY:
-        import importlib
+def _lazy_attributes(package: str, table: dict[str, str]):
+    """A package's ``__getattr__`` and ``__dir__`` (PEP 562): a name of ``table`` is taken from
+    the submodule ``table[name]``, imported on first use, and kept in the package (the next use
+    does not come here). circuit/templates/ uses them too."""
+    import sys
 
-        value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
-        globals()[name] = value  # (kept: the next use does not come here)
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    def getattr_(name: str):
+        if name in table:
+            import importlib
+
+            value = getattr(importlib.import_module(f".{table[name]}", package), name)
+            setattr(sys.modules[package], name, value)
+            return value
+        raise AttributeError(f"module {package!r} has no attribute {name!r}")
+
+    def dir_():
+        return sorted(set(vars(sys.modules[package])) | set(table))
+
+    return getattr_, dir_
 
 
-def __dir__():
-    return sorted(set(globals()) | set(_LAZY))
+__getattr__, __dir__ = _lazy_attributes(__name__, _LAZY)
 
 
 __all__ = [

@@ -33,16 +33,18 @@ def circuit_netlist(circuit: CircuitLike) -> tuple[str, Probes]:
         return str(circuit.build()), circuit.probes
     # (imported here, not at the top: a coil drive's run never loads them, circuit/__init__.py;
     # a circuit of theirs has imported its module already, and a template's run does not
-    # load the netlist reader)
-    from .templates import LOAD_PROBE, McuInput, SwitchCircuit
+    # load the netlist reader, nor the template families it does not use: loaded)
+    from .templates import loaded
 
-    if isinstance(circuit, (SwitchCircuit, McuInput)):
+    if isinstance(circuit, loaded("SwitchCircuit", "McuInput")):
         return str(circuit.build()), circuit.probes
     from .netlist import NetlistCircuit
 
     if isinstance(circuit, NetlistCircuit):
         return circuit.netlist(), circuit.probes
     if isinstance(circuit, Circuit):
+        from .templates import LOAD_PROBE
+
         return str(circuit), Probes(_pyspice_contacts(circuit), load_current=(
             f"{LOAD_PROBE}#branch" if LOAD_PROBE.lower() in {n.lower() for n in circuit.element_names} else None),
             coils=tuple(getattr(circuit, COILS_PLACED, ())))

@@ -382,7 +382,8 @@ def _tribology_fitted(table: dict, base_dir: Path, feedback: bool) -> TribologyS
 # arc and schedule the fields of theirs, and an omitted key takes its field's default. The
 # dataclasses name the keys in their errors themselves ("circuit.voltage = ...").
 
-_PARTS = ("snubber", "flyback", "arc")  # [circuit] keys that are sub-tables, each its own dataclass
+# [circuit] keys that are sub-tables, each its own dataclass (named: asked for only when given)
+_PARTS = {"snubber": "Snubber", "flyback": "FlybackDiode", "arc": "ArcModel"}
 
 
 def template_classes(template: str) -> tuple:
@@ -394,11 +395,13 @@ def template_classes(template: str) -> tuple:
         return (ck.NetlistCircuit,)
     if template == "mcu_input":
         return (ck.McuInput,)
-    source = ck.CurrentSource if template == "current_source" else ck.DCSource
-    load = {"inductive": ck.InductiveLoad, "capacitive": ck.CapacitiveLoad}.get(template, ck.ResistiveLoad)
-    switch = {"short_circuit": ck.ShortCircuit, "bridge": ck.BridgeCircuit,
-              "changeover": ck.ChangeoverCircuit}.get(template, ck.SwitchCircuit)
-    return (source, ck.Wiring, load, switch)
+    # (by name: only the chosen classes are asked for, so a run imports only their families,
+    # circuit/templates/__init__.py)
+    source = "CurrentSource" if template == "current_source" else "DCSource"
+    load = {"inductive": "InductiveLoad", "capacitive": "CapacitiveLoad"}.get(template, "ResistiveLoad")
+    switch = {"short_circuit": "ShortCircuit", "bridge": "BridgeCircuit",
+              "changeover": "ChangeoverCircuit"}.get(template, "SwitchCircuit")
+    return tuple(getattr(ck, name) for name in (source, "Wiring", load, switch))
 
 
 def key_fields(cls) -> list[str]:
@@ -445,11 +448,14 @@ def _kwargs(table: dict, cls, skip=_PARTS) -> dict:
     return {k: table[k] for k in key_fields(cls) if k in table and k not in skip}
 
 
-def _part(table: dict, name: str, cls):
+def _part(table: dict, name: str):
     """A sub-table (snubber, flyback, arc): false/absent -> None, true -> defaults, a table -> its fields."""
     value = table.get(name)
     if value is None or value is False:
         return None
+    import circuit
+
+    cls = getattr(circuit, _PARTS[name])
     if value is True:
         if name == "snubber":
             raise ValueError("circuit.snubber = true: give its resistance (ohm) and capacitance (F), "
@@ -526,7 +532,7 @@ def _circuit(table: dict, base_dir: Path, current_factor: str | None, device=Non
                          f"{hint}; its keys: {', '.join(sorted(template_keys(template)))}")
     try:
         options = ck.SimulationOptions(**_kwargs(table, ck.SimulationOptions))
-        arc = _part(table, "arc", ck.ArcModel)
+        arc = _part(table, "arc")
         if template == "netlist":
             if "netlist" not in table:
                 raise ValueError("template \"netlist\" needs netlist = \"file.cir\" (with one 'XCONTACT a b' line)")
@@ -562,8 +568,8 @@ def _circuit(table: dict, base_dir: Path, current_factor: str | None, device=Non
                                      "driven by the mechanics' [[fixed]] contacts, not by a schedule")
                 names = dict(contact_names=_changeover_names(mech))
             circ = switch(source=source(**_kwargs(table, source)), load=load(**_kwargs(table, load)),
-                          wiring=wiring(**_kwargs(table, wiring)), snubber=_part(table, "snubber", ck.Snubber),
-                          flyback=_part(table, "flyback", ck.FlybackDiode), arc=arc,
+                          wiring=wiring(**_kwargs(table, wiring)), snubber=_part(table, "snubber"),
+                          flyback=_part(table, "flyback"), arc=arc,
                           contact_current_factor=current_factor, coil=None if device is None else device.drive(),
                           **_kwargs(table, switch), **names)
         schedule = None
