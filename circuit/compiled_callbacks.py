@@ -62,6 +62,8 @@ typedef struct sw_channel {
     const double *ends, *t0, *h, *coefficients;
     long windows;
     const double *lows, *highs, *befores;
+    const double *gate_arc;
+    int gate_conductance;
 } sw_channel;
 
 typedef struct sw_arc {
@@ -116,7 +118,8 @@ STRUCTS = ("sw_channel", "sw_arc", "sw_arc_rule", "sw_state")
 #: (then come the ArcState cells' indices, circuit.arc.ARC_CELLS).
 LAYOUT = tuple(("sw_channel", f) for f in ("name", "kind", "last_t", "last_value", "calls", "constant", "lo",
                                            "hi", "start", "offset", "scale", "n", "ends", "t0", "h",
-                                           "coefficients", "windows", "lows", "highs", "befores")) + \
+                                           "coefficients", "windows", "lows", "highs", "befores", "gate_arc",
+                                           "gate_conductance")) + \
     (("sw_arc", "name"), ("sw_arc", "value"), ("sw_arc_rule", "cells"), ("sw_arc_rule", "conductance")) + \
     tuple(("sw_state", f) for f in ("failed", "evaluate", "learn", "learn_arc", "channels_used", "channels",
                                     "arcs_used", "arcs_size", "arcs", "sync_python", "has_arcs", "accepting",
