@@ -117,11 +117,6 @@ class Stepper:
         for c in self.probes.coils:
             self._errors[c.gap_source] = _error(GapError, f"{c.label} gap", "m")
         self.uses_gap = any(c.gap_source is not None for c in self.probes.contacts)
-        # each arc that reads its gap only while it burns (no breakdown to test while out):
-        # (its state, its contact's conductance source, its gap source); see _idle_gaps
-        self._gap_readers = tuple((self._arcs[c.state_source.lower()], c.conductance_source, c.gap_source)
-                                  for c in self.probes.contacts
-                                  if c.gap_source is not None and c.arc.breakdown_voltage is None)
         self.t_end = float(t_end)
         self.deck = tuple(lines)
         # s: the run's fixed lengths, from the options and t_end (asked at every macro step)
@@ -209,8 +204,6 @@ class Stepper:
         if final:
             t_next = self.t_end
         functions = self._input_functions(conductance, gap, inputs)
-        if self._started and self._gap_readers:
-            self._idle_gaps(functions, t0)
         # (most macro steps have no make or break: an empty list or tuple is taken as it is,
         # and below no left limits or landings are worked out for none, ~1.5 us a step)
         points = () if type(breakpoints) in (list, tuple) and not breakpoints else \
@@ -308,23 +301,6 @@ class Stepper:
         if gap is not None and not self.uses_gap:
             _as_function(gap, "gap", "m")  # checked, then ignored: no arc uses it
         return {self.inputs[name]: _as_function(value, *_what(name)) for name, value in given.items()}
-
-    def _idle_gaps(self, functions: dict, t0: float) -> None:
-        """Hold a contact's gap input at its value at ``t0`` over a macro step in which its
-        arc cannot read it: the arc is out at the step's start, its contact open throughout
-        (conductance the constant 0: it cannot arm), and it has no breakdown to test. Its
-        path's current is then V(arc_on) = 0 times the gap's terms, the same doubles
-        whatever the gap, so ngspice's solution is the same; the gap node holds a value
-        instead of following the contact (nothing reads it), and ngspice's compiled
-        callbacks answer it without Python. The default relay's gap came from Python at
-        ~4 900 trial points a run, ~3 700 of them after the break's arc had gone out."""
-        for arc, conductance_source, gap_source in self._gap_readers:
-            g, gap = functions[conductance_source], functions[gap_source]
-            if arc.burning or type(g) is not ConstantChannel or g.value != 0.0 or type(gap) is ConstantChannel:
-                continue
-            value = float(gap(t0))
-            if 0.0 <= value < math.inf:  # (else the function's own error, from ngspice's call)
-                functions[gap_source] = ConstantChannel(value)
 
     def _read_last(self, session: NgspiceSession) -> tuple[int, float, dict[str, float]]:
         """Points so far, the last time (s) and the last contact/load values (V, A)."""
