@@ -7,7 +7,9 @@ polynomial of the mechanics' dense output) or for an arc's state (a constant bet
 accepted points), and GetSyncData 12 000 times; cffi's dispatch into Python and the Python
 body cost ~1 us a call. The C callbacks answer those without Python and call Python only
 for the other channels and the step control's rarer cases (circuit/ngspice.py installs
-them; what runs where is described in callbacks.c).
+them; what runs where is described in callbacks.c). An arc's gap channel is held at its
+last value, with no call, while the arc is out and its contact open (callbacks.c's
+sw_held; the Python route's _on_vsrc applies the same rule).
 
 Where: ``<NUMBA_CACHE_DIR or circuit/__pycache__>/callbacks-<key>/libswitchsim_callbacks.so``,
 the key a hash of callbacks.c, the flags and the machine. Built at first use
