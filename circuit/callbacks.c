@@ -8,9 +8,9 @@
    - An input channel answers a repeated time (ngspice asks again at each Newton
      iteration) with its last value, and so does an arc's gap channel at a new time while
      nothing ngspice computes reads it (sw_held); a constant channel and a table channel
-     (a piecewise polynomial in time, below) are evaluated here; any other channel calls its Python
-     function through one trampoline (sw_state.evaluate), which also makes the error for
-     a value that is not finite and >= 0 (a table channel's bad value goes there too:
+     (a piecewise polynomial in time, below) are evaluated here; any other channel calls
+     its Python function through one trampoline (sw_state.evaluate), which also makes the
+     error for a value that is not finite and >= 0 (a table channel's bad value goes there too:
      the Python function behind it gives the same value and raises its error).
    - An arc's EXTERNAL current source reads the double that its ArcState writes.
    - SendData (sw_data, given to ngspice once, at its init, when the library is there)
