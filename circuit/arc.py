@@ -119,8 +119,8 @@ _RATE_MEMORY = 3
 _LEVEL_TOLERANCE = 1e-9  # of the armed filter's level, when landing on its crossing of 1/2
 #: ArcState.cells: the arc's state as doubles, where ngspice's compiled step callback reads
 #: and moves it too (circuit/callbacks.c's SW_ARC_*, held together by a test)
-ARC_CELLS = ("t", "level", "closed", "burning", "plain", "tau", "tolerance")
-_T, _LEVEL, _CLOSED, _BURNING, _PLAIN, _TAU, _TOLERANCE = range(len(ARC_CELLS))
+ARC_CELLS = ("t", "level", "closed", "burning", "plain", "tau", "tolerance", "idle")
+_T, _LEVEL, _CLOSED, _BURNING, _PLAIN, _TAU, _TOLERANCE, _IDLE = range(len(ARC_CELLS))
 _ATTRIBUTE = "_switchsim_arc"  # where add_arc records the model on a PySpice Circuit
 CHARACTERISTICS = ("linear", "ayrton")
 AYRTON_RESISTANCE = 1e-4  # ohm: the Ayrton arc's own slope (what stays of R_arc; 0.04 V at 400 A)
@@ -327,14 +327,16 @@ class ArcState:
     ``node_a``/``node_b`` the contact nodes, ``conductance`` the node whose voltage is
     the contact conductance G(t), ``gap`` the node whose voltage is the gap distance
     (needed only with a breakdown gradient); ``conductance_source`` the EXTERNAL source
-    that drives G(t), when it is one.
+    that drives G(t), when it is one; ``gap_source`` the one that drives d(t), when the
+    arc reads its gap (ngspice's session holds it while the arc cannot read it).
     """
 
     def __init__(self, arc: ArcModel, current: str, node_a: str, node_b: str, conductance: str,
-                 gap: str = GAP_NODE, conductance_source: str | None = None):
+                 gap: str = GAP_NODE, conductance_source: str | None = None, gap_source: str | None = None):
         self.arc = arc
         # the EXTERNAL source whose last value is G at an accepted point (saves a vector read)
         self.conductance_source = conductance_source
+        self.gap_source = gap_source
         self._tau = arc.formation_time / math.log(2.0)
         self._conductance = (conductance.lower(),)
         self._names_on = (current.lower(),)
@@ -350,7 +352,7 @@ class ArcState:
         # the state below as doubles (ARC_CELLS; never resized either): ngspice's compiled
         # step callback answers ``accepted`` itself where only the filter's level moves
         # (the arc stays lit and closed, or out and unarmed), which "plain" allows
-        self.cells = array("d", [-math.inf, 0.0, 0.0, 0.0, 0.0, self._tau, _LEVEL_TOLERANCE])
+        self.cells = array("d", [-math.inf, 0.0, 0.0, 0.0, 0.0, self._tau, _LEVEL_TOLERANCE, 0.0])
         self.start(False)
 
     # the state the compiled step callback shares (``cells``)
@@ -358,6 +360,9 @@ class ArcState:
     burning = _Cell(_BURNING, "The arc burns (or is armed).", flag=True)
     _t = _Cell(_T, "s: the last accepted point (-inf: none yet).")
     _closed = _Cell(_CLOSED, "1.0 or 0.0: the contact at that point.")
+    idle = _Cell(_IDLE, "The arc was out over the step to its last point (V(arc_on) 0 in that point's "
+                        "solution) and is out after it: its gap is read nowhere in the next step, as long as "
+                        "it cannot arm (ngspice's session then holds its gap channel).", flag=True)
 
     def _publish(self) -> None:
         """Whether the compiled step callback may answer the next accepted point (its
@@ -382,6 +387,7 @@ class ArcState:
     def start(self, closed: bool) -> None:
         """Before the run: the state at the operating point (burning/armed iff closed at t = 0)."""
         self.burning = bool(closed)
+        self.idle = not closed  # (ngspice's first iterate: all zeros)
         self.value = 1.0 if closed else 0.0
         self.level = 1.0 if closed else 0.0  # the filtered closed indicator
         self.switches = 0
@@ -453,6 +459,7 @@ class ArcState:
             self._previous = None
             if previous_t > -math.inf:
                 restart = RESTART * (t - previous_t)
+        self.idle = not burning and not self.burning
         self.burning = burning
         self.value = 1.0 if burning else 0.0
         if self._ayrton:

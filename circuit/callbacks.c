@@ -6,10 +6,11 @@
    voltage sources (the input channels) and current sources (the arcs' states).
 
    - An input channel answers a repeated time (ngspice asks again at each Newton
-     iteration) with its last value; a constant channel and a table channel (a piecewise
-     polynomial in time, below) are evaluated here; any other channel calls its Python
-     function through one trampoline (sw_state.evaluate), which also makes the error for
-     a value that is not finite and >= 0 (a table channel's bad value goes there too:
+     iteration) with its last value, and so does an arc's gap channel at a new time while
+     nothing ngspice computes reads it (sw_held); a constant channel and a table channel
+     (a piecewise polynomial in time, below) are evaluated here; any other channel calls
+     its Python function through one trampoline (sw_state.evaluate), which also makes the
+     error for a value that is not finite and >= 0 (a table channel's bad value goes there too:
      the Python function behind it gives the same value and raises its error).
    - An arc's EXTERNAL current source reads the double that its ArcState writes.
    - SendData (sw_data, given to ngspice once, at its init, when the library is there)
@@ -43,7 +44,7 @@ typedef struct sw_channel {
     int kind;             /* SW_PYTHON, SW_CONSTANT or SW_TABLE */
     double last_t;        /* the time of the last value (NaN: none in this macro step) */
     double last_value;
-    long long calls;      /* evaluations (repeats and calls after a failure not counted) */
+    long long calls;      /* evaluations (repeats, held answers and calls after a failure not counted) */
     double constant;
     /* table: value(t) = max(offset - scale * p(u), 0) with u = clamp(t, lo, hi) after
        the left-limit windows, p(u) = start for u <= lo or no pieces, else piece
@@ -56,6 +57,11 @@ typedef struct sw_channel {
        if i >= 0 and t <= highs[i], t is replaced by befores[i] */
     long windows;
     const double *lows, *highs, *befores;
+    /* an arc's gap channel (the arc without a breakdown voltage): held (sw_held) while the
+       arc whose ArcState cells these are is idle and the channel gate_conductance (its
+       contact's conductance) is the constant 0; NULL: never held */
+    const double *gate_arc;
+    int gate_conductance;
 } sw_channel;
 
 typedef struct sw_arc {
@@ -72,6 +78,7 @@ typedef struct sw_arc {
 #define SW_ARC_PLAIN 4      /* 1.0: sw_arc_plain may answer (set by Python after each of its answers) */
 #define SW_ARC_TAU 5        /* s: the filter's time constant */
 #define SW_ARC_TOLERANCE 6  /* of the level, at its crossing of 1/2 */
+#define SW_ARC_IDLE 7       /* 1.0: out over the step to the last point and after it (sw_held) */
 
 typedef struct sw_arc_rule {
     double *cells;      /* the ArcState's cells (above) */
@@ -173,6 +180,22 @@ static sw_channel *find_channel(char *name)
     return NULL;
 }
 
+/* The arc that gates ch reads it nowhere: it is idle (out, neither burning nor armed,
+   over the step to its last accepted point and after it, so V(arc_on) is 0 in the solution
+   that Newton starts from as in every iterate, and the path's current and its derivatives
+   but d/dV(arc_on) are 0 times the gap's finite terms; d/dV(arc_on) multiplies V(arc_on) = 0)
+   and its contact's conductance is the constant 0 for this macro step (it cannot arm);
+   without a breakdown voltage nothing else reads the gap (ArcState reads it only to test a
+   breakdown). The channel's last value (finite and >= 0) serves: ngspice's solution is the
+   same bits. (Out only after the last point is not enough: the first trial's Newton starts
+   from that point's solution, V(arc_on) = 1, and its linearised path reads the new gap;
+   held there, one near-zero current of five scenes moved by an ulp.) */
+static int sw_held(const sw_channel *ch)
+{
+    const sw_channel *g = state->channels + ch->gate_conductance;
+    return ch->gate_arc[SW_ARC_IDLE] != 0.0 && g->kind == SW_CONSTANT && g->constant == 0.0;
+}
+
 int sw_vsrc(double *out, double t, char *name, int ident, void *user)
 {
     (void)ident; (void)user;
@@ -188,6 +211,11 @@ int sw_vsrc(double *out, double t, char *name, int ident, void *user)
         ch = state->channels + index;  /* (learn may have moved the array) */
     }
     if (t == ch->last_t || state->failed) {
+        *out = ch->last_value;
+        return 0;
+    }
+    if (ch->gate_arc != NULL && sw_held(ch)) {  /* (not an evaluation: not counted) */
+        ch->last_t = t;
         *out = ch->last_value;
         return 0;
     }
@@ -250,6 +278,7 @@ int sw_layout(long *out, int size)
     SW_PUT(offsetof(sw_channel, h)); SW_PUT(offsetof(sw_channel, coefficients));
     SW_PUT(offsetof(sw_channel, windows)); SW_PUT(offsetof(sw_channel, lows));
     SW_PUT(offsetof(sw_channel, highs)); SW_PUT(offsetof(sw_channel, befores));
+    SW_PUT(offsetof(sw_channel, gate_arc)); SW_PUT(offsetof(sw_channel, gate_conductance));
     SW_PUT(offsetof(sw_arc, name)); SW_PUT(offsetof(sw_arc, value));
     SW_PUT(offsetof(sw_arc_rule, cells)); SW_PUT(offsetof(sw_arc_rule, conductance));
     SW_PUT(offsetof(sw_state, failed)); SW_PUT(offsetof(sw_state, evaluate));
@@ -268,7 +297,7 @@ int sw_layout(long *out, int size)
     SW_PUT(offsetof(sw_state, rejections_size)); SW_PUT(offsetof(sw_state, rejections));
     SW_PUT(offsetof(sw_state, pause_at)); SW_PUT(offsetof(sw_state, python_data));
     SW_PUT(SW_ARC_T); SW_PUT(SW_ARC_LEVEL); SW_PUT(SW_ARC_CLOSED); SW_PUT(SW_ARC_BURNING);
-    SW_PUT(SW_ARC_PLAIN); SW_PUT(SW_ARC_TAU); SW_PUT(SW_ARC_TOLERANCE);
+    SW_PUT(SW_ARC_PLAIN); SW_PUT(SW_ARC_TAU); SW_PUT(SW_ARC_TOLERANCE); SW_PUT(SW_ARC_IDLE);
     return k;
 }
 
@@ -361,6 +390,7 @@ int sw_sync(double ckttime, double *pdelta, double olddelta, int redostep, int i
                 double *c = s->arc_rules[i].cells;
                 c[SW_ARC_T] = ckttime;
                 c[SW_ARC_LEVEL] = levels[i];
+                c[SW_ARC_IDLE] = c[SW_ARC_BURNING] == 0.0 ? 1.0 : 0.0;  /* (burning unchanged) */
             }
             if (steps[i] < step) step = steps[i];  /* Python's min(step, arc_step) */
             if (lands[i] < land) land = lands[i];

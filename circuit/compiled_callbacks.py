@@ -7,7 +7,9 @@ polynomial of the mechanics' dense output) or for an arc's state (a constant bet
 accepted points), and GetSyncData 12 000 times; cffi's dispatch into Python and the Python
 body cost ~1 us a call. The C callbacks answer those without Python and call Python only
 for the other channels and the step control's rarer cases (circuit/ngspice.py installs
-them; what runs where is described in callbacks.c).
+them; what runs where is described in callbacks.c). An arc's gap channel is held at its
+last value, with no call, while the arc is out and its contact open (callbacks.c's
+sw_held; the Python route's _on_vsrc applies the same rule).
 
 Where: ``<NUMBA_CACHE_DIR or circuit/__pycache__>/callbacks-<key>/libswitchsim_callbacks.so``,
 the key a hash of callbacks.c, the flags and the machine. Built at first use
@@ -62,6 +64,8 @@ typedef struct sw_channel {
     const double *ends, *t0, *h, *coefficients;
     long windows;
     const double *lows, *highs, *befores;
+    const double *gate_arc;
+    int gate_conductance;
 } sw_channel;
 
 typedef struct sw_arc {
@@ -116,7 +120,8 @@ STRUCTS = ("sw_channel", "sw_arc", "sw_arc_rule", "sw_state")
 #: (then come the ArcState cells' indices, circuit.arc.ARC_CELLS).
 LAYOUT = tuple(("sw_channel", f) for f in ("name", "kind", "last_t", "last_value", "calls", "constant", "lo",
                                            "hi", "start", "offset", "scale", "n", "ends", "t0", "h",
-                                           "coefficients", "windows", "lows", "highs", "befores")) + \
+                                           "coefficients", "windows", "lows", "highs", "befores", "gate_arc",
+                                           "gate_conductance")) + \
     (("sw_arc", "name"), ("sw_arc", "value"), ("sw_arc_rule", "cells"), ("sw_arc_rule", "conductance")) + \
     tuple(("sw_state", f) for f in ("failed", "evaluate", "learn", "learn_arc", "channels_used", "channels",
                                     "arcs_used", "arcs_size", "arcs", "sync_python", "has_arcs", "accepting",

@@ -77,7 +77,7 @@ def arc_states(probes: Probes) -> dict[str, ArcState]:
     EXTERNAL current source that carries it."""
     return {c.state_source.lower(): ArcState(c.arc, c.arc_current_vector, c.node_a, c.node_b,
                                              c.element("contact_g"), c.element("arc_gap"),
-                                             conductance_source=c.conductance_source)
+                                             conductance_source=c.conductance_source, gap_source=c.gap_source)
             for c in probes.contacts if c.arc is not None}
 
 

@@ -28,6 +28,7 @@ from greenlet import getcurrent, greenlet
 from . import compiled_callbacks
 from ._callbacks_ffi import ffi as cffi_callbacks
 from ._ngspice_ffi import ffi
+from .arc import ARC_CELLS
 from .channels import ConstantChannel, TableChannel
 from .contact import LANDING_TOLERANCE
 from .deck_guard import check_deck
@@ -64,6 +65,7 @@ _COMMANDS_BEFORE_HISTORY_RELEASE = 5000
 # Rejected steps the compiled sync callback logs before Python moves them into its list
 # (a full log: that redo goes to Python, which empties it)
 REJECTIONS_LOGGED = 1024
+_IDLE = ARC_CELLS.index("idle")  # (an ArcState's cells: 1.0 out over the last step and after it)
 
 
 def find_library() -> str:
@@ -231,6 +233,9 @@ class NgspiceSession:
       other channels' Python functions through one trampoline (``_on_c_evaluate``); without
       the library (a failed build, or SWITCHSIM_PYTHON_CALLBACKS=1) the Python callback
       ``_on_vsrc`` does it all. The route is chosen at each ``load``; both give the same bits;
+    - on both routes an arc's gap channel is held (its last value, no call) while the arc
+      cannot read it: idle (out over the last step and after it), its contact's
+      conductance the constant 0 for the macro step, no breakdown voltage (``_gate_gaps``);
     - the EXTERNAL current sources (the arcs' states, arc.py) read their ArcState's
       ``value``: in C from its ``cell`` (the compiled callback), else ``_on_isrc``;
     - GetSyncData is compiled too (``sw_sync``, ``_on_sync``'s rules), calling ``_on_sync``
@@ -302,7 +307,8 @@ class NgspiceSession:
         self._c_rules = None
         self._c_rules_size = 0
         self._c_rule_cells: list = []
-        self._c_rules_stale = True  # the arcs or the channels changed since the rules were written
+        self._c_gate_cells: list = []  # the arcs' cells the gap channels' C cells point to (_gate_gaps)
+        self._arcs_stale = True  # the arcs or the channels changed since the gates and rules were written
         self._c_rejections = None
         self._commands_sent = 0
         self._encoded: dict[str, bytes] = {}
@@ -423,11 +429,17 @@ class NgspiceSession:
 
     def _on_vsrc(self, out, t, name, ident, user):
         # Called at every Newton iteration and on rejected trial points: the value must
-        # depend on t only. Repeated calls at the same t skip the Python function.
+        # depend on t only. Repeated calls at the same t skip the Python function, and so
+        # does an arc's gap while the arc cannot read it (_gate_gaps; callbacks.c's sw_held).
         channel = self._by_pointer.get(name)
         if channel is None:
             channel = self._learn(name)
         if t == channel.last_t or self._failure is not None:
+            out[0] = channel.last_value
+            return 0
+        gate = channel.gate
+        if gate is not None and gate[0][_IDLE] != 0.0 and gate[1].zero:  # (not counted: no evaluation)
+            channel.last_t = t
             out[0] = channel.last_value
             return 0
         channel.calls += 1
@@ -510,7 +522,7 @@ class NgspiceSession:
         state.python_data = False
         library.sw_install(state)
         self._cstate, self._clib = state, library
-        self._c_rules, self._c_rules_size, self._c_rules_stale = None, 0, True
+        self._c_rules, self._c_rules_size, self._arcs_stale = None, 0, True
         state.accepting = self._accepting
         self._set_arc_bounds(self._arc_from, self._arc_step, self._arc_land)
         self._mirror_steps()
@@ -519,14 +531,18 @@ class NgspiceSession:
         """The step control's fields that only Python writes into the compiled sync callback's
         state (after Python changed any: a pause's start and end, the arcs, a breakpoint);
         the accepting time and the arcs' step bounds, which both write, are copied where
-        Python sets them (``_set_arc_bounds``, ``_on_sync_from_c``)."""
+        Python sets them (``_set_arc_bounds``, ``_on_sync_from_c``). The arcs' ties to the
+        input channels are written afresh after either changed, on both routes."""
+        if self._arcs_stale:
+            self._gate_gaps()
+            if self._cstate is not None:
+                self._c_arc_rules()
+            self._arcs_stale = False
         state = self._cstate
         if state is None:
             return
         self._landings_from_c()
         state.target, state.max_step, state.deadline = self._target, self._max_step, self._deadline
-        if self._c_rules_stale:
-            self._c_arc_rules()
         landings = self._landings
         if len(landings) > state.landings_size:
             self._c_landings = cffi_callbacks.new("double[]", 2 * len(landings))
@@ -590,7 +606,46 @@ class NgspiceSession:
             self._c_rules[k].conductance = channel.index if isinstance(channel, CompiledChannel) else -1
         state.arc_rules_used = len(arcs)
         state.has_arcs = bool(arcs)
-        self._c_rules_stale = False
+
+    def _gate_gaps(self) -> None:
+        """Each arc's gap channel tied to the arc's state and its contact's conductance
+        channel (``Channel.gate``; in C, the channel cell's ``gate_arc`` and
+        ``gate_conductance``): both source callbacks answer the gap with its last value,
+        without evaluating it, at a new time when the arc is idle (``ArcState.idle``: out
+        over the step to its last accepted point and after it) and the conductance channel
+        is the constant 0 for the macro step. The arc then reads the gap nowhere: V(arc_on)
+        is 0 in the point Newton starts from and in every iterate, so its path's current
+        and derivatives are the same doubles whatever the gap; it cannot arm while its
+        contact stays open; and an arc without a breakdown voltage reads the gap at
+        accepted points only to test one (an arc with one is never held). So ngspice's
+        solution is the same bits; only the gap node holds its value instead of following
+        the contact. (Out only from the last point on is not enough: Newton starts from
+        that point's solution, arc lit, and the linearised path reads the new gap.) The
+        default relay's gap was called from Python at ~4 900 new times a run, ~1 050
+        with this."""
+        self._c_gate_cells = []
+        for channel in self._channels.values():
+            self._set_gate(channel, None)
+        for arc in self._arcs.values():
+            if arc.arc.breakdown_voltage is not None or not arc.gap_source or not arc.conductance_source:
+                continue
+            gap = self._channels.get(arc.gap_source.lower())
+            conductance = self._channels.get(arc.conductance_source.lower())
+            if gap is not None and conductance is not None:
+                self._set_gate(gap, (arc.cells, conductance))
+
+    def _set_gate(self, channel: "Channel", gate) -> None:
+        """``channel.gate`` (None, or an arc's cells and its conductance channel), in its C
+        cell too with the compiled callbacks."""
+        channel.gate = gate
+        if isinstance(channel, CompiledChannel):
+            cell = channel.cell
+            if gate is None or not isinstance(gate[1], CompiledChannel):
+                cell.gate_arc, cell.gate_conductance = cffi_callbacks.NULL, -1
+            else:
+                cells = cffi_callbacks.from_buffer("double[]", gate[0])
+                self._c_gate_cells.append(cells)  # (held while C reads through it)
+                cell.gate_arc, cell.gate_conductance = cells, gate[1].index
 
     def _on_sync_from_c(self, ckttime, pdelta, olddelta, redostep, ident, loc, user):
         # The compiled sync callback's calls that need Python (a failure, a deadline passed,
@@ -622,6 +677,7 @@ class NgspiceSession:
         cell = self._c_cells + index
         cell.name = cffi_callbacks.NULL
         cell.kind = compiled_callbacks.PYTHON
+        cell.gate_arc, cell.gate_conductance = cffi_callbacks.NULL, -1  # (a cell of an earlier circuit's)
         channel = CompiledChannel(name, function, make_error, cell, index)
         self._c_channels.append(channel)
         self._cstate.channels_used = index + 1
@@ -630,6 +686,7 @@ class NgspiceSession:
     def _set_function(self, channel: "Channel", function) -> None:
         """The function behind ``channel`` for the next macro step: evaluated in C if it is a
         ConstantChannel or a TableChannel and the compiled callbacks are in use."""
+        channel.zero = isinstance(function, ConstantChannel) and function.value == 0.0
         if self._compiled is None:
             channel.function = function.function if isinstance(function, (ConstantChannel, TableChannel)) else function
             return
@@ -834,7 +891,7 @@ class NgspiceSession:
         self._arcs = {}
         self._arc_by_pointer = {}
         self._set_arc_bounds(math.nan, math.inf, math.inf)
-        self._c_rules_stale = True
+        self._arcs_stale = True
 
     def load(self, lines: list[str]) -> None:
         """Load a deck (title line first, ``.end`` last); raises NetlistError with ngspice's message.
@@ -871,13 +928,15 @@ class NgspiceSession:
             channel = self._channels.get(key)
             if channel is None:
                 channel = self._channels[key] = self._new_channel(key, function, errors.get(source))
-                self._c_rules_stale = True  # (an arc's conductance channel may be this one)
+                self._arcs_stale = True  # (an arc's conductance or gap channel may be this one)
             self._set_function(channel, function)
             channel.last_t = math.nan
 
     @property
     def channel_calls(self) -> dict[str, int]:
-        """Calls of each input channel's function so far (source name -> calls)."""
+        """Evaluations of each input channel so far (source name -> calls): its function
+        called (or, in C, its constant or table evaluated) at a new time; a repeated time
+        and a held gap (``_gate_gaps``) are answered without one."""
         return {name: channel.calls for name, channel in self._channels.items()}
 
     def set_arcs(self, arcs: Mapping[str, object]) -> None:
@@ -887,7 +946,7 @@ class NgspiceSession:
         self._arc_by_pointer = {}
         self._forget_c_arcs()
         self._set_arc_bounds(math.nan, math.inf, math.inf)
-        self._c_rules_stale = True
+        self._arcs_stale = True
         self._mirror_steps()
 
     def set_breakpoint(self, t: float) -> None:
@@ -1159,9 +1218,12 @@ def _zero(t: float) -> float:
 
 class Channel:
     """One input channel: the function of time behind an EXTERNAL voltage source, its last
-    value (ngspice asks again at the same time during Newton iterations) and its calls."""
+    value (ngspice asks again at the same time during Newton iterations) and its calls;
+    ``zero``: the function is the constant 0 for this macro step; ``gate``: an arc's gap
+    channel's (the arc's cells, its contact's conductance channel), see
+    ``NgspiceSession._gate_gaps``."""
 
-    __slots__ = ("name", "function", "make_error", "last_t", "last_value", "calls")
+    __slots__ = ("name", "function", "make_error", "last_t", "last_value", "calls", "zero", "gate")
 
     def __init__(self, name: str, function: Callable[[float], float],
                  make_error: Callable[[float, float], Exception] | None = None):
@@ -1171,6 +1233,8 @@ class Channel:
         self.last_t = math.nan
         self.last_value = 0.0
         self.calls = 0
+        self.zero = False
+        self.gate = None
 
     def error(self, t: float, value: float) -> Exception:
         if self.make_error is not None:

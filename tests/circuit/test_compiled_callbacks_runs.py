@@ -2,7 +2,8 @@
 control) against runs through its Python callbacks: the same waveforms to the bit, the
 same errors and wall-clock aborts, the same channel calls; a TableChannel's C values
 against its Python function at random times; a session without the compiled library runs
-on the Python route.
+on the Python route; an arc's gap held while the arc is out and its contact open, on both
+routes, without changing a bit.
 
 The route is chosen when a Stepper loads its circuit: SWITCHSIM_PYTHON_CALLBACKS=1 forces
 the Python callbacks (compiled_callbacks.FORCE_PYTHON).
@@ -287,3 +288,52 @@ def test_a_macro_steps_last_values_are_the_stored_points_on_both_routes(monkeypa
                 t, steps = t_next, steps + 1
             assert session._point_plans and all(plan is not None for plan in session._point_plans.values())
         assert steps == round(T_END / MACRO)
+
+
+def held_or_followed(arc: ArcModel, held: bool) -> tuple[dict, dict, list[float]]:
+    """A break whose arc burns, then goes out as its gap (a Python function, its calls
+    recorded) opens at 20 m/s; the contact's conductance is the schedule until 0.2 ms and
+    then, already open, the constant 0 (``held``: the source callbacks may hold the gap) or
+    still the schedule's function, 0 all the same (the gap followed at every new time):
+    columns with the rejected steps, stats, the gap's calls (s)."""
+    calls = []
+
+    def gap(t: float) -> float:
+        calls.append(t)
+        return max(0.0, 10.0 * SPEED * (t - T_BREAK))
+
+    with Stepper(circuit(arc), T_END, OPTIONS) as stepper:
+        t = 0.0
+        while not stepper.finished:
+            t_next = min(t + MACRO, T_END)
+            conductance = 0.0 if held and t >= 0.2e-3 else BREAK
+            stepper.advance(t_next, conductance, BREAK.breakpoints(t, t_next), gap=gap)
+            t = t_next
+        columns = stepper.result_columns()
+        columns["rejected_from"], columns["rejected_newton"] = stepper.rejections
+        return columns, stepper.stats, calls
+
+
+@pytest.mark.parametrize("kind", sorted(ARCS))
+def test_an_arcs_gap_is_held_while_the_arc_is_out_and_its_contact_open_with_the_same_bits(kind, route):
+    """Once the arc has been out for a whole step, and while its contact's conductance is the
+    constant 0 (it cannot arm), ngspice reads its gap nowhere (V(arc_on) = 0 times the gap's
+    terms): the source callbacks answer the gap's last value without calling its function,
+    and the run is the same to the bit as one that follows the gap at every new time (the
+    conductance a function). An arc with a breakdown voltage, which may re-ignite, always
+    follows it. ``gap_calls`` counts the function's calls, not the held answers."""
+    (columns, stats, calls), (followed, _, followed_calls) = (held_or_followed(ARCS[kind], held)
+                                                             for held in (True, False))
+    assert same(columns, followed)
+    current, times = np.abs(columns["arc_current"]), columns["time"]
+    lit = np.nonzero(current > 1e-3)[0]
+    out = lit[-1] + 1  # the first point of the arc out (its state changed at the one before)
+    assert 0.2e-3 < times[out] < T_END - 0.1e-3  # (the contact open, its conductance given as 0.0)
+    assert stats["gap_calls"] == len(calls)
+    assert sum(t > times[out] for t in followed_calls) > 1000
+    if ARCS[kind].breakdown_voltage is None:
+        assert stats["arc_switches"] == 1  # lit from the start, out at the point before ``out``, for good
+        assert max(calls) == times[out]  # called up to the first point out, held after it
+        assert len(calls) < len(followed_calls) / 10
+    else:
+        assert calls == followed_calls
