@@ -416,8 +416,9 @@ class NgspiceSession:
 
     def _on_data(self, values, count, ngspice_id, user_data):
         # Each accepted point, after ngspice stored it: the pause (back to transient()'s caller).
+        # (the properties' fields read directly: on the Python route this runs at every point)
         accepting = self._accepting if self._compiled is None else self._cstate.accepting
-        if accepting >= self._pause_at and self._failure is None:
+        if accepting >= self._pause_value and self._failure_value is None:
             self._pause_at = math.inf
             # (valid while ngspice waits in this call: ``last_values`` reads the point from it)
             self._paused = values
@@ -544,11 +545,12 @@ class NgspiceSession:
         self._landings_from_c()
         state.target, state.max_step, state.deadline = self._target, self._max_step, self._deadline
         landings = self._landings
-        if len(landings) > state.landings_size:
-            self._c_landings = cffi_callbacks.new("double[]", 2 * len(landings))
-            state.landings, state.landings_size = self._c_landings, 2 * len(landings)
-        for k, t in enumerate(landings):
-            state.landings[k] = t
+        if landings:  # (most pauses have none)
+            if len(landings) > state.landings_size:
+                self._c_landings = cffi_callbacks.new("double[]", 2 * len(landings))
+                state.landings, state.landings_size = self._c_landings, 2 * len(landings)
+            for k, t in enumerate(landings):
+                state.landings[k] = t
         state.landings_head, state.landings_used = 0, len(landings)
         self._c_landings_seen = 0
 
@@ -684,13 +686,16 @@ class NgspiceSession:
         return channel
 
     def _set_function(self, channel: "Channel", function) -> None:
-        """The function behind ``channel`` for the next macro step: evaluated in C if it is a
-        ConstantChannel or a TableChannel and the compiled callbacks are in use."""
+        """The function behind ``channel`` for the next macro step, its last value forgotten:
+        evaluated in C if it is a ConstantChannel or a TableChannel and the compiled callbacks
+        are in use."""
         channel.zero = isinstance(function, ConstantChannel) and function.value == 0.0
         if self._compiled is None:
             channel.function = function.function if isinstance(function, (ConstantChannel, TableChannel)) else function
+            channel.last_t = math.nan
             return
         cell = channel.cell
+        cell.last_t = math.nan  # (CompiledChannel.last_t's field, without the property's call)
         if isinstance(function, ConstantChannel):
             cell.kind = compiled_callbacks.CONSTANT
             cell.constant = function.value
@@ -922,15 +927,14 @@ class NgspiceSession:
         by source name; ``errors`` (by source name) makes the error for a value that is not
         finite and >= 0 (default: a ValueError naming the source). Channels keep their
         call counts across calls; their last values are forgotten (a new step)."""
-        errors = errors or {}
+        channels = self._channels
         for source, function in functions.items():
             key = source.lower()
-            channel = self._channels.get(key)
+            channel = channels.get(key)
             if channel is None:
-                channel = self._channels[key] = self._new_channel(key, function, errors.get(source))
+                channel = channels[key] = self._new_channel(key, function, (errors or {}).get(source))
                 self._arcs_stale = True  # (an arc's conductance or gap channel may be this one)
             self._set_function(channel, function)
-            channel.last_t = math.nan
 
     @property
     def channel_calls(self) -> dict[str, int]:
@@ -1010,11 +1014,13 @@ class NgspiceSession:
             # 0.88 ns before t_end with TMAX = 30 us).
             self._check_reached(printed, threshold)
         finally:
+            # (Python's fields only: the compiled state keeps this pause's until the next
+            # transient, set_breakpoint or clear mirrors them, as ngspice takes no step
+            # while paused or after its run ended; ~1.5 us a macro step)
             self._target = math.inf
             self._max_step = math.inf
             self._deadline = math.inf
             self._landings = []
-            self._mirror_steps()
 
     def _run_body(self) -> list[str]:
         """The whole transient of the loaded circuit: one "run" (its greenlet pauses inside)."""
@@ -1157,10 +1163,19 @@ class NgspiceSession:
     def floats(self, name: str, start: int = 0, stop: int | None = None) -> list[float]:
         """``vector(name, start, stop)`` as a list of floats (the same doubles), read by cffi
         without a numpy array between."""
-        info, start, stop = self._span(name, start, stop)
-        if info.v_realdata != ffi.NULL:
-            return ffi.unpack(info.v_realdata + start, stop - start)
-        return self.vector(name, start, stop).tolist()
+        # (``_span`` and ``vector_info`` written out: a coupled macro step reads two or three
+        # columns this way, and their two calls each cost ~0.5 us of it)
+        encoded = self._encoded.get(name)
+        info = self._ngspice_shared.ngGet_Vec_Info(encoded if encoded is not None else self._encode(name))
+        if info == ffi.NULL:
+            raise KeyError(f"ngspice has no vector {name!r} in the current plot")
+        data = info.v_realdata
+        if data == ffi.NULL:
+            return self.vector(name, start, stop).tolist()
+        n = info.v_length
+        stop = n if stop is None else min(stop, n)
+        start = max(0, min(start, stop))
+        return ffi.unpack(data + start, stop - start)
 
     def length(self) -> int:
         info = self.vector_info("time")
