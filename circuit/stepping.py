@@ -123,6 +123,9 @@ class Stepper:
         self._sliver = self.options.sliver(self.t_end)
         self._min_break = self.options.min_break(self.t_end)
         self._end_tolerance = self.options.end_tolerance(self.t_end)
+        self._tol = 1e-12 * self.t_end  # s: how far past t_end a macro step's end is taken as t_end
+        # the first contact's suffix (its scalars are StepResult's attributes), None without one
+        self._first = self.probes.contacts[0].suffix if self.probes.contacts else None
         self._session: NgspiceSession | None = None
         self._t = 0.0
         self._started = False
@@ -195,7 +198,7 @@ class Stepper:
             raise ValueError(f"the run is finished (t_end = {self.t_end!r} s)")
         if not max_step > 0.0:  # (also NaN)
             raise ValueError(f"max_step = {max_step!r} s: must be > 0 (inf: no bound)")
-        tol = 1e-12 * self.t_end
+        tol = self._tol
         if not (t_next > t0 and t_next <= self.t_end + tol):
             raise ValueError(
                 f"t_next = {t_next!r} s: must satisfy {t0!r} < t_next <= t_end = {self.t_end!r} s"
@@ -250,7 +253,7 @@ class Stepper:
         self._t = t_next
         self._finished = final
         self._steps += 1
-        first = self.probes.contacts[0].suffix if self.probes.contacts else None
+        first = self._first
         read, floats = self._reader(first_index, last_index)
         return StepResult(
             t_start=t0,
