@@ -980,8 +980,8 @@ class NgspiceSession:
         self._deadline = math.inf if wall_timeout is None else time.monotonic() + wall_timeout
         self._target = math.inf if target is None else float(target)
         self._max_step = float(max_step)
-        ended = t_end - max(1e-9 * t_end, end_tolerance)  # ngspice ends a run within this of t_end
-        threshold = ended if target is None else target - stop_margin(target)
+        # (ngspice ends a run within max(1e-9 * t_end, end_tolerance) of t_end)
+        threshold = t_end - max(1e-9 * t_end, end_tolerance) if target is None else target - stop_margin(target)
         try:
             if first:
                 self._abandon_run()

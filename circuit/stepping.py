@@ -255,18 +255,19 @@ class Stepper:
         self._steps += 1
         first = self._first
         read, floats = self._reader(first_index, last_index)
+        # (by position, in the fields' order: keywords cost a macro step ~0.4 us more)
         return StepResult(
-            t_start=t0,
-            t_end=landed,
-            contact_voltage=math.nan if first is None else scalars["contact_voltage" + first],
-            contact_current=math.nan if first is None else scalars["contact_current" + first],
-            load_current=scalars["load_current"],
-            arc_current=math.nan if first is None else scalars["arc_current" + first],
-            points=last_index - first_index - 1,
-            reader=read,
-            values=scalars,
-            columns=self._columns,
-            floats=floats,
+            t0,  # t_start
+            landed,  # t_end
+            math.nan if first is None else scalars["contact_voltage" + first],  # contact_voltage
+            math.nan if first is None else scalars["contact_current" + first],  # contact_current
+            scalars["load_current"],  # load_current
+            math.nan if first is None else scalars["arc_current" + first],  # arc_current
+            last_index - first_index - 1,  # points
+            read,  # reader
+            scalars,  # values
+            self._columns,  # columns
+            floats,  # floats
         )
 
     def _input_functions(self, conductance, gap, inputs) -> dict[str, Conductance]:
