@@ -530,7 +530,8 @@ class NgspiceSession:
 
     def _mirror_steps(self) -> None:
         """The step control's fields that only Python writes into the compiled sync callback's
-        state (after Python changed any: a pause's start and end, the arcs, a breakpoint);
+        state (before ngspice steps again after Python changed any: a pause's start, the
+        arcs, a breakpoint, a clear; a pause's end leaves them, as ngspice takes no step then);
         the accepting time and the arcs' step bounds, which both write, are copied where
         Python sets them (``_set_arc_bounds``, ``_on_sync_from_c``). The arcs' ties to the
         input channels are written afresh after either changed, on both routes."""
@@ -1016,7 +1017,8 @@ class NgspiceSession:
         finally:
             # (Python's fields only: the compiled state keeps this pause's until the next
             # transient, set_breakpoint or clear mirrors them, as ngspice takes no step
-            # while paused or after its run ended; ~1.5 us a macro step)
+            # while paused or after its run ended, and an abandoned run, resumed with its
+            # failure set, aborts without reading them; ~1 us a macro step)
             self._target = math.inf
             self._max_step = math.inf
             self._deadline = math.inf
