@@ -252,6 +252,11 @@ def _kept(times: list[float], *series: list[float]) -> tuple[list[float], ...]:
     if all(later):  # (every point kept; none or one point)
         return (times, *series)
     lists = (times, *series)
+    if later.count(False) == 1:  # (the usual one: a step's first point, the last one's repeat)
+        k = later.index(False) + 1
+        for values in lists:
+            del values[k]
+        return lists
     for k in reversed(list(compress(range(1, len(times)), map(not_, later)))):
         for values in lists:
             del values[k]
@@ -275,7 +280,10 @@ class Tail:
     def observe_floats(self, t: list[float], v: list[float], jumped: bool) -> None:
         """``observe`` on the step's points as lists of floats (a caller that has them as
         lists already: the coil's two tails share the step's times)."""
-        times, values = _kept((self.t + t)[-TAIL_POINTS:], (self.v + v)[-TAIL_POINTS:])
+        # (the last TAIL_POINTS of each: new lists, whose head is deleted in place)
+        times, values = self.t + t, self.v + v
+        del times[:-TAIL_POINTS], values[:-TAIL_POINTS]
+        times, values = _kept(times, values)
         if jumped:
             times, values = times[-1:], values[-1:]
         self.t, self.v = times, values
@@ -284,8 +292,10 @@ class Tail:
         """``observe_floats(t, v, False)`` on this tail and ``other.observe_floats(t, w, False)``
         on a tail that has seen the same times (the coil's psi^2 and psi): which points are
         kept depends on the times alone, so it is worked out once (~3 us of a coil macro step)."""
-        times, values, others = _kept((self.t + t)[-TAIL_POINTS:], (self.v + v)[-TAIL_POINTS:],
-                                      (other.v + w)[-TAIL_POINTS:])
+        # (the last TAIL_POINTS of each: new lists, whose head is deleted in place)
+        times, values, others = self.t + t, self.v + v, other.v + w
+        del times[:-TAIL_POINTS], values[:-TAIL_POINTS], others[:-TAIL_POINTS]
+        times, values, others = _kept(times, values, others)
         # (one list for both tails' times: a tail replaces its lists, never changes them)
         self.t, self.v = times, values
         other.t, other.v = times, others
