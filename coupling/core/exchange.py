@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import math
 from bisect import bisect_right
+from itertools import compress
+from operator import lt, not_
 
 import numpy as np
 from mech.gauss import LEGGAUSS
@@ -217,16 +219,16 @@ def pieces_travel(segments: list[tuple], which: np.ndarray, times: np.ndarray) -
     start finds its dense step among all segments' step ends."""
     which = np.asarray(which, dtype=np.intp)
     times = np.asarray(times, dtype=np.float64)
-    starts = np.array([seg[0] for seg in segments])[which]
-    at_start = np.array([seg[1] for seg in segments])[which]
-    counts = np.array([len(seg[2]) for seg in segments], dtype=np.intp)
+    if not segments:
+        return np.array([])[which]
+    # (the segments' fields as columns in one pass: zip in C, no comprehension per field)
+    starts, at_start, ends, t0, h, c = zip(*segments)
+    starts, at_start = np.array(starts)[which], np.array(at_start)[which]
+    counts = np.array(list(map(len, ends)), dtype=np.intp)
     if not counts.sum():
         return at_start
     offsets = np.concatenate(([0], np.cumsum(counts)[:-1]))
-    ends = np.concatenate([seg[2] for seg in segments])
-    t0 = np.concatenate([seg[3] for seg in segments])
-    h = np.concatenate([seg[4] for seg in segments])
-    c = np.concatenate([seg[5] for seg in segments])
+    ends, t0, h, c = np.concatenate(ends), np.concatenate(t0), np.concatenate(h), np.concatenate(c)
     own, count = offsets[which], counts[which]
     # (min(bisect_left(its ends, t), n - 1) in its own segment; the earlier segments' ends all
     # lie before a time after its segment's start, the later ones' after it)
@@ -241,11 +243,24 @@ def pieces_travel(segments: list[tuple], which: np.ndarray, times: np.ndarray) -
 
 def _kept(times: list[float], *series: list[float]) -> tuple[list[float], ...]:
     """(times, *series) without the points no later than the one before them (a step's first
-    point is the previous step's last): a Tail's filter."""
-    keep = [k for k in range(1, len(times)) if times[k] - times[k - 1] > 0.0]
-    if len(keep) >= len(times) - 1:  # (every point kept; none or one point)
+    point is the previous step's last): a Tail's filter. The lists are its caller's fresh
+    slices, and are changed in place."""
+    # (later[k - 1]: times[k] is later than times[k - 1], t_k - t_(k-1) > 0 for doubles; the
+    # mask and the points it drops found in C (map, compress) and deleted, no Python frame
+    # per point: ~1 us less a call, once or twice a macro step)
+    later = list(map(lt, times, times[1:]))
+    if all(later):  # (every point kept; none or one point)
         return (times, *series)
-    return tuple([values[0]] + [values[k] for k in keep] for values in (times, *series))
+    lists = (times, *series)
+    if later.count(False) == 1:  # (the usual one: a step's first point, the last one's repeat)
+        k = later.index(False) + 1
+        for values in lists:
+            del values[k]
+        return lists
+    for k in reversed(list(compress(range(1, len(times)), map(not_, later)))):
+        for values in lists:
+            del values[k]
+    return lists
 
 
 class Tail:
@@ -265,7 +280,10 @@ class Tail:
     def observe_floats(self, t: list[float], v: list[float], jumped: bool) -> None:
         """``observe`` on the step's points as lists of floats (a caller that has them as
         lists already: the coil's two tails share the step's times)."""
-        times, values = _kept((self.t + t)[-TAIL_POINTS:], (self.v + v)[-TAIL_POINTS:])
+        # (the last TAIL_POINTS of each: new lists, whose head is deleted in place)
+        times, values = self.t + t, self.v + v
+        del times[:-TAIL_POINTS], values[:-TAIL_POINTS]
+        times, values = _kept(times, values)
         if jumped:
             times, values = times[-1:], values[-1:]
         self.t, self.v = times, values
@@ -274,8 +292,10 @@ class Tail:
         """``observe_floats(t, v, False)`` on this tail and ``other.observe_floats(t, w, False)``
         on a tail that has seen the same times (the coil's psi^2 and psi): which points are
         kept depends on the times alone, so it is worked out once (~3 us of a coil macro step)."""
-        times, values, others = _kept((self.t + t)[-TAIL_POINTS:], (self.v + v)[-TAIL_POINTS:],
-                                      (other.v + w)[-TAIL_POINTS:])
+        # (the last TAIL_POINTS of each: new lists, whose head is deleted in place)
+        times, values, others = self.t + t, self.v + v, other.v + w
+        del times[:-TAIL_POINTS], values[:-TAIL_POINTS], others[:-TAIL_POINTS]
+        times, values, others = _kept(times, values, others)
         # (one list for both tails' times: a tail replaces its lists, never changes them)
         self.t, self.v = times, values
         other.t, other.v = times, others
@@ -644,9 +664,12 @@ class CoilLink:
         t_list, psi_list = step.floats("time"), step.floats(self._flux_column)
         self.tail.observe_pair(self.flux_tail, t_list, [p * p for p in psi_list] if self.separable else psi_list,
                                psi_list)
-        self.flux_rate = self.flux_tail.derivatives(policy.macro_step)[0]
-        self.value = self.signal(self.flux(step))
-        self.rate, curvature = self.tail.derivatives(policy.macro_step)
+        # (end_derivatives and ``signal(flux(step))`` called inline: a Python call each less)
+        macro = policy.macro_step
+        self.flux_rate = end_derivatives(self.flux_tail.t, self.flux_tail.v, macro)[0]
+        psi = float(step.values[self._flux_column])
+        self.value = psi * psi if self.separable else psi
+        self.rate, curvature = end_derivatives(self.tail.t, self.tail.v, macro)
         self.curvature = curvature or 0.0
         curve = time_scale(self.rate, curvature, self.tail.v[-1] if self.rate != 0.0 else 0.0)
         # what the drive is extrapolated over (policy.extrapolate's horizon): the time scales
@@ -758,26 +781,35 @@ class CoilLink:
         which = [index for index, step_times in pending_q for _ in step_times]
         times = [t for _, step_times in pending_q for t in step_times]
         samples = len(times)
-        piece_step, piece_start, piece_length = [], [], []
+        piece_step, piece_index, piece_start, piece_length = [], [], [], []
         for k, (index, t0, t1, drive0, drive1, cuts) in enumerate(pending_work):
             which.append(index)
             times.append(t1)
             if t1 - t0 > 0.0 and drive1 != drive0 and (drive1 - drive0) / (t1 - t0) != 0.0:
-                inner = sorted(c for c in cuts if t0 < c < t1) if cuts else ()
+                if not cuts:  # (the usual step, without events: one piece, [t0, t1])
+                    piece_step.append(k)
+                    piece_index.append(index)
+                    piece_start.append(t0)
+                    piece_length.append(t1 - t0)
+                    continue
+                inner = sorted(c for c in cuts if t0 < c < t1)
                 edges = [t0, *inner, t1]
                 for j in range(len(edges) - 1):
                     piece_step.append(k)
+                    piece_index.append(index)
                     piece_start.append(edges[j])
                     piece_length.append(edges[j + 1] - edges[j])
         a, h = np.array(piece_start), np.array(piece_length)
         nodes = a[:, None] + np.array(GAUSS_NODES)[None, :] * h[:, None]
-        which += [pending_work[k][0] for k in piece_step for _ in range(RECEIVED_NODES)]
+        # (each piece's segment once per node, in the nodes' order)
+        which = np.concatenate([np.array(which, dtype=np.intp),
+                                np.repeat(np.array(piece_index, dtype=np.intp), RECEIVED_NODES)])
         q = pieces_travel(segments, which, np.concatenate([times, nodes.ravel()]))
         self._q.extend(q[:samples].tolist())
         if not pending_work:
             return
         steps = len(pending_work)
-        starts = np.array([segments[index][1] for index, *_ in pending_work])  # q at each step's start
+        starts = np.array([segments[work[0]][1] for work in pending_work])  # q at each step's start
         g = self._gain_integral.many(np.concatenate([q[samples:], starts]))
         g_end, g_nodes, g_start = g[:steps].tolist(), g[steps:-steps].reshape(nodes.shape), g[-steps:]
         sums = []
@@ -793,23 +825,25 @@ class CoilLink:
                 piece = piece + terms[:, j]
             sums = (h * piece).tolist()
         g_start = g_start.tolist()
-        p = 0
+        # (the sum in a local, stored at the end: the same additions in the same order)
+        received, p, count = self._received, 0, len(piece_step)
         for k, (_, t0, t1, drive0, drive1, _cuts) in enumerate(pending_work):
             span = t1 - t0
             if span <= 0.0:
-                self._received += 0.0
+                received += 0.0
                 continue
             g0 = g_start[k]
             work = drive1 * (g_end[k] - g0)
             slope = (drive1 - drive0) / span
             if slope == 0.0:
-                self._received += work
+                received += work
                 continue
             total = 0.0
-            while p < len(piece_step) and piece_step[p] == k:
+            while p < count and piece_step[p] == k:
                 total += sums[p]
                 p += 1
-            self._received += work - slope * total
+            received += work - slope * total
+        self._received = received
 
     def columns(self, waves: dict) -> dict:
         """The result's coil columns beside the circuit's (coil_current, coil_voltage,

@@ -250,9 +250,14 @@ class CoSimulation:
         rate, scale = 0.0, math.inf  # dI/dt of the loop current at t (A/s) and its time scale (s)
         coil_switched = False  # the last step ended at a switching of the coil's drive
         quiet = 0.0  # s: the last step's length if the contact stayed closed and the current steady
+        # (looked up once a run, not at each macro step: the same doubles)
+        coil_policy = self.coil_policy
+        coil_probe = coil_policy.probe if coil is not None else 0.0
+        progress = self.progress
+        last = t_end * (1.0 - 1e-14)
         try:
             with stepper, _deferred_interrupt() as interrupted:
-                while t < t_end * (1.0 - 1e-14):
+                while t < last:
                     if interrupted():  # Ctrl-C, taken here between macro steps
                         raise KeyboardInterrupt
                     # a bar held at rest (mech: loads constant, contacts quiet) changes nothing
@@ -279,19 +284,18 @@ class CoSimulation:
                         if coil is not None:  # the flux linkage: its time-scale rule, always watched
                             # (right after the drive switched, the short step of a jump)
                             switched = coil_switched
-                            t_coil, coil.slope = self.coil_policy.plan(t, t_next, t_end, touching=True,
-                                                                       jumped=switched, current=coil.value,
-                                                                       rate=coil.rate, scale=coil.scale,
-                                                                       curvature=coil.curvature)
+                            t_coil, coil.slope = coil_policy.plan(t, t_next, t_end, touching=True, jumped=switched,
+                                                                  current=coil.value, rate=coil.rate,
+                                                                  scale=coil.scale, curvature=coil.curvature)
                             # the gap rule itself holds while the armature moves, steady flux
                             # or not: a released armature's return flight under a flux below
                             # the change rule's floor (6e-4 of the rated psi^2 on the default
                             # relay) took one 1 ms step, the drive held, and the coil-armature
                             # interface missed 7.5e-4 of the energy into the coil (2.1e-4 with the rule)
-                            t_coil = min(t_coil, t + max(self.coil_policy.probe, coil.gap_scale))
+                            t_coil = min(t_coil, t + max(coil_probe, coil.gap_scale))
                             # and since the armature left a seat, steps no longer than that
                             # time (_approach_unseat)
-                            t_coil = min(t_coil, t + max(self.coil_policy.macro_step, t - coil.left_seat))
+                            t_coil = min(t_coil, t + max(coil_policy.macro_step, t - coil.left_seat))
                             switch = coil.next_switch(t)
                             t_next = min(t_next, t_coil, switch)
                             coil_switched = t_next == switch
@@ -303,7 +307,8 @@ class CoSimulation:
                         jump_since_prev = jumped
                     self.stats["macro_steps"] += 1
                     self.stats["contact_steps"] += int(touching)
-                    self.progress(t)
+                    if progress.enabled:  # (no call a macro step for a run without progress reports)
+                        progress(t)
                     if self.watch is not None:
                         self.watch(mech)
                 self.stats["wall_time"] = time.perf_counter() - tick
@@ -337,7 +342,7 @@ class CoSimulation:
         def current_at(s):
             return policy.extrapolate(i_now, slope, s - t, horizon)
 
-        mu0 = [link.mu(link.own(current_at(t))) for link in links]
+        mu0 = [link.mu(link.own(current_at(t))) for link in links] if links else ()
         arm = mech.armature_now() if coil is not None else None
 
         def drives(end: float) -> dict:
@@ -366,7 +371,8 @@ class CoSimulation:
         seg = mech.advance(t_next, drives(t_next), stop_at_switch=in_flight)
         if seated:
             t_next, seg = self._approach_unseat(mech, start, t, t_next, seg, drives, in_flight)
-        switching = [e["time"] for e in seg.events if e["kind"] in CONTACT_EVENTS]
+        # (most segments have no events: no list comprehension run for none)
+        switching = [e["time"] for e in seg.events if e["kind"] in CONTACT_EVENTS] if seg.events else []
         aligned = False
         if cp is not None and switching:
             end = policy.aligned_end(t, t_next, switching[0])

@@ -227,20 +227,26 @@ def end_derivatives(t: Sequence[float], i: Sequence[float], span: float) -> tupl
     (dI/dt, None) without a third."""
     if len(t) < 2 or not all(map(math.isfinite, i[-3:])):  # (map: no generator per call, twice a macro step)
         return 0.0, None
+    # (the shortest difference and the points it needs looked up once: the same doubles)
+    least = 1e-3 * span
+    t_last, t_k = t[-1], t[-2]
     k = len(t) - 2
-    while k > 0 and t[-1] - t[k] < 1e-3 * span:
+    while k > 0 and t_last - t_k < least:
         k -= 1
-    dt = t[-1] - t[k]
+        t_k = t[k]
+    dt = t_last - t_k
     if dt <= 0:
         return 0.0, None
-    rate = float((i[-1] - i[k]) / dt)
+    i_k = i[k]
+    rate = float((i[-1] - i_k) / dt)
     j = k - 1
-    while j > 0 and t[k] - t[j] < 1e-3 * span:
+    while j > 0 and t_k - t[j] < least:
         j -= 1
-    if j < 0 or t[k] <= t[j]:
+    if j < 0 or t_k <= t[j]:
         return rate, None
-    previous = (i[k] - i[j]) / (t[k] - t[j])
-    return rate, 2.0 * (rate - previous) / (t[-1] - t[j])
+    t_j = t[j]
+    previous = (i_k - i[j]) / (t_k - t_j)
+    return rate, 2.0 * (rate - previous) / (t_last - t_j)
 
 
 def end_rate(t: Sequence[float], i: Sequence[float], span: float) -> tuple[float, float]:
