@@ -90,6 +90,8 @@ class Recorder:
         self.dense_t0 = np.empty(dcap)
         self.dense_h = np.empty(dcap)
         self.dense_coef = np.empty((dcap, 5, state_size))
+        # the dense rows DENSE_BYTES hold (state_size is fixed: _ensure reads this at every segment)
+        self._dense_rows_max = DENSE_BYTES // (8 * (2 + 5 * state_size))
 
     @property
     def recorded(self) -> int:
@@ -100,7 +102,10 @@ class Recorder:
         """Make room for ``rows`` more rows after ``n`` (and one spare) and for a stepper's
         room up to ``room_end``: past ``row_limit`` rows by thinning (``on_full``) first,
         by growing where that freed too little."""
-        self._extend_room(rows)
+        # (the room's test inline, ``recorded`` as a sum: reserve runs at every segment,
+        # and the room is extended once in thousands of them)
+        if self.n + self.dropped + rows + 1 > self.room_end:
+            self._extend_room(rows)
         if (self.on_full is not None and self.row_limit is not None and self.n >= self.row_limit
                 and (self.n + self.room_end - self.recorded > self.capacity or self.n >= self.thin_at)):
             self.on_full()
@@ -125,8 +130,11 @@ class Recorder:
         The dense buffer spans the stepper's room up to DENSE_BYTES, and beyond that what
         the current rows need: a stepper then returns more often, each time the dense
         buffer is full (the rows since the last release are all kept)."""
-        self._extend_room(rows)
-        need = self.n + self.room_end - self.recorded
+        n = self.n
+        recorded = n + self.dropped  # (self.recorded, read once: no property call a segment)
+        if recorded + rows + 1 > self.room_end:
+            self._extend_room(rows)
+        need = n + self.room_end - recorded
         if need > self.capacity:
             cap = self.capacity
             while cap < need:
@@ -135,9 +143,9 @@ class Recorder:
                 cap = need  # past the limit (thinning freed too little): no more than needed
             self.grow(cap)
         if self.keep_dense:
-            used = self.n - self.dense_base
-            span = used + self.room_end - self.recorded
-            size = max(min(span, DENSE_BYTES // (8 * (2 + 5 * self.y.shape[1]))), used + rows + 1)
+            used = n - self.dense_base
+            span = used + self.room_end - recorded
+            size = max(min(span, self._dense_rows_max), used + rows + 1)
             if size > len(self.dense_t0):
                 cap = len(self.dense_t0)
                 while cap < size:
@@ -183,7 +191,7 @@ class Recorder:
         the dense output (t0, h, coef) (a one-row scratch when dense output is not kept).
         Both views are equally long, so a stepper that fills one never overruns the other."""
         n = self.n
-        room = min(self.capacity - n, self.room_end - self.recorded)
+        room = min(self.capacity - n, self.room_end - n - self.dropped)  # (the property read inline)
         if self.keep_dense:
             d = n - self.dense_base
             dense_room = min(room, len(self.dense_t0) - d)
