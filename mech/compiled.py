@@ -75,16 +75,29 @@ def _checked(name: str, fn, check):
     return call
 
 
-def _variant(name: str, plain, armature, count: int):
-    """A VARIANTS entry point: ``plain`` or ``armature`` (both _checked) by its last argument,
-    the armature's arrays (``count`` arguments in all; left out: None)."""
+def _variant(name: str, plain, armature, count: int, checks: tuple):
+    """A VARIANTS entry point: ``plain`` or ``armature`` (the module's two functions) by its
+    last argument, the armature's arrays (``count`` arguments in all; left out: None), its
+    arguments checked first as _checked does (``checks``: plain's and armature's check). One
+    function, not a choice that calls a _checked one: a Python call and the arguments'
+    repacking less at each compiled call (a coupled macro step makes one or two)."""
+    plain_check, armature_check = checks
+
     def call(*args):
         if len(args) < count:
             args = args + (None,)
-        return (plain if args[-1] is None else armature)(*args)
+        fn, check = (plain, plain_check) if args[-1] is None else (armature, armature_check)
+        try:
+            check(args)
+        except TypeError as err:
+            warnings.warn(f"{err}: calling numba's just-in-time {name} instead (add the call to "
+                          "mech.aot_build.warm_up)", CompiledArgumentWarning, stacklevel=2)
+            return _jit(name)(*args)
+        return fn(*args)
 
     call.__name__ = call.__qualname__ = name
-    call.__doc__ = plain.__doc__ + f" (for a model with an armature: {name}{ARMATURE_SUFFIX})"
+    call.__doc__ = (f"{name} from the ahead-of-time module, its arguments checked first (for a model "
+                    f"with an armature: {name}{ARMATURE_SUFFIX})")
     return call
 
 
@@ -92,11 +105,12 @@ def _load_aot(module, folder) -> dict:
     checks = aot.argument_checks(folder)
     out = {}
     for name in ENTRY_POINTS:
-        fn = _checked(name, getattr(module, name), checks[name])
         if name in VARIANTS:
             arm = name + ARMATURE_SUFFIX
-            fn = _variant(name, fn, _checked(name, getattr(module, arm), checks[arm]), aot.argument_count(folder, name))
-        out[name] = fn
+            out[name] = _variant(name, getattr(module, name), getattr(module, arm), aot.argument_count(folder, name),
+                                 (checks[name], checks[arm]))
+        else:
+            out[name] = _checked(name, getattr(module, name), checks[name])
     return out
 
 

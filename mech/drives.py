@@ -11,6 +11,7 @@ it is in mech.kernel.dynamics.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping
 
@@ -102,13 +103,26 @@ def step_targets(names: tuple, drives, mu) -> dict[int, tuple[float, float]]:
     if type(drives) is not dict and not isinstance(drives, Mapping):  # (the ABC's check skipped for a dict)
         raise ValueError(f"drives = {drives!r}: expected a mapping of channel names to values "
                          f"(channels: {', '.join(names)})")
+    channels = _channels(names if type(names) is tuple else tuple(names))  # (a list is not hashable)
     for name, value in drives.items():
-        if name not in names:
+        channel = channels.get(name)
+        if channel is None:
             raise ValueError(f"drives: unknown channel {name!r}; this model's channels are {', '.join(names)}")
         if mu is not None and name.startswith("mu."):
             raise ValueError(f"drives[{name!r}] and mu = {mu!r} both given: mu sets every mu.<i>; give one")
         # (the channel's name, not its message: built only for an error, not once a macro step)
-        out[names.index(name)] = _pair(kind_of(name), value, name)
+        out[channel[0]] = _pair(channel[1], value, name)
+    return out
+
+
+@functools.lru_cache(maxsize=64)
+def _channels(names: tuple) -> dict[str, tuple[int, DriveKind]]:
+    """name -> (row, kind) of each channel of ``names`` (its first row, as names.index):
+    looked up once per names tuple, not by index() and kind_of() once a macro step."""
+    out: dict[str, tuple[int, DriveKind]] = {}
+    for row, name in enumerate(names):
+        if name not in out:
+            out[name] = (row, kind_of(name))
     return out
 
 

@@ -184,16 +184,19 @@ def _rk_stages(t, y, h, k1, k2, k3, k4, k5, k6, k7, ytmp, ynew, mdl,
 
 
 @njit(cache=True)
-def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, store_dense, max_steps, work, stats,
-              arm=None):
+def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, first, dense_first, room, store_dense,
+              max_steps, work, stats, arm=None):
     """Advance y (in place) from t (s) towards t_stop (s), starting with step h (s; 0: choose).
 
     tol: (hmax s, rtol, atol per component, relmask per component: 1 where rtol applies).
     mdl: the model arrays with the drive (model.BarModel.kernel_arrays); regime and eref:
     the regimes and reference slip directions (read only); ev_sign: the side of each watched
     event function, updated at each accepted step.
-    rec: (t, y, aux, fmax) buffers from the first free row (mech.recorder.Recorder.free_rows);
-    dense: (t0, h, coef) likewise, written only with store_dense.
+    rec: (t, y, aux, fmax) buffers, written from row ``first`` on, ``room`` rows at most;
+    dense: (t0, h, coef) likewise from row ``dense_first``, written only with store_dense
+    (mech.recorder.Recorder.free_window: the recorder's whole buffers, the same tuples at
+    every call, which the Python side's argument check passes by identity, where the
+    free rows as views were seven new arrays to check at every segment).
     Returns (status, t, h_next, n_records, event_index); after an event, h_next is the
     step size in use before the step was cut at the event. Every accepted step is recorded
     (time, state, per-tip aux and the largest normal force seen at the step's ends and
@@ -203,8 +206,13 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
     model without an armature runs code compiled without it).
     """
     hmax, rtol, atol, relmask = tol
-    rec_t, rec_y, rec_aux, rec_fmax = rec
-    dense_t0, dense_h, dense_coef = dense
+    # (the free rows as views, cut as Recorder.free_rows cuts them; a slice past a buffer's
+    # end ends at it: the one-row dense scratch when the dense output is not kept)
+    end = first + room
+    rec_t = rec[0][first:end]
+    free = (rec_t, rec[1][first:end], rec[2][first:end], rec[3][first:end])
+    dense_end = dense_first + room
+    free_dense = (dense[0][dense_first:dense_end], dense[1][dense_first:dense_end], dense[2][dense_first:dense_end])
     N = y.shape[0]
     rows = mdl[9].shape[0]  # contact rows
     nev = rows * NEV_TIP + NEV_ARM
@@ -420,7 +428,7 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
                 first_theta = 1.0
             dynamics(tev, ymid, mdl, regime, eref, ytmp, aux_new, work, arm)
             stats[2] += 1
-            _record(n_rec, t, h, tev, ymid, aux_new, aux_old, coef, rec, dense, store_dense, mdl, first_theta,
+            _record(n_rec, t, h, tev, ymid, aux_new, aux_old, coef, free, free_dense, store_dense, mdl, first_theta,
                     yrec, frec, work)
             n_rec += 1
             for i in range(N):
@@ -428,7 +436,7 @@ def integrate(t, y, t_stop, h, tol, mdl, regime, eref, ev_sign, rec, dense, stor
             stats[0] += 1
             stats[3] += 1
             return EVENT, tev, h_continue, n_rec, first_k
-        _record(n_rec, t, h, t + h, ynew, aux_new, aux_old, coef, rec, dense, store_dense, mdl, 1.0,
+        _record(n_rec, t, h, t + h, ynew, aux_new, aux_old, coef, free, free_dense, store_dense, mdl, 1.0,
                 yrec, frec, work)
         n_rec += 1
         stats[0] += 1

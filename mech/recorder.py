@@ -90,6 +90,9 @@ class Recorder:
         self.dense_t0 = np.empty(dcap)
         self.dense_h = np.empty(dcap)
         self.dense_coef = np.empty((dcap, 5, state_size))
+        self._buffers = self._dense_buffers = ()  # free_window's tuples of the buffers
+        # the dense rows DENSE_BYTES hold (state_size is fixed: _ensure reads this at every segment)
+        self._dense_rows_max = DENSE_BYTES // (8 * (2 + 5 * state_size))
 
     @property
     def recorded(self) -> int:
@@ -100,7 +103,10 @@ class Recorder:
         """Make room for ``rows`` more rows after ``n`` (and one spare) and for a stepper's
         room up to ``room_end``: past ``row_limit`` rows by thinning (``on_full``) first,
         by growing where that freed too little."""
-        self._extend_room(rows)
+        # (the room's test inline, ``recorded`` as a sum: reserve runs at every segment,
+        # and the room is extended once in thousands of them)
+        if self.n + self.dropped + rows + 1 > self.room_end:
+            self._extend_room(rows)
         if (self.on_full is not None and self.row_limit is not None and self.n >= self.row_limit
                 and (self.n + self.room_end - self.recorded > self.capacity or self.n >= self.thin_at)):
             self.on_full()
@@ -125,8 +131,11 @@ class Recorder:
         The dense buffer spans the stepper's room up to DENSE_BYTES, and beyond that what
         the current rows need: a stepper then returns more often, each time the dense
         buffer is full (the rows since the last release are all kept)."""
-        self._extend_room(rows)
-        need = self.n + self.room_end - self.recorded
+        n = self.n
+        recorded = n + self.dropped  # (self.recorded, read once: no property call a segment)
+        if recorded + rows + 1 > self.room_end:
+            self._extend_room(rows)
+        need = n + self.room_end - recorded
         if need > self.capacity:
             cap = self.capacity
             while cap < need:
@@ -135,9 +144,9 @@ class Recorder:
                 cap = need  # past the limit (thinning freed too little): no more than needed
             self.grow(cap)
         if self.keep_dense:
-            used = self.n - self.dense_base
-            span = used + self.room_end - self.recorded
-            size = max(min(span, DENSE_BYTES // (8 * (2 + 5 * self.y.shape[1]))), used + rows + 1)
+            used = n - self.dense_base
+            span = used + self.room_end - recorded
+            size = max(min(span, self._dense_rows_max), used + rows + 1)
             if size > len(self.dense_t0):
                 cap = len(self.dense_t0)
                 while cap < size:
@@ -183,7 +192,7 @@ class Recorder:
         the dense output (t0, h, coef) (a one-row scratch when dense output is not kept).
         Both views are equally long, so a stepper that fills one never overruns the other."""
         n = self.n
-        room = min(self.capacity - n, self.room_end - self.recorded)
+        room = min(self.capacity - n, self.room_end - n - self.dropped)  # (the property read inline)
         if self.keep_dense:
             d = n - self.dense_base
             dense_room = min(room, len(self.dense_t0) - d)
@@ -198,6 +207,31 @@ class Recorder:
             records = tuple(a[:room] for a in records)
             return records, (self.dense_t0[d:d + room], self.dense_h[d:d + room], self.dense_coef[d:d + room])
         return records, (self.dense_t0, self.dense_h, self.dense_coef)
+
+    def free_window(self) -> tuple:
+        """``free_rows`` as the buffers and where their views start: ((t, y, aux, fmax), (t0,
+        h, coef), first, dense_first, room); free_rows' views are the buffers' ``room`` rows
+        from ``first`` (the dense buffers' from ``dense_first``; a cut past the one-row
+        scratch, when the dense output is not kept, ends at its end). The tuples are the
+        same objects while the buffers are the same arrays: the compiled stepper's argument
+        check (mech.aot) then passes them by identity, where free_rows' seven new views were
+        checked one by one at every segment (~1.5 us, and ~1 us to cut them)."""
+        bufs = self._buffers
+        if not (bufs and bufs[0] is self.t and bufs[1] is self.y and bufs[2] is self.aux and bufs[3] is self.fmax):
+            bufs = self._buffers = (self.t, self.y, self.aux, self.fmax)
+        dense = self._dense_buffers
+        if not (dense and dense[0] is self.dense_t0 and dense[1] is self.dense_h and dense[2] is self.dense_coef):
+            dense = self._dense_buffers = (self.dense_t0, self.dense_h, self.dense_coef)
+        n = self.n
+        room = min(self.capacity - n, self.room_end - n - self.dropped)  # (as free_rows)
+        if not self.keep_dense:
+            return bufs, dense, n, 0, room
+        d = n - self.dense_base
+        dense_room = min(room, len(self.dense_t0) - d)
+        if dense_room >= 0:  # (always, after reserve)
+            return bufs, dense, n, d, dense_room
+        rows, dense_rows = self.free_rows()  # (otherwise free_rows' own cut, as views)
+        return rows, dense_rows, 0, 0, len(rows[0])
 
     def commit(self, rows: int, regime: np.ndarray) -> None:
         """Count the ``rows`` a stepper wrote after ``n`` as recorded, in ``regime``."""

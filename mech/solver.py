@@ -51,6 +51,7 @@ from .stepping import CompiledStepper, Stepper
 from .frozen import frozen
 
 REGIME_NAMES = ("free", "slip", "stick")
+_FLOAT64 = np.dtype(np.float64)
 EVENT_KINDS = ("contact", "clip", "slip", "stick", "compression")
 ARMATURE_EVENTS = {EA_REST: ("armature_stop", "rest"), EA_POLE: ("armature_stop", "pole"), EA_CARD: ("card", "")}
 CHATTER_LIMIT = 200  # events at one instant (within round-off, or picoseconds apart) before the run is stopped
@@ -251,9 +252,13 @@ class Segment:
         n = len(self._t_valid)
         if a < 0 or (n and not len(self._coef)):
             return None
-        return (float(self._start_state[a]), np.ascontiguousarray(self._t_valid, dtype=np.float64),
-                np.ascontiguousarray(self._t0[:n], dtype=np.float64), np.ascontiguousarray(self._h[:n], dtype=np.float64),
-                np.ascontiguousarray(self._coef[:n, :, a], dtype=np.float64))
+        t0, h = self._t0, self._h
+        if len(t0) != n or len(h) != n:  # (advance makes them n long: no views cut then)
+            t0, h = t0[:n], h[:n]
+        # (the dtype as a dtype object: np.float64, a type, is converted at each call, ~0.15 us)
+        return (float(self._start_state[a]), np.ascontiguousarray(self._t_valid, dtype=_FLOAT64),
+                np.ascontiguousarray(t0, dtype=_FLOAT64), np.ascontiguousarray(h, dtype=_FLOAT64),
+                np.ascontiguousarray(self._coef[:n, :, a], dtype=_FLOAT64))
 
     def pair_forces(self, t: float) -> np.ndarray:
         """(rows, 3) at t (s): each contact row's (pair's, ImpactSolver.pairs) normal force
@@ -383,7 +388,8 @@ class ImpactSolver:
                 f"{MEMORY_LIMIT / 2**30:g} GiB a run may take; keep fewer rows (or fewer modes)")
         self.recorder = Recorder(m.state_size, len(self.z), capacity, keep_dense, row_limit=keep, contact_rows=rows)
         self.recorder.on_full = self._make_room
-        self.recorder.on_commit = self._check_rows
+        # (a model without contact points has nothing to check: no call at every segment)
+        self.recorder.on_commit = self._check_rows if m.pairs else None
         self._thin_mid_run = False  # thinning inside advance: only in run() (no index is held then)
         self.thinning = dict(resolution=0.0, until=0.0, rows_dropped=0, max_abs_residual=0.0, max_kinetic=0.0,
                              max_drive_work=-math.inf, max_speed=0.0, max_penetration=[-math.inf] * rows)
@@ -1379,7 +1385,7 @@ class ImpactSolver:
         closed = self.armature_closed.copy()
         for k in (EA_REST, EA_POLE, EA_CARD):
             self.armature_closed[k] = 1.0 if self.ev_sign[base + k] < 0.0 else 0.0
-        if np.any(closed != self.armature_closed):
+        if closed.tolist() != self.armature_closed.tolist():  # (a few floats: np.any(!=) cost ~2.6 us)
             event_values(self.y, self._evaluate(), self.work[22], self.eref, self.arrays, g, self.arm)
             for k in (base + EA_TURN, base + EA_SEAT):
                 if triggered != k:

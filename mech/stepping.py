@@ -55,13 +55,15 @@ class CompiledStepper:
         m = state.model
         solver = state.scene.solver
         rec = state.recorder
-        rows, dense = rec.free_rows()
+        # (the free rows as the buffers and where they start, not as new views: see free_window)
+        rows, dense, first, dense_first, room = rec.free_window()
         model, settings, tolerances = self._tolerances
         if model is not m or settings is not solver:
             tolerances = (m.max_step, solver.rtol, m.atol, m.relmask)
             self._tolerances = (m, solver, tolerances)
         return Outcome(*integrate(
             state.t, state.y, t_goal, state.h, tolerances, state.arrays,
-            state.regime, state.eref, state.ev_sign, rows, dense, rec.keep_dense, solver.max_steps,
+            state.regime, state.eref, state.ev_sign, rows, dense, first, dense_first, room, rec.keep_dense,
+            solver.max_steps,
             state.work, state.stats, state.arm,
         ))

@@ -56,6 +56,30 @@ def test_recorder_keeps_every_row_through_growth_and_truncation():
     assert rec.columns()["regimes"][-1].tolist() == [2, 1]
 
 
+def test_free_window_is_free_rows_as_buffers_and_offsets():
+    """The compiled stepper gets the free rows as the recorder's buffers and where they start
+    (free_window): cut there, they are free_rows' views, row for row, with and without the
+    dense output and after the buffers grew; the buffers' tuples are the same objects while
+    the buffers are (the argument check passes them by identity)."""
+    for keep_dense in (True, False):
+        rec = Recorder(state_size=3, n_extra=1, capacity=4, keep_dense=keep_dense)
+        first_tuples = None
+        for k in range(11):  # grows 4 -> 8 -> 16
+            rec.reserve(1)
+            bufs, dense, first, dense_first, room = rec.free_window()
+            rows, dense_rows = rec.free_rows()
+            cuts = [b[first:first + room] for b in bufs] + [b[dense_first:dense_first + room] for b in dense]
+            for cut, view in zip(cuts, rows + dense_rows):  # the same rows of the same memory
+                assert cut.shape == view.shape and cut.strides == view.strides
+                assert cut.__array_interface__["data"] == view.__array_interface__["data"]
+            again = rec.free_window()
+            assert again[0] is bufs and again[1] is dense
+            if first_tuples is None:
+                first_tuples = (bufs, dense)
+            rec.append(float(k), np.full(3, k), np.zeros((2, 8)), np.zeros(2, np.int64), np.zeros(1))
+        assert rec.capacity == 16 and rec.free_window()[0] is not first_tuples[0]  # new buffers, a new tuple
+
+
 def test_a_run_leaves_its_model_as_built():
     solver = ImpactSolver(sliding_scene(0.3), keep_dense=True)
     fresh = build_model(sliding_scene(0.3))
