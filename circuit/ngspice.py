@@ -65,6 +65,7 @@ _COMMANDS_BEFORE_HISTORY_RELEASE = 5000
 # Rejected steps the compiled sync callback logs before Python moves them into its list
 # (a full log: that redo goes to Python, which empties it)
 REJECTIONS_LOGGED = 1024
+_VALUES_ALL = ffi.typeof("pvecvaluesall")  # (SendData's point: a cast to a type object, not a name parsed)
 _IDLE = ARC_CELLS.index("idle")  # (an ArcState's cells: 1.0 out over the last step and after it)
 
 
@@ -1110,13 +1111,15 @@ class NgspiceSession:
         look-up each."""
         paused = self._paused
         if paused is not None:
-            point = ffi.cast("pvecvaluesall", paused)
+            point = ffi.cast(_VALUES_ALL, paused)
+            vectors = point.vecsa
             plan = self._point_plans.get(names, False)
-            if plan is False:
+            # (the plan holds each vector's vecvalues cell, which ngspice fills at every point
+            # of a plot: valid while SendData's array of cells is the one it was made from)
+            if plan is False or (plan is not None and plan[0] != vectors):
                 plan = self._point_plans[names] = self._point_plan(point, names)
             if plan is not None:
-                vectors = point.vecsa
-                return point.vecindex + 1, [vectors[k].creal for k in plan]
+                return point.vecindex + 1, [cell.creal for cell in plan[1]]
         values = []
         length = 0
         encoded, look_up = self._encoded, self._ngspice_shared.ngGet_Vec_Info
@@ -1131,16 +1134,20 @@ class NgspiceSession:
         return int(length), values
 
     @staticmethod
-    def _point_plan(point, names: tuple[str, ...]) -> list[int] | None:
-        """Where each of ``names`` is in SendData's vecvaluesall ``point`` (the run's vectors
-        in the plot's order), or None if any is not there as a real vector (read by look-up)."""
+    def _point_plan(point, names: tuple[str, ...]) -> tuple | None:
+        """(SendData's array of vecvalues cells in ``point``, the cell of each of ``names``):
+        where ngspice copies each vector's last value at every point (sharedspice's
+        sh_ExecutePerLoop, into the cells a plot's start allocated; their pointers read once,
+        not at every macro step: ~0.1 us a vector), or None if any is not there as a real
+        vector (read by look-up)."""
         where = {}
+        vectors = point.vecsa
         for k in range(point.veccount):
-            vector = point.vecsa[k]
+            vector = vectors[k]
             if not vector.is_complex:
-                where.setdefault(ffi.string(vector.name).decode("ascii", "replace").lower(), k)
+                where.setdefault(ffi.string(vector.name).decode("ascii", "replace").lower(), vector)
         plan = [where.get(name.lower()) for name in names]
-        return None if None in plan else plan
+        return None if None in plan else (vectors, plan)
 
     def _span(self, name: str, start: int, stop: int | None):
         """(vector_info, start, stop) of the points [start, stop) of a vector of the current

@@ -540,6 +540,8 @@ class CoilLink:
         self.gap_scale = math.inf  # s: the gap rule's time scale (inf: the armature does not move)
         self.left_seat = -math.inf  # s: when the armature last left its seat
         self._flux_column = "coil_flux_linkage" + label[len("coil"):]
+        self._observed = ("time", self._flux_column)  # (the step's columns ``observe`` reads)
+        self._gap_channel = f"{label}.gap"  # (the input channel's name, made once: asked at every step)
         self.q_times: list[float] = []  # the circuit's points (s) ...
         self._q: list[float] = []  # ... and the armature's travel there (m or rad; ``q``)
         self._sampled = False
@@ -639,8 +641,8 @@ class CoilLink:
         self._segments.append((lo, start, ends, t0, h, coefficients))
         self._pieces += len(ends)
         self._step_segment = (seg, len(self._segments) - 1)
-        return {f"{self.label}.gap": TableChannel(gap, lo, hi, start, ends, t0, h, coefficients,
-                                                  offset=self.rest_gap, scale=self.lever)}
+        return {self._gap_channel: TableChannel(gap, lo, hi, start, ends, t0, h, coefficients,
+                                                offset=self.rest_gap, scale=self.lever)}
 
     def _segment_index(self, seg) -> int | None:
         """The index in ``_segments`` of the pieces ``inputs`` kept of ``seg``, or None (a
@@ -661,7 +663,7 @@ class CoilLink:
         the same without that floor), and the armature's travel at the step's circuit points
         (for the result's columns)."""
         # (as floats once for both tails: psi * psi is the same double product as numpy's)
-        t_list, psi_list = step.floats("time"), step.floats(self._flux_column)
+        t_list, psi_list = step.float_columns(self._observed)
         self.tail.observe_pair(self.flux_tail, t_list, [p * p for p in psi_list] if self.separable else psi_list,
                                psi_list)
         # (end_derivatives and ``signal(flux(step))`` called inline: a Python call each less)

@@ -109,10 +109,17 @@ def test_step_results_cover_the_step(ringing_circuit, bounce_schedule, bounce_op
             floats = second.floats(name)
             assert floats == values.tolist() and floats is not second.floats(name)
             assert all(type(x) is float for x in floats)
+        # ... and several at once, each list the caller's own too
+        names = tuple(second.arrays())
+        lists = second.float_columns(names)
+        assert lists == [second.floats(name) for name in names]
+        assert all(a is not b for a, b in zip(lists, second.float_columns(names)))
     # After close the results stay readable.
     assert stepper.results().time.iloc[-1] == pytest.approx(0.3e-3, rel=1e-12)
     assert second.frame().time.iloc[-1] == pytest.approx(0.3e-3, rel=1e-12)
     assert first.floats("load_current") == first.reader("load_current").tolist()
+    assert first.float_columns(("time", "load_current")) == [first.reader("time").tolist(),
+                                                             first.reader("load_current").tolist()]
 
 
 def test_macro_landing_does_not_reset_the_integration(ringing_circuit, bounce_options):

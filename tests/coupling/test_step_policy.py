@@ -409,7 +409,8 @@ def test_the_coils_time_scale_at_a_zero_of_its_flux_is_the_curvatures_not_zero()
     for k, end in enumerate((t_zero - 3e-6, t_zero - 1e-6, t_zero + 0.5e-7)):
         times = np.array([end - 2e-6, end - 1e-6, end])
         psi = 0.1 * rated * np.sin(w * (times - t_zero))
-        step = SimpleNamespace(floats=lambda name, times=times, psi=psi: (times if name == "time" else psi).tolist(),
+        step = SimpleNamespace(float_columns=lambda names, times=times, psi=psi:
+                               [(times if name == "time" else psi).tolist() for name in names],
                                values={"coil_flux_linkage": float(psi[-1])})
         seg = SimpleNamespace(t_start=times[0], t_end=end, armature=lambda s: (0.0, 0.0))
         link.observe(step, seg, p)
