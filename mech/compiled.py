@@ -60,14 +60,21 @@ def jit_dispatcher(name: str):
     return _jit(name)
 
 
+def _jit_instead(name: str, err: TypeError, args: tuple):
+    """The just-in-time ``name`` on ``args``, which the ahead-of-time function was not built
+    for (``err``: the argument check's complaint), with a warning that points at the code
+    that called the entry point."""
+    warnings.warn(f"{err}: calling numba's just-in-time {name} instead (add the call to "
+                  "mech.aot_build.warm_up)", CompiledArgumentWarning, stacklevel=3)
+    return _jit(name)(*args)
+
+
 def _checked(name: str, fn, check):
     def call(*args):
         try:
             check(args)
         except TypeError as err:
-            warnings.warn(f"{err}: calling numba's just-in-time {name} instead (add the call to "
-                          "mech.aot_build.warm_up)", CompiledArgumentWarning, stacklevel=2)
-            return _jit(name)(*args)
+            return _jit_instead(name, err, args)
         return fn(*args)
 
     call.__name__ = call.__qualname__ = name
@@ -90,9 +97,7 @@ def _variant(name: str, plain, armature, count: int, checks: tuple):
         try:
             check(args)
         except TypeError as err:
-            warnings.warn(f"{err}: calling numba's just-in-time {name} instead (add the call to "
-                          "mech.aot_build.warm_up)", CompiledArgumentWarning, stacklevel=2)
-            return _jit(name)(*args)
+            return _jit_instead(name, err, args)
         return fn(*args)
 
     call.__name__ = call.__qualname__ = name

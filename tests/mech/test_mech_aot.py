@@ -90,9 +90,11 @@ def test_an_argument_of_another_type_goes_to_the_jit_function_with_a_warning():
     expected = np.empty(3)
     compiled.dense_eval(coef, 0.3, expected)
     got = np.empty(3)
-    with pytest.warns(compiled.CompiledArgumentWarning, match="dense_eval argument 0"):
+    with pytest.warns(compiled.CompiledArgumentWarning, match="dense_eval argument 0") as caught:
         compiled.dense_eval(np.asfortranarray(coef), 0.3, got)  # read wrongly by the module
     np.testing.assert_array_equal(got, expected)
+    # the warning names the line that called the entry point, not mech's own wrapper
+    assert [w.filename for w in caught] == [__file__]
     closed_form = coef[0] + 0.3 * (coef[1] + 0.7 * (coef[2] + 0.3 * (coef[3] + 0.7 * coef[4])))
     np.testing.assert_allclose(expected, closed_form, rtol=1e-15)
 
@@ -137,8 +139,9 @@ def test_a_wrong_array_inside_a_tuple_argument_is_named_and_goes_to_the_jit_func
     compiled.energies(y, model.arrays, work, expected)
     bad = tuple(a.astype(np.float32) if k == 2 else a for k, a in enumerate(work))
     got = np.empty(5)
-    with pytest.warns(compiled.CompiledArgumentWarning, match=r"energies argument 2\[2\]: .*float32"):
+    with pytest.warns(compiled.CompiledArgumentWarning, match=r"energies argument 2\[2\]: .*float32") as caught:
         compiled.energies(y, model.arrays, bad, got)
+    assert [w.filename for w in caught] == [__file__]
     np.testing.assert_array_equal(got, expected)
     assert expected[0] > 0.0  # the bar moves down at its initial speed: kinetic energy
 
