@@ -1152,8 +1152,10 @@ class NgspiceSession:
     def _span(self, name: str, start: int, stop: int | None):
         """(vector_info, start, stop) of the points [start, stop) of a vector of the current
         plot, the bounds clipped to its length; KeyError naming a vector it does not hold."""
-        info = self.vector_info(name)
-        if info is None:
+        # (vector_info's look-up in one line, not a call: a coupled macro step reads two or
+        # three columns through ``floats``)
+        info = self._ngspice_shared.ngGet_Vec_Info(self._encoded.get(name) or self._encode(name))
+        if info == ffi.NULL:
             raise KeyError(f"ngspice has no vector {name!r} in the current plot")
         n = info.v_length
         stop = n if stop is None else min(stop, n)
@@ -1172,19 +1174,10 @@ class NgspiceSession:
     def floats(self, name: str, start: int = 0, stop: int | None = None) -> list[float]:
         """``vector(name, start, stop)`` as a list of floats (the same doubles), read by cffi
         without a numpy array between."""
-        # (``_span`` and ``vector_info`` written out: a coupled macro step reads two or three
-        # columns this way, and their two calls each cost ~0.5 us of it)
-        encoded = self._encoded.get(name)
-        info = self._ngspice_shared.ngGet_Vec_Info(encoded if encoded is not None else self._encode(name))
-        if info == ffi.NULL:
-            raise KeyError(f"ngspice has no vector {name!r} in the current plot")
-        data = info.v_realdata
-        if data == ffi.NULL:
-            return self.vector(name, start, stop).tolist()
-        n = info.v_length
-        stop = n if stop is None else min(stop, n)
-        start = max(0, min(start, stop))
-        return ffi.unpack(data + start, stop - start)
+        info, start, stop = self._span(name, start, stop)
+        if info.v_realdata != ffi.NULL:
+            return ffi.unpack(info.v_realdata + start, stop - start)
+        return self.vector(name, start, stop).tolist()
 
     def length(self) -> int:
         info = self.vector_info("time")

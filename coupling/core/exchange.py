@@ -666,12 +666,9 @@ class CoilLink:
         t_list, psi_list = step.float_columns(self._observed)
         self.tail.observe_pair(self.flux_tail, t_list, [p * p for p in psi_list] if self.separable else psi_list,
                                psi_list)
-        # (end_derivatives and ``signal(flux(step))`` called inline: a Python call each less)
-        macro = policy.macro_step
-        self.flux_rate = end_derivatives(self.flux_tail.t, self.flux_tail.v, macro)[0]
-        psi = float(step.values[self._flux_column])
-        self.value = psi * psi if self.separable else psi
-        self.rate, curvature = end_derivatives(self.tail.t, self.tail.v, macro)
+        self.flux_rate = self.flux_tail.derivatives(policy.macro_step)[0]
+        self.value = self.signal(self.flux(step))
+        self.rate, curvature = self.tail.derivatives(policy.macro_step)
         self.curvature = curvature or 0.0
         curve = time_scale(self.rate, curvature, self.tail.v[-1] if self.rate != 0.0 else 0.0)
         # what the drive is extrapolated over (policy.extrapolate's horizon): the time scales
